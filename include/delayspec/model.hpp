@@ -1,0 +1,42 @@
+#pragma once
+// The model concept. A model is a small value type describing
+//
+//     y'(t) = f_j(t, y(t), y(t - tau)),   j = 1 where H(y) > 0,  j = 2 where H(y) <= 0
+//
+// with state dimension `d` known at compile time. A model provides (names are the contract):
+//
+//   static constexpr int d;                  // state dimension
+//   static constexpr bool has_switching;     // false: H is irrelevant, region is always 1
+//   static constexpr bool affine_in_state;   // f_j affine in y(t) for fixed (t, y_tau): the
+//                                            // implicit trapezoid equation is one linear solve
+//   static constexpr bool is_linear;         // f linear in (y, y_tau): the monodromy does not
+//                                            // depend on the orbit (take the zero orbit)
+//   double tau() const;                      // the delay
+//   double period() const;                   // the period T of the forcing / stroboscopic map
+//   Vec f(int j, double t, const Vec& y, const Vec& y_tau) const;
+//   Mat A(int j, double t, const Vec& y, const Vec& y_tau) const;   // df_j / dy
+//   Mat B(int j, double t, const Vec& y, const Vec& y_tau) const;   // df_j / dy_tau
+//   double H(const Vec& y) const;  Vec grad_H(const Vec& y) const;  // switching function
+//   Vec initial_state() const;               // constant initial history y(t), t <= 0
+//
+// Regions: j = 1 is the strict side H > 0 (design.md 1.5 conventions).
+#include <Eigen/Core>
+
+namespace delayspec {
+
+template <int D>
+using Vec = Eigen::Matrix<double, D, 1>;
+template <int D>
+using Mat = Eigen::Matrix<double, D, D>;
+
+// Region of a state: 1 on the strict side H > 0, else 2. Models without switching: 1.
+template <class Model>
+int region_of(const Model& model, const Vec<Model::d>& y) {
+  if constexpr (!Model::has_switching) {
+    return 1;
+  } else {
+    return model.H(y) > 0 ? 1 : 2;
+  }
+}
+
+}  // namespace delayspec

@@ -1,0 +1,128 @@
+#pragma once
+// The implicit trapezoidal ("modified Euler") step of design.md 1.2 and its step map (1.3).
+//
+// A full step from t to t + h advances the current state u_0 only; the history shift is the
+// caller's business (it happens once per full step). The step receives the delayed values at
+// its two ends, y_tau(t) and y_tau(t + h), and is built from sub-steps
+//
+//   z1 = z0 + dt/2 [ f_jl(t0, z0, w0) + f_jr(t0 + dt, z1, w1) ]          (*)
+//
+// so that an event (a crossing of H = 0) can split it into pieces with explicit regions
+// (event handling: see the events extension). The derivative of (*) is
+//
+//   dz1 = S^{-1} [ (I + dt/2 A_l) dz0 + dt/2 B_l dw0 + dt/2 B_r dw1 ],   S = I - dt/2 A_r.
+#include <cmath>
+#include <string>
+
+#include <Eigen/LU>
+
+#include "delayspec/errors.hpp"
+#include "delayspec/model.hpp"
+#include "delayspec/step_map.hpp"
+
+namespace delayspec {
+
+// How a step treats a crossing of the switching surface H = 0 (design.md 1.5).
+enum class EventMode { on, linear, off };
+// Which derivative of a step with events: the exact derivative of the discrete map
+// (event-time sensitivity included) or the paper's, with the split points frozen.
+enum class JacobianMode { consistent, frozen };
+
+struct StepOptions {
+  EventMode events = EventMode::on;
+  JacobianMode jacobian = JacobianMode::consistent;
+  int contact_substeps = 1;  // trapezoid sub-steps across each contact interval inside a step
+};
+
+// Region choice for the right node of a sub-step: a fixed region, or "the region of z1"
+// (found together with z1: the plain, unsplit trapezoid rule).
+inline constexpr int kRegionOfEndpoint = 0;
+
+template <int D>
+struct SubStepResult {
+  Vec<D> z1;
+  Mat<D> dz0;  // dz1 / dz0
+  Mat<D> dw0;  // dz1 / dw0 (delayed value at the left node)
+  Mat<D> dw1;  // dz1 / dw1 (delayed value at the right node)
+  int right_region = 1;
+};
+
+template <class Model>
+class TrapezoidStepper {
+ public:
+  static constexpr int D = Model::d;
+  using V = Vec<D>;
+  using M = Mat<D>;
+
+  explicit TrapezoidStepper(const Model& model, const StepOptions& options = {}) : model_(model), options_(options) {}
+
+  // One sub-step (*) from (t0, z0) over dt. left_region is used at the left node;
+  // right_region at the right node (kRegionOfEndpoint: the region of z1 itself).
+  // Throws NumericalFailure if the implicit equation cannot be solved.
+  SubStepResult<D> sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region,
+                            int right_region) const {
+    const double t1 = t0 + dt;
+    const V rhs0 = z0 + 0.5 * dt * model_.f(left_region, t0, z0, w0);  // explicit half
+    // Newton on G(z) = z - rhs0 - dt/2 f_jr(t1, z, w1); for an affine f_jr one step is exact,
+    // the loop then confirms it (and detects a region change of z1 in the automatic mode).
+    V z = z0;
+    int jr = right_region == kRegionOfEndpoint ? region_of(model_, z) : right_region;
+    Eigen::PartialPivLU<M> lu;
+    constexpr int kMaxIterations = 30;
+    bool converged = false;
+    int region_changes = 0;
+    for (int it = 0; it < kMaxIterations; ++it) {
+      V g = z - rhs0 - 0.5 * dt * model_.f(jr, t1, z, w1);
+      M S = M::Identity() - 0.5 * dt * model_.A(jr, t1, z, w1);
+      lu.compute(S);
+      V dz = lu.solve(g);
+      z -= dz;
+      const double scale = 1 + z.template lpNorm<Eigen::Infinity>();
+      bool small = dz.template lpNorm<Eigen::Infinity>() <= 4 * 2.2e-16 * scale;
+      if (right_region == kRegionOfEndpoint) {
+        int j_new = region_of(model_, z);
+        if (j_new != jr) {
+          jr = j_new;
+          ++region_changes;
+          if (region_changes > 8) break;  // cycling between regions: give up (reported below)
+          continue;
+        }
+      }
+      if (small || (Model::affine_in_state && it >= 1)) {
+        converged = true;
+        break;
+      }
+    }
+    if (!converged || !z.allFinite())
+      throw NumericalFailure("trapezoid step at t = " + format_number(t0) + ", dt = " + format_number(dt) +
+                             ": implicit equation not solved (region changes " + std::to_string(region_changes) +
+                             ", state " + format_number(z[0]) + ")");
+    SubStepResult<D> r;
+    r.z1 = z;
+    r.right_region = jr;
+    lu.compute(M::Identity() - 0.5 * dt * model_.A(jr, t1, z, w1));
+    r.dz0 = lu.solve(M::Identity() + 0.5 * dt * model_.A(left_region, t0, z0, w0));
+    r.dw0 = lu.solve(0.5 * dt * model_.B(left_region, t0, z0, w0));
+    r.dw1 = lu.solve(0.5 * dt * model_.B(jr, t1, z, w1));
+    return r;
+  }
+
+  // One full step without event handling: each trapezoid node uses the region of its own state.
+  // Returns u_0(t + h) and fills the step map.
+  V step(double t, double h, const V& u0, const V& w0, const V& w1, StepMap<D>& map) const {
+    SubStepResult<D> s = sub_step(t, h, u0, w0, w1, region_of(model_, u0), kRegionOfEndpoint);
+    map.P = s.dz0;
+    map.Q = s.dw0;
+    map.R = s.dw1;
+    return s.z1;
+  }
+
+  const Model& model() const { return model_; }
+  const StepOptions& options() const { return options_; }
+
+ private:
+  Model model_;
+  StepOptions options_;
+};
+
+}  // namespace delayspec

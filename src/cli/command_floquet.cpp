@@ -1,0 +1,82 @@
+// delayspec floquet: the leading Floquet multipliers of the periodic orbit (CLI contract).
+#include <chrono>
+
+#include "commands.hpp"
+#include "delayspec/floquet.hpp"
+#include "delayspec/stroboscopic_map.hpp"
+#include "orbit_settings.hpp"
+#include "output.hpp"
+#include "problem.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+EventMode parse_event_mode(const std::string& s) {
+  return s == "off" ? EventMode::off : s == "linear" ? EventMode::linear : EventMode::on;
+}
+
+}  // namespace
+
+int command_floquet(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  Problem problem = read_problem(config, 100);
+  const OrbitSettings orbit_settings = read_orbit_settings(config);
+  FloquetOptions options;
+  options.nev = static_cast<int>(config.get_int("nev", 6));
+  options.solver = parse_floquet_solver(config.get_choice("solver", "spectra", {"spectra", "arpack", "dense", "dense-eigen", "dense-lapack"}));
+  config.check_all_used();
+  const long n = std::visit([&](const auto& m) { return problem.grid.dimension(std::decay_t<decltype(m)>::d); }, problem.model);
+  if (options.nev < 1 || options.nev > n)
+    throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " + std::to_string(n));
+
+  StepOptions step_options;
+  step_options.events = parse_event_mode(problem.events);
+  step_options.jacobian = problem.jacobian == "frozen" ? JacobianMode::frozen : JacobianMode::consistent;
+
+  nlohmann::json json;
+  FloquetResult result;
+  PeriodicOrbit orbit;
+  std::visit(
+      [&](const auto& model) {
+        using Model = std::decay_t<decltype(model)>;
+        TrapezoidStepper<Model> stepper(model, step_options);
+        StroboscopicMap<Model> map(stepper, problem.grid);
+        orbit = find_orbit(model, map, orbit_settings);
+        auto monodromy = map.monodromy(orbit.history);
+        result = floquet_multipliers(monodromy, options);
+      },
+      problem.model);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  if (inv.json) {
+    json["model"] = problem.model_name;
+    json["N"] = problem.N;
+    json["dimension"] = n;
+    json["solver"] = result.solver;
+    json["multipliers"] = multipliers_json(result.multipliers);
+    json["seconds"] = seconds;
+    json["eigensolver_seconds"] = result.seconds;
+    json["operator_applications"] = result.operator_applications;
+    json["h"] = problem.grid.h;
+    json["steps_per_map"] = problem.grid.K;
+    json["events"] = problem.events;
+    json["jacobian"] = problem.jacobian;
+    json["orbit_residual"] = orbit.residual;
+    json["orbit_periods"] = orbit.maps;
+    if (!result.note.empty()) json["note"] = result.note;
+    inv.out << json.dump(2) << "\n";
+  } else {
+    inv.out << "delayspec floquet: model " << problem.model_name << ", " << problem.grid.describe() << ", n = " << n
+            << "\n";
+    inv.out << "periodic orbit: |P(U) - U| = " << orbit.residual << " after " << orbit.maps << " periods\n";
+    inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << result.solver << ", "
+            << result.operator_applications << " operator applications):\n";
+    print_multipliers(inv.out, result.multipliers);
+    if (!result.note.empty()) inv.out << "note: " << result.note << "\n";
+    inv.out << "time: " << seconds << " s\n";
+  }
+  return 0;
+}
+
+}  // namespace delayspec::cli

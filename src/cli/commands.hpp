@@ -1,0 +1,33 @@
+#pragma once
+// The command table of the `delayspec` program and the invocation every command receives.
+// A command reads its keys from the Config, calls config.check_all_used() before any heavy
+// work (so a typo fails fast, exit 2), computes, and writes one result: text on `out`, or with
+// --json exactly one JSON object on `out`. Progress and warnings go to `err`.
+// Exceptions: BadInput -> exit 2, NumericalFailure -> exit 3 (handled in run_cli).
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "config.hpp"
+
+namespace delayspec::cli {
+
+struct Invocation {
+  std::string command;
+  std::optional<std::string> scene;
+  bool json = false;
+  std::optional<std::string> out_dir;
+  bool quiet = false;
+  bool resume = false;
+  std::ostream& out;
+  std::ostream& err;
+};
+
+using CommandFunction = int (*)(Config&, const Invocation&);
+
+int command_floquet(Config& config, const Invocation& inv);
+
+// Runs the program: parses argv, dispatches, maps errors to exit codes. Never throws.
+int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
+}  // namespace delayspec::cli

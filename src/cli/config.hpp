@@ -1,0 +1,50 @@
+#pragma once
+// Config: the flat key -> value settings of one command, from a scene file (TOML) and then
+// `--set KEY=VALUE` overrides, applied in order. Typed getters validate and name the key and
+// the value in every error (BadInput, exit status 2). Every key read is marked; keys nobody
+// read are reported as unknown by check_all_used().
+//
+// Scene files: top-level `key = value` pairs; tables ([model], [floquet], ...) may group keys
+// for readability and are flattened (a key may appear only once in the whole file).
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace delayspec::cli {
+
+class Config {
+ public:
+  // Parses a TOML scene file; BadInput when it cannot be read or parsed.
+  static Config from_scene_file(const std::string& path);
+
+  // Applies "KEY=VALUE" (BadInput when there is no '=' or the key is empty).
+  void set_from_assignment(const std::string& assignment);
+  void set(const std::string& key, const std::string& value, const std::string& origin);
+
+  bool has(const std::string& key) const;
+  double get_double(const std::string& key, double fallback);
+  double require_double(const std::string& key);
+  long get_int(const std::string& key, long fallback);
+  std::string get_string(const std::string& key, const std::string& fallback);
+  // A value that must be one of `allowed`.
+  std::string get_choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed);
+  std::vector<long> get_int_list(const std::string& key, const std::vector<long>& fallback);
+
+  // Marks a key as known without reading it (e.g. keys of another command in a shared scene).
+  void mark_used(const std::string& key);
+  // BadInput naming the first key that was given but never read.
+  void check_all_used() const;
+
+  // All key/value pairs, for metadata in outputs.
+  const std::map<std::string, std::string>& values() const { return values_; }
+
+ private:
+  std::optional<std::string> lookup(const std::string& key);
+  std::map<std::string, std::string> values_;
+  std::map<std::string, std::string> origin_;
+  mutable std::set<std::string> used_;
+};
+
+}  // namespace delayspec::cli

@@ -1,0 +1,79 @@
+#include "problem.hpp"
+
+#include <climits>
+
+#include "delayspec/errors.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+int read_positive_int(Config& config, const std::string& key, long fallback) {
+  const long value = config.get_int(key, fallback);
+  if (value < 1 || value > INT_MAX)
+    throw BadInput("`" + key + " = " + std::to_string(value) + "`: must be an integer >= 1");
+  return static_cast<int>(value);
+}
+
+ImpactModel read_impact(Config& c) {
+  ImpactParameters p;
+  p.zeta = c.get_double("zeta", p.zeta);
+  p.e = c.get_double("e", p.e);
+  p.a = c.get_double("a", p.a);
+  p.beta = c.get_double("beta", p.beta);
+  p.omega = c.get_double("omega", p.omega);
+  p.k = c.get_double("k", p.k);
+  p.x0 = c.get_double("x0", p.x0);
+  p.v0 = c.get_double("v0", p.v0);
+  if (c.has("tau") && c.has("tau_over_T"))
+    throw BadInput("`tau` and `tau_over_T` are both given: give one of them");
+  if (c.has("tau")) {
+    p.tau = c.get_double("tau", 0);
+    require_positive("tau", p.tau);
+  } else {
+    p.tau_over_T = c.get_double("tau_over_T", p.tau_over_T);
+    require_positive("tau_over_T", p.tau_over_T);
+  }
+  return ImpactModel(p);
+}
+
+LinearModel read_linear(Config& c) {
+  LinearParameters p;
+  p.a = c.get_double("a", p.a);
+  p.b = c.get_double("b", p.b);
+  p.tau = c.get_double("tau", p.tau);
+  p.period = c.get_double("period", p.tau);
+  return LinearModel(p);
+}
+
+MathieuModel read_mathieu(Config& c) {
+  MathieuParameters p;
+  p.kappa = c.get_double("kappa", p.kappa);
+  p.delta = c.get_double("delta", p.delta);
+  p.eps = c.get_double("eps", p.eps);
+  p.b = c.get_double("b", p.b);
+  return MathieuModel(p);
+}
+
+}  // namespace
+
+Problem read_problem(Config& config, int default_N) {
+  Problem problem;
+  problem.model_name = config.get_choice("model", "impact", {"impact", "linear", "mathieu"});
+  if (problem.model_name == "impact") problem.model = read_impact(config);
+  if (problem.model_name == "linear") problem.model = read_linear(config);
+  if (problem.model_name == "mathieu") problem.model = read_mathieu(config);
+  problem.N = read_positive_int(config, "N", default_N);
+  problem.orbit_period = read_positive_int(config, "orbit_period", 1);
+  if (problem.orbit_period != 1 && problem.model_name == "linear")
+    throw BadInput("`orbit_period = " + std::to_string(problem.orbit_period) +
+                   "`: only for forced models (impact, mathieu); for linear set `period`");
+  problem.events = config.get_choice("events", "on", {"on", "linear", "off"});
+  problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"});
+  problem.grid = std::visit(
+      [&](const auto& model) { return make_grid(model.tau(), model.period(), problem.N, problem.orbit_period); },
+      problem.model);
+  return problem;
+}
+
+}  // namespace delayspec::cli

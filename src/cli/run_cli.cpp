@@ -1,0 +1,93 @@
+#include <exception>
+#include <map>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "delayspec/errors.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+const std::map<std::string, CommandFunction>& command_table() {
+  static const std::map<std::string, CommandFunction> table = {
+      {"floquet", command_floquet},
+  };
+  return table;
+}
+
+std::string command_list() {
+  std::string list;
+  for (const auto& [name, fn] : command_table()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+}  // namespace
+
+int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{"delayspec: stability spectra (Floquet multipliers, Lyapunov exponents) of periodically forced "
+               "delay differential equations, matrix-free.\nCommands: " +
+               command_list()};
+  app.set_version_flag("--version", "delayspec 0.1.0");
+  std::string command;
+  std::string scene;
+  std::vector<std::string> assignments;
+  std::string out_dir;
+  bool json = false, quiet = false, resume = false;
+  app.add_option("command", command, "command: " + command_list())->required();
+  app.add_option("scene", scene, "scene file (TOML); optional");
+  app.add_option("--set", assignments, "override a scene key: --set KEY=VALUE (repeatable, applied in order)")
+      ->take_last()
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  app.add_flag("--json", json, "print exactly one JSON object on stdout");
+  app.add_option("--out", out_dir, "directory for output files");
+  app.add_flag("--quiet", quiet, "no progress on stderr");
+  app.add_flag("--resume", resume, "continue an interrupted run in --out");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    out << app.help();
+    return 0;
+  } catch (const CLI::CallForVersion& e) {
+    out << "delayspec 0.1.0\n";
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    err << "delayspec: error: " << e.what() << "\n";
+    return 2;
+  }
+
+  auto it = command_table().find(command);
+  if (it == command_table().end()) {
+    err << "delayspec: error: unknown command `" << command << "` (commands: " << command_list() << ")\n";
+    return 2;
+  }
+  Invocation inv{.command = command,
+                 .scene = scene.empty() ? std::nullopt : std::optional<std::string>(scene),
+                 .json = json,
+                 .out_dir = out_dir.empty() ? std::nullopt : std::optional<std::string>(out_dir),
+                 .quiet = quiet,
+                 .resume = resume,
+                 .out = out,
+                 .err = err};
+  try {
+    Config config = scene.empty() ? Config() : Config::from_scene_file(scene);
+    for (const auto& a : assignments) config.set_from_assignment(a);
+    return it->second(config, inv);
+  } catch (const BadInput& e) {
+    err << "delayspec " << command << ": bad input: " << e.what() << "\n";
+    return 2;
+  } catch (const NumericalFailure& e) {
+    err << "delayspec " << command << ": numerical failure: " << e.what() << "\n";
+    return 3;
+  } catch (const std::bad_alloc&) {
+    err << "delayspec " << command << ": out of memory (reduce N or use a Krylov solver)\n";
+    return 3;
+  } catch (const std::exception& e) {
+    err << "delayspec " << command << ": internal error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace delayspec::cli

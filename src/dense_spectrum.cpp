@@ -1,0 +1,67 @@
+#include "delayspec/dense_spectrum.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+#include "delayspec/errors.hpp"
+
+extern "C" void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a, const int* lda, double* wr,
+                       double* wi, double* vl, const int* ldvl, double* vr, const int* ldvr, double* work,
+                       const int* lwork, int* info);
+
+namespace delayspec {
+
+void sort_by_modulus(std::vector<std::complex<double>>& values) {
+  std::stable_sort(values.begin(), values.end(), [](const auto& a, const auto& b) {
+    const double ma = std::abs(a), mb = std::abs(b);
+    if (ma != mb) return ma > mb;
+    if (a.real() != b.real()) return a.real() > b.real();
+    return a.imag() > b.imag();
+  });
+}
+
+namespace {
+
+std::vector<std::complex<double>> eigen_backend(const Eigen::MatrixXd& A) {
+  Eigen::EigenSolver<Eigen::MatrixXd> solver(A, /*computeEigenvectors=*/false);
+  if (solver.info() != Eigen::Success)
+    throw NumericalFailure("dense eigenvalues (Eigen): the QR algorithm did not converge (n = " +
+                           std::to_string(A.rows()) + ")");
+  const auto& ev = solver.eigenvalues();
+  return {ev.data(), ev.data() + ev.size()};
+}
+
+std::vector<std::complex<double>> lapack_backend(const Eigen::MatrixXd& A) {
+  const int n = static_cast<int>(A.rows());
+  Eigen::MatrixXd a = A;  // dgeev overwrites its input
+  std::vector<double> wr(n), wi(n);
+  int info = 0, lwork = -1, one = 1;
+  double query = 0, dummy = 0;
+  dgeev_("N", "N", &n, a.data(), &n, wr.data(), wi.data(), &dummy, &one, &dummy, &one, &query, &lwork, &info);
+  lwork = std::max(1, static_cast<int>(query));
+  std::vector<double> work(lwork);
+  dgeev_("N", "N", &n, a.data(), &n, wr.data(), wi.data(), &dummy, &one, &dummy, &one, work.data(), &lwork, &info);
+  if (info != 0)
+    throw NumericalFailure("dense eigenvalues (LAPACK dgeev): info = " + std::to_string(info) +
+                           (info > 0 ? " (QR algorithm failed to converge)" : " (illegal argument)"));
+  std::vector<std::complex<double>> values(n);
+  for (int i = 0; i < n; ++i) values[i] = {wr[i], wi[i]};
+  return values;
+}
+
+}  // namespace
+
+std::vector<std::complex<double>> dense_eigenvalues(const Eigen::MatrixXd& A, DenseBackend backend) {
+  if (A.rows() != A.cols())
+    throw BadInput("dense_eigenvalues: matrix is " + std::to_string(A.rows()) + " x " + std::to_string(A.cols()) +
+                   ", must be square");
+  if (!A.allFinite()) throw BadInput("dense_eigenvalues: matrix has non-finite entries");
+  if (A.rows() == 0) return {};
+  auto values = backend == DenseBackend::eigen ? eigen_backend(A) : lapack_backend(A);
+  sort_by_modulus(values);
+  return values;
+}
+
+}  // namespace delayspec

@@ -1,0 +1,88 @@
+#include "delayspec/grid.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "delayspec/errors.hpp"
+
+namespace delayspec {
+
+namespace {
+
+// Integer p/q (q <= 64) equal to x to within 1e-12 relative, or q = 0 when there is none.
+struct Ratio {
+  long p = 0, q = 0;
+};
+Ratio rational_approximation(double x) {
+  for (long q = 1; q <= 64; ++q) {
+    double p = std::round(x * static_cast<double>(q));
+    if (p >= 1 && std::abs(x * static_cast<double>(q) - p) <= 1e-12 * p) return {static_cast<long>(p), q};
+  }
+  return {};
+}
+
+constexpr long kMaxSteps = 2'000'000'000L / 8;  // keeps every block index far inside int
+
+}  // namespace
+
+std::string HistoryGrid::describe() const {
+  return "N=" + std::to_string(N) + " h=" + format_number(h) + " K=" + std::to_string(K) +
+         " M=" + std::to_string(M) + (aligned() ? " (aligned delay)" : " (fractional delay, theta=" + format_number(theta) + ")");
+}
+
+HistoryGrid make_grid(double tau, double period, int N, int periods_per_map) {
+  require_positive("tau", tau);
+  require_positive("period", period);
+  if (N < 1) throw BadInput("`N = " + std::to_string(N) + "`: must be an integer >= 1");
+  if (periods_per_map < 1)
+    throw BadInput("`orbit_period = " + std::to_string(periods_per_map) + "`: must be an integer >= 1");
+
+  HistoryGrid g;
+  g.N = N;
+  g.tau = tau;
+  g.period = period;
+  g.periods_per_map = periods_per_map;
+
+  Ratio r = rational_approximation(tau / period);  // tau / T = p / q
+  if (r.q > 0) {
+    // Aligned: h = tau / N, steps per period N T / tau = N q / p must be an integer.
+    if ((static_cast<long>(N) * r.q) % r.p != 0)
+      throw BadInput("`N = " + std::to_string(N) + "`: tau/T = " + std::to_string(r.p) + "/" +
+                     std::to_string(r.q) + " needs N divisible by " + std::to_string(r.p) +
+                     " so that a period is a whole number of steps");
+    long k1 = static_cast<long>(N) * r.q / r.p;
+    if (k1 * periods_per_map > kMaxSteps || N > kMaxSteps)
+      throw BadInput("`N = " + std::to_string(N) + "`: too many steps per map");
+    g.h = tau / N;
+    g.steps_per_period = static_cast<int>(k1);
+    g.m = N;
+    g.theta = 0;
+    g.M = N;
+  } else {
+    // Fractional: h = T / K_1, tau = (m + theta) h.
+    double k1 = std::round(static_cast<double>(N) * period / tau);
+    if (k1 < 1) k1 = 1;
+    if (k1 * periods_per_map > static_cast<double>(kMaxSteps))
+      throw BadInput("`N = " + std::to_string(N) + "`: too many steps per map");
+    g.steps_per_period = static_cast<int>(k1);
+    g.h = period / k1;
+    double ratio = tau / g.h;
+    double m = std::floor(ratio);
+    double theta = ratio - m;
+    if (theta > 1 - 1e-12) {  // tau is a whole number of steps after all
+      m += 1;
+      theta = 0;
+    }
+    if (theta < 1e-12) theta = 0;
+    if (m < 1)
+      throw BadInput("`N = " + std::to_string(N) + "`: the delay tau = " + format_number(tau) +
+                     " is shorter than one step h = " + format_number(g.h) + "; increase N");
+    g.m = static_cast<int>(m);
+    g.theta = theta;
+    g.M = theta > 0 ? g.m + 1 : g.m;
+  }
+  g.K = g.steps_per_period * periods_per_map;
+  return g;
+}
+
+}  // namespace delayspec

@@ -1,0 +1,31 @@
+#pragma once
+// Small helpers shared by the tests.
+#include <complex>
+#include <vector>
+
+#include "delayspec/floquet.hpp"
+#include "delayspec/stroboscopic_map.hpp"
+
+namespace delayspec::testing {
+
+// Leading multipliers of a linear model (zero orbit) at resolution N with the dense solver.
+template <class Model>
+std::vector<std::complex<double>> dense_multipliers(const Model& model, int N, int nev, int periods_per_map = 1) {
+  HistoryGrid grid = make_grid(model.tau(), model.period(), N, periods_per_map);
+  TrapezoidStepper<Model> stepper(model);
+  StroboscopicMap<Model> map(stepper, grid);
+  auto op = map.monodromy(Eigen::VectorXd::Zero(map.dimension()));
+  FloquetOptions options;
+  options.nev = nev;
+  options.solver = FloquetSolver::dense_lapack;
+  return floquet_multipliers(op, options).multipliers;
+}
+
+// Distance from `target` to the nearest entry of `values`.
+inline double distance_to_nearest(const std::vector<std::complex<double>>& values, std::complex<double> target) {
+  double best = INFINITY;
+  for (auto v : values) best = std::min(best, std::abs(v - target));
+  return best;
+}
+
+}  // namespace delayspec::testing
