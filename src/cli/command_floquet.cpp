@@ -10,14 +10,6 @@
 
 namespace delayspec::cli {
 
-namespace {
-
-EventMode parse_event_mode(const std::string& s) {
-  return s == "off" ? EventMode::off : s == "linear" ? EventMode::linear : EventMode::on;
-}
-
-}  // namespace
-
 int command_floquet(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
   Problem problem = read_problem(config, 100);
@@ -30,17 +22,13 @@ int command_floquet(Config& config, const Invocation& inv) {
   if (options.nev < 1 || options.nev > n)
     throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " + std::to_string(n));
 
-  StepOptions step_options;
-  step_options.events = parse_event_mode(problem.events);
-  step_options.jacobian = problem.jacobian == "frozen" ? JacobianMode::frozen : JacobianMode::consistent;
-
   nlohmann::json json;
   FloquetResult result;
   PeriodicOrbit orbit;
   std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
-        TrapezoidStepper<Model> stepper(model, step_options);
+        TrapezoidStepper<Model> stepper(model, step_options(problem));
         StroboscopicMap<Model> map(stepper, problem.grid);
         orbit = find_orbit(model, map, orbit_settings);
         auto monodromy = map.monodromy(orbit.history);

@@ -57,6 +57,13 @@ MathieuModel read_mathieu(Config& c) {
 
 }  // namespace
 
+StepOptions step_options(const Problem& problem) {
+  StepOptions options;
+  options.events = problem.events == "off" ? EventMode::off : problem.events == "linear" ? EventMode::linear : EventMode::on;
+  options.jacobian = problem.jacobian == "frozen" ? JacobianMode::frozen : JacobianMode::consistent;
+  return options;
+}
+
 Problem read_problem(Config& config, int default_N) {
   Problem problem;
   problem.model_name = config.get_choice("model", "impact", {"impact", "linear", "mathieu"});

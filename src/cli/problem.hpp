@@ -10,6 +10,7 @@
 #include "delayspec/model_impact.hpp"
 #include "delayspec/model_linear.hpp"
 #include "delayspec/model_mathieu.hpp"
+#include "delayspec/stepper.hpp"
 
 namespace delayspec::cli {
 
@@ -24,6 +25,9 @@ struct Problem {
   std::string jacobian = "consistent"; // consistent | frozen
   HistoryGrid grid;
 };
+
+// The stepper options (events, jacobian, ...) the problem asks for.
+StepOptions step_options(const Problem& problem);
 
 // Reads `model` and its parameters, N, orbit_period, events, jacobian; builds the grid.
 // default_N is used when the key N is absent.
