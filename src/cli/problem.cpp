@@ -55,6 +55,17 @@ MathieuModel read_mathieu(Config& c) {
   return MathieuModel(p);
 }
 
+MackeyGlassModel read_mackey_glass(Config& c) {
+  MackeyGlassParameters p;
+  p.beta = c.get_double("beta", p.beta);
+  p.gamma = c.get_double("gamma", p.gamma);
+  p.n = c.get_double("n", p.n);
+  p.tau = c.get_double("tau", p.tau);
+  p.period = c.get_double("period", p.tau);
+  p.x0 = c.get_double("x0", p.x0);
+  return MackeyGlassModel(p);
+}
+
 }  // namespace
 
 StepOptions step_options(const Problem& problem) {
@@ -66,15 +77,16 @@ StepOptions step_options(const Problem& problem) {
 
 Problem read_problem(Config& config, int default_N) {
   Problem problem;
-  problem.model_name = config.get_choice("model", "impact", {"impact", "linear", "mathieu"});
+  problem.model_name = config.get_choice("model", "impact", {"impact", "linear", "mathieu", "mackey-glass"});
   if (problem.model_name == "impact") problem.model = read_impact(config);
   if (problem.model_name == "linear") problem.model = read_linear(config);
   if (problem.model_name == "mathieu") problem.model = read_mathieu(config);
+  if (problem.model_name == "mackey-glass") problem.model = read_mackey_glass(config);
   problem.N = read_positive_int(config, "N", default_N);
   problem.orbit_period = read_positive_int(config, "orbit_period", 1);
-  if (problem.orbit_period != 1 && problem.model_name == "linear")
+  if (problem.orbit_period != 1 && (problem.model_name == "linear" || problem.model_name == "mackey-glass"))
     throw BadInput("`orbit_period = " + std::to_string(problem.orbit_period) +
-                   "`: only for forced models (impact, mathieu); for linear set `period`");
+                   "`: only for forced models (impact, mathieu); for linear and mackey-glass set `period`");
   problem.events = config.get_choice("events", "on", {"on", "linear", "off"});
   problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"});
   problem.grid = std::visit(

@@ -9,12 +9,13 @@
 #include "delayspec/grid.hpp"
 #include "delayspec/model_impact.hpp"
 #include "delayspec/model_linear.hpp"
+#include "delayspec/model_mackey_glass.hpp"
 #include "delayspec/model_mathieu.hpp"
 #include "delayspec/stepper.hpp"
 
 namespace delayspec::cli {
 
-using AnyModel = std::variant<ImpactModel, LinearModel, MathieuModel>;
+using AnyModel = std::variant<ImpactModel, LinearModel, MathieuModel, MackeyGlassModel>;
 
 struct Problem {
   std::string model_name;
