@@ -1,5 +1,7 @@
 #include "config.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -154,10 +156,67 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
   return out;
 }
 
+const std::vector<std::string>& contract_keys() {
+  static const std::vector<std::string> keys = {
+      // problem (problem.cpp)
+      "model", "N", "orbit_period", "events", "jacobian",
+      "zeta", "e", "a", "beta", "omega", "k", "tau_over_T", "tau", "x0", "v0",  // impact
+      "b", "period",                                                            // linear
+      "kappa", "delta", "eps",                                                  // mathieu
+      // floquet and orbits
+      "nev", "solver", "orbit", "orbit_tolerance", "orbit_max_periods",
+      // lyapunov, converge, sweep, simulate
+      "exponents", "periods", "transient", "Ns",
+      // run, plot, chart, basin (scenes)
+      "analyses", "title"};
+  return keys;
+}
+
+namespace {
+
+// Levenshtein distance, case-insensitive: `n` for `N` costs 0, so a wrong case is always suggested.
+size_t edit_distance(const std::string& a, const std::string& b) {
+  auto lower = [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); };
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t substitution = diagonal + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1);
+      diagonal = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, substitution});
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::string closest_key(const std::string& key, const std::vector<std::string>& candidates) {
+  const size_t threshold = key.size() <= 2 ? 0 : key.size() <= 4 ? 1 : 2;
+  std::string best;
+  size_t best_distance = threshold + 1;
+  for (const auto& candidate : candidates) {
+    if (candidate == key) continue;
+    const size_t d = edit_distance(key, candidate);
+    if (d < best_distance || (d == best_distance && !best.empty() && candidate < best)) {
+      best = candidate;
+      best_distance = d;
+    }
+  }
+  return best;
+}
+
 void Config::check_all_used() const {
-  for (const auto& [key, value] : values_)
-    if (!used_.count(key))
-      throw BadInput("unknown key `" + key + "` (= " + value + ", from " + origin_.at(key) + ")");
+  for (const auto& [key, value] : values_) {
+    if (used_.count(key)) continue;
+    std::vector<std::string> candidates(used_.begin(), used_.end());
+    candidates.insert(candidates.end(), contract_keys().begin(), contract_keys().end());
+    const std::string suggestion = closest_key(key, candidates);
+    throw BadInput("unknown key `" + key + "` (= " + value + ", from " + origin_.at(key) + ")" +
+                   (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?"));
+  }
 }
 
 }  // namespace delayspec::cli

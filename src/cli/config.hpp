@@ -34,7 +34,10 @@ class Config {
 
   // Marks a key as known without reading it (e.g. keys of another command in a shared scene).
   void mark_used(const std::string& key);
-  // BadInput naming the first key that was given but never read.
+  // BadInput naming the first key that was given but never read, with a did-you-mean
+  // suggestion: the closest key among those read so far and contract_keys() (edit distance,
+  // case-insensitive; keys of 1-2 characters only by case, 3-4 characters at most 1 edit, longer
+  // at most 2).
   void check_all_used() const;
 
   // All key/value pairs, for metadata in outputs.
@@ -46,5 +49,12 @@ class Config {
   std::map<std::string, std::string> origin_;
   mutable std::set<std::string> used_;
 };
+
+// Every key any command reads (the CLI contract plus documented extensions). A command that
+// adds a key adds it here too, so that a typo of it gets a suggestion from every command.
+const std::vector<std::string>& contract_keys();
+
+// The closest candidate to `key` within the threshold of check_all_used(), or "" if none.
+std::string closest_key(const std::string& key, const std::vector<std::string>& candidates);
 
 }  // namespace delayspec::cli

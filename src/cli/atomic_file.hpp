@@ -1,0 +1,39 @@
+#pragma once
+// Atomic output files: every file a command writes goes through here. The contents are written
+// to a hidden temporary file in the same directory (`.NAME.tmp-PID-SEQ`), flushed to disk, and
+// renamed onto NAME (rename(2) within one file system is atomic). An interrupted run therefore
+// leaves either the previous complete file or none, never a truncated file that looks
+// complete; at worst a hidden `.NAME.tmp-*` file remains.
+// Errors (directory missing and not creatable, disk full, permission) throw BadInput naming the
+// path and the system's reason: the user asked for an output location that cannot be written.
+//
+// Example:
+//     AtomicFile file(out_dir / "exponents.csv");
+//     file.stream() << "# delayspec 0.1.0\nk,lambda1\n";
+//     file.commit();            // without commit(), the destructor discards the temporary
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+namespace delayspec::cli {
+
+// Writes `contents` to `target` atomically (see above). Creates the parent directory if needed.
+void write_file_atomically(const std::filesystem::path& target, const std::string& contents);
+
+// A file built in memory and written atomically by commit(). Output files of delayspec are
+// small (tables, JSON), so buffering them whole is cheap and keeps the write a single step.
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::filesystem::path target) : target_(std::move(target)) {}
+  std::ostream& stream() { return buffer_; }
+  const std::filesystem::path& path() const { return target_; }
+  // Writes and renames; a second commit() is a no-op.
+  void commit();
+
+ private:
+  std::filesystem::path target_;
+  std::ostringstream buffer_;
+  bool committed_ = false;
+};
+
+}  // namespace delayspec::cli

@@ -1,0 +1,168 @@
+// Config: scene parsing and one test per error path of the typed getters (each names the key
+// and the value), and the did-you-mean suggestion of check_all_used().
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "config.hpp"
+#include "delayspec/errors.hpp"
+
+using delayspec::BadInput;
+using delayspec::cli::closest_key;
+using delayspec::cli::Config;
+
+namespace {
+
+// The message of the BadInput thrown by f, or "" (and a test failure) when none is thrown.
+template <class F>
+std::string bad_input_message(F&& f) {
+  try {
+    f();
+  } catch (const BadInput& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected BadInput";
+  return "";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+std::string write_scene(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / ("delayspec_test_config_" + name + ".toml");
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+Config with(const std::string& key, const std::string& value) {
+  Config c;
+  c.set(key, value, "test");
+  return c;
+}
+
+}  // namespace
+
+TEST(Config, SceneTablesAreFlattenedAndTypesSpelledAsSet) {
+  Config c = Config::from_scene_file(write_scene("flat", "model = \"impact\"\n[grid]\nN = 40\n[floquet]\n"
+                                                         "nev = 3\nk = 0.25\nanalyses = [\"floquet\", \"lyapunov\"]\n"
+                                                         "quiet = true\n"));
+  EXPECT_EQ(c.get_string("model", ""), "impact");
+  EXPECT_EQ(c.get_int("N", 0), 40);
+  EXPECT_EQ(c.get_int("nev", 0), 3);
+  EXPECT_EQ(c.get_double("k", 0), 0.25);
+  EXPECT_EQ(c.get_string("analyses", ""), "floquet,lyapunov");
+  EXPECT_EQ(c.get_string("quiet", ""), "true");
+  c.check_all_used();  // every key was read: no throw
+}
+
+TEST(Config, SetOverridesSceneInOrder) {
+  Config c = Config::from_scene_file(write_scene("override", "N = 40\n"));
+  c.set_from_assignment("N=50");
+  c.set_from_assignment(" N = 60 ");
+  EXPECT_EQ(c.get_int("N", 0), 60);
+}
+
+TEST(ConfigErrors, DuplicateKeyAcrossTables) {
+  const std::string path = write_scene("dup", "N = 40\n[grid]\nN = 50\n");
+  const std::string m = bad_input_message([&] { Config::from_scene_file(path); });
+  EXPECT_TRUE(contains(m, "`N` is given twice")) << m;
+}
+
+TEST(ConfigErrors, UnparsableSceneNamesFileAndLine) {
+  const std::string path = write_scene("broken", "N = 40\nnev = = 3\n");
+  const std::string m = bad_input_message([&] { Config::from_scene_file(path); });
+  EXPECT_TRUE(contains(m, path)) << m;
+  EXPECT_TRUE(contains(m, "line 2")) << m;
+}
+
+TEST(ConfigErrors, UnsupportedValueType) {
+  const std::string path = write_scene("date", "start = 1979-05-27\n");
+  const std::string m = bad_input_message([&] { Config::from_scene_file(path); });
+  EXPECT_TRUE(contains(m, "`start`")) << m;
+}
+
+TEST(ConfigErrors, MissingFile) {
+  const std::string m = bad_input_message([] { Config::from_scene_file("/nonexistent/x.toml"); });
+  EXPECT_TRUE(contains(m, "/nonexistent/x.toml")) << m;
+}
+
+TEST(ConfigErrors, MalformedAssignment) {
+  Config c;
+  EXPECT_TRUE(contains(bad_input_message([&] { c.set_from_assignment("N"); }), "KEY=VALUE"));
+  EXPECT_TRUE(contains(bad_input_message([&] { c.set_from_assignment(" =3"); }), "the key is empty"));
+}
+
+TEST(ConfigErrors, DoubleNotANumberNotFiniteOverflow) {
+  for (const char* bad : {"abc", "", "1.5x", "1e999", "nan", "inf", "-inf"}) {
+    Config c = with("k", bad);
+    const std::string m = bad_input_message([&] { c.get_double("k", 0); });
+    EXPECT_TRUE(contains(m, std::string("`k = ") + bad + "`")) << bad << ": " << m;
+  }
+}
+
+TEST(ConfigErrors, RequiredDoubleMissing) {
+  Config c;
+  EXPECT_TRUE(contains(bad_input_message([&] { c.require_double("tau"); }), "missing key `tau`"));
+}
+
+TEST(ConfigErrors, IntegerNotAnIntegerOrOverflow) {
+  for (const char* bad : {"ten", "3.5", "", "99999999999999999999", "4 2"}) {
+    Config c = with("N", bad);
+    const std::string m = bad_input_message([&] { c.get_int("N", 0); });
+    EXPECT_TRUE(contains(m, std::string("`N = ") + bad + "`: not an integer")) << bad << ": " << m;
+  }
+}
+
+TEST(ConfigErrors, ChoiceListsAllowedValues) {
+  Config c = with("events", "maybe");
+  const std::string m = bad_input_message([&] { c.get_choice("events", "on", {"on", "linear", "off"}); });
+  EXPECT_TRUE(contains(m, "`events = maybe`: must be one of on, linear, off")) << m;
+}
+
+TEST(ConfigErrors, IntListBadItemAndEmpty) {
+  Config c = with("Ns", "50,x,200");
+  std::string m = bad_input_message([&] { c.get_int_list("Ns", {}); });
+  EXPECT_TRUE(contains(m, "`Ns = 50,x,200`: `x` is not an integer")) << m;
+  Config e = with("Ns", "");
+  m = bad_input_message([&] { e.get_int_list("Ns", {}); });
+  EXPECT_TRUE(contains(m, "empty list")) << m;
+}
+
+TEST(ConfigErrors, UnknownKeySuggestsClosestReadKey) {
+  Config c = with("orbit_tolerence", "1e-10");
+  c.get_double("orbit_tolerance", 1e-12);
+  const std::string m = bad_input_message([&] { c.check_all_used(); });
+  EXPECT_TRUE(contains(m, "unknown key `orbit_tolerence` (= 1e-10, from test)")) << m;
+  EXPECT_TRUE(contains(m, "did you mean `orbit_tolerance`?")) << m;
+}
+
+TEST(ConfigErrors, UnknownKeySuggestsContractKeyNotReadYet) {
+  // `exponents` belongs to lyapunov; a command that never reads it still suggests it.
+  Config c = with("exponent", "3");
+  const std::string m = bad_input_message([&] { c.check_all_used(); });
+  EXPECT_TRUE(contains(m, "did you mean `exponents`?")) << m;
+}
+
+TEST(ConfigErrors, UnknownKeyWrongCase) {
+  Config c = with("n", "40");
+  const std::string m = bad_input_message([&] { c.check_all_used(); });
+  EXPECT_TRUE(contains(m, "did you mean `N`?")) << m;
+}
+
+TEST(ConfigErrors, UnknownKeyFarFromEverythingHasNoSuggestion) {
+  Config c = with("colour_scheme", "dark");
+  const std::string m = bad_input_message([&] { c.check_all_used(); });
+  EXPECT_TRUE(contains(m, "unknown key `colour_scheme`")) << m;
+  EXPECT_FALSE(contains(m, "did you mean")) << m;
+}
+
+TEST(ClosestKey, ThresholdsByLength) {
+  const std::vector<std::string> keys = {"N", "Ns", "nev", "solver", "transient", "k", "e"};
+  EXPECT_EQ(closest_key("ns", keys), "Ns");        // case only
+  EXPECT_EQ(closest_key("x", keys), "");           // 1-2 characters: case only, no guessing
+  EXPECT_EQ(closest_key("nve", keys), "");         // transposition = 2 edits > 1 for 3 characters
+  EXPECT_EQ(closest_key("neev", keys), "nev");     // 1 insertion
+  EXPECT_EQ(closest_key("slover", keys), "solver");  // 2 edits, 6 characters
+  EXPECT_EQ(closest_key("transiant", keys), "transient");
+  EXPECT_EQ(closest_key("solvers_x", keys), "");   // 3 edits
+}
