@@ -1,0 +1,147 @@
+#pragma once
+// Convergence studies (design.md 1.8): sweep the resolution N, compute the leading Floquet
+// multipliers at each level, match them across levels, measure errors, correct digits and the
+// observed order, and extrapolate (richardson.hpp).
+//
+// Model-agnostic: a study takes a LevelFunction, "the leading `count` multipliers at resolution
+// N" (plus what they cost), so it can be driven by any model, solver, or a synthetic sequence.
+//
+// Matching. Multipliers are followed as tracks, anchored at the exact values (when given) or at
+// the finest level's leading nev. Going from the finest level to the coarsest, level i is matched
+// to the matched values of level i + 1 by a minimum-total-distance assignment (Hungarian
+// algorithm on |mu_a - mu_b|), among nev + extra candidates. This is robust to two multipliers
+// swapping rank in modulus between levels and to a complex pair that becomes two real
+// multipliers (each gets one partner; no value is used twice), where matching by index is not.
+//
+// Errors are relative: e = |mu - mu_ref| / |mu_ref|. Correct digits (LRE) = -log10(e), capped at
+// the precision of the reference (its own relative error estimate, at least 1e-16).
+//
+// Reference:
+//   exact        the exact multipliers (e.g. Lambert W for the scalar linear DDE);
+//   extrapolated Richardson on the matched levels (richardson.hpp), with its error estimate;
+//   finest       the finest level (its error estimated from the last two levels);
+//   automatic    exact when given, else extrapolated (>= 2 levels).
+//
+// Observed order (of the leading track):
+//   exact reference: per pair of levels p = log(e_i / e_{i+1}) / log(N_{i+1} / N_i), using only
+//     levels whose error is above 10x the reference precision;
+//   otherwise: from successive differences d_i = |mu_{i+1} - mu_i| (they do not depend on a
+//     reference built from the same levels, which would make the order tautological):
+//     p = log(d_i / d_{i+1}) / log(r), r the geometric mean step ratio of the three levels.
+//   The least-squares slope of log e (or log d) against log N over all usable levels.
+//   Settled when the last (up to 3) pair orders spread by at most `settled_spread`; only then is
+//   `observed` set (the slope over the levels of those pairs). Otherwise it stays empty and `note`
+//   says that the sequence is pre-asymptotic, with the numbers.
+#include <complex>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "delayspec/richardson.hpp"
+
+namespace delayspec {
+
+using Multipliers = std::vector<std::complex<double>>;
+
+// assignment[i] = index in `candidates` matched to targets[i], minimising sum_i |t_i - c_a(i)|.
+// BadInput when there are fewer candidates than targets or a value is not finite.
+std::vector<int> match_by_proximity(const Multipliers& targets, const Multipliers& candidates);
+
+// What one level of a study computed.
+struct LevelResult {
+  Multipliers multipliers;         // the leading multipliers (any order; matching does not rely on it)
+  double seconds = 0;              // what the level cost (wall time)
+  long operator_applications = 0;  // single-vector applications of the monodromy
+};
+
+// The leading `count` multipliers at resolution N.
+using LevelFunction = std::function<LevelResult(int N, int count)>;
+
+enum class ReferenceKind { exact, extrapolated, finest, automatic };
+// "exact", "extrapolated", "finest", "auto"; BadInput otherwise.
+ReferenceKind parse_reference_kind(const std::string& name);
+std::string to_string(ReferenceKind kind);
+
+struct ConvergenceOptions {
+  std::vector<int> Ns;              // strictly increasing, each >= 1
+  int nev = 1;                      // multipliers tracked
+  int extra = 2;                    // computed beyond nev at each level, as matching candidates
+  ReferenceKind reference = ReferenceKind::automatic;
+  Multipliers exact;                // exact multipliers (>= nev of them), for `exact` / `automatic`
+  double exact_precision = 1e-14;   // relative accuracy of `exact`
+  RichardsonOptions richardson;     // the error expansion (order 2, step 2: trapezoid, smooth)
+  double settled_spread = 0.3;      // pair orders within this band count as settled
+};
+
+struct ConvergenceRow {
+  int N = 0;
+  Multipliers multipliers;              // matched: multipliers[k] is track k
+  std::vector<double> errors;           // relative error of each track
+  std::vector<double> correct_digits;   // LRE of each track, capped
+  double error = 0;                     // errors[0], the leading track
+  double seconds = 0;
+  long operator_applications = 0;
+};
+
+struct OrderReport {
+  std::string basis;                    // "error" (exact reference) or "difference"
+  std::vector<double> pair_orders;      // basis error: rows (i, i+1); difference: rows (i, i+1, i+2)
+  std::vector<int> pair_N;              // the finest N involved in each pair order
+  double least_squares = 0;             // slope over all usable levels (NaN when < 2 points)
+  std::optional<double> observed;       // set only when the orders are settled
+  bool settled = false;
+  std::string note;                     // why `observed` is empty, or a caveat
+};
+
+struct ExtrapolatedMultiplier {
+  std::complex<double> value;
+  double error_estimate = 0;            // absolute (see richardson.hpp)
+  int levels = 0;
+};
+
+// Richardson columns of the leading track: columns[j][i] = T[i][j] (entries with fewer than j + 1
+// levels below them are absent: the column starts at row j), with errors against the reference
+// and the observed order of each column.
+struct RichardsonReport {
+  std::vector<int> Ns;
+  std::vector<std::vector<std::complex<double>>> columns;
+  std::vector<std::vector<double>> errors;   // relative, NaN where the reference is not independent
+  std::vector<std::optional<double>> column_orders;  // least-squares order of each column's errors
+  std::vector<double> expected_orders;       // e_{j+1} for column j
+};
+
+struct ConvergenceStudy {
+  std::vector<ConvergenceRow> rows;
+  ReferenceKind reference = ReferenceKind::automatic;  // the one used (never automatic)
+  Multipliers reference_values;                        // per track
+  std::vector<double> reference_precision;             // relative, per track
+  OrderReport order;                                   // of track 0
+  std::vector<OrderReport> track_orders;               // of every track
+  std::vector<ExtrapolatedMultiplier> extrapolated;    // per track (empty with one level)
+  RichardsonReport richardson;                         // of track 0
+  double seconds = 0;                                  // sum over the levels
+};
+
+// Runs the level function at every N of options.Ns (count = nev + extra) and analyses the
+// results. BadInput: empty or non-increasing Ns, nev < 1, reference exact without exact values,
+// extrapolated/finest with one level. NumericalFailure: a level returns fewer than nev values.
+ConvergenceStudy run_convergence_study(const LevelFunction& level, const ConvergenceOptions& options);
+
+// The analysis part alone, for levels computed elsewhere (levels[i] belongs to options.Ns[i]).
+ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, const ConvergenceOptions& options);
+
+// Relative errors and capped LRE of `values` against `reference` (matched by proximity;
+// values.size() >= reference.size()). matched[k] is the value matched to reference[k].
+struct MatchedErrors {
+  Multipliers matched;
+  std::vector<double> errors;
+  std::vector<double> correct_digits;
+};
+MatchedErrors errors_against(const Multipliers& values, const Multipliers& reference,
+                             const std::vector<double>& reference_precision);
+
+// -log10(error), capped at -log10(max(precision, 1e-16)); the cap when error == 0.
+double correct_digits(double relative_error, double reference_precision);
+
+}  // namespace delayspec

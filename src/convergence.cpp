@@ -1,0 +1,361 @@
+#include "delayspec/convergence.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "delayspec/dense_spectrum.hpp"
+#include "delayspec/errors.hpp"
+
+namespace delayspec {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kMinPrecision = 1e-16;  // no reference is better than double rounding
+// Relative size below which a successive difference is treated as round-off (eigen-solver noise
+// dominates there, the discretisation error is no longer visible).
+constexpr double kNoiseFloor = 1e-13;
+
+// Least-squares slope of y against x (NaN with fewer than two points or no spread in x).
+double slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const size_t n = x.size();
+  if (n < 2) return kNaN;
+  double mx = 0, my = 0;
+  for (size_t i = 0; i < n; ++i) mx += x[i] / n, my += y[i] / n;
+  double sxy = 0, sxx = 0;
+  for (size_t i = 0; i < n; ++i) sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx);
+  return sxx > 0 ? sxy / sxx : kNaN;
+}
+
+double relative_error(std::complex<double> value, std::complex<double> reference) {
+  const double scale = std::abs(reference);
+  return std::abs(value - reference) / (scale > 0 ? scale : 1.0);
+}
+
+void validate(const ConvergenceOptions& o) {
+  if (o.Ns.empty()) throw BadInput("convergence study: `Ns` is empty: give at least one N");
+  for (size_t i = 0; i < o.Ns.size(); ++i) {
+    if (o.Ns[i] < 1) throw BadInput("convergence study: `N = " + std::to_string(o.Ns[i]) + "`: must be >= 1");
+    if (i > 0 && o.Ns[i] <= o.Ns[i - 1])
+      throw BadInput("convergence study: `Ns`: must be strictly increasing (" + std::to_string(o.Ns[i - 1]) +
+                     " then " + std::to_string(o.Ns[i]) + ")");
+  }
+  if (o.nev < 1) throw BadInput("convergence study: `nev = " + std::to_string(o.nev) + "`: must be >= 1");
+  if (o.extra < 0) throw BadInput("convergence study: `extra = " + std::to_string(o.extra) + "`: must be >= 0");
+  if (!(o.settled_spread > 0))
+    throw BadInput("convergence study: `settled_spread = " + format_number(o.settled_spread) + "`: must be > 0");
+  if (o.reference == ReferenceKind::exact && static_cast<int>(o.exact.size()) < o.nev)
+    throw BadInput("convergence study: `reference = exact` needs " + std::to_string(o.nev) +
+                   " exact multipliers, this model provides " + std::to_string(o.exact.size()) +
+                   " (use reference = extrapolated or finest)");
+  if ((o.reference == ReferenceKind::extrapolated || o.reference == ReferenceKind::finest) && o.Ns.size() < 2)
+    throw BadInput("convergence study: `reference = " + to_string(o.reference) + "` needs at least two N, got `Ns` of " +
+                   std::to_string(o.Ns.size()));
+  if (o.reference == ReferenceKind::automatic && o.exact.empty() && o.Ns.size() < 2)
+    throw BadInput("convergence study: no exact multipliers and one N only: give at least two N");
+}
+
+// Settledness of a list of pair orders (design 1.5: pre-asymptotic behaviour must be said).
+void judge(OrderReport& r, const std::vector<double>& log_x, const std::vector<double>& log_y, double spread_limit) {
+  const size_t n = r.pair_orders.size();
+  if (n == 0) {
+    r.note = r.basis == "error" ? "no order: fewer than two levels with an error above the reference precision"
+                                : "no order: needs three levels whose successive differences are above round-off";
+    return;
+  }
+  if (n == 1) {
+    r.observed = r.pair_orders[0];
+    r.note = "one pair of levels only: whether the order has settled cannot be checked";
+    return;
+  }
+  const size_t m = std::min<size_t>(3, n);
+  const auto first = r.pair_orders.end() - static_cast<long>(m);
+  const double lo = *std::min_element(first, r.pair_orders.end());
+  const double hi = *std::max_element(first, r.pair_orders.end());
+  r.settled = hi - lo <= spread_limit;
+  if (r.settled) {
+    // Slope over the points behind the last m pair orders (m + 1 points).
+    const size_t k = std::min(log_x.size(), m + 1);
+    std::vector<double> xs(log_x.end() - static_cast<long>(k), log_x.end());
+    std::vector<double> ys(log_y.end() - static_cast<long>(k), log_y.end());
+    r.observed = -slope(xs, ys);
+  } else {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "orders not settled: the last %zu pair orders range over [%.3g, %.3g] (spread %.2g > %.2g): pre-asymptotic, refine N",
+                  m, lo, hi, hi - lo, spread_limit);
+    r.note = buf;
+  }
+}
+
+// Order of one track: from errors (exact reference) or from successive differences.
+OrderReport track_order(const std::vector<int>& Ns, const std::vector<std::complex<double>>& values,
+                        const std::vector<double>& errors, bool exact_reference, double precision,
+                        double spread_limit) {
+  OrderReport r;
+  std::vector<double> log_x, log_y;
+  const size_t L = Ns.size();
+  if (exact_reference) {
+    r.basis = "error";
+    const double floor = std::max(10 * precision, kNoiseFloor);
+    std::vector<bool> usable(L);
+    for (size_t i = 0; i < L; ++i) usable[i] = errors[i] > floor && std::isfinite(errors[i]);
+    for (size_t i = 0; i < L; ++i)
+      if (usable[i]) log_x.push_back(std::log(Ns[i])), log_y.push_back(std::log(errors[i]));
+    for (size_t i = 0; i + 1 < L; ++i)
+      if (usable[i] && usable[i + 1]) {
+        r.pair_orders.push_back(std::log(errors[i] / errors[i + 1]) / std::log(double(Ns[i + 1]) / Ns[i]));
+        r.pair_N.push_back(Ns[i + 1]);
+      }
+  } else {
+    r.basis = "difference";
+    std::vector<double> d(L > 0 ? L - 1 : 0);
+    std::vector<bool> usable(d.size());
+    for (size_t i = 0; i + 1 < L; ++i) {
+      d[i] = std::abs(values[i + 1] - values[i]);
+      const double scale = std::max(std::abs(values[i + 1]), 1e-300);
+      usable[i] = d[i] / scale > kNoiseFloor;
+      if (usable[i]) log_x.push_back(std::log(Ns[i])), log_y.push_back(std::log(d[i]));
+    }
+    for (size_t i = 0; i + 1 < d.size(); ++i)
+      if (usable[i] && usable[i + 1]) {
+        const double ratio = std::sqrt(double(Ns[i + 2]) / Ns[i]);  // geometric mean step ratio
+        r.pair_orders.push_back(std::log(d[i] / d[i + 1]) / std::log(ratio));
+        r.pair_N.push_back(Ns[i + 2]);
+      }
+  }
+  r.least_squares = -slope(log_x, log_y);
+  judge(r, log_x, log_y, spread_limit);
+  return r;
+}
+
+// Hungarian algorithm (potentials, O(n^2 m)) for an n x m cost matrix, n <= m.
+std::vector<int> hungarian(const std::vector<std::vector<double>>& cost, int n, int m) {
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> u(n + 1, 0), v(m + 1, 0);
+  std::vector<int> p(m + 1, 0), way(m + 1, 0);
+  for (int i = 1; i <= n; ++i) {
+    p[0] = i;
+    int j0 = 0;
+    std::vector<double> minv(m + 1, inf);
+    std::vector<char> used(m + 1, false);
+    do {
+      used[j0] = true;
+      const int i0 = p[j0];
+      double delta = inf;
+      int j1 = 0;
+      for (int j = 1; j <= m; ++j) {
+        if (used[j]) continue;
+        const double cur = cost[i0 - 1][j - 1] - u[i0] - v[j];  // reduced cost
+        if (cur < minv[j]) minv[j] = cur, way[j] = j0;
+        if (minv[j] < delta) delta = minv[j], j1 = j;
+      }
+      for (int j = 0; j <= m; ++j) {
+        if (used[j]) u[p[j]] += delta, v[j] -= delta;
+        else minv[j] -= delta;
+      }
+      j0 = j1;
+    } while (p[j0] != 0);
+    do {  // augment along the alternating path
+      const int j1 = way[j0];
+      p[j0] = p[j1];
+      j0 = j1;
+    } while (j0 != 0);
+  }
+  std::vector<int> assignment(n, -1);
+  for (int j = 1; j <= m; ++j)
+    if (p[j] != 0) assignment[p[j] - 1] = j - 1;
+  return assignment;
+}
+
+}  // namespace
+
+ReferenceKind parse_reference_kind(const std::string& name) {
+  if (name == "exact") return ReferenceKind::exact;
+  if (name == "extrapolated") return ReferenceKind::extrapolated;
+  if (name == "finest") return ReferenceKind::finest;
+  if (name == "auto") return ReferenceKind::automatic;
+  throw BadInput("`reference = " + name + "`: must be one of exact, extrapolated, finest, auto");
+}
+
+std::string to_string(ReferenceKind kind) {
+  switch (kind) {
+    case ReferenceKind::exact: return "exact";
+    case ReferenceKind::extrapolated: return "extrapolated";
+    case ReferenceKind::finest: return "finest";
+    case ReferenceKind::automatic: return "auto";
+  }
+  return "?";
+}
+
+std::vector<int> match_by_proximity(const Multipliers& targets, const Multipliers& candidates) {
+  if (candidates.size() < targets.size())
+    throw BadInput("match_by_proximity: " + std::to_string(targets.size()) + " targets but only " +
+                   std::to_string(candidates.size()) + " candidates");
+  auto finite = [](std::complex<double> z) { return std::isfinite(z.real()) && std::isfinite(z.imag()); };
+  for (auto z : targets)
+    if (!finite(z)) throw BadInput("match_by_proximity: a target is not finite");
+  for (auto z : candidates)
+    if (!finite(z)) throw BadInput("match_by_proximity: a candidate is not finite");
+  const int n = static_cast<int>(targets.size()), m = static_cast<int>(candidates.size());
+  if (n == 0) return {};
+  std::vector<std::vector<double>> cost(n, std::vector<double>(m));
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) cost[i][j] = std::abs(targets[i] - candidates[j]);
+  return hungarian(cost, n, m);
+}
+
+double correct_digits(double relative_error, double reference_precision) {
+  const double cap = -std::log10(std::max(reference_precision, kMinPrecision));
+  if (!(relative_error > 0)) return cap;
+  return std::min(cap, -std::log10(relative_error));
+}
+
+MatchedErrors errors_against(const Multipliers& values, const Multipliers& reference,
+                             const std::vector<double>& reference_precision) {
+  if (reference_precision.size() != reference.size())
+    throw BadInput("errors_against: " + std::to_string(reference.size()) + " reference values but " +
+                   std::to_string(reference_precision.size()) + " precisions");
+  const std::vector<int> a = match_by_proximity(reference, values);
+  MatchedErrors out;
+  for (size_t k = 0; k < reference.size(); ++k) {
+    out.matched.push_back(values[a[k]]);
+    out.errors.push_back(relative_error(values[a[k]], reference[k]));
+    out.correct_digits.push_back(correct_digits(out.errors.back(), reference_precision[k]));
+  }
+  return out;
+}
+
+ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, const ConvergenceOptions& options) {
+  validate(options);
+  const size_t L = options.Ns.size();
+  const int nev = options.nev;
+  if (levels.size() != L)
+    throw BadInput("analyse_convergence: " + std::to_string(levels.size()) + " levels for " + std::to_string(L) + " N");
+  for (size_t i = 0; i < L; ++i)
+    if (static_cast<int>(levels[i].multipliers.size()) < nev)
+      throw NumericalFailure("convergence study: N = " + std::to_string(options.Ns[i]) + " gave " +
+                             std::to_string(levels[i].multipliers.size()) + " multipliers, " + std::to_string(nev) +
+                             " are tracked (nev)");
+
+  ConvergenceStudy study;
+  study.reference = options.reference;
+  if (study.reference == ReferenceKind::automatic)
+    study.reference = static_cast<int>(options.exact.size()) >= nev ? ReferenceKind::exact : ReferenceKind::extrapolated;
+  const bool exact = study.reference == ReferenceKind::exact;
+
+  // Anchors of the tracks: the exact values, or the finest level's leading nev.
+  Multipliers anchors;
+  if (exact) {
+    anchors.assign(options.exact.begin(), options.exact.begin() + nev);
+  } else {
+    Multipliers finest = levels.back().multipliers;
+    sort_by_modulus(finest);
+    anchors.assign(finest.begin(), finest.begin() + nev);
+  }
+  // Match from the finest level down: each level against the next finer one.
+  std::vector<Multipliers> matched(L);
+  Multipliers targets = anchors;
+  for (size_t step = 0; step < L; ++step) {
+    const size_t i = L - 1 - step;
+    const std::vector<int> a = match_by_proximity(targets, levels[i].multipliers);
+    matched[i].resize(nev);
+    for (int k = 0; k < nev; ++k) matched[i][k] = levels[i].multipliers[a[k]];
+    targets = matched[i];
+  }
+  auto track = [&](int k) {
+    std::vector<std::complex<double>> x(L);
+    for (size_t i = 0; i < L; ++i) x[i] = matched[i][k];
+    return x;
+  };
+  std::vector<double> h(L);
+  for (size_t i = 0; i < L; ++i) h[i] = 1.0 / options.Ns[i];  // relative step: h = tau / N
+
+  // Extrapolated multipliers (every study with >= 2 levels reports them).
+  if (L >= 2)
+    for (int k = 0; k < nev; ++k) {
+      const Extrapolation e = richardson_extrapolate(h, track(k), options.richardson);
+      study.extrapolated.push_back({e.value, e.error_estimate, e.levels});
+    }
+
+  // The reference and its relative precision, per track.
+  for (int k = 0; k < nev; ++k) {
+    std::complex<double> ref;
+    double precision = kMinPrecision;
+    const double scale_floor = 1e-300;
+    if (exact) {
+      ref = options.exact[k];
+      precision = std::max(options.exact_precision, kMinPrecision);
+    } else if (study.reference == ReferenceKind::extrapolated) {
+      ref = study.extrapolated[k].value;
+      precision = std::max(study.extrapolated[k].error_estimate / std::max(std::abs(ref), scale_floor), kMinPrecision);
+    } else {  // finest: its own error estimated from the last two levels, e ~ |x_f - x_{f-1}| / (r^p - 1)
+      ref = matched[L - 1][k];
+      const double r = double(options.Ns[L - 1]) / options.Ns[L - 2];
+      const double est = std::abs(matched[L - 1][k] - matched[L - 2][k]) / (std::pow(r, options.richardson.order) - 1);
+      precision = std::max(est / std::max(std::abs(ref), scale_floor), kMinPrecision);
+    }
+    study.reference_values.push_back(ref);
+    study.reference_precision.push_back(precision);
+  }
+
+  // Rows.
+  for (size_t i = 0; i < L; ++i) {
+    ConvergenceRow row;
+    row.N = options.Ns[i];
+    row.multipliers = matched[i];
+    row.seconds = levels[i].seconds;
+    row.operator_applications = levels[i].operator_applications;
+    for (int k = 0; k < nev; ++k) {
+      const double e = relative_error(matched[i][k], study.reference_values[k]);
+      row.errors.push_back(e);
+      row.correct_digits.push_back(correct_digits(e, study.reference_precision[k]));
+    }
+    row.error = row.errors[0];
+    study.seconds += row.seconds;
+    study.rows.push_back(std::move(row));
+  }
+
+  // Orders.
+  for (int k = 0; k < nev; ++k) {
+    std::vector<double> e(L);
+    for (size_t i = 0; i < L; ++i) e[i] = study.rows[i].errors[k];
+    study.track_orders.push_back(
+        track_order(options.Ns, track(k), e, exact, study.reference_precision[k], options.settled_spread));
+  }
+  study.order = study.track_orders[0];
+
+  // Richardson columns of the leading track, with errors against the reference.
+  RichardsonReport& rr = study.richardson;
+  rr.Ns = options.Ns;
+  const RichardsonTableau tab = richardson_tableau(h, track(0), options.richardson);
+  const int columns = std::min<int>(static_cast<int>(L), options.richardson.max_columns);
+  rr.columns.assign(columns, {});
+  rr.errors.assign(columns, {});
+  for (int j = 0; j < columns; ++j) {
+    rr.expected_orders.push_back(tab.remaining_order(j));
+    std::vector<double> log_n, log_e;
+    const double floor = std::max(10 * study.reference_precision[0], kNoiseFloor);
+    for (size_t i = j; i < L; ++i) {
+      rr.columns[j].push_back(tab.T[i][j]);
+      // An entry that uses the finest level is not independent of a finest/extrapolated reference.
+      const bool independent = exact || i + 1 < L;
+      const double err = independent ? relative_error(tab.T[i][j], study.reference_values[0]) : kNaN;
+      rr.errors[j].push_back(err);
+      if (independent && err > floor) log_n.push_back(std::log(options.Ns[i])), log_e.push_back(std::log(err));
+    }
+    const double s = slope(log_n, log_e);
+    rr.column_orders.push_back(std::isfinite(s) ? std::optional<double>(-s) : std::nullopt);
+  }
+  return study;
+}
+
+ConvergenceStudy run_convergence_study(const LevelFunction& level, const ConvergenceOptions& options) {
+  validate(options);
+  std::vector<LevelResult> levels;
+  for (int N : options.Ns) levels.push_back(level(N, options.nev + options.extra));
+  return analyse_convergence(levels, options);
+}
+
+}  // namespace delayspec
