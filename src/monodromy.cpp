@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "delayspec/block_kernel.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {
@@ -56,7 +57,7 @@ void Monodromy<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
 template <int D>
 void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const {
   const long M = grid_.M, m = grid_.m, K = grid_.K;
-  const double theta = grid_.theta, c0 = 1 - theta;
+  const double theta = grid_.theta;
   const size_t need = static_cast<size_t>(M + 1 + K) * D * k;
   if (block_work_.size() < need) block_work_.resize(need);
   double* b = block_work_.data();
@@ -64,43 +65,9 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
   for (long v = 0; v < k; ++v)
     for (long i = 0; i < n_; ++i) b[i * k + v] = X[v * ldx + i];
   const long stride = static_cast<long>(D) * k;  // one history slot
-  double w[2 * D * 64];  // delayed values at both ends, for up to 64 vectors per pass
-  for (long l = 0; l < K; ++l) {
-    const StepMap<D>& s = maps_[l];
-    const double* u0 = b + (M + l) * stride;
-    const double* d0 = b + (M + l - m) * stride;  // y_tau(t) when aligned
-    const double* d1 = d0 + stride;               // y_tau(t + h) when aligned
-    double* out = b + (M + l + 1) * stride;
-    for (long v0 = 0; v0 < k; v0 += 64) {
-      const long kk = std::min<long>(64, k - v0);
-      const double* w0 = d0 + v0;
-      const double* w1 = d1 + v0;
-      long ws = k;  // row stride of w0/w1
-      if (theta != 0) {
-        const double* dm = d0 - stride;  // u_{m+1}
-        for (int r = 0; r < D; ++r)
-          for (long v = 0; v < kk; ++v) {
-            w[r * 64 + v] = c0 * d0[r * k + v0 + v] + theta * dm[r * k + v0 + v];
-            w[(D + r) * 64 + v] = c0 * d1[r * k + v0 + v] + theta * d0[r * k + v0 + v];
-          }
-        w0 = w;
-        w1 = w + D * 64;
-        ws = 64;
-      }
-      // out_r = sum_c P_rc u0_c + Q_rc w0_c + R_rc w1_c, vectorised over the kk vectors
-      for (int r = 0; r < D; ++r) {
-        double* o = out + r * k + v0;
-        for (long v = 0; v < kk; ++v) o[v] = 0;
-        for (int c = 0; c < D; ++c) {
-          const double p = s.P(r, c), q = s.Q(r, c), rr = s.R(r, c);
-          const double* a = u0 + c * k + v0;
-          const double* e0 = w0 + c * ws;
-          const double* e1 = w1 + c * ws;
-          for (long v = 0; v < kk; ++v) o[v] += p * a[v] + q * e0[v] + rr * e1[v];
-        }
-      }
-    }
-  }
+  // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), delayed slot M+l-m (block_kernel.hpp)
+  for (long l = 0; l < K; ++l)
+    step_block<D>(maps_[l], b + (M + l) * stride, b + (M + l - m) * stride, k, theta, b + (M + l + 1) * stride);
   const double* res = b + K * stride;
   for (long v = 0; v < k; ++v)
     for (long i = 0; i < n_; ++i) Y[v * ldy + i] = res[i * k + v];

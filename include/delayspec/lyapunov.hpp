@@ -1,0 +1,235 @@
+#pragma once
+// Lyapunov exponents of the discretised stroboscopic map (design.md 1.7).
+//
+// A block of k tangent vectors (k = `exponents`, much smaller than n = d (M + 1)) is carried
+// along the trajectory, fused with it step by step: each step of the stepper produces its step
+// map (P, Q, R), which is applied at once to the k interleaved tangent vectors
+// (block_kernel.hpp) and then forgotten; no step map is stored. Every `qr_every` stroboscopic
+// periods the n x k block is Householder-QR factorised in place (TangentQR), log |R_ii| is
+// accumulated and the block is replaced by Q. The first `transient` periods (trajectory and
+// tangent block both advance, so the block has time to align with the leading Lyapunov
+// vectors) are discarded. Exponents come per stroboscopic period ("per period": one map, p
+// forcing periods when periods_per_map = p) and per unit time (divided by K h = p T), with a
+// standard error by batch means over the measured QR intervals.
+//
+// Layout (as StroboscopicMap and Monodromy): linear buffers of M + 1 + K slots for the
+// trajectory and for the block; slots 0..M hold the history at the start of a period, step l
+// writes slot M + l + 1, the history at the end is slots K..K+M. There the block is factorised
+// in place; Q is written back to slots 0..M and the trajectory slots are moved down. All
+// buffers are allocated once per call.
+//
+// QR interval. With qr_every = m > 1 the block is not re-orthonormalised for m periods, so its
+// columns separate by the ratio of the Floquet/Lyapunov growth factors over m periods; the
+// k-th column then keeps only about 16 - log10(R_11 / R_kk) digits, and a large enough growth
+// overflows. The run therefore checks every QR of an interval m > 1: if max_i |log R_ii| > 300
+// (entries near 1e130, halfway to overflow) or R_11 / R_kk > 1e8 (fewer than 8 digits left in
+// the k-th direction) it stops with NumericalFailure asking for a smaller qr_every. With
+// qr_every = 1 (the default) no such check applies: any loss is then a property of one period
+// of the map itself.
+//
+// Errors: BadInput for invalid options (named by their CLI keys: exponents, periods,
+// transient, qr_every, batches); NumericalFailure when the trajectory or the block stops being
+// finite or a diagonal entry of R is zero (the tangent vectors became dependent).
+//
+// Example:
+//   StroboscopicMap<LinearModel> map(TrapezoidStepper<LinearModel>(model), grid);
+//   LyapunovResult r = lyapunov_exponents(map, map.constant_history(Vec<1>(1)), LyapunovOptions{});
+//   r.per_time[0] +- r.standard_error_per_time[0]
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "delayspec/block_kernel.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec/stroboscopic_map.hpp"
+
+namespace delayspec {
+
+struct LyapunovOptions {
+  int exponents = 2;         // k: tangent vectors (exponents wanted), 1 <= k <= n
+  long periods = 1000;       // stroboscopic periods averaged (a multiple of qr_every)
+  long transient = 100;      // periods discarded first (>= 0)
+  std::uint64_t seed = 1;    // initial tangent block: a fixed pseudo-random n x k block, orthonormalised
+  int qr_every = 1;          // periods between QR factorisations (see the header comment)
+  int batches = 20;          // batch means: measured QR intervals are split into this many batches
+  long section_points = 0;   // record u_0 at this many forcing-period boundaries after the transient
+  // Called after every period with (periods done, periods in total incl. the transient); may be empty.
+  std::function<void(long, long)> progress;
+};
+
+struct LyapunovResult {
+  std::vector<double> per_period;                  // sum log |R_ii| / periods, largest first as computed
+  std::vector<double> per_time;                    // per_period / (K h)
+  std::vector<double> standard_error_per_period;   // batch means: sd(batch means) / sqrt(batches)
+  std::vector<double> standard_error_per_time;
+  long periods = 0, transient = 0;
+  int qr_every = 1, batches = 0;
+  double map_time = 0;            // K h: the time of one stroboscopic period
+  long steps = 0;                 // stepper steps taken (transient included)
+  double seconds = 0;             // wall time of the whole run
+  double qr_seconds = 0;          // of which: QR factorisations and forming Q
+  Eigen::VectorXd final_history;  // the trajectory's history at the end
+  Eigen::MatrixXd section;        // section_points x d: y(t0 + j T), one row per forcing period
+};
+
+// The QR step on an n x k block stored row-major (the interleaved layout: row i = entry i of
+// the k vectors), factorised in place with Eigen's HouseholderQR. Binds to the block's memory
+// once; no allocation after construction (k < 48: Eigen's unblocked path).
+class TangentQR {
+ public:
+  TangentQR(double* block, long n, int k);
+  ~TangentQR();
+  TangentQR(const TangentQR&) = delete;
+  TangentQR& operator=(const TangentQR&) = delete;
+
+  // Factorises the bound block = Q R in place, writes Q (n x k row-major, columns signed so
+  // that R_ii > 0) to q_out (must not overlap the block) and stores log |R_ii| in log_r[0..k).
+  // NumericalFailure when an entry of R is not finite or R_ii = 0.
+  void factorise(double* q_out, double* log_r);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  long n_;
+  int k_;
+};
+
+// Fills the n x k row-major block with a reproducible pseudo-random matrix (entries uniform
+// in [-1/2, 1/2) from a 64-bit mt19937 stream, the same on every platform).
+void random_block(double* block, long n, int k, std::uint64_t seed);
+
+// Mean per period and batch-means standard error from the per-interval sums of log |R_ii|
+// (interval_logs[i * k + j], intervals of `qr_every` periods each).
+void batch_statistics(const std::vector<double>& interval_logs, int k, int qr_every, int batches,
+                      std::vector<double>& mean_per_period, std::vector<double>& standard_error, int& batches_used);
+
+// Validates options against the dimension n (BadInput naming the CLI key).
+void validate_lyapunov_options(const LyapunovOptions& options, long n);
+
+// The k leading Lyapunov exponents of the stroboscopic map starting from history U0.
+template <class Model, class Stepper>
+LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, const Eigen::VectorXd& U0,
+                                  const LyapunovOptions& options) {
+  constexpr int D = Model::d;
+  using V = Vec<D>;
+  const HistoryGrid& grid = map.grid();
+  const long n = map.dimension();
+  validate_lyapunov_options(options, n);
+  if (U0.size() != n)
+    throw BadInput("lyapunov_exponents: initial history has " + std::to_string(U0.size()) + " entries, expected " +
+                   std::to_string(n));
+  if (!U0.allFinite()) throw BadInput("lyapunov_exponents: the initial history is not finite");
+
+  const auto start = std::chrono::steady_clock::now();
+  const long M = grid.M, m = grid.m, K = grid.K, spp = grid.steps_per_period;
+  const double theta = grid.theta, c0 = 1 - theta, h = grid.h;
+  const int k = options.exponents;
+  const long stride = static_cast<long>(D) * k;  // one slot of the block
+  const Stepper& stepper = map.stepper();
+
+  std::vector<V> traj(static_cast<size_t>(M + 1 + K));
+  for (long j = 0; j <= M; ++j) traj[j] = U0.template segment<D>(j * D);
+  std::vector<double> block(static_cast<size_t>((M + 1 + K) * stride));
+  double* const result_slots = block.data() + K * stride;  // slots K..K+M: the block after a period
+  const bool q_fits_front = K >= M + 1;                    // slots 0..M and K..K+M do not overlap
+  std::vector<double> q_scratch(q_fits_front ? 0 : static_cast<size_t>(n * k));
+  double* const q_out = q_fits_front ? block.data() : q_scratch.data();
+  TangentQR qr(result_slots, n, k);
+  std::vector<double> log_r(k);
+  double qr_seconds = 0;
+
+  // QR of the block in slots K..K+M; Q into slots 0..M; log |R_ii| into log_r.
+  auto reorthonormalise = [&] {
+    const auto t0 = std::chrono::steady_clock::now();
+    qr.factorise(q_out, log_r.data());
+    if (!q_fits_front) std::copy(q_scratch.begin(), q_scratch.end(), block.begin());
+    qr_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  random_block(result_slots, n, k, options.seed);
+  reorthonormalise();
+
+  LyapunovResult result;
+  result.section.resize(options.section_points, D);
+  long section_count = 0;
+  StepMap<D> step_map;
+  // One stroboscopic period, trajectory and block fused; afterwards the trajectory history is
+  // back in slots 0..M and the (unnormalised) block in slots K..K+M.
+  auto advance = [&](bool record) {
+    for (long l = 0; l < K; ++l) {
+      const long j = M + l - m;  // delayed slot at the step's start
+      const V w0 = theta == 0 ? traj[j] : V(c0 * traj[j] + theta * traj[j - 1]);
+      const V w1 = theta == 0 ? traj[j + 1] : V(c0 * traj[j + 1] + theta * traj[j]);
+      const double t = static_cast<double>(l % spp) * h;
+      traj[M + l + 1] = stepper.step(t, h, traj[M + l], w0, w1, step_map);
+      // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors
+      step_block<D>(step_map, block.data() + (M + l) * stride, block.data() + j * stride, k, theta,
+                    block.data() + (M + l + 1) * stride);
+      if (record && (l + 1) % spp == 0 && section_count < options.section_points)
+        result.section.row(section_count++) = traj[M + l + 1].transpose();
+    }
+    std::copy(traj.begin() + K, traj.end(), traj.begin());  // history at the end -> slots 0..M
+  };
+  auto check_interval = [&](int interval) {
+    if (interval <= 1) return;
+    const auto [lo, hi] = std::minmax_element(log_r.begin(), log_r.end());
+    const double biggest = std::max(std::abs(*lo), std::abs(*hi));
+    if (biggest > 300 || *hi - *lo > 18.420680743952367)  // e^300 ~ 1e130; log(1e8)
+      throw NumericalFailure("`qr_every = " + std::to_string(interval) +
+                             "`: within one QR interval the tangent block grew or separated too much (log|R_ii| in [" +
+                             format_number(*lo) + ", " + format_number(*hi) +
+                             "]; limits 300 and a spread of log(1e8)); use a smaller qr_every");
+  };
+
+  const long total = options.transient + options.periods;
+  long done = 0;
+  // Transient: QR every qr_every periods and at its end; logs discarded.
+  for (long p = 0; p < options.transient; ++p) {
+    advance(false);
+    const bool due = (p + 1) % options.qr_every == 0 || p + 1 == options.transient;
+    if (due) {
+      reorthonormalise();
+      check_interval(options.qr_every);
+    } else {
+      std::copy(result_slots, result_slots + n * k, block.data());
+    }
+    if (options.progress) options.progress(++done, total);
+  }
+  // Measurement.
+  const long intervals = options.periods / options.qr_every;
+  std::vector<double> interval_logs(static_cast<size_t>(intervals * k));
+  for (long i = 0; i < intervals; ++i) {
+    for (int q = 0; q < options.qr_every; ++q) {
+      advance(true);
+      if (q + 1 < options.qr_every) std::copy(result_slots, result_slots + n * k, block.data());
+      if (options.progress) options.progress(++done, total);
+    }
+    reorthonormalise();
+    check_interval(options.qr_every);
+    std::copy(log_r.begin(), log_r.end(), interval_logs.begin() + i * k);
+  }
+
+  batch_statistics(interval_logs, k, options.qr_every, options.batches, result.per_period,
+                   result.standard_error_per_period, result.batches);
+  result.map_time = static_cast<double>(K) * h;
+  for (int i = 0; i < k; ++i) {
+    result.per_time.push_back(result.per_period[i] / result.map_time);
+    result.standard_error_per_time.push_back(result.standard_error_per_period[i] / result.map_time);
+  }
+  result.periods = options.periods;
+  result.transient = options.transient;
+  result.qr_every = options.qr_every;
+  result.steps = total * K;
+  result.final_history.resize(n);
+  for (long j = 0; j <= M; ++j) result.final_history.template segment<D>(j * D) = traj[j];
+  result.section.conservativeResize(section_count, D);
+  result.qr_seconds = qr_seconds;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace delayspec

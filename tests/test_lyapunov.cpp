@@ -1,0 +1,305 @@
+// Lyapunov exponents by QR reorthonormalisation (lyapunov.hpp), checked against what the code
+// under test did not produce: exact characteristic roots (Lambert W), the same-N Floquet
+// multipliers from the dense reference, identities of the QR, and the trajectory of
+// StroboscopicMap.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "delayspec/lambert_w.hpp"
+#include "delayspec/lyapunov.hpp"
+#include "delayspec/model_impact.hpp"
+#include "delayspec/model_linear.hpp"
+#include "delayspec/model_mackey_glass.hpp"
+#include "delayspec/model_mathieu.hpp"
+#include "delayspec/orbit_simulation.hpp"
+#include "test_support.hpp"
+
+namespace ds = delayspec;
+using ds::LyapunovOptions;
+using ds::LyapunovResult;
+
+namespace {
+
+template <class Model>
+ds::StroboscopicMap<Model> make_map(const Model& model, int N) {
+  return ds::StroboscopicMap<Model>(ds::TrapezoidStepper<Model>(model), ds::make_grid(model.tau(), model.period(), N));
+}
+
+template <class Model>
+LyapunovResult run(const Model& model, int N, LyapunovOptions o) {
+  auto map = make_map(model, N);
+  return ds::lyapunov_exponents(map, map.constant_history(model.initial_state()), o);
+}
+
+ds::LinearModel linear(double a, double b, double tau, double period) {
+  ds::LinearParameters p;
+  p.a = a;
+  p.b = b;
+  p.tau = tau;
+  p.period = period;
+  return ds::LinearModel(p);
+}
+
+}  // namespace
+
+TEST(TangentQR, QIsOrthonormalAndQtAIsUpperTriangularWithPositiveDiagonal) {
+  const long n = 57;
+  const int k = 4;
+  std::vector<double> block(n * k), q(n * k), log_r(k);
+  ds::TangentQR qr(block.data(), n, k);
+  ds::random_block(block.data(), n, k, 7);
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const RowMajor A = Eigen::Map<RowMajor>(block.data(), n, k);  // copy: factorise overwrites the block
+  qr.factorise(q.data(), log_r.data());
+  const Eigen::Map<RowMajor> Q(q.data(), n, k);
+  const Eigen::MatrixXd QtQ = Q.transpose() * Q, R = Q.transpose() * A;
+  // Householder QR is backward stable: orthogonality and the residual are O(n eps)
+  const double tol = 10 * n * 2.2e-16;
+  EXPECT_LT((QtQ - Eigen::MatrixXd::Identity(k, k)).cwiseAbs().maxCoeff(), tol);
+  for (int i = 0; i < k; ++i) {
+    EXPECT_NEAR(R(i, i), std::exp(log_r[i]), tol * A.norm()) << i;
+    EXPECT_GT(R(i, i), 0) << "signs fixed so that R_ii > 0";
+    for (int j = 0; j < i; ++j) EXPECT_NEAR(R(i, j), 0, tol * A.norm()) << i << "," << j;
+  }
+  // A = Q R reconstructed from the bound block's factor
+  EXPECT_LT((Q * R.triangularView<Eigen::Upper>() - A).cwiseAbs().maxCoeff(), tol * A.norm());
+}
+
+TEST(Lyapunov, RandomBlockIsReproducible) {
+  std::vector<double> a(30), b(30), c(30);
+  ds::random_block(a.data(), 10, 3, 42);
+  ds::random_block(b.data(), 10, 3, 42);
+  ds::random_block(c.data(), 10, 3, 43);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  for (double x : a) EXPECT_TRUE(x >= -0.5 && x < 0.5);
+}
+
+// x' = -x - 2 x(t - 1): rightmost roots -0.0925 +- 2.00i and -1.363 +- 7.81i. Four exponents
+// per unit time (T = 1): two equal to Re of each complex pair.
+TEST(Lyapunov, LinearDdeExponentsAreRealPartsOfExactRoots) {
+  const auto model = linear(-1, -2, 1, 1);
+  const int N = 100;
+  const auto roots = ds::linear_dde_roots(-1, -2, 1, 3);
+  const auto mu = ds::testing::dense_multipliers(model, N, 4);
+  LyapunovOptions o;
+  o.exponents = 4;
+  o.transient = 100;  // the block aligns at the rate |mu_5 / mu_4| = e^{-0.59} per period: e^-59 after 100
+  o.periods = 1000;
+  const LyapunovResult short_run = run(model, N, o);
+  o.periods = 16000;
+  const LyapunovResult long_run = run(model, N, o);
+  for (int i = 0; i < 4; ++i) {
+    const double exact = roots[i].real();                // roots come sorted by real part
+    const double same_N = std::log(std::abs(mu[i])) / 1;  // the discrete map's own value, T = 1
+    // trapezoid rule: O(h^2) discretisation error, h = 1e-2, constant |lambda|^3/12 ~ 40 for the second pair
+    EXPECT_NEAR(same_N, exact, 40 * 1e-4) << i;
+    for (const LyapunovResult* r : {&short_run, &long_run}) {
+      // statistical agreement with the same-N value: 3 standard errors
+      EXPECT_NEAR(r->per_time[i], same_N, 3 * r->standard_error_per_time[i]) << i << " periods " << r->periods;
+      // against the exact root: statistics plus the discretisation error just bounded
+      EXPECT_NEAR(r->per_time[i], exact, 3 * r->standard_error_per_time[i] + std::abs(same_N - exact)) << i;
+    }
+    // 16x the run: the quasi-periodic fluctuation of a complex pair averages out like 1/periods,
+    // noise like 1/sqrt(periods); either way the error estimate shrinks by more than 3x
+    EXPECT_LT(long_run.standard_error_per_time[i], short_run.standard_error_per_time[i] / 3) << i;
+    EXPECT_GT(long_run.standard_error_per_time[i], 0) << i;
+  }
+  EXPECT_EQ(long_run.periods, 16000);
+  EXPECT_DOUBLE_EQ(long_run.map_time, 1.0);
+}
+
+// A stable delayed Mathieu point whose leading multipliers are real and simple:
+// mu = -0.690, -0.346, 0.307, ... (N = 100). The block converges to the leading two-dimensional
+// Floquet subspace at the rate |mu_3 / mu_2| = 0.887 per period; after a transient of 400
+// periods the misalignment is 0.887^400 ~ 1e-21, so every measured period contributes exactly
+// log |mu_1| and log |mu_2| up to rounding.
+TEST(Lyapunov, StableMathieuPointGivesLogOfFloquetMultipliers) {
+  ds::MathieuParameters p;
+  p.kappa = 0.6;
+  p.delta = 0.25;
+  p.eps = 0.6;
+  p.b = 0.1;
+  const ds::MathieuModel model(p);
+  const int N = 100;
+  const auto mu = ds::testing::dense_multipliers(model, N, 3);
+  ASSERT_LT(std::abs(mu[0]), 1);
+  ASSERT_EQ(mu[0].imag(), 0);
+  ASSERT_EQ(mu[1].imag(), 0);
+  LyapunovOptions o;
+  o.exponents = 2;
+  o.transient = 400;
+  o.periods = 200;
+  const LyapunovResult r = run(model, N, o);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(r.per_period[i], std::log(std::abs(mu[i])), 1e-6) << i;  // the bound
+    // and in fact to rounding: each period's QR is backward stable, ~ n eps relative
+    EXPECT_NEAR(r.per_period[i], std::log(std::abs(mu[i])), 1e-11) << i;
+    EXPECT_NEAR(r.per_time[i], r.per_period[i] / (2 * std::numbers::pi), 1e-15) << i;
+  }
+}
+
+// The impact oscillator's period-1 orbit at tau = T, k = 1 (found by simulation from the default
+// scene's history, N = 200). Its leading multipliers are a complex pair mu, conj(mu) (|mu| =
+// 0.98), then another pair of modulus 0.76. For a complex pair the individual values log R_11,
+// log R_22 oscillate with the phase of the rotation (their averages approach log|mu| only like
+// log(cond)/periods), but the area growth of the invariant plane is exactly |mu|^2 every
+// period once the block has aligned: log R_11 + log R_22 = 2 log |mu|. Alignment rate
+// |mu_3 / mu_1| = 0.77: after 300 periods 1e-34.
+TEST(Lyapunov, ImpactPeriodOneOrbitGivesLogOfFloquetMultipliers) {
+  ds::ImpactParameters p;
+  p.k = 1.0;
+  p.x0 = -0.0566;
+  p.v0 = 1.0101;
+  const ds::ImpactModel model(p);
+  const int N = 200;
+  auto map = make_map(model, N);
+  ds::OrbitBySimulationOptions so;
+  so.tolerance = 1e-13;
+  so.max_maps = 5000;
+  const ds::PeriodicOrbit orbit = ds::orbit_by_simulation(map, map.constant_history(model.initial_state()), so);
+  ds::FloquetOptions fo;
+  fo.nev = 3;
+  fo.solver = ds::FloquetSolver::dense_lapack;
+  const auto mu = ds::floquet_multipliers(map.monodromy(orbit.history), fo).multipliers;
+  ASSERT_LT(std::abs(mu[0]), 1);
+  ASSERT_NEAR(std::abs(mu[0]), std::abs(mu[1]), 1e-12);  // a complex pair
+  LyapunovOptions o;
+  o.exponents = 2;
+  o.transient = 300;
+  o.periods = 400;
+  const LyapunovResult r = ds::lyapunov_exponents(map, orbit.history, o);
+  const double log_mu = std::log(std::abs(mu[0]));
+  EXPECT_NEAR(r.per_period[0] + r.per_period[1], 2 * log_mu, 1e-6);  // the bound
+  // individually: within the reported error (the oscillation is what the batches see)
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(r.per_period[i], log_mu, 3 * r.standard_error_per_period[i]) << i;
+  // the run stays on the orbit: final history equals the orbit to the simulation tolerance
+  EXPECT_LT((r.final_history - orbit.history).lpNorm<Eigen::Infinity>(), 1e-9);
+}
+
+// Mackey-Glass, tau = 17 (chaotic): the exponents must not depend on the seed of the initial
+// block, nor on the QR interval, beyond the stated errors.
+TEST(Lyapunov, SeedAndQrIntervalChangeResultsOnlyWithinTheError) {
+  ds::MackeyGlassParameters p;
+  p.tau = 17;
+  p.period = 17;
+  p.x0 = 0.5;
+  const ds::MackeyGlassModel model(p);
+  const int N = 85;  // h = 0.2
+  LyapunovOptions o;
+  o.exponents = 2;
+  o.transient = 100;
+  o.periods = 1200;
+  std::vector<LyapunovResult> runs;
+  for (auto [seed, every] : {std::pair{1, 1}, {2, 1}, {3, 1}, {1, 3}, {2, 4}}) {
+    o.seed = seed;
+    o.qr_every = every;
+    runs.push_back(run(model, N, o));
+  }
+  for (size_t a = 1; a < runs.size(); ++a)
+    for (int i = 0; i < 2; ++i) {
+      // the same trajectory in every run, so the difference is the tangent block's start and
+      // the QR schedule: bounded by 4 combined standard errors (independent-error bound is 3;
+      // the runs share the trajectory, which only makes them closer)
+      const double se = std::hypot(runs[0].standard_error_per_period[i], runs[a].standard_error_per_period[i]);
+      EXPECT_NEAR(runs[a].per_period[i], runs[0].per_period[i], 4 * se) << "run " << a << " exponent " << i;
+    }
+  EXPECT_GT(runs[0].per_period[0], 0) << "tau = 17 is chaotic: lambda_1 > 0";
+  // lambda_2 is the flow direction (zero) up to the error
+  EXPECT_NEAR(runs[0].per_period[1], 0, 4 * runs[0].standard_error_per_period[1] + 0.01);
+}
+
+TEST(Lyapunov, TooLongQrIntervalIsRefused) {
+  // x' = -x - 2 x(t - 1): exponents -0.09 and -1.36 per period. Over 20 periods the block's
+  // columns separate by e^{1.27 * 20} ~ 1e11 > 1e8: the run must refuse rather than lose digits.
+  LyapunovOptions o;
+  o.exponents = 4;
+  o.transient = 0;
+  o.periods = 40;
+  o.qr_every = 20;
+  EXPECT_THROW(run(linear(-1, -2, 1, 1), 40, o), ds::NumericalFailure);
+  o.qr_every = 2;  // e^2.5 ~ 12: fine
+  EXPECT_NO_THROW(run(linear(-1, -2, 1, 1), 40, o));
+}
+
+// x' = -50 x + x(t - 1), N = 20 (h = 0.05): the rightmost roots have Re lambda ~ -ln(50) / tau
+// = -3.8, so the tangent vectors shrink by e^-3.8 per period (and the local step by 0.11 per
+// step): an unnormalised product would underflow below 1e-308 after about 190 periods. Over
+// 1e5 periods, 500 times longer, the exponents must stay finite and equal log|mu| of the
+// same-N multipliers.
+TEST(Lyapunov, StaysFiniteOverManyPeriodsOfStrongContraction) {
+  const auto model = linear(-50, 1, 1, 1);
+  const int N = 20;
+  LyapunovOptions o;
+  o.exponents = 2;
+  o.transient = 100;
+  o.periods = 100000;
+  const LyapunovResult r = run(model, N, o);
+  const auto mu = ds::testing::dense_multipliers(model, N, 2);
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_TRUE(std::isfinite(r.per_period[i])) << i;
+    ASSERT_TRUE(std::isfinite(r.standard_error_per_period[i])) << i;
+    EXPECT_LT(r.per_period[i], -3.5) << i;  // contracting as computed above
+    // the same-N value to the error, plus the log of a relative rounding of R_ii per period
+    EXPECT_NEAR(r.per_period[i], std::log(std::abs(mu[i])), 3 * r.standard_error_per_period[i] + 1e-9) << i;
+  }
+}
+
+TEST(Lyapunov, OverflowIsANumericalFailure) {
+  // x' = 800 x: the trapezoid factor (1 + 0.4) / (1 - 0.4) per step at N = 1000 grows by e^847
+  // per period: beyond the largest double.
+  LyapunovOptions o;
+  o.exponents = 1;
+  o.transient = 0;
+  o.periods = 4;
+  EXPECT_THROW(run(linear(800, 0, 1, 1), 1000, o), ds::NumericalFailure);
+}
+
+TEST(Lyapunov, BadOptionsAreBadInput) {
+  const auto model = linear(-1, 0.5, 1, 1);
+  auto bad = [&](auto change) {
+    LyapunovOptions o;
+    o.periods = 10;
+    o.transient = 0;
+    change(o);
+    EXPECT_THROW(run(model, 10, o), ds::BadInput);
+  };
+  bad([](LyapunovOptions& o) { o.exponents = 0; });
+  bad([](LyapunovOptions& o) { o.exponents = 12; });  // n = 11
+  bad([](LyapunovOptions& o) { o.qr_every = 0; });
+  bad([](LyapunovOptions& o) { o.qr_every = 3; });  // 10 periods: not a multiple
+  bad([](LyapunovOptions& o) { o.periods = 1; });
+  bad([](LyapunovOptions& o) { o.transient = -1; });
+  bad([](LyapunovOptions& o) { o.batches = 1; });
+  auto map = make_map(model, 10);
+  Eigen::VectorXd U = map.constant_history(model.initial_state());
+  U[3] = NAN;
+  EXPECT_THROW(ds::lyapunov_exponents(map, U, LyapunovOptions{}), ds::BadInput);
+  EXPECT_THROW(ds::lyapunov_exponents(map, Eigen::VectorXd::Zero(5), LyapunovOptions{}), ds::BadInput);
+}
+
+TEST(Lyapunov, SectionPointsAreTheTrajectoryAtEveryForcingPeriod) {
+  ds::ImpactParameters p;
+  p.k = 0.02;
+  p.x0 = 0.5;
+  const ds::ImpactModel model(p);
+  auto map = make_map(model, 50);
+  LyapunovOptions o;
+  o.exponents = 1;
+  o.transient = 3;
+  o.periods = 4;
+  o.section_points = 3;
+  const Eigen::VectorXd U0 = map.constant_history(model.initial_state());
+  const LyapunovResult r = ds::lyapunov_exponents(map, U0, o);
+  ASSERT_EQ(r.section.rows(), 3);
+  Eigen::VectorXd U = U0;
+  for (int i = 0; i < o.transient; ++i) U = map.apply(U);
+  for (int i = 0; i < 3; ++i) {
+    U = map.apply(U);
+    // the same arithmetic in the same order: equal to the last bit
+    EXPECT_EQ(r.section(i, 0), U[U.size() - 2]) << i;
+    EXPECT_EQ(r.section(i, 1), U[U.size() - 1]) << i;
+  }
+}
