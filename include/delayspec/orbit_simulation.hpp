@@ -6,6 +6,7 @@
 #include <string>
 
 #include "delayspec/errors.hpp"
+#include "delayspec/periodic_orbit.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec {
@@ -13,12 +14,6 @@ namespace delayspec {
 struct OrbitBySimulationOptions {
   double tolerance = 1e-12;  // relative sup-norm residual to accept
   long max_maps = 20000;     // applications of the stroboscopic map before giving up
-};
-
-struct PeriodicOrbit {
-  Eigen::VectorXd history;  // U with P(U) ~ U
-  double residual = NAN;    // |P(U) - U|_inf
-  long maps = 0;            // stroboscopic maps applied to get there
 };
 
 template <class Map>

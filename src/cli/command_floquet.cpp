@@ -25,12 +25,14 @@ int command_floquet(Config& config, const Invocation& inv) {
   nlohmann::json json;
   FloquetResult result;
   PeriodicOrbit orbit;
+  ContactSummary contacts;
   std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
         TrapezoidStepper<Model> stepper(model, step_options(problem));
         StroboscopicMap<Model> map(stepper, problem.grid);
         orbit = find_orbit(model, map, orbit_settings);
+        contacts = orbit_contacts(model, map, orbit);
         auto monodromy = map.monodromy(orbit.history);
         result = floquet_multipliers(monodromy, options);
       },
@@ -52,12 +54,13 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["jacobian"] = problem.jacobian;
     json["orbit_residual"] = orbit.residual;
     json["orbit_periods"] = orbit.maps;
+    json["orbit"] = orbit_json(orbit, contacts);
     if (!result.note.empty()) json["note"] = result.note;
     inv.out << json.dump(2) << "\n";
   } else {
     inv.out << "delayspec floquet: model " << problem.model_name << ", " << problem.grid.describe() << ", n = " << n
             << "\n";
-    inv.out << "periodic orbit: |P(U) - U| = " << orbit.residual << " after " << orbit.maps << " periods\n";
+    print_orbit(inv.out, orbit, contacts);
     inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << result.solver << ", "
             << result.operator_applications << " operator applications):\n";
     print_multipliers(inv.out, result.multipliers);

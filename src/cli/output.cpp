@@ -21,4 +21,44 @@ void print_multipliers(std::ostream& out, const std::vector<std::complex<double>
   }
 }
 
+nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& contacts) {
+  nlohmann::json j;
+  j["method"] = orbit.method;
+  j["residual"] = orbit.residual;
+  j["periods"] = orbit.maps;
+  j["contacts"] = contacts.contacts;
+  j["nodes_in_contact"] = contacts.nodes_in_contact;
+  j["max_H"] = contacts.max_H;  // NaN (models without switching) is written as null
+  if (orbit.method == "newton") {
+    j["newton_iterations"] = orbit.newton_iterations;
+    j["newton_residuals"] = orbit.newton_residuals;
+    j["newton_step_fractions"] = orbit.newton_step_fractions;
+    j["jacobian_reciprocal_condition"] = orbit.jacobian_reciprocal_condition;
+    j["jacobian_nonzeros"] = orbit.jacobian_nonzeros;
+    j["factor_nonzeros"] = orbit.factor_nonzeros;
+  }
+  return j;
+}
+
+void print_orbit(std::ostream& out, const PeriodicOrbit& orbit, const ContactSummary& contacts) {
+  if (orbit.method == "zero") {
+    out << "periodic orbit: the zero orbit (linear model)\n";
+    return;
+  }
+  out << "periodic orbit (" << orbit.method << "): |P(U) - U| = " << orbit.residual;
+  if (orbit.method == "newton")
+    out << " after " << orbit.newton_iterations << " Newton iterations from a guess simulated for " << orbit.maps
+        << " periods";
+  else
+    out << " after " << orbit.maps << " periods";
+  out << "\n";
+  if (orbit.method == "newton") {
+    out << "  Newton |F|_inf:";
+    for (double r : orbit.newton_residuals) out << " " << r;
+    out << "\n";
+  }
+  out << "  contacts per map: " << contacts.contacts << " (" << contacts.nodes_in_contact
+      << " grid nodes in contact, max H = " << contacts.max_H << ")\n";
+}
+
 }  // namespace delayspec::cli

@@ -6,11 +6,20 @@
 
 #include <nlohmann/json.hpp>
 
+#include "delayspec/orbit_contacts.hpp"
+#include "delayspec/periodic_orbit.hpp"
+
 namespace delayspec::cli {
 
 // [{"re": .., "im": .., "abs": ..}, ...]
 nlohmann::json multipliers_json(const std::vector<std::complex<double>>& values);
 // One line per multiplier: index, re, im, |mu|.
 void print_multipliers(std::ostream& out, const std::vector<std::complex<double>>& values);
+// The periodic orbit the multipliers belong to: {"method", "residual", "periods", "contacts",
+// "nodes_in_contact", "max_H", and for newton "newton_iterations", "newton_residuals",
+// "newton_step_fractions", "jacobian_reciprocal_condition", "jacobian_nonzeros", "factor_nonzeros"}.
+nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& contacts);
+// The same for people, one or two lines.
+void print_orbit(std::ostream& out, const PeriodicOrbit& orbit, const ContactSummary& contacts);
 
 }  // namespace delayspec::cli
