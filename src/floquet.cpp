@@ -1,9 +1,14 @@
 #include "delayspec/floquet.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
 
 #include "delayspec/dense_spectrum.hpp"
 #include "delayspec/errors.hpp"
+#include "krylov.hpp"
 
 namespace delayspec {
 
@@ -25,31 +30,195 @@ std::string to_string(FloquetSolver solver) {
   return "?";
 }
 
+int default_ncv(int nev, long n) {
+  const long ncv = std::max(2L * nev + 1, static_cast<long>(nev) + 10);
+  return static_cast<int>(std::min(ncv, n));
+}
+
+Eigen::VectorXd start_vector(long n, std::uint64_t seed) {
+  Eigen::VectorXd v(n);
+  std::uint64_t state = seed;
+  for (long i = 0; i < n; ++i) {
+    // SplitMix64 (Steele, Lea, Flood 2014)
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    v[i] = 2.0 * static_cast<double>(z >> 11) * 0x1.0p-53 - 1.0;  // uniform in [-1, 1)
+  }
+  return v;
+}
+
+namespace krylov {
+
+double largest_relative_estimate(const std::vector<std::complex<double>>& theta, const std::vector<double>& estimate,
+                                 int nev) {
+  const double eps23 = std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);
+  std::vector<size_t> order(theta.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return std::abs(theta[a]) > std::abs(theta[b]); });
+  double worst = 0;
+  for (size_t k = 0; k < order.size() && k < static_cast<size_t>(nev); ++k) {
+    const size_t i = order[k];
+    worst = std::max(worst, estimate[i] / std::max(std::abs(theta[i]), eps23));
+  }
+  return worst;
+}
+
+std::string short_number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", value);
+  return buffer;
+}
+
+}  // namespace krylov
+
+namespace {
+
+// True residuals |M v - mu v| / (|mu| |v|) of the Ritz pairs, from applying M to the Ritz
+// vectors (real form) in blocks of at most kChunk columns, a complex pair's two columns always in
+// the same block (bounds the extra memory to 2 kChunk vectors plus the operator's block buffer).
+template <int D>
+std::vector<double> ritz_residuals(const Monodromy<D>& op, const krylov::RitzPairs& pairs) {
+  constexpr long kChunk = 8;
+  const long n = op.rows();
+  std::vector<double> residual(pairs.values.size(), 0.0);
+  Eigen::MatrixXd X, Y;
+  size_t first = 0;
+  while (first < pairs.values.size()) {
+    // pairs [first, last) whose columns fit in one block
+    size_t last = first;
+    long k = 0;
+    while (last < pairs.values.size()) {
+      const long w = pairs.values[last].imag() == 0 ? 1 : 2;
+      if (k + w > kChunk) break;
+      k += w;
+      ++last;
+    }
+    X.resize(n, k);
+    for (size_t i = first, c = 0; i < last; ++i) {
+      X.col(c++) = pairs.vectors.col(pairs.column[i]);
+      if (pairs.values[i].imag() != 0) X.col(c++) = pairs.vectors.col(pairs.column[i] + 1);
+    }
+    op.apply_block(X, Y);  // Y = M X
+    for (size_t i = first, c = 0; i < last; ++i) {
+      const std::complex<double> mu = pairs.values[i];
+      const auto a = X.col(c);
+      const auto Ma = Y.col(c);
+      if (mu.imag() == 0) {
+        // |M a - mu a| / (|mu| |a|)
+        residual[i] = (Ma - mu.real() * a).norm() / (std::abs(mu) * a.norm());
+        c += 1;
+      } else {
+        // v = a + i b, mu = al + i be:  M v - mu v = (M a - al a + be b) + i (M b - al b - be a)
+        const auto b = X.col(c + 1);
+        const auto Mb = Y.col(c + 1);
+        const double al = mu.real(), be = mu.imag();
+        const double re = (Ma - al * a + be * b).squaredNorm(), im = (Mb - al * b - be * a).squaredNorm();
+        residual[i] = std::sqrt(re + im) / (std::abs(mu) * std::sqrt(a.squaredNorm() + b.squaredNorm()));
+        c += 2;
+      }
+    }
+    first = last;
+  }
+  return residual;
+}
+
+template <int D>
+void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, FloquetResult& result) {
+  const long n = op.rows();
+  krylov::Settings settings;
+  settings.nev = options.nev;
+  settings.ncv = options.ncv == 0 ? default_ncv(options.nev, n) : options.ncv;
+  settings.tolerance = options.tolerance;
+  settings.max_iterations = options.max_iterations;
+  if (settings.ncv < options.nev + 2)
+    throw BadInput("`ncv = " + std::to_string(settings.ncv) + "`: must be >= nev + 2 = " +
+                   std::to_string(options.nev + 2));
+  if (settings.ncv > n) {
+    result.note = "ncv = " + std::to_string(settings.ncv) + " reduced to the dimension n = " + std::to_string(n);
+    settings.ncv = static_cast<int>(n);
+  }
+  const Eigen::VectorXd start = start_vector(n, options.seed);
+  krylov::RitzPairs pairs = options.solver == FloquetSolver::spectra
+                                ? krylov::spectra_ritz_pairs(op, settings, start)
+                                : krylov::arpack_ritz_pairs(op, settings, start);
+  const std::vector<double> residual = ritz_residuals(op, pairs);
+
+  // Expand the pairs into both conjugates, sort like the dense reference, keep nev.
+  std::vector<std::complex<double>> values;
+  std::vector<double> res;
+  for (size_t i = 0; i < pairs.values.size(); ++i) {
+    values.push_back(pairs.values[i]);
+    res.push_back(residual[i]);
+    if (pairs.values[i].imag() != 0) {
+      values.push_back(std::conj(pairs.values[i]));
+      res.push_back(residual[i]);
+    }
+  }
+  if (static_cast<int>(values.size()) < options.nev)
+    throw NumericalFailure("Krylov (" + to_string(options.solver) + "): only " + std::to_string(values.size()) +
+                           " Ritz values returned for nev = " + std::to_string(options.nev));
+  for (const auto& mu : values)
+    if (!std::isfinite(mu.real()) || !std::isfinite(mu.imag()))
+      throw NumericalFailure("Krylov (" + to_string(options.solver) + "): non-finite Ritz value");
+  std::vector<std::complex<double>> sorted = values;
+  sort_by_modulus(sorted);
+  for (int k = 0; k < options.nev; ++k) {
+    const auto it = std::find(values.begin(), values.end(), sorted[k]);
+    result.multipliers.push_back(sorted[k]);
+    result.residuals.push_back(res[static_cast<size_t>(it - values.begin())]);
+  }
+  result.ncv = settings.ncv;
+  result.converged = pairs.converged;
+  result.iterations = pairs.iterations;
+  result.restarts = std::max(0, pairs.iterations - 1);
+}
+
+}  // namespace
+
 template <int D>
 FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& options) {
   const long n = op.rows();
   if (options.nev < 1 || options.nev > n)
     throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " +
                    std::to_string(n));
+  const bool krylov = options.solver == FloquetSolver::spectra || options.solver == FloquetSolver::arpack;
+  if (krylov) {
+    if (options.ncv != 0 && options.ncv < options.nev + 2)
+      throw BadInput("`ncv = " + std::to_string(options.ncv) + "`: must be 0 (automatic) or >= nev + 2 = " +
+                     std::to_string(options.nev + 2));
+    if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
+      throw BadInput("`tol = " + format_number(options.tolerance) + "`: must be > 0 and finite");
+    if (options.max_iterations < 1)
+      throw BadInput("`max_iterations = " + std::to_string(options.max_iterations) + "`: must be >= 1");
+  }
   const auto start = std::chrono::steady_clock::now();
   FloquetResult result;
   const long applications_before = op.applications();
-  switch (options.solver) {
+  FloquetSolver solver = options.solver;
+  if (krylov && options.nev > n - 2) {
+    result.note = "nev = " + std::to_string(options.nev) + " > n - 2 = " + std::to_string(n - 2) +
+                  ": Krylov (" + to_string(options.solver) + ") needs nev <= n - 2, used the dense LAPACK solver";
+    solver = FloquetSolver::dense_lapack;
+  }
+  switch (solver) {
     case FloquetSolver::spectra:
     case FloquetSolver::arpack:
-      throw BadInput("`solver = " + to_string(options.solver) +
-                     "`: the Krylov solvers are not available yet; use solver = dense");
+      krylov_solve(op, options, result);
+      break;
     case FloquetSolver::dense_eigen:
     case FloquetSolver::dense_lapack: {
       const DenseBackend backend =
-          options.solver == FloquetSolver::dense_eigen ? DenseBackend::eigen : DenseBackend::lapack;
+          solver == FloquetSolver::dense_eigen ? DenseBackend::eigen : DenseBackend::lapack;
       auto values = dense_eigenvalues(op.to_dense(), backend);
       values.resize(options.nev);
       result.multipliers = std::move(values);
+      result.converged = options.nev;
       break;
     }
   }
-  result.solver = to_string(options.solver);
+  result.solver = to_string(solver);
   result.operator_applications = op.applications() - applications_before;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

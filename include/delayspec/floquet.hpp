@@ -1,11 +1,33 @@
 #pragma once
 // Floquet multipliers: the largest-modulus eigenvalues of a Monodromy (design.md 1.6).
-// One entry point, several backends on the same operator:
-//   dense_eigen / dense_lapack: form the n x n matrix, all eigenvalues (reference, O(n^3));
-//   spectra / arpack: Krylov on the matrix-free operator (see the Krylov extension).
+// One entry point, several backends on the same matrix-free operator:
+//   spectra: Spectra 1.0 GenEigsSolver (implicitly restarted Arnoldi) with the Monodromy as op;
+//   arpack:  ARPACK-ng dnaupd/dneupd reverse communication calling the same perform_op;
+//   dense_eigen / dense_lapack: form the n x n matrix, all eigenvalues (reference, O(n^3)).
+//
+// Both Krylov backends start from the same vector (start_vector(n, seed), reproducible),
+// stop when every wanted Ritz pair has the Arnoldi residual estimate
+//     |M x - theta x| <= tolerance * max(|theta|, eps^(2/3))      (x unit Ritz vector)
+// (the criterion Spectra and ARPACK share), and are then checked a posteriori: the Ritz vectors
+// are formed and applied once more (one extra apply_block), giving the true residual
+// |M v - mu v| / (|mu| |v|) of each returned pair in FloquetResult::residuals.
+//
+// Example:
+//   FloquetOptions o;  o.nev = 20;  o.solver = FloquetSolver::arpack;
+//   FloquetResult r = floquet_multipliers(monodromy, o);   // r.multipliers[0] = spectral radius
+//
+// Errors: BadInput (nev < 1 or > n, ncv < nev + 2, tolerance <= 0, max_iterations < 1);
+// NumericalFailure when a Krylov backend does not converge within max_iterations (the message
+// names the iterations, the converged count and the largest relative Ritz residual estimate) or
+// reports an error (ARPACK info != 0). Never a silently shorter list.
+// Krylov needs nev <= n - 2 (Spectra's and ARPACK's constraint); a larger nev with
+// solver = spectra | arpack runs the dense LAPACK path instead and says so in `note`.
 #include <complex>
+#include <cstdint>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "delayspec/monodromy.hpp"
 
@@ -20,19 +42,38 @@ std::string to_string(FloquetSolver solver);
 struct FloquetOptions {
   int nev = 6;                              // multipliers wanted
   FloquetSolver solver = FloquetSolver::spectra;
+  // Krylov only:
+  int ncv = 0;                  // Krylov subspace dimension; 0 = default_ncv(nev, n); clamped to n
+  double tolerance = 1e-12;     // relative Ritz residual at which a pair counts as converged
+  int max_iterations = 300;     // Arnoldi iterations (1 + implicit restarts), ARPACK's MXITER
+  std::uint64_t seed = 1;       // start vector = start_vector(n, seed) for both backends
 };
 
 struct FloquetResult {
-  std::vector<std::complex<double>> multipliers;  // sorted by modulus, largest first
+  std::vector<std::complex<double>> multipliers;  // sorted by modulus, largest first (sort_by_modulus)
   std::string solver;                            // backend that produced them
-  long operator_applications = 0;                // single-vector applications of the operator
-  double seconds = 0;                            // wall time of the eigen-solve (incl. assembly)
+  long operator_applications = 0;                // single-vector applications of the operator (all of them)
+  double seconds = 0;                            // wall time of the eigen-solve (incl. assembly / residuals)
   std::string note;                              // e.g. why a Krylov request went dense
+  // Krylov only (dense: converged = nev, the rest 0 / empty):
+  int ncv = 0;                    // subspace dimension used
+  int converged = 0;              // Ritz values the backend reports converged (ARPACK iparam(5)), >= nev
+  int iterations = 0;             // Arnoldi iterations taken (1 + restarts)
+  int restarts = 0;               // implicit restarts = iterations - 1
+  std::vector<double> residuals;  // per multiplier: |M v - mu v| / (|mu| |v|), from one extra application
 };
 
-// The nev leading multipliers. BadInput: nev < 1 or nev > n. NumericalFailure: no convergence.
+// The nev leading multipliers. See the header comment for errors.
 template <int D>
 FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& options);
+
+// Default Krylov subspace dimension for nev wanted values of an n x n operator:
+// min(n, max(2 nev + 1, nev + 10)).
+int default_ncv(int nev, long n);
+
+// The reproducible start vector of both Krylov backends: entries uniform in [-1, 1) from a
+// SplitMix64 stream seeded with `seed` (platform independent).
+Eigen::VectorXd start_vector(long n, std::uint64_t seed);
 
 extern template FloquetResult floquet_multipliers<1>(const Monodromy<1>&, const FloquetOptions&);
 extern template FloquetResult floquet_multipliers<2>(const Monodromy<2>&, const FloquetOptions&);

@@ -1,8 +1,10 @@
 // delayspec floquet: the leading Floquet multipliers of the periodic orbit (CLI contract).
+#include <algorithm>
 #include <chrono>
 
 #include "commands.hpp"
 #include "delayspec/floquet.hpp"
+#include "floquet_settings.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 #include "orbit_settings.hpp"
 #include "output.hpp"
@@ -14,9 +16,7 @@ int command_floquet(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
   Problem problem = read_problem(config, 100);
   const OrbitSettings orbit_settings = read_orbit_settings(config);
-  FloquetOptions options;
-  options.nev = static_cast<int>(config.get_int("nev", 6));
-  options.solver = parse_floquet_solver(config.get_choice("solver", "spectra", {"spectra", "arpack", "dense", "dense-eigen", "dense-lapack"}));
+  const FloquetOptions options = read_floquet_options(config);
   config.check_all_used();
   const long n = std::visit([&](const auto& m) { return problem.grid.dimension(std::decay_t<decltype(m)>::d); }, problem.model);
   if (options.nev < 1 || options.nev > n)
@@ -48,6 +48,15 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["seconds"] = seconds;
     json["eigensolver_seconds"] = result.seconds;
     json["operator_applications"] = result.operator_applications;
+    json["converged"] = result.converged;
+    json["restarts"] = result.restarts;
+    json["residuals"] = result.residuals;  // |M v - mu v| / (|mu| |v|) per multiplier; [] for dense
+    if (result.ncv > 0) {
+      json["ncv"] = result.ncv;
+      json["tol"] = options.tolerance;
+      json["iterations"] = result.iterations;
+      json["seed"] = options.seed;
+    }
     json["h"] = problem.grid.h;
     json["steps_per_map"] = problem.grid.K;
     json["events"] = problem.events;
@@ -64,6 +73,12 @@ int command_floquet(Config& config, const Invocation& inv) {
     inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << result.solver << ", "
             << result.operator_applications << " operator applications):\n";
     print_multipliers(inv.out, result.multipliers);
+    if (!result.residuals.empty()) {
+      double worst = 0;
+      for (double r : result.residuals) worst = std::max(worst, r);
+      inv.out << "Krylov: ncv = " << result.ncv << ", " << result.converged << " converged, " << result.restarts
+              << " restarts, largest residual |M v - mu v| / |mu| = " << worst << "\n";
+    }
     if (!result.note.empty()) inv.out << "note: " << result.note << "\n";
     inv.out << "time: " << seconds << " s\n";
   }

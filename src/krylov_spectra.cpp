@@ -1,0 +1,102 @@
+// Spectra backend of floquet_multipliers(): GenEigsSolver (implicitly restarted Arnoldi) with
+// the Monodromy itself as the operator (its perform_op is Spectra's duck type).
+// GCC 12 reports a false -Wuse-after-free inside Eigen's aligned_free when it inlines Spectra's
+// UpperHessenbergEigen (a known GCC 12 false positive on Eigen temporaries); nothing here frees twice.
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
+#pragma GCC diagnostic ignored "-Wuse-after-free"
+#endif
+#include <Spectra/GenEigsSolver.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "delayspec/errors.hpp"
+#include "krylov.hpp"
+
+namespace delayspec::krylov {
+
+namespace {
+
+// GenEigsSolver plus read access to what Spectra keeps protected: the Arnoldi basis V, the
+// Ritz coefficient vectors y (Ritz vector = V y) and the residual estimates |f| |e_m^T y|.
+template <int D>
+class SpectraSolver : public Spectra::GenEigsSolver<const Monodromy<D>> {
+  using Base = Spectra::GenEigsSolver<const Monodromy<D>>;
+
+ public:
+  SpectraSolver(const Monodromy<D>& op, int nev, int ncv) : Base(op, nev, ncv) {}
+
+  const Eigen::MatrixXd& basis() const { return this->m_fac.matrix_V(); }
+  // The nev wanted Ritz values and their coefficient vectors (ncv x nev), sorted by modulus.
+  std::complex<double> value(int i) const { return this->m_ritz_val[i]; }
+  Eigen::VectorXcd coefficients(int i) const { return this->m_ritz_vec.col(i); }
+
+  // Largest relative residual estimate of the wanted Ritz values (for the failure message).
+  // After compute() only the first nev Ritz values are sorted and valid; they are in the same
+  // (largest-modulus) order as the estimates, conjugate pairs having equal estimates.
+  double largest_estimate() const {
+    std::vector<std::complex<double>> theta;
+    std::vector<double> est;
+    for (Eigen::Index i = 0; i < this->m_nev; ++i) {
+      theta.push_back(this->m_ritz_val[i]);
+      est.push_back(std::abs(this->m_ritz_est[i]) * this->m_fac.f_norm());
+    }
+    return largest_relative_estimate(theta, est, static_cast<int>(this->m_nev));
+  }
+};
+
+}  // namespace
+
+template <int D>
+RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eigen::VectorXd& start) {
+  SpectraSolver<D> solver(op, s.nev, s.ncv);
+  solver.init(start.data());  // Spectra starts from M * start (forces the vector into M's range)
+  const Eigen::Index nconv = solver.compute(Spectra::SortRule::LargestMagn, s.max_iterations, s.tolerance,
+                                            Spectra::SortRule::LargestMagn);
+  RitzPairs pairs;
+  pairs.converged = static_cast<int>(nconv);
+  pairs.iterations = static_cast<int>(solver.num_iterations());
+  if (solver.info() != Spectra::CompInfo::Successful || nconv < s.nev)
+    throw NumericalFailure("Krylov (spectra) did not converge: " + std::to_string(nconv) + " of nev = " +
+                           std::to_string(s.nev) + " Ritz values converged after " +
+                           std::to_string(pairs.iterations) + " Arnoldi iterations (max_iterations = " +
+                           std::to_string(s.max_iterations) + " = 1 + max_restarts, ncv = " + std::to_string(s.ncv) +
+                           "), largest relative residual estimate " + format_number(solver.largest_estimate()) +
+                           " > tol " + short_number(s.tolerance));
+
+  // Representatives: real values, and each complex pair once with imag > 0 (a pair split by nev
+  // is completed from its conjugate).
+  std::vector<Eigen::VectorXcd> coeffs;
+  for (int i = 0; i < s.nev; ++i) {
+    std::complex<double> mu = solver.value(i);
+    Eigen::VectorXcd y = solver.coefficients(i);
+    if (mu.imag() < 0) {
+      bool partner_listed = false;
+      for (int j = 0; j < s.nev; ++j) partner_listed = partner_listed || solver.value(j) == std::conj(mu);
+      if (partner_listed) continue;
+      mu = std::conj(mu);
+      y = y.conjugate();
+    }
+    pairs.values.push_back(mu);
+    coeffs.push_back(std::move(y));
+  }
+  // Real coefficient matrix C (one column per real value, Re/Im columns per pair); vectors = V C.
+  long columns = 0;
+  for (const auto& mu : pairs.values) {
+    pairs.column.push_back(columns);
+    columns += mu.imag() == 0 ? 1 : 2;
+  }
+  Eigen::MatrixXd C(s.ncv, columns);
+  for (size_t i = 0; i < pairs.values.size(); ++i) {
+    C.col(pairs.column[i]) = coeffs[i].real();
+    if (pairs.values[i].imag() != 0) C.col(pairs.column[i] + 1) = coeffs[i].imag();
+  }
+  pairs.vectors.noalias() = solver.basis() * C;  // Ritz vectors x = V y, real form
+  return pairs;
+}
+
+template RitzPairs spectra_ritz_pairs<1>(const Monodromy<1>&, const Settings&, const Eigen::VectorXd&);
+template RitzPairs spectra_ritz_pairs<2>(const Monodromy<2>&, const Settings&, const Eigen::VectorXd&);
+
+}  // namespace delayspec::krylov

@@ -1,0 +1,83 @@
+// `delayspec floquet` with the Krylov solvers: the JSON contract (sorted multipliers, solver,
+// operator_applications, converged, restarts, residuals), exit 3 on forced non-convergence,
+// and exit 2 naming key and value for every bad Krylov key.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+#include "delayspec_test_paths.hpp"
+
+namespace {
+
+struct CliResult {
+  int status;
+  std::string out, err;
+};
+
+CliResult run(std::vector<std::string> args) {
+  args.insert(args.begin(), "delayspec");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  int status = delayspec::cli::run_cli(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {status, out.str(), err.str()};
+}
+
+const std::string kScene = DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml";
+
+}  // namespace
+
+TEST(KrylovCli, JsonContractForBothBackends) {
+  for (const char* solver : {"spectra", "arpack"}) {
+    CliResult r = run({"floquet", kScene, "--json", "--set", "N=80", "--set", "nev=8", "--set",
+                       std::string("solver=") + solver});
+    ASSERT_EQ(r.status, 0) << r.err;
+    auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["solver"], solver);
+    for (const char* key : {"model", "N", "dimension", "multipliers", "seconds", "operator_applications", "converged",
+                            "restarts", "residuals", "ncv", "tol", "iterations", "seed"})
+      EXPECT_TRUE(j.contains(key)) << key;
+    ASSERT_EQ(j["multipliers"].size(), 8u);
+    ASSERT_EQ(j["residuals"].size(), 8u);
+    EXPECT_GE(j["converged"].get<int>(), 8);
+    for (size_t i = 0; i < 8; ++i) {
+      if (i + 1 < 8) {
+        EXPECT_GE(j["multipliers"][i]["abs"].get<double>(), j["multipliers"][i + 1]["abs"].get<double>());
+      }
+      EXPECT_LE(j["residuals"][i].get<double>(), 1e-9);  // stopping rule 1e-12 plus rounding (test_krylov.cpp)
+    }
+  }
+}
+
+TEST(KrylovCli, DefaultSceneUsesSpectra) {
+  CliResult r = run({"floquet", kScene, "--json", "--set", "N=60"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["solver"], "spectra");
+}
+
+TEST(KrylovCli, ForcedNonConvergenceExitsThree) {
+  for (const char* solver : {"spectra", "arpack"}) {
+    CliResult r = run({"floquet", kScene, "--json", "--set", "N=100", "--set", "nev=10", "--set", "ncv=12", "--set",
+                       "max_restarts=0", "--set", std::string("solver=") + solver});
+    EXPECT_EQ(r.status, 3) << solver << ": " << r.err;
+    EXPECT_NE(r.err.find("did not converge"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << "no partial result: " << r.out;
+  }
+}
+
+TEST(KrylovCli, BadKrylovKeysExitTwoNamingKeyAndValue) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"ncv", "-1"}, {"ncv", "7"},  // 7 < nev + 2 = 8
+      {"ncv", "many"}, {"tol", "0"}, {"tol", "-1e-9"}, {"tol", "nan"}, {"tol", "x"},
+      {"max_restarts", "-1"}, {"max_restarts", "1.5"}, {"seed", "-3"}, {"seed", "abc"}};
+  for (const auto& [key, value] : bad) {
+    CliResult r = run({"floquet", "--set", "model=mathieu", "--set", "N=20", "--set", "solver=arpack", "--set",
+                       key + "=" + value});
+    EXPECT_EQ(r.status, 2) << key << "=" << value << ": " << r.err;
+    EXPECT_NE(r.err.find("`" + key), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(value), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty());
+  }
+}
