@@ -19,7 +19,7 @@
 // back): U is the last M + 1 states, U = (u_{-M}, ..., u_0) with u_{-j} = u_{K-j}.
 //
 // Newton: x <- x + lambda s with J(x) s = -F(x); lambda = 1 unless the full step does not
-// reduce |F|_inf (or leaves the stepper's domain), then halved up to 30 times (a safeguard for
+// reduce |F|_2 (or leaves the stepper's domain), then halved up to 30 times (a safeguard for
 // poor guesses; near the orbit every step is full and convergence is quadratic for a smooth
 // residual). Converged when |F|_inf <= tolerance (1 + |x|_inf).
 //
@@ -176,7 +176,7 @@ PeriodicOrbit orbit_by_newton(const Map& map, Eigen::VectorXd x, const OrbitByNe
     orbit.factor_nonzeros = lu.factor_nonzeros();
     const Eigen::VectorXd s = lu.solve(-F);  // J s = -F
     ++orbit.newton_iterations;
-    // Full step unless it fails to reduce |F|_inf; then halve (at most 30 times).
+    // Full step unless it fails to reduce |F|_2; then halve (at most 30 times).
     bool accepted = false;
     double lambda = 1;
     for (int halvings = 0; halvings <= 30 && !accepted; ++halvings, lambda *= 0.5) {
@@ -189,7 +189,7 @@ PeriodicOrbit orbit_by_newton(const Map& map, Eigen::VectorXd x, const OrbitByNe
         continue;  // the stepper could not take a step from this trial: shorten
       }
       const double r_trial = F_trial.lpNorm<Eigen::Infinity>();
-      if (r_trial < r) {
+      if (F_trial.norm() < F.norm()) {  // |F|_2 decreases: s is a descent direction for |F|_2^2
         x.swap(trial);
         F.swap(F_trial);
         J = std::move(J_trial);
