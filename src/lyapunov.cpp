@@ -107,8 +107,8 @@ void validate_lyapunov_options(const LyapunovOptions& o, long n) {
                    std::to_string(n));
   if (o.qr_every < 1) throw BadInput("`qr_every = " + std::to_string(o.qr_every) + "`: must be an integer >= 1");
   if (o.periods < 2 * static_cast<long>(o.qr_every) || o.periods % o.qr_every != 0)
-    throw BadInput("`periods = " + std::to_string(o.periods) + "`: must be a multiple of qr_every = " +
-                   std::to_string(o.qr_every) + " with at least two QR intervals (for the error estimate)");
+    throw BadInput("`periods = " + std::to_string(o.periods) + "` must be a multiple of `qr_every = " +
+                   std::to_string(o.qr_every) + "` with at least two QR intervals (for the error estimate)");
   if (o.transient < 0) throw BadInput("`transient = " + std::to_string(o.transient) + "`: must be >= 0");
   if (o.batches < 2) throw BadInput("`batches = " + std::to_string(o.batches) + "`: must be an integer >= 2");
   if (o.section_points < 0)

@@ -26,6 +26,8 @@ struct Invocation {
 using CommandFunction = int (*)(Config&, const Invocation&);
 
 int command_floquet(Config& config, const Invocation& inv);
+int command_lyapunov(Config& config, const Invocation& inv);
+int command_sweep(Config& config, const Invocation& inv);
 
 // Runs the program: parses argv, dispatches, maps errors to exit codes. Never throws.
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err);

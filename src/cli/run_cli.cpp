@@ -14,6 +14,8 @@ namespace {
 const std::map<std::string, CommandFunction>& command_table() {
   static const std::map<std::string, CommandFunction> table = {
       {"floquet", command_floquet},
+      {"lyapunov", command_lyapunov},
+      {"sweep", command_sweep},
   };
   return table;
 }

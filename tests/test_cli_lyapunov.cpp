@@ -1,0 +1,209 @@
+// The `delayspec lyapunov` and `delayspec sweep` commands: contract JSON keys, bad input (exit 2
+// naming key and value), files written point by point, --resume completing an interrupted sweep.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliResult {
+  int status;
+  std::string out, err;
+};
+
+CliResult run(std::vector<std::string> args) {
+  args.insert(args.begin(), "delayspec");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  int status = delayspec::cli::run_cli(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {status, out.str(), err.str()};
+}
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path fresh_dir(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("delayspec_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+struct BadValue {
+  const char* key;
+  const char* value;
+};
+void PrintTo(const BadValue& b, std::ostream* os) { *os << b.key << "=" << b.value; }
+
+class LyapunovBadInput : public ::testing::TestWithParam<BadValue> {};
+class SweepBadInput : public ::testing::TestWithParam<BadValue> {};
+
+const std::vector<std::string> kSmallLinear = {"--set", "model=linear", "--set", "N=10", "--set", "periods=20",
+                                               "--set", "transient=0"};
+
+}  // namespace
+
+TEST_P(LyapunovBadInput, ExitsTwoNamingKeyAndValue) {
+  const BadValue b = GetParam();
+  auto args = kSmallLinear;
+  args.insert(args.begin(), "lyapunov");
+  args.insert(args.end(), {"--set", std::string(b.key) + "=" + b.value});
+  CliResult r = run(args);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(std::string("`") + b.key), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(b.value), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+// clang-format off
+INSTANTIATE_TEST_SUITE_P(Keys, LyapunovBadInput, ::testing::Values(
+    BadValue{"exponents", "0"}, BadValue{"exponents", "12"}, BadValue{"exponents", "two"},
+    BadValue{"periods", "1"}, BadValue{"periods", "-5"}, BadValue{"periods", "1e3"},
+    BadValue{"transient", "-1"}, BadValue{"transient", "x"}, BadValue{"seed", "-3"}, BadValue{"seed", "abc"},
+    BadValue{"qr_every", "0"}, BadValue{"qr_every", "3"}, BadValue{"batches", "1"}, BadValue{"N", "0"}));
+// clang-format on
+
+TEST(LyapunovCli, JsonHasContractKeys) {
+  CliResult r = run({"lyapunov", "--json", "--set", "model=linear", "--set", "a=-1", "--set", "b=-2", "--set", "N=20",
+                     "--set", "periods=40", "--set", "transient=10", "--set", "exponents=3"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);  // exactly one JSON object on stdout
+  for (const char* key : {"N", "exponents_per_period", "exponents_per_time", "standard_error_per_period", "periods",
+                          "transient", "seconds"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["exponents_per_period"].size(), 3u);
+  EXPECT_EQ(j["periods"], 40);
+  EXPECT_EQ(j["transient"], 10);
+  // period = tau = 1 by default for `linear`: per time equals per period
+  for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(j["exponents_per_time"][i].get<double>(), j["exponents_per_period"][i].get<double>());
+}
+
+TEST(LyapunovCli, OverflowExitsThree) {
+  CliResult r = run({"lyapunov", "--set", "model=linear", "--set", "a=800", "--set", "b=0", "--set", "N=1000", "--set",
+                     "periods=4", "--set", "transient=0", "--set", "exponents=1"});
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("numerical failure"), std::string::npos) << r.err;
+}
+
+TEST_P(SweepBadInput, ExitsTwoNamingKeyAndValue) {
+  const BadValue b = GetParam();
+  std::vector<std::string> args = {"sweep", "--set", "sweep_key=b", "--set", "sweep_from=-1", "--set", "sweep_to=1"};
+  args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
+  args.insert(args.end(), {"--set", std::string(b.key) + "=" + b.value});
+  CliResult r = run(args);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(std::string("`") + b.key), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(b.value), std::string::npos) << r.err;
+}
+
+// clang-format off
+INSTANTIATE_TEST_SUITE_P(Keys, SweepBadInput, ::testing::Values(
+    BadValue{"sweep_key", "periods"}, BadValue{"sweep_key", "model"}, BadValue{"sweep_from", "nan"},
+    BadValue{"sweep_to", "x"}, BadValue{"sweep_points", "0"}, BadValue{"threads", "-2"},
+    BadValue{"section_points", "-1"}, BadValue{"exponents", "0"}));
+// clang-format on
+
+TEST(SweepCli, SweptKeyMustBeAParameterOfTheModel) {
+  // `kappa` is a mathieu key, not a linear one: reported as unknown
+  CliResult r = run({"sweep", "--set", "model=linear", "--set", "sweep_key=kappa", "--set", "sweep_from=0", "--set",
+                     "sweep_to=1", "--set", "N=10", "--set", "periods=20"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("`kappa`"), std::string::npos) << r.err;
+  // a value outside the model's domain at some point of the range
+  r = run({"sweep", "--set", "model=linear", "--set", "sweep_key=tau", "--set", "sweep_from=1", "--set", "sweep_to=-1",
+           "--set", "sweep_points=3", "--set", "N=10", "--set", "periods=20"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("`tau"), std::string::npos) << r.err;
+  EXPECT_EQ(run({"sweep", "--set", "sweep_from=0"}).status, 2);  // no sweep_key
+}
+
+// A linear sweep over b: at each point the exponents must equal a lyapunov run at that point.
+TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
+  const fs::path dir = fresh_dir("sweep");
+  std::vector<std::string> args = {"sweep", "--json", "--out", dir.string(), "--set", "sweep_key=b", "--set",
+                                   "sweep_from=-2", "--set", "sweep_to=-1", "--set", "sweep_points=3", "--set",
+                                   "section_points=4", "--set", "threads=2"};
+  args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
+  CliResult r = run(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["points"].size(), 3u);
+  CliResult single = run({"lyapunov", "--json", "--set", "model=linear", "--set", "N=10", "--set", "periods=20", "--set",
+                          "transient=0", "--set", "b=-1.5"});
+  ASSERT_EQ(single.status, 0) << single.err;
+  auto s = nlohmann::json::parse(single.out);
+  // same arithmetic, different thread: identical to the last bit
+  EXPECT_EQ(j["points"][1]["parameter"].get<double>(), -1.5);
+  EXPECT_EQ(j["points"][1]["exponents_per_period"], s["exponents_per_period"]);
+  EXPECT_EQ(j["points"][1]["section_x"].size(), 4u);
+  for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "sweep_settings.json"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+  const std::string csv = read(dir / "exponents.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 points
+  const std::string section = read(dir / "section.csv");
+  EXPECT_EQ(std::count(section.begin(), section.end(), '\n'), 1 + 3 * 4);
+  // the same directory again without --resume is refused
+  CliResult again = run(args);
+  EXPECT_EQ(again.status, 2);
+  EXPECT_NE(again.err.find("--resume"), std::string::npos) << again.err;
+  fs::remove_all(dir);
+}
+
+// An interrupted sweep: two point files and no final files. --resume computes only the missing
+// points and produces the same tables as an uninterrupted sweep; other settings are refused.
+TEST(SweepCli, ResumeCompletesAnInterruptedSweep) {
+  const fs::path dir = fresh_dir("resume");
+  std::vector<std::string> args = {"sweep", "--json", "--quiet", "--out", dir.string(), "--set", "sweep_key=a",
+                                   "--set", "sweep_from=-2", "--set", "sweep_to=0", "--set", "sweep_points=5"};
+  args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
+  ASSERT_EQ(run(args).status, 0);
+  const std::string complete_csv = read(dir / "exponents.csv");
+  // simulate the interruption after points 0 and 3
+  for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "points/point_00001.json",
+                        "points/point_00002.json", "points/point_00004.json"})
+    fs::remove(dir / f);
+  std::vector<std::string> changed = args;
+  changed.insert(changed.end(), {"--set", "seed=9", "--resume"});
+  CliResult refused = run(changed);
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_NE(refused.err.find("`seed`"), std::string::npos) << refused.err;
+  args.push_back("--resume");
+  CliResult r = run(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["points_computed_now"], 3);
+  // the seconds column differs between runs; compare everything else
+  auto strip_seconds = [](const std::string& csv) {
+    std::string out;
+    std::stringstream ss(csv);
+    std::string line;
+    while (std::getline(ss, line)) out += line.substr(0, line.rfind(',')) + "\n";
+    return out;
+  };
+  EXPECT_EQ(strip_seconds(read(dir / "exponents.csv")), strip_seconds(complete_csv));
+  fs::remove_all(dir);
+}
+
+TEST(SweepCli, ResumeNeedsAnOutDirectoryWithASweep) {
+  std::vector<std::string> args = {"sweep", "--resume", "--set", "sweep_key=a", "--set", "sweep_from=-2", "--set",
+                                   "sweep_to=0"};
+  args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
+  EXPECT_EQ(run(args).status, 2);
+  const fs::path dir = fresh_dir("noresume");
+  args.insert(args.end(), {"--out", dir.string()});
+  CliResult r = run(args);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("sweep_settings.json"), std::string::npos) << r.err;
+}
