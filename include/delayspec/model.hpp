@@ -19,6 +19,13 @@
 //   double H(const Vec& y) const;  Vec grad_H(const Vec& y) const;  // switching function
 //   Vec initial_state() const;               // constant initial history y(t), t <= 0
 //
+// Models with switching (has_switching) also provide, for event handling (event_step.hpp):
+//   Vec f_t(int j, double t, const Vec& y, const Vec& y_tau) const;   // df_j / dt at fixed y, y_tau
+//   Vec f_tt(int j, double t, const Vec& y, const Vec& y_tau) const;  // d2f_j / dt2 (events = linear)
+// and must have f_1 = f_2 on H = 0 (a continuous vector field: no saltation; design.md 1.5).
+// The event code assumes H affine (grad_H constant); events = linear with the consistent
+// Jacobian also assumes A and B constant within a region (true for the impact model).
+//
 // Regions: j = 1 is the strict side H > 0 (design.md 1.5 conventions).
 #include <Eigen/Core>
 

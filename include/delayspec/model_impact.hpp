@@ -72,6 +72,15 @@ class ImpactModel {
     b << 0, 0, 0, p_.k;
     return b;
   }
+  // Explicit time derivatives of f (the forcing), for the event-time sensitivity of a split
+  // step (event_step.hpp): df/dt and d2f/dt2 at fixed (y, y_tau).
+  V f_t(int, double t, const V&, const V&) const {
+    return V(0, p_.a * p_.omega * p_.omega * p_.omega * std::cos(p_.omega * t));
+  }
+  V f_tt(int, double t, const V&, const V&) const {
+    const double w2 = p_.omega * p_.omega;
+    return V(0, -p_.a * w2 * w2 * std::sin(p_.omega * t));
+  }
   double H(const V& y) const { return y[0] - p_.e; }
   V grad_H(const V&) const { return V(1, 0); }
   V initial_state() const { return V(p_.x0, p_.v0); }

@@ -11,6 +11,7 @@
 // (event handling: see the events extension). The derivative of (*) is
 //
 //   dz1 = S^{-1} [ (I + dt/2 A_l) dz0 + dt/2 B_l dw0 + dt/2 B_r dw1 ],   S = I - dt/2 A_r.
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -31,8 +32,32 @@ enum class JacobianMode { consistent, frozen };
 struct StepOptions {
   EventMode events = EventMode::on;
   JacobianMode jacobian = JacobianMode::consistent;
-  int contact_substeps = 1;  // trapezoid sub-steps across each contact interval inside a step
+  // Trapezoid sub-steps per piece of a step on the H > 0 side (contact), events on/linear only:
+  // resolves a contact shorter than h (design.md 1.5). >= 1; 1 = one trapezoid per piece.
+  int contact_substeps = 1;
 };
+
+// What happened inside one step (filled by step() when asked; events off: always empty).
+struct StepEvents {
+  static constexpr int kMaxEvents = 16;  // more crossings than this in one step: NumericalFailure
+  int count = 0;
+  std::array<double, kMaxEvents> offset{};  // event time minus step start, in [0, h]
+  std::array<int, kMaxEvents> new_region{};  // region entered at the event (1: H > 0, contact)
+  // Number of entries into region 1 (impacts, for the impact model).
+  int entries_into_region1() const {
+    int n = 0;
+    for (int i = 0; i < count; ++i) n += new_region[i] == 1;
+    return n;
+  }
+};
+
+template <class Model>
+class TrapezoidStepper;
+// One full step with event location (event_step.hpp); called by TrapezoidStepper::step().
+template <class Model>
+Vec<Model::d> event_step(const TrapezoidStepper<Model>& stepper, double t, double h, const Vec<Model::d>& u0,
+                         const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepMap<Model::d>& map,
+                         StepEvents* events);
 
 // Region choice for the right node of a sub-step: a fixed region, or "the region of z1"
 // (found together with z1: the plain, unsplit trapezoid rule).
@@ -54,7 +79,11 @@ class TrapezoidStepper {
   using V = Vec<D>;
   using M = Mat<D>;
 
-  explicit TrapezoidStepper(const Model& model, const StepOptions& options = {}) : model_(model), options_(options) {}
+  // BadInput when options.contact_substeps < 1.
+  explicit TrapezoidStepper(const Model& model, const StepOptions& options = {}) : model_(model), options_(options) {
+    if (options.contact_substeps < 1)
+      throw BadInput("`contact_substeps = " + std::to_string(options.contact_substeps) + "`: must be >= 1");
+  }
 
   // One sub-step (*) from (t0, z0) over dt. left_region is used at the left node;
   // right_region at the right node (kRegionOfEndpoint: the region of z1 itself).
@@ -107,9 +136,22 @@ class TrapezoidStepper {
     return r;
   }
 
-  // One full step without event handling: each trapezoid node uses the region of its own state.
-  // Returns u_0(t + h) and fills the step map.
-  V step(double t, double h, const V& u0, const V& w0, const V& w1, StepMap<D>& map) const {
+  // One full step from t to t + h: returns u_0(t + h) and fills the step map (its exact
+  // derivative wrt u0, w0 = y_tau(t), w1 = y_tau(t + h)). For a model with switching and
+  // events on/linear the step is split at the events inside it (event_step.hpp) and `events`,
+  // when given, receives them; otherwise (events off, or no switching) it is the plain
+  // trapezoid, each node in the region of its own state.
+  V step(double t, double h, const V& u0, const V& w0, const V& w1, StepMap<D>& map,
+         StepEvents* events = nullptr) const {
+    if constexpr (Model::has_switching) {
+      if (options_.events != EventMode::off) return event_step(*this, t, h, u0, w0, w1, map, events);
+    }
+    if (events) events->count = 0;
+    return plain_step(t, h, u0, w0, w1, map);
+  }
+
+  // The plain (unsplit) trapezoid step, whatever the options: each node in its own region.
+  V plain_step(double t, double h, const V& u0, const V& w0, const V& w1, StepMap<D>& map) const {
     SubStepResult<D> s = sub_step(t, h, u0, w0, w1, region_of(model_, u0), kRegionOfEndpoint);
     map.P = s.dz0;
     map.Q = s.dw0;
@@ -126,3 +168,5 @@ class TrapezoidStepper {
 };
 
 }  // namespace delayspec
+
+#include "delayspec/event_step.hpp"  // IWYU pragma: export (event_step() used by step())

@@ -72,6 +72,7 @@ StepOptions step_options(const Problem& problem) {
   StepOptions options;
   options.events = problem.events == "off" ? EventMode::off : problem.events == "linear" ? EventMode::linear : EventMode::on;
   options.jacobian = problem.jacobian == "frozen" ? JacobianMode::frozen : JacobianMode::consistent;
+  options.contact_substeps = problem.contact_substeps;
   return options;
 }
 
@@ -89,6 +90,7 @@ Problem read_problem(Config& config, int default_N) {
                    "`: only for forced models (impact, mathieu); for linear and mackey-glass set `period`");
   problem.events = config.get_choice("events", "on", {"on", "linear", "off"});
   problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"});
+  problem.contact_substeps = read_positive_int(config, "contact_substeps", problem.contact_substeps);
   problem.grid = std::visit(
       [&](const auto& model) { return make_grid(model.tau(), model.period(), problem.N, problem.orbit_period); },
       problem.model);

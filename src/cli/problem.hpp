@@ -24,13 +24,15 @@ struct Problem {
   int orbit_period = 1;
   std::string events = "on";           // on | linear | off
   std::string jacobian = "consistent"; // consistent | frozen
+  int contact_substeps = 1;            // trapezoid sub-steps per contact piece of an event step
   HistoryGrid grid;
 };
 
 // The stepper options (events, jacobian, ...) the problem asks for.
 StepOptions step_options(const Problem& problem);
 
-// Reads `model` and its parameters, N, orbit_period, events, jacobian; builds the grid.
+// Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps;
+// builds the grid.
 // default_N is used when the key N is absent.
 Problem read_problem(Config& config, int default_N = 100);
 

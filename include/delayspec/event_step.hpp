@@ -1,0 +1,358 @@
+#pragma once
+// One full step of the trapezoid rule split at the events inside it (design.md 1.5, the paper's
+// Section 4 as corrected in paper/ERRATA.md items 2-7), and its exact derivative.
+//
+// The step from t to t + h is a sequence of pieces [a, b] (offsets from t), each with an
+// explicit region j used at every node of the piece; consecutive pieces are separated by an
+// event, a zero of H. A piece on the H > 0 side (region 1, contact) is integrated with
+// m = contact_substeps equal trapezoid sub-steps, a piece in region 2 with one:
+//
+//   z_i = z_{i-1} + L/2 [ f_j(t + s_{i-1}, z_{i-1}, w(s_{i-1})) + f_j(t + s_i, z_i, w(s_i)) ],
+//   s_i = a + i (b - a) / m,   L = (b - a) / m,   w(s) = (1 - s/h) w0 + (s/h) w1,
+//
+// where w0 = y_tau(t), w1 = y_tau(t + h): the delayed value inside the step is the linear
+// interpolant of the two history blocks the step map already uses (ERRATA 4). Only u_0 moves;
+// the history shifts once per full step (ERRATA 3), so the composed step map is again
+// du_0(t + h) = P du_0 + Q dw0 + R dw1.
+//
+// Event times (key `events`):
+//   on:     b solves H(z_b(b)) = 0 exactly for the discrete piece (z_b = the piece's result as a
+//           function of its end b), by a bracketed root finder (Brent) to machine precision;
+//   linear: the paper's estimates, corrected (ERRATA 6): from a point strictly inside a region
+//           b = a - H / H' (first order); from a point on H = 0 (a contact that ends inside the
+//           step) b = a - 2 H' / H'' (the second zero of the quadratic Taylor polynomial).
+// H' and H'' are the time derivatives of H along the vector field of the piece's region.
+//
+// Detection, per piece starting at a in region j: (1) H at the piece's trial end (b = h) is on
+// the other side: an exit inside (a, h] (paper's case 1); (2) the same side at both ends: a
+// grazing excursion (case 2) is looked for when the cubic Hermite interpolant of H(z(s)) on
+// [a, h] (values and slopes H' at both ends) has an interior extremum that comes within
+// `margin` = |slope change| * L of H = 0; then the true extremum of H(z(s)) is located (Brent's
+// minimiser) and, if it lies beyond H = 0 by more than a few hundred ulps, the step is split at
+// the two zeros. Why nothing is missed for small h: H(z(s)) is smooth on a piece, and the
+// Hermite cubic matches it to O(L^4 max|H''''|); a turning point of H inside the step changes
+// the slope by ~L |H''|, so for small L every excursion that reaches H = 0 has a Hermite
+// extremum within O(L^4) << margin ~ L^2 |H''| of it and triggers the exact search. Two turning
+// points in one step need H'' to change sign within L: the excursion between them is then
+// O(L^3) deep and its effect on the step below the local error. Excursions shallower than the
+// threshold (256 eps (1 + |z|) |grad H|) are ignored: a contact that shallow changes the step
+// by O(beta p^(3/2)) with p <= 1e-13, far below rounding of the result.
+//
+// Step map (key `jacobian`):
+//   consistent: the exact derivative of the discrete step, including how the event times move
+//               with (u0, w0, w1): for `on`, implicit differentiation of H(z_b) = 0 gives
+//               db = -grad H . X / grad H . Y where dz_b = X + Y db (X: derivative at fixed b,
+//               Y = dz_b/db); for `linear`, the derivative of the estimate formula;
+//   frozen:     the paper's: split points held fixed (db = 0). Not the derivative of the
+//               discrete map; near grazing its error is O(1) (ERRATA 7).
+// Forward-mode tangents: each node carries dz (d x 3d, columns u0, w0, w1) and ds (1 x 3d).
+//
+// Conventions at degenerate points. H(u0) = 0 exactly counts as region 2 (model.hpp); a
+// trajectory leaving it upwards gets a zero-length region-2 piece and an event at s = 0, so the
+// step map is the limit from the H < 0 side. The discrete map is continuous but only one-sided
+// differentiable where an event enters or leaves a step through one of its ends (its
+// derivative jumps by O(h^2 |A_1 - A_2|)), and at the onset of grazing (the split itself
+// changes the trapezoid's O(h^3) local error).
+//
+// Cost: a step with no event and no near-surface turning point costs one sub-step more than
+// the plain trapezoid (the trial end is the result); an event costs ~10-60 piece evaluations.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/LU>
+
+#include "delayspec/errors.hpp"
+#include "delayspec/model.hpp"
+#include "delayspec/scalar_search.hpp"
+#include "delayspec/step_map.hpp"
+#include "delayspec/stepper.hpp"
+
+namespace delayspec {
+
+namespace detail {
+
+template <class Model>
+class EventStepSolver {
+ public:
+  static constexpr int D = Model::d;
+  using V = Vec<D>;
+  using M = Mat<D>;
+  using Tangent = Eigen::Matrix<double, D, 3 * D>;  // d(.)/d(u0, w0, w1)
+  using Row = Eigen::Matrix<double, 1, 3 * D>;
+
+  EventStepSolver(const TrapezoidStepper<Model>& stepper, double t, double h, const V& w0, const V& w1)
+      : stepper_(stepper), model_(stepper.model()), options_(stepper.options()), t_(t), h_(h), w0_(w0), w1_(w1) {
+    static_assert(requires(const Model& m, V y) {
+      { m.f_t(1, 0.0, y, y) } -> std::convertible_to<V>;
+      { m.f_tt(1, 0.0, y, y) } -> std::convertible_to<V>;
+    }, "a model with switching must provide f_t and f_tt (model.hpp)");
+    wdot_ = (w1 - w0) / h;
+  }
+
+  V run(const V& u0, StepMap<D>& map, StepEvents* events) const {
+    double a = 0;
+    V z = u0;
+    int j = region_of(model_, u0);
+    Tangent dz = Tangent::Zero();
+    dz.template leftCols<D>().setIdentity();
+    Row da = Row::Zero();
+    int count = 0;
+    for (;;) {
+      const int m = substeps(j);
+      const Exit exit = find_exit(a, z, j, m, count > 0);
+      const double b = exit.event ? exit.b : h_;
+      const Piece piece = piece_with_tangent(a, b, z, dz, da, j, m);
+      Row db = Row::Zero();  // the end of the step (b = h) and frozen split points do not move
+      if (exit.event && options_.jacobian == JacobianMode::consistent) {
+        if (options_.events == EventMode::on || exit.clamped) {
+          if (options_.events == EventMode::on) db = implicit_event_time_derivative(piece, b);
+        } else {
+          db = linear_event_time_derivative(a, z, dz, da, j, exit.from_surface);
+        }
+      }
+      dz = piece.X + piece.Y * db;  // dz_b = X + Y db
+      da = db;
+      z = piece.z;
+      a = b;
+      if (!exit.event) break;
+      if (count == StepEvents::kMaxEvents)
+        throw NumericalFailure("event step at t = " + format_number(t_) + ", h = " + format_number(h_) + ": more than " +
+                               std::to_string(StepEvents::kMaxEvents) + " events in one step (reduce h)");
+      j = 3 - j;
+      if (events) {
+        events->offset[count] = b;
+        events->new_region[count] = j;
+      }
+      ++count;
+    }
+    if (events) events->count = count;
+    map.P = dz.template leftCols<D>();
+    map.Q = dz.template middleCols<D>(D);
+    map.R = dz.template rightCols<D>();
+    return z;
+  }
+
+ private:
+  struct Exit {
+    bool event = false;
+    double b = 0;
+    bool from_surface = false;  // the piece started on H = 0 (after an earlier event)
+    bool clamped = false;       // events = linear: the estimate was clamped to the piece
+  };
+  struct Piece {
+    V z;        // the piece's end state
+    Tangent X;  // dz_b at fixed end time b
+    V Y;        // dz_b / db
+  };
+
+  int substeps(int j) const { return j == 1 ? options_.contact_substeps : 1; }
+  V w_at(double s) const { return (1 - s / h_) * w0_ + (s / h_) * w1_; }
+  static double node(double a, double b, int m, int i) { return i == m ? b : a + (b - a) * i / m; }
+  double threshold(const V& z) const {
+    return 256 * std::numeric_limits<double>::epsilon() * (1 + z.template lpNorm<Eigen::Infinity>()) *
+           (model_.grad_H(z).template lpNorm<Eigen::Infinity>());
+  }
+
+  // The piece [a, b] in region j with m sub-steps, values only.
+  V piece_end(double a, double b, const V& za, int j, int m) const {
+    V z = za;
+    for (int i = 1; i <= m; ++i) {
+      const double s0 = node(a, b, m, i - 1), s1 = node(a, b, m, i);
+      z = stepper_.sub_step(t_ + s0, s1 - s0, z, w_at(s0), w_at(s1), j, j).z1;
+    }
+    return z;
+  }
+
+  // The same piece with forward-mode tangents. Node s_i = (1 - c_i) a + c_i b, c_i = i/m, so
+  // ds_i = (1 - c_i) da + c_i db; the db part is carried separately in Y (db is not known
+  // until the event condition at the piece's end is differentiated).
+  Piece piece_with_tangent(double a, double b, const V& za, const Tangent& dza, const Row& da, int j, int m) const {
+    Piece p{za, dza, V::Zero()};
+    for (int i = 1; i <= m; ++i) {
+      const double s0 = node(a, b, m, i - 1), s1 = node(a, b, m, i), L = s1 - s0;
+      const double c0 = static_cast<double>(i - 1) / m, c1 = static_cast<double>(i) / m;
+      const V wl = w_at(s0), wr = w_at(s1);
+      const V zl = p.z;
+      const V zr = stepper_.sub_step(t_ + s0, L, zl, wl, wr, j, j).z1;
+      const double tl = t_ + s0, tr = t_ + s0 + L;
+      const V fl = model_.f(j, tl, zl, wl), fr = model_.f(j, tr, zr, wr);
+      const M Al = model_.A(j, tl, zl, wl), Ar = model_.A(j, tr, zr, wr);
+      const M Bl = model_.B(j, tl, zl, wl), Br = model_.B(j, tr, zr, wr);
+      const V ftl = model_.f_t(j, tl, zl, wl), ftr = model_.f_t(j, tr, zr, wr);
+      const Eigen::PartialPivLU<M> lu(M(M::Identity() - 0.5 * L * Ar));  // S = I - L/2 A_r
+      const M Jz = lu.solve(M(M::Identity() + 0.5 * L * Al));             // dz_i/dz_{i-1}
+      // dz_i/ds_{i-1} and dz_i/ds_i: the length changes by -1/+1, the node's time and delayed
+      // value move with it (d/ds f(t + s, z, w(s)) = f_t + B w').
+      const V Js0 = lu.solve(V(-0.5 * (fl + fr) + 0.5 * L * (ftl + Bl * wdot_)));
+      const V Js1 = lu.solve(V(0.5 * (fl + fr) + 0.5 * L * (ftr + Br * wdot_)));
+      // dz_i/dw0, dz_i/dw1 through w(s_{i-1}) and w(s_i)
+      const M Jw0 = lu.solve(M(0.5 * L * (Bl * (1 - s0 / h_) + Br * (1 - s1 / h_))));
+      const M Jw1 = lu.solve(M(0.5 * L * (Bl * (s0 / h_) + Br * (s1 / h_))));
+      Tangent X = Jz * p.X + Js0 * ((1 - c0) * da) + Js1 * ((1 - c1) * da);
+      X.template middleCols<D>(D) += Jw0;
+      X.template rightCols<D>(D) += Jw1;
+      p.Y = Jz * p.Y + Js0 * c0 + Js1 * c1;
+      p.X = X;
+      p.z = zr;
+    }
+    return p;
+  }
+
+  // events = on: H(z_b) = 0 for all inputs => grad H . (X + Y db) = 0.
+  Row implicit_event_time_derivative(const Piece& p, double b) const {
+    const V g = model_.grad_H(p.z);
+    const double slope = g.dot(p.Y);  // dH/db along the piece: zero only at an exact tangency
+    const double scale = g.template lpNorm<1>() * (p.Y.template lpNorm<Eigen::Infinity>() + 1e-300);
+    if (!(std::abs(slope) > 1e-12 * scale))
+      throw NumericalFailure("event step at t = " + format_number(t_) + ": event at offset " + format_number(b) +
+                             " is tangential (dH/dt = " + format_number(slope) + "), its time has no derivative");
+    return -(g.transpose() * p.X) / slope;
+  }
+
+  // events = linear: derivative of b = a - H/H' (from inside) or b = a - 2 H'/H'' (from the
+  // surface), H' = g.F, H'' = g.(f_t + A F + B w'), F = f_j(t + a, z_a, w(a)); assumes grad H,
+  // A and B constant within the region (model.hpp).
+  Row linear_event_time_derivative(double a, const V& za, const Tangent& dza, const Row& da, int j,
+                                   bool from_surface) const {
+    const double ta = t_ + a;
+    const V wa = w_at(a);
+    const V g = model_.grad_H(za);
+    const V F = model_.f(j, ta, za, wa), ft = model_.f_t(j, ta, za, wa);
+    const M A = model_.A(j, ta, za, wa), B = model_.B(j, ta, za, wa);
+    Tangent dw = Tangent::Zero();  // dw(a) = (1 - a/h) dw0 + (a/h) dw1 + w' da
+    dw.template middleCols<D>(D) = (1 - a / h_) * M::Identity();
+    dw.template rightCols<D>(D) = (a / h_) * M::Identity();
+    dw += wdot_ * da;
+    const Tangent dF = A * dza + B * dw + ft * da;
+    const double H1 = g.dot(F);
+    const Row dH1 = g.transpose() * dF;
+    if (!from_surface) {
+      const double H0 = model_.H(za);
+      const Row dH0 = g.transpose() * dza;
+      return da - (dH0 * H1 - H0 * dH1) / (H1 * H1);
+    }
+    const V ftt = model_.f_tt(j, ta, za, wa);
+    const double H2 = g.dot(ft + A * F + B * wdot_);
+    Tangent dBwdot = Tangent::Zero();  // d(B w') = B (dw1 - dw0) / h
+    dBwdot.template middleCols<D>(D) = -B / h_;
+    dBwdot.template rightCols<D>(D) = B / h_;
+    const Row dH2 = g.transpose() * (ftt * da + A * dF + dBwdot);
+    return da - 2 * (dH1 * H2 - H1 * dH2) / (H2 * H2);
+  }
+
+  // The paper's estimates (events = linear), clamped to [a, limit].
+  Exit linear_estimate(double a, const V& za, int j, bool from_surface, double limit) const {
+    const double ta = t_ + a;
+    const V wa = w_at(a);
+    const V g = model_.grad_H(za);
+    const V F = model_.f(j, ta, za, wa);
+    const double H1 = g.dot(F);
+    double b;
+    if (!from_surface) {
+      b = a - model_.H(za) / H1;
+    } else {
+      const double H2 = g.dot(model_.f_t(j, ta, za, wa) + model_.A(j, ta, za, wa) * F + model_.B(j, ta, za, wa) * wdot_);
+      b = a - 2 * H1 / H2;
+    }
+    Exit e{true, b, from_surface, false};
+    if (!(b > a && b < limit)) {  // outside the piece, or not finite
+      e.b = std::isfinite(b) && b >= limit ? limit : a;
+      e.clamped = true;
+    }
+    return e;
+  }
+
+  // The first time in (a, h] at which the piece in region j leaves it, if any (see the header).
+  Exit find_exit(double a, const V& za, int j, int m, bool on_surface) const {
+    if (!(a < h_)) return {};
+    auto g = [&](double s) { return model_.H(piece_end(a, s, za, j, m)); };
+    auto wrong = [j](double v) { return j == 1 ? v <= 0 : v > 0; };
+    const double into = j == 1 ? 1 : -1;  // into * H > 0 deep inside region j
+    const V zL = piece_end(a, h_, za, j, m);
+    const double ga = model_.H(za), gL = model_.H(zL);
+    // A point in [a, limit) where H is on region j's side (strictly, unless it is a itself):
+    // a when the piece does not start on the surface, else the deepest point (Brent).
+    auto inside_point = [&](double limit, double& s, double& gs) {
+      if (!on_surface && !wrong(ga)) {
+        s = a, gs = ga;
+        return true;
+      }
+      const ScalarSearchResult r = bounded_minimum([&](double x) { return -into * g(x); }, a, limit);
+      s = r.x, gs = -into * r.g;
+      return into * gs > 0;
+    };
+    double lo, glo;
+    if (wrong(gL)) {  // case 1: the piece ends on the other side
+      if (!inside_point(h_, lo, glo)) return {true, a, on_surface, false};  // no resolvable time inside region j
+      if (options_.events == EventMode::linear) return linear_estimate(a, za, j, on_surface, h_);
+      return {true, root(g, lo, h_, glo, gL), on_surface, false};
+    }
+    if (!excursion_suspected(a, za, zL, ga, gL, j)) return {};
+    // case 2: the deepest point towards the other side
+    const ScalarSearchResult r = bounded_minimum([&](double x) { return into * g(x); }, a, h_);
+    const double gw = into * r.g;
+    if (!(wrong(gw) && std::abs(gw) > threshold(za))) return {};
+    if (!inside_point(r.x, lo, glo)) return {};
+    if (options_.events == EventMode::linear) return linear_estimate(a, za, j, on_surface, r.x);
+    return {true, root(g, lo, r.x, glo, gw), on_surface, false};
+  }
+
+  template <class G>
+  double root(const G& g, double lo, double hi, double glo, double ghi) const {
+    const ScalarSearchResult r = bracketed_root(g, lo, hi, glo, ghi);
+    if (!std::isfinite(r.x))
+      throw NumericalFailure("event step at t = " + format_number(t_) + ": event location failed in [" +
+                             format_number(lo) + ", " + format_number(hi) + "]");
+    return r.x;
+  }
+
+  // Does the cubic Hermite interpolant of H on [a, h] have an interior extremum within
+  // `margin` of H = 0 (or beyond it)? tau in [0, 1] is the scaled time.
+  bool excursion_suspected(double a, const V& za, const V& zL, double ga, double gL, int j) const {
+    const double L = h_ - a;
+    const double d0 = L * model_.grad_H(za).dot(model_.f(j, t_ + a, za, w_at(a)));
+    const double d1 = L * model_.grad_H(zL).dot(model_.f(j, t_ + h_, zL, w1_));
+    const double c1 = d0, c2 = -3 * ga - 2 * d0 + 3 * gL - d1, c3 = 2 * ga + d0 - 2 * gL + d1;
+    const double margin = std::abs(d1 - d0) + threshold(za);
+    const double into = j == 1 ? 1 : -1;
+    // p'(tau) = c1 + 2 c2 tau + 3 c3 tau^2
+    const double qa = 3 * c3, qb = 2 * c2, qc = c1;
+    double roots[2];
+    int n = 0;
+    if (std::abs(qa) <= 1e-14 * (std::abs(qb) + std::abs(qc))) {
+      if (qb != 0) roots[n++] = -qc / qb;
+    } else {
+      const double disc = qb * qb - 4 * qa * qc;
+      if (disc >= 0) {
+        const double q = -0.5 * (qb + std::copysign(std::sqrt(disc), qb));
+        if (q != 0) roots[n++] = q / qa;
+        roots[n++] = q != 0 ? qc / q : -qb / (2 * qa);
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      const double tau = roots[i];
+      if (!(tau > 0 && tau < 1)) continue;
+      const double p = ga + tau * (c1 + tau * (c2 + tau * c3));
+      if (into * p < margin) return true;
+    }
+    return false;
+  }
+
+  const TrapezoidStepper<Model>& stepper_;
+  const Model& model_;
+  const StepOptions& options_;
+  double t_, h_;
+  V w0_, w1_, wdot_;
+};
+
+}  // namespace detail
+
+template <class Model>
+Vec<Model::d> event_step(const TrapezoidStepper<Model>& stepper, double t, double h, const Vec<Model::d>& u0,
+                         const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepMap<Model::d>& map,
+                         StepEvents* events) {
+  return detail::EventStepSolver<Model>(stepper, t, h, w0, w1).run(u0, map, events);
+}
+
+}  // namespace delayspec

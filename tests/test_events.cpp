@@ -1,0 +1,172 @@
+// Event steps (crossing and grazing inside a step): the consistent step map is the exact
+// derivative of the discrete step, checked against central finite differences of the step and of
+// the whole stroboscopic map on the paper's period-1 orbit with impacts; the frozen (paper's)
+// Jacobian is not, near grazing.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "event_fd_support.hpp"
+
+using namespace delayspec;
+using namespace delayspec::testing;
+
+namespace {
+
+// FD step and tolerance for the step checks. The step is smooth in its inputs away from the
+// degenerate points (event.hpp header); central differences err by delta^2/6 |y'''|. Near an
+// impact the third derivative is dominated by the event time s(u) ~ H/v with impact speed
+// v ~ 0.05 on this orbit: |s'''| ~ 1/v^3 ~ 1e4, times |f| ~ 1: delta = 1e-6 gives ~2e-9, plus
+// rounding eps |y| / delta ~ 1e-10. 1e-6 relative (the bound) leaves a wide margin
+// and is still 1e5 times smaller than the frozen Jacobian's error.
+constexpr double kDelta = 1e-6;
+constexpr double kTolerance = 1e-6;
+
+// The period-1 orbit of events = on, consistent, one sub-step (N = 100), and a stepper with
+// `options` whose steps are checked along it. (Other options have slightly different discrete
+// orbits; at N = 100 some of them are not reached from this start, so all checks use this one.)
+struct OrbitFixture {
+  ImpactModel model;
+  TrapezoidStepper<ImpactModel> stepper;
+  StroboscopicMap<ImpactModel> map;
+  PeriodicOrbit orbit;
+  explicit OrbitFixture(const StepOptions& options)
+      : model(paper_orbit_parameters()),
+        stepper(model, options),
+        map(stepper, make_grid(model.tau(), model.period(), 100)) {
+    static const PeriodicOrbit reference = [&] {  // computed once for all tests (N = 100 only)
+      OrbitBySimulationOptions o;
+      o.tolerance = 1e-10;  // the checks need an orbit with impacts, not a converged one
+      const StroboscopicMap<ImpactModel> reference_map(TrapezoidStepper<ImpactModel>(model), map.grid());
+      return orbit_by_simulation(reference_map, map.constant_history(model.initial_state()), o);
+    }();
+    orbit = reference;
+  }
+};
+
+// Checks every step of the orbit; returns the number of steps with events.
+int expect_steps_match_fd(const OrbitFixture& f, double tolerance) {
+  int event_steps = 0;
+  double max_x = -INFINITY;
+  for (const StepInput& in : step_inputs(f.map, f.orbit.history)) {
+    StepEvents events;
+    const StepJacobian J = step_jacobian(f.stepper, in, &events);
+    const StepJacobian F = central_differences(f.stepper, in, kDelta);
+    EXPECT_LE(relative_error(F, J), tolerance) << "step at t = " << in.t << " with " << events.count << " events";
+    event_steps += events.count > 0;
+    max_x = std::max(max_x, in.u0[0]);
+  }
+  EXPECT_GT(max_x, f.model.parameters().e) << "the orbit must impact";
+  return event_steps;
+}
+
+StepOptions options(EventMode events, JacobianMode jacobian, int contact_substeps = 1) {
+  StepOptions o;
+  o.events = events;
+  o.jacobian = jacobian;
+  o.contact_substeps = contact_substeps;
+  return o;
+}
+
+}  // namespace
+
+TEST(EventStep, ConsistentStepMapsMatchFiniteDifferencesAlongImpactOrbit) {
+  OrbitFixture f(options(EventMode::on, JacobianMode::consistent));
+  EXPECT_GE(expect_steps_match_fd(f, kTolerance), 2);  // one entry and one exit per period
+}
+
+TEST(EventStep, ConsistentWithContactSubstepsMatchesFiniteDifferences) {
+  OrbitFixture f(options(EventMode::on, JacobianMode::consistent, 4));
+  EXPECT_GE(expect_steps_match_fd(f, kTolerance), 1);
+}
+
+TEST(EventStep, LinearEventTimesWithConsistentJacobianMatchFiniteDifferences) {
+  OrbitFixture f(options(EventMode::linear, JacobianMode::consistent));
+  EXPECT_GE(expect_steps_match_fd(f, kTolerance), 2);
+}
+
+TEST(EventStep, StroboscopicMapFiniteDifferencesMatchMonodromy) {
+  OrbitFixture f(options(EventMode::on, JacobianMode::consistent));
+  const Monodromy<2> M = f.map.monodromy(f.orbit.history);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> gauss;
+  // The whole map composes K = 100 steps, two with events: the same FD bound per step, amplified
+  // by products of step maps of norm <= ~1.1 (the orbit is stable): 1e-6 still applies.
+  for (int trial = 0; trial < 3; ++trial) {
+    Eigen::VectorXd v(f.map.dimension());
+    for (auto& x : v) x = gauss(rng);
+    const Eigen::VectorXd fd =
+        (f.map.apply(f.orbit.history + kDelta * v) - f.map.apply(f.orbit.history - kDelta * v)) / (2 * kDelta);
+    Eigen::VectorXd Mv;
+    M.apply(v, Mv);
+    EXPECT_LE((fd - Mv).lpNorm<Eigen::Infinity>(), kTolerance * Mv.lpNorm<Eigen::Infinity>()) << "trial " << trial;
+  }
+}
+
+TEST(EventStep, FrozenJacobianDisagreesWithFiniteDifferencesAtImpacts) {
+  OrbitFixture f(options(EventMode::on, JacobianMode::frozen));
+  double worst = 0;
+  for (const StepInput& in : step_inputs(f.map, f.orbit.history)) {
+    StepEvents events;
+    const StepJacobian J = step_jacobian(f.stepper, in, &events);
+    if (events.count > 0) worst = std::max(worst, relative_error(central_differences(f.stepper, in, kDelta), J));
+  }
+  // Frozen split points drop ds/du times the jump of f' across the event: O(1) here.
+  EXPECT_GT(worst, 1e-2);
+}
+
+TEST(EventStep, GrazingStepConsistentMatchesFrozenDoesNot) {
+  const GrazingCase g = grazing_case(1e-4);
+  const ImpactModel model(g.parameters);
+  const TrapezoidStepper<ImpactModel> consistent(model, options(EventMode::on, JacobianMode::consistent));
+  const TrapezoidStepper<ImpactModel> frozen(model, options(EventMode::on, JacobianMode::frozen));
+  StepEvents events;
+  const StepJacobian J = step_jacobian(consistent, g.input, &events);
+  ASSERT_EQ(events.count, 2);  // in and out within the step
+  EXPECT_EQ(events.new_region[0], 1);
+  EXPECT_EQ(events.new_region[1], 2);
+  EXPECT_LT(events.offset[0], g.s_max);
+  EXPECT_GT(events.offset[1], g.s_max);
+  // Contact time ~ sqrt(8 p / |x''|) ~ 0.03: the FD step must stay well inside it; 1e-7 gives a
+  // truncation error delta^2 |s'''| with |s'''| ~ c^-3 ~ 4e4: ~4e-10, rounding ~1e-9.
+  const StepJacobian F = central_differences(consistent, g.input, 1e-7);
+  EXPECT_LE(relative_error(F, J), kTolerance);
+  // With both trapezoid nodes of the contact piece on H = 0, the nonlinear step does not feel
+  // the contact force, but the frozen Jacobian applies A_1 across it (design.md 1.5).
+  EXPECT_GT(relative_error(F, step_jacobian(frozen, g.input)), 1e-3);
+}
+
+TEST(EventStep, EventsOffIsThePlainTrapezoid) {
+  OrbitFixture f(options(EventMode::off, JacobianMode::consistent));
+  for (const StepInput& in : step_inputs(f.map, f.orbit.history)) {
+    StepMap<2> a, b;
+    StepEvents events;
+    const V2 ya = f.stepper.step(in.t, in.h, in.u0, in.w0, in.w1, a, &events);
+    const V2 yb = f.stepper.plain_step(in.t, in.h, in.u0, in.w0, in.w1, b);
+    EXPECT_EQ(events.count, 0);
+    EXPECT_EQ(ya, yb);
+    EXPECT_EQ(as_matrix(a), as_matrix(b));
+  }
+}
+
+TEST(EventStep, StepWithoutEventsInFreeFlightEqualsPlainTrapezoid) {
+  // Away from the obstacle the event step is one region-2 piece: the plain trapezoid. Both
+  // solve the same 2x2 linear system; results agree to rounding (a few ulps of |y| ~ 1).
+  OrbitFixture f(options(EventMode::on, JacobianMode::consistent));
+  int free_steps = 0;
+  for (const StepInput& in : step_inputs(f.map, f.orbit.history)) {
+    if (in.u0[0] > 1.0) continue;  // near the obstacle: may be an event step
+    ++free_steps;
+    StepMap<2> a, b;
+    const V2 ya = f.stepper.step(in.t, in.h, in.u0, in.w0, in.w1, a);
+    const V2 yb = f.stepper.plain_step(in.t, in.h, in.u0, in.w0, in.w1, b);
+    EXPECT_LE((ya - yb).lpNorm<Eigen::Infinity>(), 1e-14);
+    EXPECT_LE((as_matrix(a) - as_matrix(b)).lpNorm<Eigen::Infinity>(), 1e-14);
+  }
+  EXPECT_GT(free_steps, 50);
+}
+
+TEST(EventStep, ContactSubstepsMustBePositive) {
+  const ImpactModel model;
+  EXPECT_THROW(TrapezoidStepper<ImpactModel>(model, options(EventMode::on, JacobianMode::consistent, 0)), BadInput);
+}
