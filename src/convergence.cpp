@@ -339,8 +339,9 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
     const double floor = std::max(10 * study.reference_precision[0], kNoiseFloor);
     for (size_t i = j; i < L; ++i) {
       rr.columns[j].push_back(tab.T[i][j]);
-      // An entry that uses the finest level is not independent of a finest/extrapolated reference.
-      const bool independent = exact || i + 1 < L;
+      // An entry that combines the finest level with others is not independent of a finest or
+      // extrapolated reference (column 0 is the level itself, its row error).
+      const bool independent = exact || j == 0 || i + 1 < L;
       const double err = independent ? relative_error(tab.T[i][j], study.reference_values[0]) : kNaN;
       rr.errors[j].push_back(err);
       if (independent && err > floor) log_n.push_back(std::log(options.Ns[i])), log_e.push_back(std::log(err));

@@ -167,6 +167,9 @@ const std::vector<std::string>& contract_keys() {
       "nev", "solver", "orbit", "orbit_tolerance", "orbit_max_periods",
       // lyapunov, converge, sweep, simulate
       "exponents", "periods", "transient", "Ns",
+      // converge, bench (command_converge.cpp, command_bench.cpp)
+      "N_min", "N_max", "reference", "extrapolation_order", "extrapolation_order_step", "extrapolation_levels",
+      "solvers", "dense_memory_limit_mb",
       // run, plot, chart, basin (scenes)
       "analyses", "title"};
   return keys;

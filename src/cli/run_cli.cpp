@@ -16,6 +16,7 @@ const std::map<std::string, CommandFunction>& command_table() {
       {"floquet", command_floquet},
       {"lyapunov", command_lyapunov},
       {"sweep", command_sweep},
+      {"converge", command_converge},
   };
   return table;
 }

@@ -1,0 +1,303 @@
+// delayspec converge: h-convergence study of the leading Floquet multipliers (CLI contract,
+// design.md 1.8). Library part: include/delayspec/convergence.hpp.
+//
+// Keys: Ns (comma list) or N_min/N_max (doubling); nev; reference = exact | extrapolated |
+// finest | auto; solver; extrapolation_order, extrapolation_order_step, extrapolation_levels;
+// events (a comma list: for the impact model `on,off` by default, side by side); the problem's
+// and the orbit's keys.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "delayspec/convergence.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec/floquet.hpp"
+#include "level_runner.hpp"
+#include "output.hpp"
+#include "problem.hpp"
+#include "progress.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+nlohmann::json number_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) {
+  nlohmann::json j;
+  j["events"] = events;
+  j["reference"] = to_string(s.reference);
+  j["reference_values"] = multipliers_json(s.reference_values);
+  j["reference_precision"] = s.reference_precision;
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& r : s.rows) {
+    nlohmann::json row;
+    row["N"] = r.N;
+    row["multipliers"] = multipliers_json(r.multipliers);
+    row["error"] = number_or_null(r.error);
+    row["errors"] = nlohmann::json::array();
+    for (double e : r.errors) row["errors"].push_back(number_or_null(e));
+    row["correct_digits"] = r.correct_digits;
+    row["seconds"] = r.seconds;
+    row["operator_applications"] = r.operator_applications;
+    rows.push_back(row);
+  }
+  j["rows"] = rows;
+  j["observed_order"] = s.order.observed ? nlohmann::json(*s.order.observed) : nlohmann::json(nullptr);
+  j["order_settled"] = s.order.settled;
+  j["order_basis"] = s.order.basis;
+  j["order_note"] = s.order.note;
+  j["least_squares_order"] = number_or_null(s.order.least_squares);
+  nlohmann::json pairs = nlohmann::json::array();
+  for (size_t i = 0; i < s.order.pair_orders.size(); ++i)
+    pairs.push_back({{"N", s.order.pair_N[i]}, {"order", number_or_null(s.order.pair_orders[i])}});
+  j["pair_orders"] = pairs;
+  nlohmann::json tracks = nlohmann::json::array();
+  for (const auto& t : s.track_orders)
+    tracks.push_back(t.observed ? nlohmann::json(*t.observed) : nlohmann::json(nullptr));
+  j["track_orders"] = tracks;
+  nlohmann::json ex = nlohmann::json::array();
+  for (const auto& e : s.extrapolated)
+    ex.push_back({{"re", e.value.real()},
+                  {"im", e.value.imag()},
+                  {"abs", std::abs(e.value)},
+                  {"error_estimate", e.error_estimate},
+                  {"levels", e.levels}});
+  j["extrapolated"] = ex;
+  nlohmann::json cols = nlohmann::json::array();
+  for (size_t c = 0; c < s.richardson.columns.size(); ++c) {
+    nlohmann::json col;
+    col["levels"] = c + 1;
+    col["expected_order"] = s.richardson.expected_orders[c];
+    col["observed_order"] =
+        s.richardson.column_orders[c] ? nlohmann::json(*s.richardson.column_orders[c]) : nlohmann::json(nullptr);
+    nlohmann::json entries = nlohmann::json::array();
+    for (size_t i = 0; i < s.richardson.columns[c].size(); ++i) {
+      const auto v = s.richardson.columns[c][i];
+      entries.push_back({{"N", s.richardson.Ns[i + c]},
+                         {"re", v.real()},
+                         {"im", v.imag()},
+                         {"abs", std::abs(v)},
+                         {"error", number_or_null(s.richardson.errors[c][i])}});
+    }
+    col["entries"] = entries;
+    cols.push_back(col);
+  }
+  j["richardson"] = cols;
+  j["seconds"] = s.seconds;
+  return j;
+}
+
+void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string& events, bool switching) {
+  char line[256];
+  if (switching) out << "\nevents = " << events << "\n";
+  out << "reference: " << to_string(s.reference) << " (relative precision " << s.reference_precision[0] << ")\n";
+  std::snprintf(line, sizeof line, "  %6s  %10s  %8s  %20s  %10s  %6s  %6s\n", "N", "seconds", "op.appl", "|mu_1|",
+                "error", "digits", "order");
+  out << line;
+  for (size_t i = 0; i < s.rows.size(); ++i) {
+    const auto& r = s.rows[i];
+    std::string order = "";
+    for (size_t k = 0; k < s.order.pair_N.size(); ++k)
+      if (s.order.pair_N[k] == r.N) {
+        std::snprintf(line, sizeof line, "%.3f", s.order.pair_orders[k]);
+        order = line;
+      }
+    std::snprintf(line, sizeof line, "  %6d  %10.4f  %8ld  %20.15f  %10.3e  %6.2f  %6s\n", r.N, r.seconds,
+                  r.operator_applications, std::abs(r.multipliers[0]), r.error, r.correct_digits[0], order.c_str());
+    out << line;
+  }
+  out << "observed order (" << s.order.basis << " based): ";
+  if (s.order.observed) {
+    std::snprintf(line, sizeof line, "%.3f", *s.order.observed);
+    out << line << (s.order.settled ? " (settled)" : "");
+  } else {
+    out << "none";
+  }
+  std::snprintf(line, sizeof line, "; least-squares slope over all levels %.3f", s.order.least_squares);
+  out << line << "\n";
+  if (!s.order.note.empty()) out << "note: " << s.order.note << "\n";
+  if (!s.extrapolated.empty()) {
+    out << "extrapolated multipliers (Richardson):\n";
+    for (size_t k = 0; k < s.extrapolated.size(); ++k) {
+      const auto& e = s.extrapolated[k];
+      std::snprintf(line, sizeof line, "  %3zu  %22.15e  %22.15e  |mu| %18.15f  +- %.1e (%d levels)\n", k + 1,
+                    e.value.real(), e.value.imag(), std::abs(e.value), e.error_estimate, e.levels);
+      out << line;
+    }
+  }
+  if (s.richardson.columns.size() > 1) {
+    out << "Richardson columns of mu_1 (relative error against the reference):\n  " << std::string(6, ' ');
+    for (size_t c = 0; c < s.richardson.columns.size(); ++c) {
+      std::snprintf(line, sizeof line, "  %10s", (std::to_string(c + 1) + " level" + (c ? "s" : "")).c_str());
+      out << line;
+    }
+    out << "\n";
+    for (size_t i = 0; i < s.richardson.Ns.size(); ++i) {
+      std::snprintf(line, sizeof line, "  %6d", s.richardson.Ns[i]);
+      out << line;
+      for (size_t c = 0; c < s.richardson.columns.size(); ++c) {
+        if (i < c) {
+          std::snprintf(line, sizeof line, "  %10s", "");
+        } else {
+          const double e = s.richardson.errors[c][i - c];
+          if (std::isfinite(e)) std::snprintf(line, sizeof line, "  %10.3e", e);
+          else std::snprintf(line, sizeof line, "  %10s", "(ref)");
+        }
+        out << line;
+      }
+      out << "\n";
+    }
+    out << "  order ";
+    for (size_t c = 0; c < s.richardson.columns.size(); ++c) {
+      if (s.richardson.column_orders[c]) std::snprintf(line, sizeof line, "  %10.2f", *s.richardson.column_orders[c]);
+      else std::snprintf(line, sizeof line, "  %10s", "-");
+      out << line;
+    }
+    out << "\n  expect";
+    for (size_t c = 0; c < s.richardson.columns.size(); ++c) {
+      std::snprintf(line, sizeof line, "  %10.0f", s.richardson.expected_orders[c]);
+      out << line;
+    }
+    out << "\n";
+  }
+}
+
+}  // namespace
+
+int command_converge(Config& config, const Invocation& inv) {
+  // events may be a list here (side by side); the problem reads the first of them.
+  const bool switching_default = config.get_string("model", "impact") == "impact";
+  const std::vector<std::string> events =
+      read_word_list(config, "events", switching_default ? "on,off" : "on", {"on", "linear", "off"});
+  config.set("events", events.front(), "converge");
+  Problem problem = read_problem(config, 100);
+  const bool switching =
+      std::visit([](const auto& m) { return std::decay_t<decltype(m)>::has_switching; }, problem.model);
+  const OrbitSettings orbit_settings = read_orbit_settings(config);
+  ConvergenceOptions base;
+  base.Ns = read_N_list(config, problem, 25, 400);
+  base.nev = static_cast<int>(config.get_int("nev", 2));
+  if (base.nev < 1) throw BadInput("`nev = " + std::to_string(base.nev) + "`: must be >= 1");
+  base.extra = std::max(2, base.nev / 2);
+  base.reference = parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
+  const FloquetSolver solver = parse_floquet_solver(
+      config.get_choice("solver", "dense", {"spectra", "arpack", "dense", "dense-eigen", "dense-lapack"}));
+  const bool order_given = config.has("extrapolation_order"), step_given = config.has("extrapolation_order_step");
+  const double x_order = config.get_double("extrapolation_order", 2);
+  const double x_step = config.get_double("extrapolation_order_step", 2);
+  require_positive("extrapolation_order", x_order);
+  require_positive("extrapolation_order_step", x_step);
+  base.richardson.max_columns = static_cast<int>(config.get_int("extrapolation_levels", 4));
+  if (base.richardson.max_columns < 1)
+    throw BadInput("`extrapolation_levels = " + std::to_string(base.richardson.max_columns) + "`: must be >= 1");
+  config.check_all_used();
+
+  const int d = state_dimension(problem);
+  long n_min = 0;
+  std::visit([&](const auto& m) { n_min = make_grid(m.tau(), m.period(), base.Ns.front(), problem.orbit_period).dimension(d); },
+             problem.model);
+  if (base.nev > n_min)
+    throw BadInput("`nev = " + std::to_string(base.nev) + "`: more than the dimension n = " + std::to_string(n_min) +
+                   " at the coarsest N = " + std::to_string(base.Ns.front()));
+  base.exact = exact_multipliers(problem, base.nev + base.extra);
+  if (base.reference == ReferenceKind::exact && base.exact.empty())
+    throw BadInput("`reference = exact`: model `" + problem.model_name +
+                   "` has no exact multipliers (use extrapolated or finest)");
+
+  std::vector<ConvergenceStudy> studies;
+  Progress progress(inv.err, "converge", static_cast<long>(base.Ns.size() * events.size()), inv.quiet);
+  for (const std::string& ev : events) {
+    ConvergenceOptions options = base;
+    // Without event handling a step across the switching surface is first order (design 1.5):
+    // the error expansion is then c1 h + c2 h^2 + ...
+    const bool first_order = switching && ev == "off";
+    options.richardson.order = order_given ? x_order : first_order ? 1 : 2;
+    options.richardson.order_step = step_given ? x_step : first_order ? 1 : 2;
+    LevelFunction level = [&](int N, int count) {
+      LevelResult r;
+      const auto start = std::chrono::steady_clock::now();
+      with_monodromy(problem, ev, orbit_settings, N, [&](const auto& op, const PeriodicOrbit&, double) {
+        FloquetOptions fo;
+        fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
+        fo.solver = solver;
+        const FloquetResult f = floquet_multipliers(op, fo);
+        r.multipliers = f.multipliers;
+        r.operator_applications = f.operator_applications;
+      });
+      r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      progress.add();
+      return r;
+    };
+    studies.push_back(run_convergence_study(level, options));
+  }
+  progress.finish();
+
+  if (inv.out_dir) {
+    const std::filesystem::path dir(*inv.out_dir);
+    AtomicFile rows(dir / "converge.csv");
+    rows.stream() << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver)
+                  << "\nevents,N,track,re,im,abs,error,correct_digits,seconds,operator_applications\n";
+    rows.stream().precision(17);
+    AtomicFile rich(dir / "converge_richardson.csv");
+    rich.stream() << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";
+    rich.stream().precision(17);
+    for (size_t v = 0; v < studies.size(); ++v) {
+      const auto& s = studies[v];
+      for (const auto& r : s.rows)
+        for (size_t k = 0; k < r.multipliers.size(); ++k)
+          rows.stream() << events[v] << "," << r.N << "," << k + 1 << "," << r.multipliers[k].real() << ","
+                        << r.multipliers[k].imag() << "," << std::abs(r.multipliers[k]) << "," << r.errors[k] << ","
+                        << r.correct_digits[k] << "," << r.seconds << "," << r.operator_applications << "\n";
+      for (size_t c = 0; c < s.richardson.columns.size(); ++c)
+        for (size_t i = 0; i < s.richardson.columns[c].size(); ++i) {
+          const auto x = s.richardson.columns[c][i];
+          rich.stream() << events[v] << "," << s.richardson.Ns[i + c] << "," << c + 1 << "," << x.real() << ","
+                        << x.imag() << "," << std::abs(x) << "," << s.richardson.errors[c][i] << "\n";
+        }
+    }
+    rows.commit();
+    rich.commit();
+  }
+
+  if (inv.json) {
+    nlohmann::json j = study_json(studies.front(), events.front());
+    j["model"] = problem.model_name;
+    j["solver"] = to_string(solver);
+    j["nev"] = base.nev;
+    if (studies.size() > 1) {
+      j["by_events"] = nlohmann::json::array();
+      for (size_t v = 0; v < studies.size(); ++v) j["by_events"].push_back(study_json(studies[v], events[v]));
+    }
+    inv.out << j.dump(2) << "\n";
+    return 0;
+  }
+  inv.out << "delayspec converge: model " << problem.model_name << ", solver " << to_string(solver) << ", nev "
+          << base.nev << ", N = ";
+  for (size_t i = 0; i < base.Ns.size(); ++i) inv.out << (i ? "," : "") << base.Ns[i];
+  inv.out << "\n";
+  for (size_t v = 0; v < studies.size(); ++v) print_study(inv.out, studies[v], events[v], switching);
+  if (studies.size() > 1) {
+    char line[200];
+    inv.out << "\nside by side: relative error of mu_1 (correct digits)\n  " << std::string(6, ' ');
+    for (const auto& ev : events) {
+      std::snprintf(line, sizeof line, "  %22s", ("events = " + ev).c_str());
+      inv.out << line;
+    }
+    inv.out << "\n";
+    for (size_t i = 0; i < base.Ns.size(); ++i) {
+      std::snprintf(line, sizeof line, "  %6d", base.Ns[i]);
+      inv.out << line;
+      for (const auto& s : studies) {
+        std::snprintf(line, sizeof line, "  %13.3e (%5.2f)", s.rows[i].error, s.rows[i].correct_digits[0]);
+        inv.out << line;
+      }
+      inv.out << "\n";
+    }
+  }
+  return 0;
+}
+
+}  // namespace delayspec::cli
