@@ -13,9 +13,11 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
   const bool has_list = config.has("Ns");
   const bool has_range = config.has("N_min") || config.has("N_max");
   if (has_list && has_range) throw BadInput("`Ns` and `N_min`/`N_max` are both given: give one of them");
+  std::string what = "`Ns`";
   if (has_list) {
+    what = "`Ns = " + config.get_string("Ns", "") + "`";
     for (long N : config.get_int_list("Ns", {})) {
-      if (N < 1 || N > INT_MAX) throw BadInput("`Ns`: `N = " + std::to_string(N) + "` must be an integer >= 1");
+      if (N < 1 || N > INT_MAX) throw BadInput(what + ": `" + std::to_string(N) + "` is not an integer >= 1");
       Ns.push_back(static_cast<int>(N));
     }
   } else {
@@ -27,7 +29,7 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
   }
   for (size_t i = 1; i < Ns.size(); ++i)
     if (Ns[i] <= Ns[i - 1])
-      throw BadInput("`Ns`: must be strictly increasing (" + std::to_string(Ns[i - 1]) + " then " +
+      throw BadInput(what + ": must be strictly increasing (" + std::to_string(Ns[i - 1]) + " then " +
                      std::to_string(Ns[i]) + ")");
   for (int N : Ns)  // fail fast on an N the grid cannot take
     std::visit([&](const auto& m) { make_grid(m.tau(), m.period(), N, problem.orbit_period); }, problem.model);

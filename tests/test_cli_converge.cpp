@@ -1,0 +1,139 @@
+// The `delayspec converge` command: JSON keys of the CLI contract, the observed order on the
+// smooth models (second order, the trapezoidal rule), the gain of the two-level extrapolation,
+// impact events side by side, CSV output, and every bad-input path (exit 2 naming key and value).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+#include "delayspec_test_paths.hpp"
+
+namespace {
+
+struct CliResult {
+  int status;
+  std::string out, err;
+};
+
+CliResult run(std::vector<std::string> args) {
+  args.insert(args.begin(), "delayspec");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  int status = delayspec::cli::run_cli(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {status, out.str(), err.str()};
+}
+
+}  // namespace
+
+TEST(ConvergeCli, LinearAgainstLambertWIsSecondOrder) {
+  // x' = -x + 0.5 x(t - 1): a real leading root; trapezoid error C h^2 (1 + O(h^2)): order 2 to < 0.1.
+  CliResult r = run({"converge", "--json", "--set", "model=linear", "--set", "a=-1", "--set", "b=0.5", "--set",
+                     "Ns=25,50,100,200", "--set", "nev=3"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"rows", "reference", "observed_order", "extrapolated"}) EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["reference"], "exact");
+  ASSERT_EQ(j["rows"].size(), 4u);
+  for (const auto& row : j["rows"])
+    for (const char* key : {"N", "multipliers", "error", "seconds", "operator_applications", "correct_digits"})
+      EXPECT_TRUE(row.contains(key)) << key;
+  ASSERT_TRUE(j["observed_order"].is_number()) << j["order_note"];
+  EXPECT_GE(j["observed_order"].get<double>(), 1.9);
+  EXPECT_LE(j["observed_order"].get<double>(), 2.1);
+  EXPECT_EQ(j["extrapolated"].size(), 3u);
+  for (const auto& e : j["extrapolated"]) EXPECT_TRUE(e.contains("error_estimate"));
+  // Two-level Richardson (column "levels": 2) is O(h^4) against the exact value: >= 3.5.
+  ASSERT_TRUE(j["richardson"][1]["observed_order"].is_number());
+  EXPECT_GE(j["richardson"][1]["observed_order"].get<double>(), 3.5);
+}
+
+TEST(ConvergeCli, MathieuIsSecondOrderAndTwoLevelExtrapolationGains) {
+  // Issue 6 target parameters; no exact value, so orders come from successive differences and the
+  // Richardson columns are measured against the 4-level extrapolation (O(h^8), ~1e-10 here).
+  CliResult r = run({"converge", "--json", "--set", "model=mathieu", "--set", "kappa=0.1", "--set", "delta=1", "--set",
+                     "eps=1", "--set", "b=0.2", "--set", "N_min=25", "--set", "N_max=400"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["reference"], "extrapolated");
+  EXPECT_EQ(j["rows"].size(), 5u);  // 25, 50, 100, 200, 400
+  ASSERT_TRUE(j["observed_order"].is_number()) << j["order_note"];
+  EXPECT_GE(j["observed_order"].get<double>(), 1.9);
+  EXPECT_LE(j["observed_order"].get<double>(), 2.1);
+  ASSERT_TRUE(j["richardson"][1]["observed_order"].is_number());
+  EXPECT_GE(j["richardson"][1]["observed_order"].get<double>(), 3.5);
+  // The published |mu_1| = 1.267945049893 (12 digits): the extrapolation reaches it to 1e-10.
+  EXPECT_NEAR(j["extrapolated"][0]["abs"].get<double>(), 1.267945049893, 1.3e-10);
+}
+
+TEST(ConvergeCli, ImpactShowsEventsOnAndOffSideBySideAndWritesCsv) {
+  const auto dir = std::filesystem::temp_directory_path() / "delayspec_test_converge_out";
+  std::filesystem::remove_all(dir);
+  CliResult r = run({"converge", std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/default.toml", "--json", "--out",
+                     dir.string(), "--set", "Ns=100,200,400", "--set", "nev=2"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.contains("by_events"));
+  ASSERT_EQ(j["by_events"].size(), 2u);
+  EXPECT_EQ(j["by_events"][0]["events"], "on");
+  EXPECT_EQ(j["by_events"][1]["events"], "off");
+  EXPECT_EQ(j["rows"], j["by_events"][0]["rows"]);  // the contract's top level is the first variant
+  // The note is never empty when no order is given: the output says why.
+  for (const auto& v : j["by_events"])
+    if (v["observed_order"].is_null()) EXPECT_FALSE(v["order_note"].get<std::string>().empty());
+  std::ifstream csv(dir / "converge.csv");
+  ASSERT_TRUE(csv.good());
+  std::string line;
+  int lines = 0;
+  while (std::getline(csv, line)) ++lines;
+  EXPECT_EQ(lines, 2 + 2 * 3 * 2);  // comment + header, 2 events x 3 N x 2 tracks
+  EXPECT_TRUE(std::filesystem::exists(dir / "converge_richardson.csv"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ConvergeCli, TextOutputSaysWhenOrdersAreNotSettled) {
+  CliResult r = run({"converge", std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/default.toml", "--set",
+                     "Ns=50,100,200,400", "--set", "nev=2", "--set", "events=off"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("observed order"), std::string::npos) << r.out;
+  // At these N the impact orbit's multiplier is far from asymptotic (design 1.5): the command must
+  // say so rather than print a single order.
+  EXPECT_NE(r.out.find("pre-asymptotic"), std::string::npos) << r.out;
+}
+
+struct BadValue {
+  const char* key;
+  const char* value;
+};
+void PrintTo(const BadValue& b, std::ostream* os) { *os << b.key << "=" << b.value; }
+class ConvergeBadInput : public ::testing::TestWithParam<BadValue> {};
+
+TEST_P(ConvergeBadInput, ExitsTwoNamingKeyAndValue) {
+  const BadValue b = GetParam();
+  CliResult r = run({"converge", "--set", "model=mathieu", "--set", std::string(b.key) + "=" + b.value});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(std::string("`") + b.key), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(b.value), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+// clang-format off
+INSTANTIATE_TEST_SUITE_P(Keys, ConvergeBadInput, ::testing::Values(
+    BadValue{"Ns", "50,25"}, BadValue{"Ns", "0,10"}, BadValue{"Ns", "ten"}, BadValue{"Ns", "10,,20"},
+    BadValue{"N_min", "0"}, BadValue{"N_max", "-3"}, BadValue{"nev", "0"}, BadValue{"nev", "5000"},
+    BadValue{"reference", "best"}, BadValue{"reference", "exact"}, BadValue{"events", "on,maybe"},
+    BadValue{"events", "on,on"}, BadValue{"solver", "magic"}, BadValue{"extrapolation_order", "-1"},
+    BadValue{"extrapolation_order_step", "nan"}, BadValue{"extrapolation_levels", "0"}));
+// clang-format on
+
+TEST(ConvergeCli, ListAndRangeTogetherIsBadInput) {
+  CliResult r = run({"converge", "--set", "model=linear", "--set", "Ns=10,20", "--set", "N_max=40"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("`Ns`"), std::string::npos) << r.err;
+  r = run({"converge", "--set", "model=linear", "--set", "Ns=10", "--set", "reference=finest"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("finest"), std::string::npos) << r.err;
+}
