@@ -15,6 +15,7 @@
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "level_runner.hpp"
+#include "lyapunov_settings.hpp"  // state_dimension
 #include "output.hpp"
 #include "problem.hpp"
 #include "progress.hpp"

@@ -69,8 +69,4 @@ std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int 
   return {};
 }
 
-int state_dimension(const Problem& problem) {
-  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::d; }, problem.model);
-}
-
 }  // namespace delayspec::cli

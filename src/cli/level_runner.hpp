@@ -24,9 +24,6 @@ std::vector<std::string> read_word_list(Config& config, const std::string& key, 
 // The exact leading multipliers when the model has them (linear: Lambert W), else empty.
 std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count);
 
-// The number of state components d of the problem's model.
-int state_dimension(const Problem& problem);
-
 // Builds the problem at resolution N with the given events mode, finds its periodic orbit and
 // calls fn(monodromy, orbit, setup_seconds). fn is generic in the Monodromy<D> type.
 template <class Fn>
