@@ -104,12 +104,16 @@ TEST(ConvergeCli, TextOutputSaysWhenOrdersAreNotSettled) {
   EXPECT_NE(r.out.find("pre-asymptotic"), std::string::npos) << r.out;
 }
 
+namespace {
+
 struct BadValue {
   const char* key;
   const char* value;
 };
 void PrintTo(const BadValue& b, std::ostream* os) { *os << b.key << "=" << b.value; }
 class ConvergeBadInput : public ::testing::TestWithParam<BadValue> {};
+
+}  // namespace
 
 TEST_P(ConvergeBadInput, ExitsTwoNamingKeyAndValue) {
   const BadValue b = GetParam();

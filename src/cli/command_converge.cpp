@@ -1,7 +1,8 @@
 // delayspec converge: h-convergence study of the leading Floquet multipliers (CLI contract,
 // design.md 1.8). Library part: include/delayspec/convergence.hpp.
 //
-// Keys: Ns (comma list) or N_min/N_max (doubling); nev; reference = exact | extrapolated |
+// Keys: Ns (comma list) or N_min/N_max (doubling); nev, solver (default spectra), ncv, tol,
+// max_restarts, seed (floquet_settings.hpp); reference = exact | extrapolated |
 // finest | auto; solver; extrapolation_order, extrapolation_order_step, extrapolation_levels;
 // events (a comma list: for the impact model `on,off` by default, side by side); the problem's
 // and the orbit's keys.
@@ -14,6 +15,7 @@
 #include "delayspec/convergence.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
+#include "floquet_settings.hpp"
 #include "level_runner.hpp"
 #include "lyapunov_settings.hpp"  // state_dimension
 #include "output.hpp"
@@ -180,12 +182,11 @@ int command_converge(Config& config, const Invocation& inv) {
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   ConvergenceOptions base;
   base.Ns = read_N_list(config, problem, 25, 400);
-  base.nev = static_cast<int>(config.get_int("nev", 2));
-  if (base.nev < 1) throw BadInput("`nev = " + std::to_string(base.nev) + "`: must be >= 1");
+  const FloquetOptions solver_options = read_floquet_options(config, 2);  // nev, solver, ncv, tol, ...
+  const FloquetSolver solver = solver_options.solver;
+  base.nev = solver_options.nev;
   base.extra = std::max(2, base.nev / 2);
   base.reference = parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
-  const FloquetSolver solver = parse_floquet_solver(
-      config.get_choice("solver", "dense", {"spectra", "arpack", "dense", "dense-eigen", "dense-lapack"}));
   const bool order_given = config.has("extrapolation_order"), step_given = config.has("extrapolation_order_step");
   const double x_order = config.get_double("extrapolation_order", 2);
   const double x_step = config.get_double("extrapolation_order_step", 2);
@@ -221,9 +222,8 @@ int command_converge(Config& config, const Invocation& inv) {
       LevelResult r;
       const auto start = std::chrono::steady_clock::now();
       with_monodromy(problem, ev, orbit_settings, N, [&](const auto& op, const PeriodicOrbit&, double) {
-        FloquetOptions fo;
+        FloquetOptions fo = solver_options;
         fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
-        fo.solver = solver;
         const FloquetResult f = floquet_multipliers(op, fo);
         r.multipliers = f.multipliers;
         r.operator_applications = f.operator_applications;

@@ -29,6 +29,7 @@ int command_floquet(Config& config, const Invocation& inv);
 int command_lyapunov(Config& config, const Invocation& inv);
 int command_sweep(Config& config, const Invocation& inv);
 int command_converge(Config& config, const Invocation& inv);
+int command_bench(Config& config, const Invocation& inv);
 
 // Runs the program: parses argv, dispatches, maps errors to exit codes. Never throws.
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err);

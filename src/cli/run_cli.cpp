@@ -17,6 +17,7 @@ const std::map<std::string, CommandFunction>& command_table() {
       {"lyapunov", command_lyapunov},
       {"sweep", command_sweep},
       {"converge", command_converge},
+      {"bench", command_bench},
   };
   return table;
 }

@@ -1,0 +1,259 @@
+// delayspec bench: the same problem solved by the Krylov and the dense eigen-solvers at several
+// N, in one run: time, peak memory, operator applications and error against a reference
+// (CLI contract `bench`). Library parts: floquet.hpp, convergence.hpp.
+//
+// Keys: Ns (comma list) or N_min/N_max (doubling); solvers (comma list of spectra, arpack,
+// dense-lapack, dense-eigen; default all but dense-eigen); nev (default 10), ncv, tol,
+// max_restarts, seed; reference = exact | extrapolated | finest | auto (the reference values:
+// exact multipliers, or Richardson / the finest level of the solver with the most levels);
+// dense_memory_limit_mb (default 2048): a dense row whose matrices would need more is skipped
+// with a message instead of exhausting the machine's memory; the problem's and orbit's keys.
+//
+// Per row: seconds (the eigen-solve, incl. forming the dense matrix), setup_seconds (orbit and
+// step maps, shared by the solvers of one N), peak_bytes (memory_probe.hpp: what the solve added
+// at its peak), error (relative, leading multiplier), max_error (over the nev), correct_digits,
+// deviation_from_dense (max |mu_k - mu_k^dense| / |mu_1^dense| at the same N, when dense ran).
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "delayspec/convergence.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec/floquet.hpp"
+#include "floquet_settings.hpp"
+#include "level_runner.hpp"
+#include "lyapunov_settings.hpp"  // state_dimension
+#include "memory_probe.hpp"
+#include "output.hpp"
+#include "progress.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+struct BenchRow {
+  int N = 0;
+  long n = 0;
+  std::string solver;
+  std::string status = "ok";  // ok | skipped | failed
+  std::string message;
+  Multipliers multipliers;
+  double seconds = NAN, setup_seconds = NAN;
+  long peak_bytes = -1;
+  long operator_applications = 0;
+  double error = NAN, max_error = NAN, correct_digits = NAN, deviation_from_dense = NAN;
+};
+
+bool is_dense(FloquetSolver s) { return s == FloquetSolver::dense_lapack || s == FloquetSolver::dense_eigen; }
+
+// Bytes the dense path holds at its peak: the assembled matrix, the copy LAPACK overwrites (or
+// Eigen's Schur form), and the QR workspace / Householder blocks: about 3 n^2 doubles.
+double dense_bytes_estimate(long n) { return 3.0 * 8.0 * static_cast<double>(n) * static_cast<double>(n); }
+
+nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+int command_bench(Config& config, const Invocation& inv) {
+  if (config.has("solver"))
+    throw BadInput("`solver = " + config.get_string("solver", "") + "`: bench compares several: use `solvers` (a comma list)");
+  Problem problem = read_problem(config, 100);
+  const OrbitSettings orbit_settings = read_orbit_settings(config);
+  const std::vector<int> Ns = read_N_list(config, problem, 100, 400);
+  const std::vector<std::string> solver_names = read_word_list(
+      config, "solvers", "spectra,arpack,dense-lapack", {"spectra", "arpack", "dense", "dense-lapack", "dense-eigen"});
+  FloquetOptions base = read_floquet_options(config, 10);
+  const ReferenceKind reference_kind =
+      parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
+  const double limit_mb = config.get_double("dense_memory_limit_mb", 2048);
+  require_positive("dense_memory_limit_mb", limit_mb);
+  config.check_all_used();
+
+  std::vector<FloquetSolver> solvers;
+  for (const auto& s : solver_names) solvers.push_back(parse_floquet_solver(s));
+  const int d = state_dimension(problem);
+  const long n_min = static_cast<long>(d) * (Ns.front() + 1);  // at least d (N + 1)
+  if (base.nev > n_min - 2)
+    throw BadInput("`nev = " + std::to_string(base.nev) + "`: the Krylov solvers need nev <= n - 2, and n is about " +
+                   std::to_string(n_min) + " at the coarsest N = " + std::to_string(Ns.front()));
+  const Multipliers exact = exact_multipliers(problem, base.nev);
+  if (reference_kind == ReferenceKind::exact && exact.empty())
+    throw BadInput("`reference = exact`: model `" + problem.model_name + "` has no exact multipliers");
+
+  std::vector<BenchRow> rows;
+  Progress progress(inv.err, "bench", static_cast<long>(Ns.size() * solvers.size()), inv.quiet);
+  for (int N : Ns) {
+    with_monodromy(problem, problem.events, orbit_settings, N, [&](const auto& op, const PeriodicOrbit&, double setup) {
+      for (FloquetSolver solver : solvers) {
+        BenchRow row;
+        row.N = N;
+        row.n = op.rows();
+        row.solver = to_string(solver);
+        row.setup_seconds = setup;
+        const double need_mb = dense_bytes_estimate(row.n) / (1024.0 * 1024.0);
+        if (is_dense(solver) && need_mb > limit_mb) {
+          char buf[200];
+          std::snprintf(buf, sizeof buf, "dense needs about %.0f MB (3 n^2 doubles, n = %ld) > dense_memory_limit_mb = %g",
+                        need_mb, row.n, limit_mb);
+          row.status = "skipped";
+          row.message = buf;
+          inv.err << "bench: N = " << N << ", " << row.solver << ": skipped: " << buf << "\n";
+        } else {
+          FloquetOptions o = base;
+          o.solver = solver;
+          try {
+            const MemoryProbe probe;
+            const FloquetResult r = floquet_multipliers(op, o);
+            row.peak_bytes = probe.peak_bytes();
+            row.multipliers = r.multipliers;
+            row.seconds = r.seconds;
+            row.operator_applications = r.operator_applications;
+            if (!r.note.empty()) row.message = r.note;
+          } catch (const NumericalFailure& e) {
+            row.status = "failed";
+            row.message = e.what();
+            inv.err << "bench: N = " << N << ", " << row.solver << ": failed: " << e.what() << "\n";
+          }
+        }
+        rows.push_back(row);
+        progress.add();
+      }
+    });
+  }
+  progress.finish();
+
+  // The reference: exact, or from the solver with the most completed levels (first listed on ties).
+  Multipliers ref;
+  std::vector<double> ref_precision;
+  std::string reference_used = "none", reference_note;
+  if (!exact.empty() && (reference_kind == ReferenceKind::exact || reference_kind == ReferenceKind::automatic)) {
+    ref = exact;
+    ref_precision.assign(ref.size(), 1e-14);
+    reference_used = "exact";
+  } else {
+    std::string best;
+    size_t best_count = 0;
+    for (const auto& name : solver_names) {
+      const std::string canonical = to_string(parse_floquet_solver(name));
+      size_t count = 0;
+      for (const auto& r : rows) count += r.solver == canonical && r.status == "ok";
+      if (count > best_count) best_count = count, best = canonical;
+    }
+    if (best_count >= 2) {
+      ConvergenceOptions co;
+      co.nev = base.nev;
+      co.extra = 0;
+      co.reference = reference_kind == ReferenceKind::finest ? ReferenceKind::finest : ReferenceKind::extrapolated;
+      std::vector<LevelResult> levels;
+      for (const auto& r : rows)
+        if (r.solver == best && r.status == "ok") {
+          co.Ns.push_back(r.N);
+          levels.push_back({r.multipliers, r.seconds, r.operator_applications});
+        }
+      const ConvergenceStudy s = analyse_convergence(levels, co);
+      ref = s.reference_values;
+      ref_precision = s.reference_precision;
+      reference_used = to_string(s.reference);
+      reference_note = "from the " + best + " rows";
+    } else {
+      reference_note = "no exact values and fewer than two completed levels: errors not computed";
+    }
+  }
+  for (auto& r : rows) {
+    if (r.status != "ok") continue;
+    if (!ref.empty()) {
+      const MatchedErrors m = errors_against(r.multipliers, ref, ref_precision);
+      r.error = m.errors[0];
+      r.max_error = *std::max_element(m.errors.begin(), m.errors.end());
+      r.correct_digits = m.correct_digits[0];
+    }
+    for (const auto& dense : rows)
+      if (dense.N == r.N && dense.status == "ok" && is_dense(parse_floquet_solver(dense.solver)) && &dense != &r) {
+        const MatchedErrors m = errors_against(r.multipliers, dense.multipliers, std::vector<double>(dense.multipliers.size(), 0));
+        double dev = 0;
+        for (size_t k = 0; k < m.matched.size(); ++k) dev = std::max(dev, std::abs(m.matched[k] - dense.multipliers[k]));
+        r.deviation_from_dense = dev / std::abs(dense.multipliers[0]);
+        break;
+      }
+  }
+
+  if (inv.out_dir) {
+    AtomicFile csv(std::filesystem::path(*inv.out_dir) / "bench.csv");
+    csv.stream() << "# delayspec bench: model " << problem.model_name << ", nev " << base.nev << ", reference "
+                 << reference_used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
+                 << "error,max_error,correct_digits,deviation_from_dense,abs_mu1\n";
+    csv.stream().precision(10);
+    for (const auto& r : rows)
+      csv.stream() << r.N << "," << r.n << "," << r.solver << "," << r.status << "," << r.seconds << ","
+                   << r.setup_seconds << "," << r.peak_bytes << "," << r.operator_applications << "," << r.error
+                   << "," << r.max_error << "," << r.correct_digits << "," << r.deviation_from_dense << ","
+                   << (r.multipliers.empty() ? NAN : std::abs(r.multipliers[0])) << "\n";
+    csv.commit();
+  }
+
+  if (inv.json) {
+    nlohmann::json j;
+    j["model"] = problem.model_name;
+    j["events"] = problem.events;
+    j["nev"] = base.nev;
+    j["reference"] = reference_used;
+    if (!reference_note.empty()) j["reference_note"] = reference_note;
+    j["dense_memory_limit_mb"] = limit_mb;
+    j["peak_bytes_method"] = "VmHWM - VmRSS after malloc_trim and a reset of the peak mark (per row)";
+    j["rows"] = nlohmann::json::array();
+    for (const auto& r : rows) {
+      nlohmann::json row = {{"N", r.N},
+                            {"dimension", r.n},
+                            {"solver", r.solver},
+                            {"status", r.status},
+                            {"seconds", num(r.seconds)},
+                            {"setup_seconds", num(r.setup_seconds)},
+                            {"peak_bytes", r.peak_bytes >= 0 ? nlohmann::json(r.peak_bytes) : nlohmann::json(nullptr)},
+                            {"error", num(r.error)},
+                            {"max_error", num(r.max_error)},
+                            {"correct_digits", num(r.correct_digits)},
+                            {"deviation_from_dense", num(r.deviation_from_dense)},
+                            {"operator_applications", r.operator_applications},
+                            {"multipliers", multipliers_json(r.multipliers)}};
+      if (!r.message.empty()) row["message"] = r.message;
+      j["rows"].push_back(row);
+    }
+    inv.out << j.dump(2) << "\n";
+    return 0;
+  }
+  char line[300];
+  inv.out << "delayspec bench: model " << problem.model_name << ", nev " << base.nev << ", reference " << reference_used
+          << (reference_note.empty() ? "" : " (" + reference_note + ")") << "\n";
+  std::snprintf(line, sizeof line, "  %6s  %7s  %-12s  %10s  %10s  %9s  %10s  %10s  %6s  %10s\n", "N", "n", "solver",
+                "seconds", "peak MB", "op.appl", "error", "max error", "digits", "vs dense");
+  inv.out << line;
+  for (const auto& r : rows) {
+    if (r.status != "ok") {
+      std::snprintf(line, sizeof line, "  %6d  %7ld  %-12s  %s: %s\n", r.N, r.n, r.solver.c_str(), r.status.c_str(),
+                    r.message.c_str());
+      inv.out << line;
+      continue;
+    }
+    std::snprintf(line, sizeof line, "  %6d  %7ld  %-12s  %10.4g  %10.3g  %9ld  %10.3e  %10.3e  %6.2f  %10.2e\n", r.N,
+                  r.n, r.solver.c_str(), r.seconds, r.peak_bytes / (1024.0 * 1024.0), r.operator_applications, r.error,
+                  r.max_error, r.correct_digits, r.deviation_from_dense);
+    inv.out << line;
+  }
+  // Speed-up of each Krylov solver over dense LAPACK at the same N.
+  for (const auto& dense : rows) {
+    if (dense.solver != "dense-lapack" || dense.status != "ok") continue;
+    for (const auto& r : rows)
+      if (r.N == dense.N && r.status == "ok" && !is_dense(parse_floquet_solver(r.solver))) {
+        std::snprintf(line, sizeof line, "  N = %d: %s is %.0fx faster than dense-lapack\n", r.N, r.solver.c_str(),
+                      dense.seconds / r.seconds);
+        inv.out << line;
+      }
+  }
+  inv.out << "peak MB: resident memory the solve added at its peak (VmHWM after a reset, per row)\n";
+  return 0;
+}
+
+}  // namespace delayspec::cli

@@ -1,0 +1,116 @@
+// The `delayspec bench` command: contract keys, Krylov and dense agreeing at the same N, errors
+// against the exact (Lambert W) values, per-row peak memory, the dense memory limit, bad input.
+// No timing is asserted here (speed belongs to bench/ and docs/).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+
+namespace {
+
+struct CliResult {
+  int status;
+  std::string out, err;
+};
+
+CliResult run(std::vector<std::string> args) {
+  args.insert(args.begin(), "delayspec");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  int status = delayspec::cli::run_cli(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {status, out.str(), err.str()};
+}
+
+}  // namespace
+
+TEST(BenchCli, KrylovAndDenseAgreeAndMatchLambertW) {
+  CliResult r = run({"bench", "--json", "--set", "model=linear", "--set", "a=-1", "--set", "b=-2", "--set",
+                     "Ns=100,400", "--set", "nev=4", "--set", "solvers=spectra,arpack,dense-lapack"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["reference"], "exact");
+  ASSERT_EQ(j["rows"].size(), 6u);
+  for (const auto& row : j["rows"]) {
+    for (const char* key : {"N", "solver", "seconds", "peak_bytes", "error", "operator_applications"})
+      EXPECT_TRUE(row.contains(key)) << key;
+    ASSERT_EQ(row["status"], "ok") << row.dump();
+    // The discretisation error at N: C h^2 with C ~ 0.24 here (test_convergence: 3.9e-4 at N = 25),
+    // so below 1e-4 at N = 100; the eigen-solver's own error (tol 1e-12) is far below it.
+    EXPECT_LT(row["error"].get<double>(), 1e-4) << row.dump();
+    if (row["solver"] != "dense-lapack") {
+      // Krylov against dense at the same N: both solve the same matrix; Ritz residual tolerance
+      // 1e-12 relative bounds the eigenvalue error of these well-separated values by ~1e-11.
+      EXPECT_LT(row["deviation_from_dense"].get<double>(), 1e-10) << row.dump();
+      EXPECT_LT(row["operator_applications"].get<long>(), row["N"].get<long>()) << "Krylov needs fewer than n";
+    } else {
+      // Dense forms the matrix: n = N + 1 applications, and holds at least one n x n matrix.
+      const long n = row["dimension"].get<long>();
+      EXPECT_EQ(row["operator_applications"].get<long>(), n);
+      EXPECT_GE(row["peak_bytes"].get<long>(), static_cast<long>(0.5 * 8.0 * n * n)) << "at least the matrix (half, for slack)";
+    }
+  }
+}
+
+TEST(BenchCli, DenseStopsAtTheMemoryLimitWithAMessage) {
+  // N = 800, d = 2: n = 1602, 3 n^2 doubles = 59 MB > 10 MB: dense must not run.
+  CliResult r = run({"bench", "--json", "--set", "model=mathieu", "--set", "Ns=800", "--set", "nev=2", "--set",
+                     "solvers=spectra,dense-lapack", "--set", "dense_memory_limit_mb=10"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["rows"].size(), 2u);
+  EXPECT_EQ(j["rows"][0]["status"], "ok");
+  EXPECT_EQ(j["rows"][1]["status"], "skipped");
+  EXPECT_NE(j["rows"][1]["message"].get<std::string>().find("dense_memory_limit_mb"), std::string::npos);
+  EXPECT_NE(r.err.find("skipped"), std::string::npos) << r.err;
+  // One level, no exact values: no reference, and the output says so instead of inventing one.
+  EXPECT_EQ(j["reference"], "none");
+  EXPECT_TRUE(j["rows"][0]["error"].is_null());
+}
+
+TEST(BenchCli, TextTableAndCsv) {
+  const auto dir = std::filesystem::temp_directory_path() / "delayspec_test_bench_out";
+  std::filesystem::remove_all(dir);
+  CliResult r = run({"bench", "--out", dir.string(), "--set", "model=mathieu", "--set", "Ns=50,100,200", "--set",
+                     "nev=3", "--set", "solvers=spectra,dense"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("faster than dense-lapack"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("reference extrapolated"), std::string::npos) << r.out;
+  std::ifstream csv(dir / "bench.csv");
+  std::string line;
+  int lines = 0;
+  while (std::getline(csv, line)) ++lines;
+  EXPECT_EQ(lines, 2 + 3 * 2);  // comment + header, 3 N x 2 solvers
+  std::filesystem::remove_all(dir);
+}
+
+namespace {
+
+struct BadValue {
+  const char* key;
+  const char* value;
+};
+void PrintTo(const BadValue& b, std::ostream* os) { *os << b.key << "=" << b.value; }
+class BenchBadInput : public ::testing::TestWithParam<BadValue> {};
+
+}  // namespace
+
+TEST_P(BenchBadInput, ExitsTwoNamingKeyAndValue) {
+  const BadValue b = GetParam();
+  CliResult r = run({"bench", "--set", "model=linear", "--set", "Ns=20,40", "--set", std::string(b.key) + "=" + b.value});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(std::string("`") + b.key), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(b.value), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+// clang-format off
+INSTANTIATE_TEST_SUITE_P(Keys, BenchBadInput, ::testing::Values(
+    BadValue{"solvers", "magic"}, BadValue{"solvers", "spectra,spectra"}, BadValue{"solvers", ""},
+    BadValue{"solver", "spectra"}, BadValue{"dense_memory_limit_mb", "-1"}, BadValue{"dense_memory_limit_mb", "lots"},
+    BadValue{"nev", "40"}, BadValue{"nev", "0"}, BadValue{"reference", "best"}, BadValue{"Ns", "40,20"}));
+// clang-format on
