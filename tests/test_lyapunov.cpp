@@ -7,6 +7,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <Eigen/QR>
+
 #include "delayspec/lambert_w.hpp"
 #include "delayspec/lyapunov.hpp"
 #include "delayspec/model_impact.hpp"
@@ -65,6 +67,47 @@ TEST(TangentQR, QIsOrthonormalAndQtAIsUpperTriangularWithPositiveDiagonal) {
   }
   // A = Q R reconstructed from the bound block's factor
   EXPECT_LT((Q * R.triangularView<Eigen::Upper>() - A).cwiseAbs().maxCoeff(), tol * A.norm());
+}
+
+// The layout-specific kernel against the reference kernel (Eigen's HouseholderQR, column-major)
+// for every compile-time k and the runtime path (k > 8), and for blocks far from unit scale
+// (the power-of-two scaling path).
+TEST(TangentQR, MatchesEigenHouseholderQR) {
+  const long n = 41;
+  for (int k : {1, 2, 3, 5, 8, 9, 13}) {
+    for (double scale : {1.0, 1e200, 1e-200}) {
+      std::vector<double> block(n * k), q(n * k), log_r(k);
+      ds::TangentQR qr(block.data(), n, k);
+      ds::random_block(block.data(), n, k, 100 + k);
+      for (double& x : block) x *= scale;
+      using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+      const Eigen::MatrixXd A = Eigen::Map<RowMajor>(block.data(), n, k) / scale;
+      qr.factorise(q.data(), log_r.data());
+      const Eigen::HouseholderQR<Eigen::MatrixXd> reference(A);
+      const Eigen::MatrixXd Q_ref = reference.householderQ() * Eigen::MatrixXd::Identity(n, k);
+      const Eigen::Map<RowMajor> Q(q.data(), n, k);
+      for (int i = 0; i < k; ++i) {
+        const double r_ref = reference.matrixQR()(i, i);
+        // both backward stable: R agrees to O(n eps) relative; log adds log(scale) exactly
+        EXPECT_NEAR(log_r[i] - std::log(scale), std::log(std::abs(r_ref)), 10 * n * 2.2e-16) << k << " " << i;
+        // same reflectors up to the sign convention fixed by R_ii > 0
+        const double sign = r_ref < 0 ? -1 : 1;
+        EXPECT_LT((Q.col(i) - sign * Q_ref.col(i)).cwiseAbs().maxCoeff(), 10 * n * 2.2e-16) << k << " " << i;
+      }
+    }
+  }
+}
+
+TEST(TangentQR, NonFiniteOrDependentBlockIsANumericalFailure) {
+  const long n = 10;
+  const int k = 2;
+  std::vector<double> block(n * k), q(n * k), log_r(k);
+  ds::TangentQR qr(block.data(), n, k);
+  ds::random_block(block.data(), n, k, 1);
+  block[5] = NAN;
+  EXPECT_THROW(qr.factorise(q.data(), log_r.data()), ds::NumericalFailure);
+  for (long i = 0; i < n; ++i) block[i * k] = block[i * k + 1] = 1.0 + i;  // two equal columns
+  EXPECT_THROW(qr.factorise(q.data(), log_r.data()), ds::NumericalFailure);
 }
 
 TEST(Lyapunov, RandomBlockIsReproducible) {

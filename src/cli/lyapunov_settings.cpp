@@ -23,8 +23,8 @@ LyapunovOptions read_lyapunov_options(Config& config, int default_exponents) {
   o.seed = static_cast<std::uint64_t>(read_long(config, "seed", 1, 0));
   o.qr_every = static_cast<int>(std::min<long>(read_long(config, "qr_every", 1, 1), INT_MAX));
   o.batches = static_cast<int>(std::min<long>(read_long(config, "batches", o.batches, 2), INT_MAX));
-  if (o.exponents > 4096)
-    throw BadInput("`exponents = " + std::to_string(o.exponents) + "`: at most 4096 (only the leading ones are meant)");
+  if (o.exponents > 64)
+    throw BadInput("`exponents = " + std::to_string(o.exponents) + "`: at most 64 (only the leading ones are meant)");
   if (o.periods % o.qr_every != 0)
     throw BadInput("`periods = " + std::to_string(o.periods) + "` must be a multiple of `qr_every = " +
                    std::to_string(o.qr_every) + "`");
