@@ -139,35 +139,50 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
     result.note = "ncv = " + std::to_string(settings.ncv) + " reduced to the dimension n = " + std::to_string(n);
     settings.ncv = static_cast<int>(n);
   }
-  const Eigen::VectorXd start = start_vector(n, options.seed);
+  Eigen::VectorXd start;
+  if (options.start.size() == 0) {
+    start = start_vector(n, options.seed);
+  } else {
+    if (options.start.size() != n)
+      throw BadInput("FloquetOptions::start has " + std::to_string(options.start.size()) +
+                     " entries, the operator is " + std::to_string(n) + " x " + std::to_string(n));
+    if (!options.start.allFinite() || options.start.norm() == 0)
+      throw BadInput("FloquetOptions::start: must be finite and not zero");
+    start = options.start;
+  }
   krylov::RitzPairs pairs = options.solver == FloquetSolver::spectra
                                 ? krylov::spectra_ritz_pairs(op, settings, start)
                                 : krylov::arpack_ritz_pairs(op, settings, start);
   const std::vector<double> residual = ritz_residuals(op, pairs);
 
   // Expand the pairs into both conjugates, sort like the dense reference, keep nev.
-  std::vector<std::complex<double>> values;
-  std::vector<double> res;
+  struct Entry {
+    std::complex<double> value;
+    size_t pair;
+    bool conjugate;
+  };
+  std::vector<Entry> entries;
   for (size_t i = 0; i < pairs.values.size(); ++i) {
-    values.push_back(pairs.values[i]);
-    res.push_back(residual[i]);
-    if (pairs.values[i].imag() != 0) {
-      values.push_back(std::conj(pairs.values[i]));
-      res.push_back(residual[i]);
-    }
-  }
-  if (static_cast<int>(values.size()) < options.nev)
-    throw NumericalFailure("Krylov (" + to_string(options.solver) + "): only " + std::to_string(values.size()) +
-                           " Ritz values returned for nev = " + std::to_string(options.nev));
-  for (const auto& mu : values)
+    const auto mu = pairs.values[i];
     if (!std::isfinite(mu.real()) || !std::isfinite(mu.imag()))
       throw NumericalFailure("Krylov (" + to_string(options.solver) + "): non-finite Ritz value");
-  std::vector<std::complex<double>> sorted = values;
+    entries.push_back({mu, i, false});
+    if (mu.imag() != 0) entries.push_back({std::conj(mu), i, true});
+  }
+  if (static_cast<int>(entries.size()) < options.nev)
+    throw NumericalFailure("Krylov (" + to_string(options.solver) + "): only " + std::to_string(entries.size()) +
+                           " Ritz values returned for nev = " + std::to_string(options.nev));
+  std::vector<std::complex<double>> sorted;
+  for (const auto& e : entries) sorted.push_back(e.value);
   sort_by_modulus(sorted);
+  sorted.resize(options.nev);
+  if (options.keep_vectors) result.subspace.resize(n, options.nev);
   for (int k = 0; k < options.nev; ++k) {
-    const auto it = std::find(values.begin(), values.end(), sorted[k]);
-    result.multipliers.push_back(sorted[k]);
-    result.residuals.push_back(res[static_cast<size_t>(it - values.begin())]);
+    const auto it =
+        std::find_if(entries.begin(), entries.end(), [&](const Entry& e) { return e.value == sorted[k]; });
+    result.multipliers.push_back(it->value);
+    result.residuals.push_back(residual[it->pair]);
+    if (options.keep_vectors) result.subspace.col(k) = pairs.vectors.col(pairs.column[it->pair] + (it->conjugate ? 1 : 0));
   }
   result.ncv = settings.ncv;
   result.converged = pairs.converged;

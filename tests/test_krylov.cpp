@@ -3,6 +3,8 @@
 // pairs, forced non-convergence, routing of tiny problems to dense, bad options.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/model_impact.hpp"
@@ -178,4 +180,39 @@ TEST(Krylov, BadOptionsAreBadInput) {
   const FloquetResult r = solve(op, FloquetSolver::spectra, 6, 1000);
   EXPECT_EQ(r.ncv, op.rows());
   EXPECT_NE(r.note.find("reduced"), std::string::npos);
+}
+
+TEST(Krylov, UserStartVectorAndInvariantSubspace) {
+  auto op = zero_orbit_monodromy(MathieuModel(), 120);
+  const FloquetResult base = solve(op, FloquetSolver::spectra, 6);
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+    FloquetOptions o;
+    o.nev = 6;
+    o.solver = solver;
+    o.start = start_vector(op.rows(), 99);
+    o.keep_vectors = true;
+    const FloquetResult r = floquet_multipliers(op, o);
+    // another start vector, same converged multipliers (tolerance as in expect_backends_agree)
+    for (int k = 0; k < 6; ++k)
+      EXPECT_LE(std::abs(r.multipliers[k] - base.multipliers[k]), 1e-10 * std::abs(base.multipliers[0]));
+    // the kept columns span an invariant subspace: M S = S C for C = S^+ M S, up to the Ritz
+    // residuals (<= 1e-12 relative each) times |mu_1| / |mu_6| for the mixing of the columns
+    ASSERT_EQ(r.subspace.cols(), 6);
+    Eigen::MatrixXd MS;
+    op.apply_block(r.subspace, MS);
+    const Eigen::MatrixXd C = r.subspace.colPivHouseholderQr().solve(MS);
+    EXPECT_LE((MS - r.subspace * C).norm(), 1e-9 * MS.norm());
+    // and C carries the multipliers
+    Eigen::EigenSolver<Eigen::MatrixXd> es(C);
+    for (int k = 0; k < 6; ++k) {
+      double best = INFINITY;
+      for (int j = 0; j < 6; ++j) best = std::min(best, std::abs(es.eigenvalues()[j] - r.multipliers[k]));
+      EXPECT_LE(best, 1e-10 * std::abs(r.multipliers[0]));
+    }
+  }
+  FloquetOptions bad;
+  bad.start = Eigen::VectorXd::Ones(op.rows() + 1);
+  EXPECT_THROW(floquet_multipliers(op, bad), BadInput);
+  bad.start = Eigen::VectorXd::Zero(op.rows());
+  EXPECT_THROW(floquet_multipliers(op, bad), BadInput);
 }

@@ -47,6 +47,8 @@ struct FloquetOptions {
   double tolerance = 1e-12;     // relative Ritz residual at which a pair counts as converged
   int max_iterations = 300;     // Arnoldi iterations (1 + implicit restarts), ARPACK's MXITER
   std::uint64_t seed = 1;       // start vector = start_vector(n, seed) for both backends
+  Eigen::VectorXd start;        // when non-empty: the start vector instead (n finite entries, not all 0)
+  bool keep_vectors = false;    // fill FloquetResult::subspace (Krylov only)
 };
 
 struct FloquetResult {
@@ -61,6 +63,9 @@ struct FloquetResult {
   int iterations = 0;             // Arnoldi iterations taken (1 + restarts)
   int restarts = 0;               // implicit restarts = iterations - 1
   std::vector<double> residuals;  // per multiplier: |M v - mu v| / (|mu| |v|), from one extra application
+  // keep_vectors: n x nev real basis of the invariant subspace of the returned multipliers:
+  // column k = Re v_k when Im mu_k >= 0, Im v_k otherwise (a conjugate pair spans {Re v, Im v}).
+  Eigen::MatrixXd subspace;
 };
 
 // The nev leading multipliers. See the header comment for errors.
