@@ -1,13 +1,23 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds and runs the whole test suite:
 #  1. Release build, all tests (ctest);
-#  2. AddressSanitizer + UndefinedBehaviorSanitizer build, all tests
+#  2. install into a temporary prefix; build and run examples/user_model against the installed
+#     package (find_package(delayspec));
+#  3. AddressSanitizer + UndefinedBehaviorSanitizer build, all tests
 #     (skip with DELAYSPEC_NO_SANITIZE=1 for a quick local run).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 "$here/scripts/setup-debian.sh"
 "$here/scripts/build.sh" "$here/build"
 (cd "$here/build" && ctest --output-on-failure -j "$(nproc)")
+prefix=$(mktemp -d)
+trap 'rm -rf "$prefix"' EXIT
+cmake --install "$here/build" --prefix "$prefix/install" >/dev/null
+cmake -S "$here/examples/user_model" -B "$prefix/example" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$prefix/install" >/dev/null
+cmake --build "$prefix/example" >/dev/null
+"$prefix/example/user_model"
+"$prefix/install/bin/delayspec" --version
 if [ "${DELAYSPEC_NO_SANITIZE:-0}" != 1 ]; then
   "$here/scripts/build.sh" "$here/build-sanitize" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDELAYSPEC_SANITIZE=ON \
     -DDELAYSPEC_BUILD_BENCH=OFF

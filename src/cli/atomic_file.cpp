@@ -21,8 +21,9 @@ namespace {
 
 std::filesystem::path temporary_name(const std::filesystem::path& target) {
   static std::atomic<unsigned long> sequence{0};
-  const std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                           std::to_string(sequence.fetch_add(1));
+  std::string name(".");  // (append, not operator+: GCC 12 warns falsely on "." + string)
+  name.append(target.filename().string()).append(".tmp-").append(std::to_string(::getpid()));
+  name.append("-").append(std::to_string(sequence.fetch_add(1)));
   return target.parent_path() / name;
 }
 

@@ -4,6 +4,7 @@
 // work (so a typo fails fast, exit 2), computes, and writes one result: text on `out`, or with
 // --json exactly one JSON object on `out`. Progress and warnings go to `err`.
 // Exceptions: BadInput -> exit 2, NumericalFailure -> exit 3 (handled in run_cli).
+#include <map>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -30,6 +31,10 @@ int command_lyapunov(Config& config, const Invocation& inv);
 int command_sweep(Config& config, const Invocation& inv);
 int command_converge(Config& config, const Invocation& inv);
 int command_bench(Config& config, const Invocation& inv);
+int command_run(Config& config, const Invocation& inv);
+
+// The command table (name -> function); `run` dispatches a scene's analyses through it.
+const std::map<std::string, CommandFunction>& command_table();
 
 // Runs the program: parses argv, dispatches, maps errors to exit codes. Never throws.
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err);

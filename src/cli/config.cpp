@@ -53,10 +53,12 @@ void flatten(const toml::table& table, Config& config, const std::string& path, 
 
 }  // namespace
 
-Config Config::from_scene_file(const std::string& path) {
+namespace {
+
+Config parse_scene(const std::string& path, const std::string* text) {
   Config config;
   try {
-    toml::table table = toml::parse_file(path);
+    toml::table table = text ? toml::parse(*text, path) : toml::parse_file(path);
     std::set<std::string> seen;
     flatten(table, config, path, seen);
   } catch (const toml::parse_error& e) {
@@ -67,6 +69,12 @@ Config Config::from_scene_file(const std::string& path) {
   }
   return config;
 }
+
+}  // namespace
+
+Config Config::from_scene_file(const std::string& path) { return parse_scene(path, nullptr); }
+
+Config Config::from_scene_text(const std::string& text, const std::string& name) { return parse_scene(name, &text); }
 
 void Config::set_from_assignment(const std::string& assignment) {
   const auto eq = assignment.find('=');
@@ -171,7 +179,9 @@ const std::vector<std::string>& contract_keys() {
       "N_min", "N_max", "reference", "extrapolation_order", "extrapolation_order_step", "extrapolation_levels",
       "solvers", "dense_memory_limit_mb",
       // run, plot, chart, basin (scenes)
-      "analyses", "title"};
+      "analyses", "title",
+      // mackey-glass
+      "gamma", "n"};
   return keys;
 }
 
@@ -212,6 +222,7 @@ std::string closest_key(const std::string& key, const std::vector<std::string>& 
 }
 
 void Config::check_all_used() const {
+  if (collect_keys_only_) throw KeysCollected{used_};
   for (const auto& [key, value] : values_) {
     if (used_.count(key)) continue;
     std::vector<std::string> candidates(used_.begin(), used_.end());

@@ -18,6 +18,8 @@ class Config {
  public:
   // Parses a TOML scene file; BadInput when it cannot be read or parsed.
   static Config from_scene_file(const std::string& path);
+  // Parses TOML text; `name` stands for the file in messages. BadInput when it cannot be parsed.
+  static Config from_scene_text(const std::string& text, const std::string& name);
 
   // Applies "KEY=VALUE" (BadInput when there is no '=' or the key is empty).
   void set_from_assignment(const std::string& assignment);
@@ -40,6 +42,14 @@ class Config {
   // at most 2).
   void check_all_used() const;
 
+  // Keys read (or marked) so far.
+  const std::set<std::string>& used_keys() const { return used_; }
+
+  // Key collection for `delayspec run`: a scene validated before any analysis computes. When
+  // on, check_all_used() throws KeysCollected (carrying the keys read so far) instead of
+  // checking, which stops the command right before its heavy work.
+  void collect_keys_only(bool on) { collect_keys_only_ = on; }
+
   // All key/value pairs, for metadata in outputs.
   const std::map<std::string, std::string>& values() const { return values_; }
 
@@ -48,6 +58,13 @@ class Config {
   std::map<std::string, std::string> values_;
   std::map<std::string, std::string> origin_;
   mutable std::set<std::string> used_;
+  bool collect_keys_only_ = false;
+};
+
+// Thrown by check_all_used() in key-collection mode (not an error: not derived from
+// std::exception so that no error handler mistakes it for one).
+struct KeysCollected {
+  std::set<std::string> keys;
 };
 
 // Every key any command reads (the CLI contract plus documented extensions). A command that

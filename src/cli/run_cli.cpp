@@ -6,10 +6,9 @@
 
 #include "commands.hpp"
 #include "delayspec/errors.hpp"
+#include "delayspec/version.hpp"
 
 namespace delayspec::cli {
-
-namespace {
 
 const std::map<std::string, CommandFunction>& command_table() {
   static const std::map<std::string, CommandFunction> table = {
@@ -18,9 +17,12 @@ const std::map<std::string, CommandFunction>& command_table() {
       {"sweep", command_sweep},
       {"converge", command_converge},
       {"bench", command_bench},
+      {"run", command_run},
   };
   return table;
 }
+
+namespace {
 
 std::string command_list() {
   std::string list;
@@ -34,7 +36,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
   CLI::App app{"delayspec: stability spectra (Floquet multipliers, Lyapunov exponents) of periodically forced "
                "delay differential equations, matrix-free.\nCommands: " +
                command_list()};
-  app.set_version_flag("--version", "delayspec 0.1.0");
+  app.set_version_flag("--version", std::string("delayspec ") + DELAYSPEC_VERSION);
   std::string command;
   std::string scene;
   std::vector<std::string> assignments;
@@ -55,7 +57,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
     out << app.help();
     return 0;
   } catch (const CLI::CallForVersion& e) {
-    out << "delayspec 0.1.0\n";
+    out << "delayspec " << DELAYSPEC_VERSION << "\n";
     return 0;
   } catch (const CLI::ParseError& e) {
     err << "delayspec: error: " << e.what() << "\n";
@@ -78,6 +80,9 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
   try {
     Config config = scene.empty() ? Config() : Config::from_scene_file(scene);
     for (const auto& a : assignments) config.set_from_assignment(a);
+    // Scene-level keys (for `run`): any command may be given a scene that has them.
+    config.mark_used("analyses");
+    config.mark_used("title");
     return it->second(config, inv);
   } catch (const BadInput& e) {
     err << "delayspec " << command << ": bad input: " << e.what() << "\n";

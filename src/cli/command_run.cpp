@@ -1,0 +1,153 @@
+// delayspec run SCENE --out DIR: runs the analyses a scene lists (`analyses = ["floquet", ...]`),
+// each through the command table exactly as `delayspec NAME SCENE --json` would, and writes
+// DIR/NAME.json (the command's JSON plus a "metadata" object, see metadata.hpp) and a manifest
+// DIR/run.json. Every file is written atomically (atomic_file.hpp).
+//
+// The whole scene is validated before anything is computed: each analysis first runs in
+// key-collection mode (Config::collect_keys_only: it reads its keys and stops at
+// check_all_used()), then every key of the scene must be read by at least one analysis.
+// A key only one analysis reads is therefore not "unknown" to the others.
+#include <chrono>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "delayspec/errors.hpp"
+#include "metadata.hpp"
+#include "progress.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Analyses that are planned commands of delayspec but may be missing from this build.
+const std::set<std::string>& planned_analyses() {
+  static const std::set<std::string> names = {"simulate", "lyapunov", "sweep", "converge", "bench", "chart", "basin"};
+  return names;
+}
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const auto b = item.find_first_not_of(" \t");
+    const auto e = item.find_last_not_of(" \t");
+    if (b != std::string::npos) out.push_back(item.substr(b, e - b + 1));
+  }
+  return out;
+}
+
+std::vector<std::string> read_analyses(Config& config) {
+  const std::string text = config.get_string("analyses", "");
+  const std::vector<std::string> names = split_list(text);
+  if (names.empty())
+    throw BadInput("`analyses` is missing or empty: list what to run, e.g. analyses = [\"floquet\"] in the scene");
+  std::vector<std::string> available;
+  for (const auto& [name, fn] : command_table())
+    if (name != "run" && name != "plot") available.push_back(name);
+  std::string available_list;
+  for (const auto& a : available) available_list += (available_list.empty() ? "" : ", ") + a;
+  std::set<std::string> seen;
+  for (const auto& name : names) {
+    if (!seen.insert(name).second) throw BadInput("`analyses = " + text + "`: `" + name + "` is listed twice");
+    if (name == "run" || name == "plot")
+      throw BadInput("`analyses = " + text + "`: `" + name + "` is a command, not an analysis");
+    if (command_table().count(name)) continue;
+    if (planned_analyses().count(name))
+      throw BadInput("`analyses = " + text + "`: analysis `" + name + "` is not available in this build (available: " +
+                     available_list + ")");
+    const std::string suggestion = closest_key(name, available);
+    throw BadInput("`analyses = " + text + "`: unknown analysis `" + name + "`" +
+                   (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?") + " (available: " +
+                   available_list + ")");
+  }
+  return names;
+}
+
+// Runs `name` in key-collection mode and returns the keys it reads.
+std::set<std::string> keys_read_by(const std::string& name, const Config& config, const Invocation& inv) {
+  Config probe = config;
+  probe.collect_keys_only(true);
+  std::ostringstream sink_out, sink_err;
+  Invocation dry{.command = name, .scene = inv.scene, .json = true, .out_dir = std::nullopt, .quiet = true,
+                 .resume = false, .out = sink_out, .err = sink_err};
+  try {
+    command_table().at(name)(probe, dry);
+  } catch (const KeysCollected& collected) {
+    return collected.keys;
+  }
+  return probe.used_keys();  // a command that never checked its keys (it should): what it read
+}
+
+}  // namespace
+
+int command_run(Config& config, const Invocation& inv) {
+  const auto run_start = std::chrono::steady_clock::now();
+  const std::vector<std::string> analyses = read_analyses(config);
+  const std::string title = config.get_string("title", "");
+  if (!inv.out_dir) throw BadInput("`delayspec run` needs --out DIR: the directory the results are written to");
+  const fs::path dir = *inv.out_dir;
+
+  // 1. Validate the whole scene before computing anything.
+  std::set<std::string> known = {"analyses", "title"};
+  for (const auto& name : analyses) {
+    const std::set<std::string> keys = keys_read_by(name, config, inv);
+    known.insert(keys.begin(), keys.end());
+  }
+  for (const auto& [key, value] : config.values()) {
+    if (known.count(key)) continue;
+    std::vector<std::string> candidates(known.begin(), known.end());
+    candidates.insert(candidates.end(), contract_keys().begin(), contract_keys().end());
+    const std::string suggestion = closest_key(key, candidates);
+    throw BadInput("unknown key `" + key + "` (= " + value + "): no analysis of this scene reads it" +
+                   (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?"));
+  }
+
+  // 2. Run the analyses; each result file appears only once it is complete.
+  nlohmann::json manifest;
+  manifest["analyses"] = nlohmann::json::array();
+  if (!title.empty()) manifest["title"] = title;
+  Progress progress(inv.err, "run", static_cast<long>(analyses.size()), inv.quiet);
+  for (const auto& name : analyses) {
+    Config analysis_config = config;
+    for (const auto& key : known) analysis_config.mark_used(key);  // keys of the other analyses
+    std::ostringstream json_out;
+    Invocation analysis{.command = name, .scene = inv.scene, .json = true, .out_dir = inv.out_dir,
+                        .quiet = inv.quiet, .resume = inv.resume, .out = json_out, .err = inv.err};
+    const auto start = std::chrono::steady_clock::now();
+    const int status = command_table().at(name)(analysis_config, analysis);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (status != 0) return status;
+    nlohmann::json result;
+    try {
+      result = nlohmann::json::parse(json_out.str());
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error("analysis `" + name + "` printed no single JSON object: " + e.what());
+    }
+    result["metadata"] = metadata_json(make_metadata(name, inv.scene, config, result, seconds));
+    const fs::path file = dir / (name + ".json");
+    write_file_atomically(file, result.dump(2) + "\n");
+    manifest["analyses"].push_back({{"name", name}, {"file", file.filename().string()}, {"seconds", seconds}});
+    if (!inv.json) inv.out << name << ": wrote " << file.string() << " (" << format_duration(seconds) << ")\n";
+    progress.add();
+  }
+  progress.finish();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
+  manifest["metadata"] = metadata_json(make_metadata("run", inv.scene, config, nlohmann::json::object(), wall));
+  write_file_atomically(dir / "run.json", manifest.dump(2) + "\n");
+  if (inv.json) {
+    manifest["out"] = dir.string();
+    inv.out << manifest.dump(2) << "\n";
+  } else {
+    inv.out << "run: " << analyses.size() << " analyses in " << format_duration(wall) << "; results in "
+            << dir.string() << " (plot them: delayspec plot " << dir.string() << ")\n";
+  }
+  return 0;
+}
+
+}  // namespace delayspec::cli

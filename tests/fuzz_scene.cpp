@@ -1,0 +1,44 @@
+// libFuzzer target for the scene parser: arbitrary bytes as a scene file, then everything a
+// command does with a scene before computing (flatten, typed getters, the problem and orbit
+// keys, the grid, the unknown-key check). Bad input must end in BadInput; anything else (another
+// exception, a crash, a sanitizer report, a hang) is a finding.
+// Not part of the unit tests (the name does not match tests/test_*.cpp). Build and run:
+//     CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DDELAYSPEC_FUZZ=ON -DDELAYSPEC_BUILD_TESTS=OFF \
+//         -DDELAYSPEC_BUILD_BENCH=OFF
+//     ninja -C build-fuzz fuzz_scene
+//     build-fuzz/fuzz_scene -max_total_time=60 -max_len=512 tests/fuzz_corpus
+// (docs/fuzzing.md)
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "config.hpp"
+#include "delayspec/errors.hpp"
+#include "orbit_settings.hpp"
+#include "problem.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try {
+    delayspec::cli::Config config = delayspec::cli::Config::from_scene_text(text, "fuzz.toml");
+    // Every key the scene gives, through every typed getter (each must throw BadInput or succeed).
+    for (const auto& [key, value] : config.values()) {  // the getters below work on copies
+      for (int getter = 0; getter < 4; ++getter) {
+        delayspec::cli::Config copy = config;
+        try {
+          if (getter == 0) copy.get_double(key, 0);
+          if (getter == 1) copy.get_int(key, 0);
+          if (getter == 2) copy.get_int_list(key, {});
+          if (getter == 3) copy.get_choice(key, "on", {"on", "off"});
+        } catch (const delayspec::BadInput&) {
+        }
+      }
+    }
+    delayspec::cli::Problem problem = delayspec::cli::read_problem(config, 100);
+    delayspec::cli::read_orbit_settings(config);
+    config.get_string("analyses", "");
+    config.check_all_used();
+  } catch (const delayspec::BadInput&) {
+  }
+  return 0;
+}

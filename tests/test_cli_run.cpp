@@ -1,0 +1,133 @@
+// `delayspec run`: dispatch through the command table, metadata in every file, the whole scene
+// validated before any computation, and one test per bad-input path (exit 2, nothing written).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+#include "delayspec_test_paths.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliResult {
+  int status;
+  std::string out, err;
+};
+
+CliResult run(std::vector<std::string> args) {
+  args.insert(args.begin(), "delayspec");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const int status = delayspec::cli::run_cli(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {status, out.str(), err.str()};
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_run_" + name);
+  fs::remove_all(dir);
+  return dir;
+}
+
+std::string scene(const std::string& name, const std::string& text) {
+  const fs::path path = fs::temp_directory_path() / ("delayspec_test_run_" + name + ".toml");
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+const char* kLinearScene =
+    "title = \"linear test\"\nanalyses = [\"floquet\"]\nmodel = \"linear\"\na = -1\nb = 0.5\n"
+    "N = 40\nsolver = \"dense\"\nnev = 3\n";
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST(RunCli, WritesResultWithMetadataAndManifest) {
+  const fs::path dir = fresh_dir("ok");
+  const std::string path = scene("ok", kLinearScene);
+  CliResult r = run({"run", path, "--out", dir.string(), "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto manifest = nlohmann::json::parse(r.out);  // --json: exactly one object on stdout
+  EXPECT_EQ(manifest["analyses"][0]["name"], "floquet");
+
+  std::ifstream in(dir / "floquet.json");
+  auto result = nlohmann::json::parse(in);
+  const auto& meta = result["metadata"];
+  for (const char* key : {"delayspec_version", "command", "scene", "parameters", "N", "events", "jacobian",
+                          "wall_seconds", "finished_utc"})
+    EXPECT_TRUE(meta.contains(key)) << key;
+  EXPECT_EQ(meta["N"], 40);
+  EXPECT_EQ(meta["scene"], path);
+  EXPECT_EQ(meta["parameters"]["b"], "0.5");
+
+  // The same numbers as the command run on its own (run only dispatches).
+  CliResult direct = run({"floquet", path, "--json", "--set", "analyses=floquet", "--set", "title=x"});
+  ASSERT_EQ(direct.status, 0) << direct.err;
+  auto alone = nlohmann::json::parse(direct.out);
+  ASSERT_EQ(alone["multipliers"].size(), result["multipliers"].size());
+  for (size_t i = 0; i < alone["multipliers"].size(); ++i)
+    EXPECT_EQ(alone["multipliers"][i]["re"], result["multipliers"][i]["re"]);
+  EXPECT_TRUE(fs::exists(dir / "run.json"));
+}
+
+TEST(RunCli, DefaultSceneRuns) {
+  const fs::path dir = fresh_dir("default");
+  CliResult r = run({"run", DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml", "--out", dir.string(), "--set",
+                     "N=40", "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "floquet.json"));
+}
+
+struct RunBadInput {
+  const char* name;
+  std::vector<std::string> extra;  // appended to: run SCENE --out DIR
+  const char* expected;            // part of the message
+};
+
+void PrintTo(const RunBadInput& b, std::ostream* os) { *os << b.name; }
+
+class RunCliBadInput : public ::testing::TestWithParam<RunBadInput> {};
+
+TEST_P(RunCliBadInput, ExitsTwoWritesNothing) {
+  const RunBadInput b = GetParam();
+  const fs::path dir = fresh_dir(b.name);
+  std::vector<std::string> args = {"run", scene(b.name, kLinearScene), "--out", dir.string()};
+  args.insert(args.end(), b.extra.begin(), b.extra.end());
+  CliResult r = run(args);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, b.expected)) << r.err;
+  EXPECT_FALSE(fs::exists(dir)) << "validation happens before anything is written";
+}
+
+// clang-format off
+INSTANTIATE_TEST_SUITE_P(Paths, RunCliBadInput, ::testing::Values(
+    RunBadInput{"no_analyses", {"--set", "analyses="}, "`analyses` is missing or empty"},
+    RunBadInput{"typo_analysis", {"--set", "analyses=floqet"}, "unknown analysis `floqet`; did you mean `floquet`?"},
+    RunBadInput{"far_analysis", {"--set", "analyses=eigenfaces"}, "unknown analysis `eigenfaces` (available: "},
+    RunBadInput{"planned", {"--set", "analyses=floquet,basin"}, "analysis `basin` is not available in this build"},
+    RunBadInput{"twice", {"--set", "analyses=floquet,floquet"}, "`floquet` is listed twice"},
+    RunBadInput{"recursive", {"--set", "analyses=run"}, "`run` is a command, not an analysis"},
+    RunBadInput{"unknown_key", {"--set", "nevv=4"}, "unknown key `nevv` (= 4): no analysis of this scene reads it; did you mean `nev`?"},
+    RunBadInput{"bad_value", {"--set", "N=zero"}, "`N = zero`: not an integer"}));
+// clang-format on
+
+TEST(RunCli, NeedsOutDir) {
+  CliResult r = run({"run", scene("noout", kLinearScene)});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "needs --out DIR")) << r.err;
+}
+
+TEST(RunCli, UnwritableOutDirIsBadInput) {
+  const fs::path dir = fresh_dir("blocked");
+  fs::create_directories(dir);
+  std::ofstream(dir / "file") << "x";
+  CliResult r = run({"run", scene("blocked", kLinearScene), "--out", (dir / "file").string()});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "cannot write")) << r.err;
+}
