@@ -172,14 +172,18 @@ const std::vector<std::string>& contract_keys() {
       "b", "period",                                                            // linear
       "kappa", "delta", "eps",                                                  // mathieu
       // floquet and orbits
-      "nev", "solver", "orbit", "orbit_tolerance", "orbit_max_periods",
+      "nev", "solver", "orbit", "orbit_tolerance", "orbit_max_periods", "orbit_guess_periods",
+      "orbit_max_iterations", "ncv", "tol", "max_restarts", "seed",
       // lyapunov, converge, sweep, simulate
       "exponents", "periods", "transient", "Ns",
       // converge, bench (command_converge.cpp, command_bench.cpp)
       "N_min", "N_max", "reference", "extrapolation_order", "extrapolation_order_step", "extrapolation_levels",
       "solvers", "dense_memory_limit_mb",
       // run, plot, chart, basin (scenes)
-      "analyses", "title",
+      "analyses", "title", "threads",
+      "chart_x", "chart_y", "chart_x_range", "chart_y_range", "chart_x_points", "chart_y_points",
+      "basin_x", "basin_y", "basin_x_range", "basin_y_range", "basin_x_points", "basin_y_points",
+      "basin_transient", "basin_max_period", "basin_tolerance", "plot_gnuplot", "plot_width", "plot_height",
       // mackey-glass
       "gamma", "n"};
   return keys;

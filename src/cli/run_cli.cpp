@@ -18,6 +18,9 @@ const std::map<std::string, CommandFunction>& command_table() {
       {"converge", command_converge},
       {"bench", command_bench},
       {"run", command_run},
+      {"chart", command_chart},
+      {"basin", command_basin},
+      {"plot", command_plot},
   };
   return table;
 }
@@ -78,7 +81,8 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
                  .out = out,
                  .err = err};
   try {
-    Config config = scene.empty() ? Config() : Config::from_scene_file(scene);
+    // `plot DIR`: the positional argument is a results directory, not a scene.
+    Config config = scene.empty() || command == "plot" ? Config() : Config::from_scene_file(scene);
     for (const auto& a : assignments) config.set_from_assignment(a);
     // Scene-level keys (for `run`): any command may be given a scene that has them.
     config.mark_used("analyses");

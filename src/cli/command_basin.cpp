@@ -1,0 +1,153 @@
+// delayspec basin: basins of attraction over a grid of constant initial histories (paper
+// Fig. 6.1: (x0, v0) at k = 0). Each point is simulated for `basin_transient` stroboscopic
+// maps, then its attractor is classified by period detection on the section: the smallest
+// p <= basin_max_period with |U_{j+p} - U_j|_inf <= basin_tolerance (1 + |U_j|_inf) for
+// j = 0..basin_max_period (U_j the history after transient + j maps); period 0 when there is
+// none (chaotic, quasi-periodic, a longer period, or not yet settled). Each point also reports
+// max x over the section points (telling apart attractors of equal period) and the impacts.
+//
+// Keys: basin_x, basin_y (default x0, v0), basin_x_range, basin_y_range ([min, max]),
+// basin_x_points, basin_y_points (>= 2), basin_transient (default 400), basin_max_period
+// (default 8), basin_tolerance (default 1e-6), threads; plus the problem keys.
+// Output: JSON {"x", "y", "rows": [{"x", "y", "period", "max_section_x"}], "counts": {period: n}};
+// with --out DIR also DIR/basin.csv: x,y,period,max_section_x in gnuplot's grid format.
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "delayspec/stroboscopic_map.hpp"
+#include "metadata.hpp"
+#include "parallel_points.hpp"
+#include "parameter_grid.hpp"
+#include "problem.hpp"
+#include "progress.hpp"
+#include "section_period.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+
+struct Classification {
+  int period = 0;  // 0: no period <= max_period found
+  double max_section_x = NAN;
+};
+
+}  // namespace
+
+int command_basin(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  const ParameterAxis x = read_parameter_axis(config, "basin", "x", "x0", -3, 3, 15);
+  const ParameterAxis y = read_parameter_axis(config, "basin", "y", "v0", -3, 3, 15);
+  if (x.name == y.name) throw BadInput("`basin_x = basin_y = " + x.name + "`: the two axes must differ");
+  const long transient = config.get_int("basin_transient", 400);
+  if (transient < 0 || transient > 100000000)
+    throw BadInput("`basin_transient = " + std::to_string(transient) + "`: must be between 0 and 1e8");
+  const long max_period = config.get_int("basin_max_period", 8);
+  if (max_period < 1 || max_period > 10000)
+    throw BadInput("`basin_max_period = " + std::to_string(max_period) + "`: must be between 1 and 10000");
+  const double tolerance = config.get_double("basin_tolerance", 1e-6);
+  require_positive("basin_tolerance", tolerance);
+  const int threads = read_threads(config);
+  const Problem problem = read_problem(config, 50);
+  require_model_parameter(config, "basin_x", x.name, problem.model_name);
+  require_model_parameter(config, "basin_y", y.name, problem.model_name);
+  config.check_all_used();
+
+  const long count = x.points * y.points;
+  std::vector<Classification> result(static_cast<size_t>(count));
+  std::vector<std::string> failure(static_cast<size_t>(count));
+  Progress progress(inv.err, "basin", count, inv.quiet);
+  parallel_points(count, threads, [&](long i) {
+    Config point = config;
+    point.set(x.name, format_number(x.value(i % x.points)), "basin");
+    point.set(y.name, format_number(y.value(i / x.points)), "basin");
+    const Problem p = read_problem(point, 50);
+    std::visit(
+        [&](const auto& model) {
+          using Model = std::decay_t<decltype(model)>;
+          TrapezoidStepper<Model> stepper(model, step_options(p));
+          StroboscopicMap<Model> map(stepper, p.grid);
+          Eigen::VectorXd U = map.constant_history(model.initial_state());
+          for (long j = 0; j < transient; ++j) U = map.apply(U);
+          // Section sequence U_0 .. U_{2 P}: enough to test every p <= P on P + 1 pairs.
+          std::vector<Eigen::VectorXd> section(static_cast<size_t>(2 * max_period + 1));
+          section[0] = U;
+          for (long j = 1; j <= 2 * max_period; ++j) section[j] = map.apply(section[j - 1]);
+          Classification c;
+          c.max_section_x = -INFINITY;
+          for (const auto& S : section) {
+            if (!S.allFinite()) {
+              failure[i] = "trajectory not finite";
+              return;
+            }
+            c.max_section_x = std::max(c.max_section_x, S[S.size() - Model::d]);  // u_0's first component
+          }
+          c.period = section_period(section, max_period, tolerance);
+          result[i] = c;
+        },
+        p.model);
+    progress.add();
+  });
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::map<int, long> counts;
+  long failed = 0;
+  nlohmann::json rows = nlohmann::json::array();
+  for (long i = 0; i < count; ++i) {
+    nlohmann::json row = {{"x", x.value(i % x.points)}, {"y", y.value(i / x.points)}};
+    if (failure[i].empty()) {
+      row["period"] = result[i].period;
+      row["max_section_x"] = result[i].max_section_x;
+      ++counts[result[i].period];
+    } else {
+      row["period"] = nullptr;
+      row["failure"] = failure[i];
+      ++failed;
+    }
+    rows.push_back(row);
+  }
+  nlohmann::json count_json = nlohmann::json::object();
+  for (const auto& [period, n] : counts) count_json[std::to_string(period)] = n;
+  nlohmann::json json = {{"model", problem.model_name}, {"N", problem.N}, {"events", problem.events},
+                         {"jacobian", problem.jacobian}, {"x", x.name}, {"y", y.name},
+                         {"x_range", {x.min, x.max}}, {"y_range", {y.min, y.max}}, {"x_points", x.points},
+                         {"y_points", y.points}, {"transient", transient}, {"max_period", max_period},
+                         {"tolerance", tolerance}, {"counts", count_json}, {"failed_points", failed},
+                         {"threads", threads}, {"seconds", seconds}, {"rows", rows}};
+  if (inv.out_dir) {
+    AtomicFile csv(std::filesystem::path(*inv.out_dir) / "basin.csv");
+    csv.stream() << metadata_comment_lines(make_metadata("basin", inv.scene, config, json, seconds));
+    csv.stream() << x.name << "," << y.name << ",period,max_section_x\n";
+    csv.stream().precision(12);
+    for (long i = 0; i < count; ++i) {
+      if (i > 0 && i % x.points == 0) csv.stream() << "\n";
+      csv.stream() << x.value(i % x.points) << "," << y.value(i / x.points) << ",";
+      if (failure[i].empty())
+        csv.stream() << result[i].period << "," << result[i].max_section_x << "\n";
+      else
+        csv.stream() << "nan,nan\n";
+    }
+    csv.commit();
+  }
+  if (inv.json) {
+    inv.out << json.dump(2) << "\n";
+  } else {
+    inv.out << "delayspec basin: model " << problem.model_name << ", N = " << problem.N << ", " << x.name << " in ["
+            << x.min << ", " << x.max << "] x " << y.name << " in [" << y.min << ", " << y.max << "], " << count
+            << " points, transient " << transient << " periods\n";
+    for (const auto& [period, n] : counts)
+      inv.out << "  " << (period == 0 ? "no period <= " + std::to_string(max_period) : "period " + std::to_string(period))
+              << ": " << n << " points\n";
+    if (failed) inv.out << "  failed: " << failed << " points\n";
+    inv.out << "time: " << seconds << " s\n";
+  }
+  return 0;
+}
+
+}  // namespace delayspec::cli

@@ -1,0 +1,56 @@
+#include "parameter_grid.hpp"
+
+#include <algorithm>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "delayspec/errors.hpp"
+
+namespace delayspec::cli {
+
+ParameterAxis read_parameter_axis(Config& config, const std::string& prefix, const std::string& axis,
+                                  const std::string& default_name, double default_min, double default_max,
+                                  long default_points) {
+  ParameterAxis a;
+  a.name = config.get_string(prefix + "_" + axis, default_name);
+  const std::string range_key = prefix + "_" + axis + "_range";
+  const std::string range = config.get_string(range_key, format_number(default_min) + "," + format_number(default_max));
+  std::vector<double> values;
+  std::stringstream ss(range);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    Config one;  // the typed number parser, so that errors name the key
+    one.set(range_key, item, range_key);
+    try {
+      values.push_back(one.get_double(range_key, 0));
+    } catch (const BadInput&) {
+      throw BadInput("`" + range_key + " = " + range + "`: `" + item + "` is not a finite number");
+    }
+  }
+  if (values.size() != 2 || !(values[0] < values[1]))
+    throw BadInput("`" + range_key + " = " + range + "`: must be two numbers [min, max] with min < max");
+  a.min = values[0];
+  a.max = values[1];
+  const std::string points_key = prefix + "_" + axis + "_points";
+  a.points = config.get_int(points_key, default_points);
+  if (a.points < 2 || a.points > 100000)
+    throw BadInput("`" + points_key + " = " + std::to_string(a.points) + "`: must be between 2 and 100000");
+  return a;
+}
+
+void require_model_parameter(const Config& config, const std::string& key, const std::string& name,
+                             const std::string& model_name) {
+  if (!config.used_keys().count(name) || name == "N" || name == "model" || name == "orbit_period")
+    throw BadInput("`" + key + " = " + name + "`: not a numeric parameter of model " + model_name);
+}
+
+int read_threads(Config& config) {
+  const long hardware = std::max(1u, std::thread::hardware_concurrency());
+  const long threads = config.get_int("threads", hardware);
+  if (threads < 1 || threads > 1024)
+    throw BadInput("`threads = " + std::to_string(threads) + "`: must be between 1 and 1024");
+  return static_cast<int>(threads);
+}
+
+}  // namespace delayspec::cli

@@ -1,0 +1,34 @@
+#pragma once
+// The keys of a two-parameter grid (chart, basin): PREFIX_x / PREFIX_y name the parameters,
+// PREFIX_x_range / PREFIX_y_range are [min, max], PREFIX_x_points / PREFIX_y_points (>= 2) the
+// number of equally spaced values including both ends; and `threads` for running the points.
+#include <string>
+
+#include "config.hpp"
+
+namespace delayspec::cli {
+
+struct ParameterAxis {
+  std::string name;
+  double min = 0, max = 0;
+  long points = 0;
+  // The i-th value, i = 0..points-1: min + (max - min) i / (points - 1).
+  double value(long i) const { return min + (max - min) * static_cast<double>(i) / static_cast<double>(points - 1); }
+};
+
+// Reads PREFIX_AXIS, PREFIX_AXIS_range, PREFIX_AXIS_points (AXIS = "x" or "y"); BadInput naming
+// the key and value when the range is not two finite numbers min < max or points is not in
+// [2, 100000].
+ParameterAxis read_parameter_axis(Config& config, const std::string& prefix, const std::string& axis,
+                                  const std::string& default_name, double default_min, double default_max,
+                                  long default_points);
+
+// After read_problem(config): BadInput unless the axis names a numeric model parameter (a key
+// read_problem read, other than model and N).
+void require_model_parameter(const Config& config, const std::string& key, const std::string& name,
+                             const std::string& model_name);
+
+// The `threads` key: default the machine's hardware threads; BadInput unless 1..1024.
+int read_threads(Config& config);
+
+}  // namespace delayspec::cli

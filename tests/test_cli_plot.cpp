@@ -1,0 +1,101 @@
+// `delayspec plot`: renders PNG and SVG (gnuplot) from result files, atomically, and rejects
+// bad directories and settings with exit 2.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliResult {
+  int status;
+  std::string out, err;
+};
+
+CliResult run(std::vector<std::string> args) {
+  args.insert(args.begin(), "delayspec");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const int status = delayspec::cli::run_cli(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {status, out.str(), err.str()};
+}
+
+std::string head(const fs::path& p, size_t n) {
+  std::ifstream in(p, std::ios::binary);
+  std::string s(n, '\0');
+  in.read(s.data(), static_cast<std::streamsize>(n));
+  s.resize(static_cast<size_t>(in.gcount()));
+  return s;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_plot_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST(PlotCli, RendersMultipliersAndChartAsPngAndSvg) {
+  const fs::path dir = fresh_dir("render");
+  // Inputs written by the commands themselves.
+  CliResult f = run({"floquet", "--json", "--set", "model=linear", "--set", "N=20", "--set", "solver=dense",
+                     "--set", "nev=4"});
+  ASSERT_EQ(f.status, 0) << f.err;
+  std::ofstream(dir / "floquet.json") << f.out;
+  CliResult c = run({"chart", "--out", dir.string(), "--set", "model=mathieu", "--set", "N=10", "--set",
+                     "solver=dense", "--set", "chart_x_points=3", "--set", "chart_y_points=3"});
+  ASSERT_EQ(c.status, 0) << c.err;
+
+  CliResult p = run({"plot", dir.string(), "--json", "--set", "plot_width=300", "--set", "plot_height=200"});
+  ASSERT_EQ(p.status, 0) << p.err;
+  auto j = nlohmann::json::parse(p.out);
+  EXPECT_EQ(j["files"].size(), 4u);
+  for (const char* name : {"multipliers", "chart"}) {
+    EXPECT_EQ(head(dir / "plots" / (std::string(name) + ".png"), 8), std::string("\x89PNG\r\n\x1a\n", 8)) << name;
+    EXPECT_NE(head(dir / "plots" / (std::string(name) + ".svg"), 400).find("<svg"), std::string::npos) << name;
+    EXPECT_TRUE(fs::exists(dir / "plots" / (std::string(name) + ".gp"))) << name;
+  }
+  for (const auto& entry : fs::directory_iterator(dir / "plots"))
+    EXPECT_NE(entry.path().filename().string()[0], '.') << "temporary left behind: " << entry.path();
+}
+
+TEST(PlotCli, BadInputPaths) {
+  CliResult missing = run({"plot", "/nonexistent/results"});
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("not a directory"), std::string::npos) << missing.err;
+
+  CliResult none = run({"plot"});
+  EXPECT_EQ(none.status, 2);
+  EXPECT_NE(none.err.find("needs a results directory"), std::string::npos) << none.err;
+
+  const fs::path empty = fresh_dir("empty");
+  CliResult nothing = run({"plot", empty.string()});
+  EXPECT_EQ(nothing.status, 2);
+  EXPECT_NE(nothing.err.find("nothing to plot"), std::string::npos) << nothing.err;
+
+  CliResult width = run({"plot", empty.string(), "--set", "plot_width=5"});
+  EXPECT_EQ(width.status, 2);
+  EXPECT_NE(width.err.find("`plot_width = 5`"), std::string::npos) << width.err;
+
+  const fs::path dir = fresh_dir("nognuplot");
+  std::ofstream(dir / "floquet.json") << R"({"model": "linear", "N": 4, "solver": "dense",
+      "multipliers": [{"re": 0.5, "im": 0, "abs": 0.5}]})";
+  CliResult no_gnuplot = run({"plot", dir.string(), "--set", "plot_gnuplot=/nonexistent/gnuplot"});
+  EXPECT_EQ(no_gnuplot.status, 2);
+  EXPECT_NE(no_gnuplot.err.find("cannot run gnuplot"), std::string::npos) << no_gnuplot.err;
+  EXPECT_FALSE(fs::exists(dir / "plots" / "multipliers.png"));
+
+  std::ofstream(dir / "floquet.json") << "{ not json";
+  CliResult broken = run({"plot", dir.string()});
+  EXPECT_EQ(broken.status, 2);
+  EXPECT_NE(broken.err.find("not JSON"), std::string::npos) << broken.err;
+}
