@@ -11,7 +11,8 @@
 //   converge.json             -> convergence: error against h, log-log, with h and h^2 guides;
 //                                speed_error: seconds against error
 //   bench.json                -> speed_error (bench rows)
-//   sweep.csv / sweep.json    -> exponents (against the parameter, zero line) and bifurcation
+//   exponents.csv (sweep)     -> exponents: against the swept parameter, error bars, zero line
+//   section.csv (sweep)       -> bifurcation: Poincare-section x against the swept parameter
 //   simulate.csv              -> phase portrait with Poincare points and the impact boundary x = e
 // Keys: plot_gnuplot (the program, default "gnuplot"), plot_width, plot_height (pixels of the PNG).
 #include <sys/wait.h>
@@ -131,7 +132,7 @@ std::string parameter(const std::map<std::string, std::string>& p, const std::st
 class Plotter {
  public:
   Plotter(fs::path dir, PlotSettings settings, const Invocation& inv)
-      : dir_(std::move(dir)), plots_(dir_ / "plots"), settings_(std::move(settings)), inv_(inv) {}
+      : dir_(std::move(dir)), plots_(fs::absolute(dir_) / "plots"), settings_(std::move(settings)), inv_(inv) {}
 
   // Writes NAME.gp (the body plots once; the header sets the PNG terminal, a footer replots as
   // SVG), runs gnuplot, renames the images into place.
@@ -155,7 +156,7 @@ class Plotter {
                                 " -e " + shell_quoted("DELAYSPEC_PNG=" + quoted(png_tmp.filename().string()) +
                                                       "; DELAYSPEC_SVG=" + quoted(svg_tmp.filename().string())) +
                                 " " + shell_quoted(script.filename().string()) + " 2>" +
-                                shell_quoted((plots_ / ("." + name + ".log")).string());
+                                shell_quoted("." + name + ".log");  // relative to plots/ (the cd)
     const int status = std::system(command.c_str());
     const fs::path log = plots_ / ("." + name + ".log");
     std::string log_text;
@@ -332,6 +333,56 @@ void plot_speed_error(Plotter& plotter, const std::vector<std::pair<std::string,
   plotter.figure("speed_error", gp.str());
 }
 
+std::string sweep_label(const fs::path& dir) {
+  if (!fs::exists(dir / "sweep.json")) return "parameter";
+  const Json j = read_json(dir / "sweep.json");
+  return j.contains("sweep_key") && j["sweep_key"].is_string() ? j["sweep_key"].get<std::string>() : "parameter";
+}
+
+// exponents.csv (sweep): parameter,lambda1..k,se1..k,... -> exponents against the parameter with
+// standard-error bars and the zero line.
+void plot_exponents(Plotter& plotter, const Table& t, const std::string& label) {
+  std::vector<int> lambda, se;
+  for (int i = 1;; ++i) {
+    const int l = t.column("lambda" + std::to_string(i));
+    if (l < 0) break;
+    lambda.push_back(l);
+    se.push_back(t.column("se" + std::to_string(i)));
+  }
+  if (lambda.empty() || t.column("parameter") != 0) throw BadInput("exponents.csv: expected columns parameter,lambda1,...");
+  std::ostringstream gp, plot;
+  const char* colours[] = {"#000000", "#d62728", "#1f77b4", "#9467bd", "#8c564b", "#e377c2"};
+  for (size_t i = 0; i < lambda.size(); ++i) {
+    std::string rows;
+    for (const auto& row : t.rows)
+      if (!row.empty() && static_cast<int>(row.size()) > lambda[i])
+        rows += number(row[0]) + " " + number(row[lambda[i]]) + " " + number(se[i] >= 0 ? row[se[i]] : 0) + "\n";
+    std::string name("l");  // (append: GCC 12 warns falsely on "l" + string)
+    name.append(std::to_string(i + 1));
+    gp << datablock(name, rows);
+    plot << (i == 0 ? "plot " : ", \\\n     ") << "$" << name << " using 1:2:3 with yerrorlines pt 7 ps 0.5 lc rgb '"
+         << colours[i % 6] << "' title '{/Symbol l}_" << i + 1 << "'";
+  }
+  gp << "set title " << quoted("Lyapunov exponents per period against " + label + " (zero line green)") << "\n";
+  gp << "set xlabel " << quoted(label) << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
+  gp << plot.str() << ", \\\n     0 with lines lc rgb '#2ca02c' lw 2 title 'zero'\n";
+  plotter.figure("exponents", gp.str());
+}
+
+// section.csv (sweep): parameter,x -> bifurcation diagram.
+void plot_bifurcation(Plotter& plotter, const Table& t, const std::string& label) {
+  if (t.columns.size() < 2) throw BadInput("section.csv: expected columns parameter,x");
+  std::string rows;
+  for (const auto& row : t.rows)
+    if (row.size() >= 2) rows += number(row[0]) + " " + number(row[1]) + "\n";
+  std::ostringstream gp;
+  gp << datablock("section", rows);
+  gp << "set title " << quoted("Bifurcation diagram: x on the Poincare section against " + label) << "\n";
+  gp << "set xlabel " << quoted(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
+  gp << "plot $section using 1:2 with dots lc rgb '#000000'\n";
+  plotter.figure("bifurcation", gp.str());
+}
+
 }  // namespace
 
 int command_plot(Config& config, const Invocation& inv) {
@@ -355,6 +406,8 @@ int command_plot(Config& config, const Invocation& inv) {
   if (fs::exists(dir / "floquet.json")) plot_multipliers(plotter, read_json(dir / "floquet.json"));
   if (fs::exists(dir / "chart.csv")) plot_chart(plotter, read_table(dir / "chart.csv"));
   if (fs::exists(dir / "basin.csv")) plot_basin(plotter, read_table(dir / "basin.csv"));
+  if (fs::exists(dir / "exponents.csv")) plot_exponents(plotter, read_table(dir / "exponents.csv"), sweep_label(dir));
+  if (fs::exists(dir / "section.csv")) plot_bifurcation(plotter, read_table(dir / "section.csv"), sweep_label(dir));
   if (fs::exists(dir / "converge.json")) {
     Json j = read_json(dir / "converge.json");
     plot_convergence(plotter, j);
@@ -366,7 +419,7 @@ int command_plot(Config& config, const Invocation& inv) {
   if (plotter.written().empty())
     throw BadInput("`" + dir.string() +
                    "`: nothing to plot (looked for floquet.json, chart.csv, basin.csv, converge.json, bench.json, "
-                   "sweep.csv, simulate.csv; see docs/formats.md)");
+                   "exponents.csv, section.csv, simulate.csv; see docs/formats.md)");
   if (inv.json) inv.out << Json{{"directory", dir.string()}, {"files", plotter.written()}}.dump(2) << "\n";
   return 0;
 }

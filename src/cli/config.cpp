@@ -167,7 +167,7 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
 const std::vector<std::string>& contract_keys() {
   static const std::vector<std::string> keys = {
       // problem (problem.cpp)
-      "model", "N", "orbit_period", "events", "jacobian",
+      "model", "N", "orbit_period", "events", "jacobian", "contact_substeps",
       "zeta", "e", "a", "beta", "omega", "k", "tau_over_T", "tau", "x0", "v0",  // impact
       "b", "period",                                                            // linear
       "kappa", "delta", "eps",                                                  // mathieu
@@ -179,6 +179,8 @@ const std::vector<std::string>& contract_keys() {
       // converge, bench (command_converge.cpp, command_bench.cpp)
       "N_min", "N_max", "reference", "extrapolation_order", "extrapolation_order_step", "extrapolation_levels",
       "solvers", "dense_memory_limit_mb",
+      "exponents", "periods", "transient", "Ns", "qr_every", "batches",
+      "sweep_key", "sweep_from", "sweep_to", "sweep_points", "section_points",
       // run, plot, chart, basin (scenes)
       "analyses", "title", "threads",
       "chart_x", "chart_y", "chart_x_range", "chart_y_range", "chart_x_points", "chart_y_points",

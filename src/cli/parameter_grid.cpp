@@ -47,10 +47,10 @@ void require_model_parameter(const Config& config, const std::string& key, const
 
 int read_threads(Config& config) {
   const long hardware = std::max(1u, std::thread::hardware_concurrency());
-  const long threads = config.get_int("threads", hardware);
-  if (threads < 1 || threads > 1024)
-    throw BadInput("`threads = " + std::to_string(threads) + "`: must be between 1 and 1024");
-  return static_cast<int>(threads);
+  const long threads = config.get_int("threads", 0);
+  if (threads < 0 || threads > 4096)
+    throw BadInput("`threads = " + std::to_string(threads) + "`: must be 0 (all cores) or a number of threads up to 4096");
+  return static_cast<int>(threads == 0 ? hardware : threads);
 }
 
 }  // namespace delayspec::cli

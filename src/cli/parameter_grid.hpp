@@ -28,7 +28,8 @@ ParameterAxis read_parameter_axis(Config& config, const std::string& prefix, con
 void require_model_parameter(const Config& config, const std::string& key, const std::string& name,
                              const std::string& model_name);
 
-// The `threads` key: default the machine's hardware threads; BadInput unless 1..1024.
+// The `threads` key (as `sweep`): 0 (the default) = the machine's hardware threads; BadInput
+// unless 0..4096.
 int read_threads(Config& config);
 
 }  // namespace delayspec::cli

@@ -86,6 +86,7 @@ std::string Progress::describe(long done, double seconds) const {
 void Progress::add(long count) {
   if (quiet_) return;
   const long done = done_.fetch_add(count, std::memory_order_relaxed) + count;
+  if (total_ > 0 && done >= total_) return;  // the last report is finish()'s
   const double seconds = elapsed_seconds();
   double due = next_report_seconds_.load(std::memory_order_relaxed);
   if (seconds < due) return;
