@@ -107,7 +107,7 @@ TEST_P(RunCliBadInput, ExitsTwoWritesNothing) {
 
 // clang-format off
 INSTANTIATE_TEST_SUITE_P(Paths, RunCliBadInput, ::testing::Values(
-    RunBadInput{"no_analyses", {"--set", "analyses="}, "`analyses` is missing or empty"},
+    RunBadInput{"empty_analyses", {"--set", "analyses="}, "`analyses` is empty"},
     RunBadInput{"typo_analysis", {"--set", "analyses=floqet"}, "unknown analysis `floqet`; did you mean `floquet`?"},
     RunBadInput{"far_analysis", {"--set", "analyses=eigenfaces"}, "unknown analysis `eigenfaces` (available: "},
     RunBadInput{"twice", {"--set", "analyses=floquet,floquet"}, "`floquet` is listed twice"},

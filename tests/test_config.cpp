@@ -166,3 +166,25 @@ TEST(ClosestKey, ThresholdsByLength) {
   EXPECT_EQ(closest_key("transiant", keys), "transient");
   EXPECT_EQ(closest_key("solvers_x", keys), "");   // 3 edits
 }
+
+TEST(ConfigErrors, NonAsciiOutsideStringsAndCommentsIsRejected) {
+  // Regression (fuzz_scene): toml++ 3.3.0 reaches undefined behaviour on U+00A1 after `=`.
+  const std::string m = bad_input_message([] { Config::from_scene_text("N = 4\nmodel = \xc2\xa1\n", "x.toml"); });
+  EXPECT_TRUE(contains(m, "non-ASCII character outside a string or comment (line 2, column 9)")) << m;
+  const std::string crash = "model =\xef\xbb\xbb" "abetau\"\newsrb\"\n_Cax_delta =3\n";  // the fuzzer's input
+  EXPECT_TRUE(contains(bad_input_message([&] { Config::from_scene_text(crash, "c.toml"); }), "non-ASCII"));
+}
+
+TEST(Config, NonAsciiInStringsAndCommentsIsFine) {
+  Config c = Config::from_scene_text(
+      "title = \"Z\xc3\xbcrich \\\" \xc3\x9f\"  # caf\xc3\xa9\nname = 'M\xc3\xbcller'\n"
+      "note = \"\"\"\nmulti \xc2\xa1\n\"\"\"\nN = 3\n",
+      "ok.toml");
+  EXPECT_EQ(c.get_int("N", 0), 3);
+  EXPECT_EQ(c.get_string("name", ""), "M\xc3\xbcller");
+}
+
+TEST(ConfigErrors, DirectoryIsNotAScene) {
+  const std::string m = bad_input_message([] { Config::from_scene_file(std::filesystem::temp_directory_path().string()); });
+  EXPECT_TRUE(contains(m, "cannot be read")) << m;
+}

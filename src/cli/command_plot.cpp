@@ -243,30 +243,47 @@ void plot_chart(Plotter& plotter, const Table& t) {
 
 void plot_basin(Plotter& plotter, const Table& t) {
   if (t.columns.size() < 3) throw BadInput("basin.csv: expected columns x,y,period");
+  // Fixed colours per period (an rgbimage, so that a period has the same colour in every figure):
+  // 0 (no period found: chaotic or longer) black, then a qualitative palette.
+  static const int rgb[10][3] = {{17, 17, 17},  {31, 119, 180}, {44, 160, 44},  {148, 103, 189}, {140, 86, 75},
+                                 {214, 39, 40}, {255, 127, 14}, {188, 189, 34}, {227, 119, 194}, {127, 127, 127}};
   std::string rows;
-  double max_period = 1;
+  std::map<int, long> present;
   for (const auto& row : t.rows) {
-    rows += row.empty() ? "\n" : number(row[0]) + " " + number(row[1]) + " " + number(row[2]) + "\n";
-    if (!row.empty() && std::isfinite(row[2])) max_period = std::max(max_period, row[2]);
+    if (row.empty()) {
+      rows += "\n";
+      continue;
+    }
+    const int period = std::isfinite(row[2]) ? static_cast<int>(row[2]) : -1;
+    const int* c = period >= 0 ? rgb[period % 10] : rgb[9];
+    rows += number(row[0]) + " " + number(row[1]) + " " + std::to_string(c[0]) + " " + std::to_string(c[1]) + " " +
+            std::to_string(c[2]) + "\n";
+    ++present[period];
   }
   std::ostringstream gp;
   gp << datablock("basin", rows);
-  gp << "set title " << quoted("Basins of attraction: period on the section (0: none <= max period, chaotic or "
-                               "longer), model " + parameter(t.metadata, "model", "?") + ", k = " +
-                               parameter(t.metadata, "k", "0"))
+  gp << "set title " << quoted("Basins of attraction, model " + parameter(t.metadata, "model", "?") + ", k = " +
+                               parameter(t.metadata, "k", "0") + ", N = " + parameter(t.metadata, "N", "default"))
      << "\n";
   gp << "set xlabel " << quoted(t.columns[0]) << "\nset ylabel " << quoted(t.columns[1]) << "\n";
-  gp << "set cbrange [-0.5:" << max_period + 0.5 << "]\nset cbtics 1\nset cblabel 'period'\n";
-  gp << "set palette maxcolors " << static_cast<int>(max_period) + 1
-     << "\nset palette defined (0 '#111111', 1 '#1f77b4', 2 '#2ca02c', 3 '#9467bd', 4 '#8c564b', 5 '#d62728', "
-        "6 '#e377c2', 7 '#7f7f7f', 8 '#bcbd22')\n";
-  gp << "set autoscale fix\nset key off\n";
+  gp << "set autoscale fix\nset key outside right top box opaque\nset style fill solid 1.0\n";
+  std::ostringstream legend;
+  for (const auto& [period, n] : present) {
+    const int* c = period >= 0 ? rgb[period % 10] : rgb[9];
+    char colour[16];
+    std::snprintf(colour, sizeof colour, "#%02x%02x%02x", c[0], c[1], c[2]);
+    const std::string label = period < 0   ? "failed"
+                              : period == 0 ? "no period (chaotic?)"
+                                            : "period " + std::to_string(period);
+    legend << ", \\\n     NaN with boxes lc rgb '" << colour << "' title " << quoted(label + " (" + std::to_string(n) + ")");
+  }
+  std::string impact_line;
   if (t.columns[0] == "x0" && parameter(t.metadata, "model", "impact") == "impact") {
     const std::string e = parameter(t.metadata, "e", "1.26");
-    gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#00bfff' lw 2 front\n";
-    gp << "set label 'x = e' at " << e << ", graph 0.95 offset 0.5,0 tc rgb '#00bfff' front\n";
+    gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#00bfff' lw 3 front\n";
+    impact_line = ", \\\n     NaN with lines lc rgb '#00bfff' lw 3 title 'impact boundary x = e'";
   }
-  gp << "plot $basin using 1:2:3 with image\n";
+  gp << "plot $basin using 1:2:3:4:5 with rgbimage notitle" << legend.str() << impact_line << "\n";
   plotter.figure("basin", gp.str());
 }
 
@@ -279,51 +296,81 @@ double first_error(const Json& row) {
   return NAN;
 }
 
-void plot_convergence(Plotter& plotter, const Json& j) {
-  std::string rows;
-  double h0 = NAN, e0 = NAN;
-  for (const auto& row : j.at("rows")) {
-    const double N = row.at("N").get<double>();
-    const double h = row.contains("h") ? row["h"].get<double>() : 1.0 / N;
-    const double e = first_error(row);
-    if (!(e > 0)) continue;
-    rows += number(h) + " " + number(e) + " " + number(row.value("seconds", NAN)) + "\n";
-    if (std::isnan(h0)) h0 = h, e0 = e;
+// The studies of a converge result: one per events variant ("by_events"), else the top level.
+std::vector<std::pair<std::string, Json>> convergence_studies(const Json& j) {
+  std::vector<std::pair<std::string, Json>> out;
+  if (j.contains("by_events") && j["by_events"].is_array()) {
+    for (const auto& s : j["by_events"]) out.emplace_back("events = " + s.value("events", std::string("?")), s);
+  } else {
+    out.emplace_back(j.contains("events") && j["events"].is_string() ? "events = " + j["events"].get<std::string>()
+                                                                      : "error",
+                     j);
   }
-  if (rows.empty()) throw BadInput("converge.json: no row with a positive error to plot");
-  const bool has_h = !j.at("rows").empty() && j["rows"][0].contains("h");
-  std::ostringstream gp;
-  gp << datablock("conv", rows);
-  gp << "set title " << quoted("Convergence of |{/Symbol m}_1| (reference: " + j.value("reference", std::string("?")) +
-                               ")")
+  return out;
+}
+
+void plot_convergence(Plotter& plotter, const Json& j) {
+  const char* colours[] = {"#d62728", "#1f77b4", "#2ca02c", "#9467bd"};
+  std::ostringstream gp, plot;
+  double h0 = NAN, e0 = NAN;
+  bool has_h = true;
+  int block = 0;
+  for (const auto& [label, study] : convergence_studies(j)) {
+    std::string rows;
+    for (const auto& row : study.at("rows")) {
+      const double N = row.at("N").get<double>();
+      has_h = has_h && row.contains("h");
+      const double h = row.contains("h") ? row["h"].get<double>() : 1.0 / N;
+      const double e = first_error(row);
+      if (!(e > 0)) continue;
+      rows += number(h) + " " + number(e) + "\n";
+      if (std::isnan(h0) || e > e0) h0 = h, e0 = e;  // guides through the largest error
+    }
+    if (rows.empty()) continue;
+    std::string name("c");
+    name.append(std::to_string(block));
+    gp << datablock(name, rows);
+    plot << (block == 0 ? "plot " : ", \\\n     ") << "$" << name << " using 1:2 with linespoints pt 7 lw 2 lc rgb '"
+         << colours[block % 4] << "' title " << quoted(label);
+    ++block;
+  }
+  if (block == 0) throw BadInput("converge.json: no row with a positive error to plot");
+  gp << "set title " << quoted("Convergence of the leading multiplier (reference: " +
+                               j.value("reference", std::string("?")) + ")")
      << "\n";
-  gp << "set logscale xy\nset grid\nset format y '10^{%L}'\nset key top left\n";
-  gp << "set xlabel " << quoted(has_h ? "h" : "1/N (proportional to h)") << "\nset ylabel 'error'\n";
+  gp << "set logscale xy\nset grid\nset format y '10^{%L}'\nset key bottom right\n";
+  gp << "set xlabel " << quoted(has_h ? "h" : "1/N (h = tau/N)") << "\nset ylabel 'error of {/Symbol m}_1'\n";
   gp << "h0 = " << number(h0) << "; e0 = " << number(e0) << "\n";
-  gp << "plot $conv using 1:2 with linespoints pt 7 lw 2 lc rgb '#d62728' title 'error', \\\n"
-        "     e0*(x/h0) with lines dt 2 lc rgb '#555555' title 'slope 1 (h)', \\\n"
-        "     e0*(x/h0)**2 with lines dt 3 lc rgb '#1f77b4' title 'slope 2 (h^2)'\n";
+  gp << plot.str() << ", \\\n     e0*(x/h0) with lines dt 2 lc rgb '#555555' title 'slope 1 (h)', \\\n"
+     << "     e0*(x/h0)**2 with lines dt 3 lc rgb '#000000' title 'slope 2 (h^2)'\n";
   plotter.figure("convergence", gp.str());
 }
 
 void plot_speed_error(Plotter& plotter, const std::vector<std::pair<std::string, Json>>& sources) {
   std::ostringstream gp, plot;
   int block = 0;
-  for (const auto& [label, j] : sources) {
-    std::map<std::string, std::string> by_solver;
-    for (const auto& row : j.at("rows")) {
-      const double e = first_error(row);
-      const double s = row.value("seconds", NAN);
-      if (!(e > 0) || !(s > 0)) continue;
-      const std::string solver = row.contains("solver") ? row["solver"].get<std::string>() : label;
-      by_solver[solver] += number(e) + " " + number(s) + " " + number(row.value("N", 0.0)) + "\n";
-    }
-    for (const auto& [solver, rows] : by_solver) {
-      std::string name("s");  // (append: GCC 12 warns falsely on "s" + string)
-      name.append(std::to_string(block++));
-      gp << datablock(name, rows);
-      plot << (plot.tellp() > 0 ? ", \\\n     " : "plot ") << "$" << name
-           << " using 1:2 with linespoints pt 7 lw 2 title " << quoted(solver);
+  for (const auto& [source, whole] : sources) {
+    std::vector<std::pair<std::string, Json>> parts;
+    if (source == "converge") parts = convergence_studies(whole);
+    else parts.emplace_back(source, whole);
+    for (const auto& [label, j] : parts) {
+      std::map<std::string, std::string> by_solver;
+      for (const auto& row : j.at("rows")) {
+        const double e = first_error(row);
+        const double s = row.value("seconds", NAN);
+        if (!(e > 0) || !(s > 0)) continue;
+        const std::string solver = row.contains("solver") && row["solver"].is_string()
+                                       ? source + ": " + row["solver"].get<std::string>()
+                                       : source + ": " + label;
+        by_solver[solver] += number(e) + " " + number(s) + " " + number(row.value("N", 0.0)) + "\n";
+      }
+      for (const auto& [solver, rows] : by_solver) {
+        std::string name("s");  // (append: GCC 12 warns falsely on "s" + string)
+        name.append(std::to_string(block++));
+        gp << datablock(name, rows);
+        plot << (plot.tellp() > 0 ? ", \\\n     " : "plot ") << "$" << name
+             << " using 1:2 with linespoints pt 7 lw 2 title " << quoted(solver);
+      }
     }
   }
   if (block == 0) return;

@@ -1,4 +1,5 @@
-// delayspec run SCENE --out DIR: runs the analyses a scene lists (`analyses = ["floquet", ...]`),
+// delayspec run SCENE --out DIR: runs the analyses a scene lists (`analyses = ["floquet", ...]`,
+// default ["floquet"]),
 // each through the command table exactly as `delayspec NAME SCENE --json` would, and writes
 // DIR/NAME.json (the command's JSON plus a "metadata" object, see metadata.hpp) and a manifest
 // DIR/run.json. Every file is written atomically (atomic_file.hpp).
@@ -43,10 +44,11 @@ std::vector<std::string> split_list(const std::string& text) {
 }
 
 std::vector<std::string> read_analyses(Config& config) {
-  const std::string text = config.get_string("analyses", "");
+  // A scene without `analyses` (e.g. one written for `delayspec floquet SCENE`) runs floquet.
+  const std::string text = config.get_string("analyses", "floquet");
   const std::vector<std::string> names = split_list(text);
   if (names.empty())
-    throw BadInput("`analyses` is missing or empty: list what to run, e.g. analyses = [\"floquet\"] in the scene");
+    throw BadInput("`analyses` is empty: list what to run, e.g. analyses = [\"floquet\"] in the scene");
   std::vector<std::string> available;
   for (const auto& [name, fn] : command_table())
     if (name != "run" && name != "plot") available.push_back(name);

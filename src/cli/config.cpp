@@ -5,6 +5,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -55,10 +57,68 @@ void flatten(const toml::table& table, Config& config, const std::string& path, 
 
 namespace {
 
+// TOML 1.0 allows non-ASCII only inside strings and comments. Rejecting it elsewhere before
+// toml++ sees the text is correct TOML, and it also guards against a bug of toml++ 3.3.0 (Debian
+// 12): its non-ASCII whitespace test reaches TOML_UNREACHABLE (undefined behaviour) for many
+// code points, e.g. U+00A1 or U+FEFB after `=` (found by tests/fuzz_scene.cpp, docs/fuzzing.md).
+void require_ascii_outside_strings(const std::string& text, const std::string& path) {
+  enum class State { code, comment, basic, literal, multi_basic, multi_literal } state = State::code;
+  long line = 1, column = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    ++column;
+    auto starts = [&](const char* token) { return text.compare(i, std::char_traits<char>::length(token), token) == 0; };
+    if (c == '\n') {
+      ++line;
+      column = 0;
+      if (state == State::comment || state == State::basic || state == State::literal) state = State::code;
+      continue;
+    }
+    switch (state) {
+      case State::code:
+        if (static_cast<unsigned char>(c) >= 0x80)
+          throw BadInput("scene `" + path + "`: non-ASCII character outside a string or comment (line " +
+                         std::to_string(line) + ", column " + std::to_string(column) + ")");
+        if (c == '#') state = State::comment;
+        else if (starts("\"\"\"")) state = State::multi_basic, i += 2, column += 2;
+        else if (starts("'''")) state = State::multi_literal, i += 2, column += 2;
+        else if (c == '"') state = State::basic;
+        else if (c == '\'') state = State::literal;
+        break;
+      case State::comment:
+        break;
+      case State::basic:
+        if (c == '\\') ++i, ++column;  // an escape: skip the escaped character
+        else if (c == '"') state = State::code;
+        break;
+      case State::literal:
+        if (c == '\'') state = State::code;
+        break;
+      case State::multi_basic:
+        if (c == '\\') ++i, ++column;
+        else if (starts("\"\"\"")) state = State::code, i += 2, column += 2;
+        break;
+      case State::multi_literal:
+        if (starts("'''")) state = State::code, i += 2, column += 2;
+        break;
+    }
+  }
+}
+
 Config parse_scene(const std::string& path, const std::string* text) {
   Config config;
+  std::string file_text;
+  if (!text) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in || std::filesystem::is_directory(path)) throw BadInput("scene `" + path + "`: cannot be read (missing file or no permission)");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    file_text = ss.str();
+    text = &file_text;
+  }
+  require_ascii_outside_strings(*text, path);
   try {
-    toml::table table = text ? toml::parse(*text, path) : toml::parse_file(path);
+    toml::table table = toml::parse(*text, path);
     std::set<std::string> seen;
     flatten(table, config, path, seen);
   } catch (const toml::parse_error& e) {
@@ -181,6 +241,8 @@ const std::vector<std::string>& contract_keys() {
       "solvers", "dense_memory_limit_mb",
       "exponents", "periods", "transient", "Ns", "qr_every", "batches",
       "sweep_key", "sweep_from", "sweep_to", "sweep_points", "section_points",
+      "reference", "extrapolation_levels", "extrapolation_order", "extrapolation_order_step",  // converge
+      "N_min", "N_max", "dense_memory_limit_mb",                                                // bench
       // run, plot, chart, basin (scenes)
       "analyses", "title", "threads",
       "chart_x", "chart_y", "chart_x_range", "chart_y_range", "chart_x_points", "chart_y_points",
