@@ -99,3 +99,27 @@ TEST(PlotCli, BadInputPaths) {
   EXPECT_EQ(broken.status, 2);
   EXPECT_NE(broken.err.find("not JSON"), std::string::npos) << broken.err;
 }
+
+TEST(PlotCli, RendersSweepSimulateConvergeAndBenchFiles) {
+  // Synthetic inputs in the formats the sweep, simulate, converge and bench commands write
+  // (docs/formats.md): every figure is produced as a PNG and an SVG.
+  const fs::path dir = fresh_dir("formats");
+  std::ofstream(dir / "exponents.csv") << "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds\n"
+                                          "0,0.1,-0.2,0.01,0.01,0.0127,-0.025,1\n0.5,-0.1,-0.3,0.01,0.02,-0.0127,-0.038,1\n";
+  std::ofstream(dir / "section.csv") << "parameter,x\n0,0.1\n0,0.2\n0.5,-0.05\n";
+  std::ofstream(dir / "sweep.json") << R"({"sweep_key": "k"})";
+  std::ofstream(dir / "trajectory.csv") << "t,x,v\n0,0,1\n0.1,0.1,0.99\n0.2,0.2,0.96\n0.3,0.29,0.9\n";
+  std::ofstream(dir / "poincare.csv") << "t,x,v\n0,0,1\n";
+  std::ofstream(dir / "impacts.csv") << "t,count\n0,0\n5,1\n9,2\n";
+  std::ofstream(dir / "converge.json") << R"({"reference": "exact", "by_events": [
+      {"events": "on", "rows": [{"N": 100, "error": 1e-3, "seconds": 0.1}, {"N": 200, "error": 2.5e-4, "seconds": 0.2}]},
+      {"events": "off", "rows": [{"N": 100, "error": 1e-2, "seconds": 0.1}, {"N": 200, "error": 5e-3, "seconds": 0.2}]}]})";
+  std::ofstream(dir / "bench.json") << R"({"rows": [{"N": 100, "solver": "spectra", "seconds": 0.01, "error": 1e-3},
+      {"N": 200, "solver": "spectra", "seconds": 0.02, "error": 2e-4}]})";
+  CliResult p = run({"plot", dir.string(), "--set", "plot_width=300", "--set", "plot_height=200"});
+  ASSERT_EQ(p.status, 0) << p.err;
+  for (const char* name : {"exponents", "bifurcation", "phase", "impacts", "convergence", "speed_error"}) {
+    EXPECT_EQ(head(dir / "plots" / (std::string(name) + ".png"), 8), std::string("\x89PNG\r\n\x1a\n", 8)) << name;
+    EXPECT_NE(head(dir / "plots" / (std::string(name) + ".svg"), 400).find("<svg"), std::string::npos) << name;
+  }
+}

@@ -148,3 +148,14 @@ TEST(RunCli, PlannedAnalysesAreReportedUnavailableUntilTheyExist) {
     }
   }
 }
+
+TEST(RunCli, SceneWithoutAnalysesRunsTheCommandItsKeysBelongTo) {
+  // A chart scene written for `delayspec chart SCENE` (no `analyses`): run infers chart.
+  const fs::path dir = fresh_dir("inferred");
+  const std::string path = scene("inferred", "model = \"mathieu\"\nN = 8\nsolver = \"dense\"\nchart_x_points = 2\n"
+                                             "chart_y_points = 2\n");
+  CliResult r = run({"run", path, "--out", dir.string(), "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "chart.json"));
+  EXPECT_TRUE(fs::exists(dir / "chart.csv"));
+}

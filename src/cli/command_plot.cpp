@@ -13,7 +13,8 @@
 //   bench.json                -> speed_error (bench rows)
 //   exponents.csv (sweep)     -> exponents: against the swept parameter, error bars, zero line
 //   section.csv (sweep)       -> bifurcation: Poincare-section x against the swept parameter
-//   simulate.csv              -> phase portrait with Poincare points and the impact boundary x = e
+//   trajectory.csv, poincare.csv (simulate) -> phase: portrait with Poincare points and x = e
+//   impacts.csv (simulate)    -> impacts: cumulative impact count against time
 // Keys: plot_gnuplot (the program, default "gnuplot"), plot_width, plot_height (pixels of the PNG).
 #include <sys/wait.h>
 
@@ -426,8 +427,70 @@ void plot_bifurcation(Plotter& plotter, const Table& t, const std::string& label
   gp << datablock("section", rows);
   gp << "set title " << quoted("Bifurcation diagram: x on the Poincare section against " + label) << "\n";
   gp << "set xlabel " << quoted(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
-  gp << "plot $section using 1:2 with dots lc rgb '#000000'\n";
+  gp << "plot $section using 1:2 with points pt 7 ps 0.3 lc rgb '#000000'\n";
   plotter.figure("bifurcation", gp.str());
+}
+
+// The impact boundary e of a simulate result: from DIR/simulate.json's metadata (run) or the
+// CSV's metadata lines, else the paper's 1.26.
+std::string impact_boundary(const fs::path& dir, const Table& t) {
+  if (fs::exists(dir / "simulate.json")) {
+    const Json j = read_json(dir / "simulate.json");
+    if (j.contains("metadata") && j["metadata"].contains("parameters") && j["metadata"]["parameters"].contains("e"))
+      return j["metadata"]["parameters"]["e"].get<std::string>();
+  }
+  return parameter(t.metadata, "e", "1.26");
+}
+
+// Rows of columns (a, b), at most max_rows of them (evenly thinned: a figure, not the data).
+std::string thinned(const Table& t, int a, int b, size_t max_rows, bool* was_thinned) {
+  size_t n = 0;
+  for (const auto& row : t.rows) n += !row.empty();
+  const size_t stride = n > max_rows ? (n + max_rows - 1) / max_rows : 1;
+  if (was_thinned) *was_thinned = stride > 1;
+  std::string rows;
+  size_t i = 0;
+  for (const auto& row : t.rows) {
+    if (row.empty() || static_cast<int>(row.size()) <= std::max(a, b)) continue;
+    if (i++ % stride == 0) rows += number(row[a]) + " " + number(row[b]) + "\n";
+  }
+  return rows;
+}
+
+// trajectory.csv + poincare.csv (simulate: t,x,v) -> phase portrait with the section points and
+// the impact boundary x = e.
+void plot_phase(Plotter& plotter, const fs::path& dir) {
+  const Table trajectory = read_table(dir / "trajectory.csv");
+  const int x = trajectory.column("x"), v = trajectory.column("v");
+  if (x < 0 || v < 0) return;  // a scalar model: no phase plane
+  bool thin = false;
+  std::ostringstream gp;
+  gp << datablock("trajectory", thinned(trajectory, x, v, 200000, &thin));
+  std::string section_plot;
+  if (fs::exists(dir / "poincare.csv")) {
+    const Table poincare = read_table(dir / "poincare.csv");
+    gp << datablock("section", thinned(poincare, poincare.column("x"), poincare.column("v"), 200000, nullptr));
+    section_plot = ", \\\n     $section using 1:2 with points pt 7 ps 0.8 lc rgb '#000000' title 'Poincare points'";
+  }
+  const std::string e = impact_boundary(dir, trajectory);
+  gp << "set title " << quoted(std::string("Phase portrait") + (thin ? " (trajectory thinned for drawing)" : "")) << "\n";
+  gp << "set xlabel 'x'\nset ylabel 'v = dx/dt'\nset grid\nset key outside bottom center horizontal\n";
+  gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#1f77b4' lw 2 front\n";
+  gp << "plot $trajectory using 1:2 with lines lc rgb '#999999' title 'trajectory'" << section_plot
+     << ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title 'impact boundary x = e = " << e << "'\n";
+  plotter.figure("phase", gp.str());
+}
+
+// impacts.csv (simulate: t,count) -> cumulative impacts against time (paper Fig. 6.3).
+void plot_impacts(Plotter& plotter, const fs::path& dir) {
+  const Table t = read_table(dir / "impacts.csv");
+  if (t.columns.size() < 2) throw BadInput("impacts.csv: expected columns t,count");
+  std::ostringstream gp;
+  gp << datablock("impacts", thinned(t, 0, 1, 200000, nullptr));
+  gp << "set title 'Number of impacts against time'\nset xlabel 't'\nset ylabel 'impacts (cumulative)'\n"
+        "set grid\nset key off\n";
+  gp << "plot $impacts using 1:2 with steps lw 2 lc rgb '#d62728'\n";
+  plotter.figure("impacts", gp.str());
 }
 
 }  // namespace
@@ -455,6 +518,8 @@ int command_plot(Config& config, const Invocation& inv) {
   if (fs::exists(dir / "basin.csv")) plot_basin(plotter, read_table(dir / "basin.csv"));
   if (fs::exists(dir / "exponents.csv")) plot_exponents(plotter, read_table(dir / "exponents.csv"), sweep_label(dir));
   if (fs::exists(dir / "section.csv")) plot_bifurcation(plotter, read_table(dir / "section.csv"), sweep_label(dir));
+  if (fs::exists(dir / "trajectory.csv")) plot_phase(plotter, dir);
+  if (fs::exists(dir / "impacts.csv")) plot_impacts(plotter, dir);
   if (fs::exists(dir / "converge.json")) {
     Json j = read_json(dir / "converge.json");
     plot_convergence(plotter, j);
@@ -466,7 +531,7 @@ int command_plot(Config& config, const Invocation& inv) {
   if (plotter.written().empty())
     throw BadInput("`" + dir.string() +
                    "`: nothing to plot (looked for floquet.json, chart.csv, basin.csv, converge.json, bench.json, "
-                   "exponents.csv, section.csv, simulate.csv; see docs/formats.md)");
+                   "exponents.csv, section.csv, trajectory.csv, impacts.csv; see docs/formats.md)");
   if (inv.json) inv.out << Json{{"directory", dir.string()}, {"files", plotter.written()}}.dump(2) << "\n";
   return 0;
 }

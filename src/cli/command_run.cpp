@@ -1,5 +1,5 @@
-// delayspec run SCENE --out DIR: runs the analyses a scene lists (`analyses = ["floquet", ...]`,
-// default ["floquet"]),
+// delayspec run SCENE --out DIR: runs the analyses a scene lists (`analyses = ["floquet", ...]`;
+// without the key, the one command the scene's keys belong to, see read_analyses),
 // each through the command table exactly as `delayspec NAME SCENE --json` would, and writes
 // DIR/NAME.json (the command's JSON plus a "metadata" object, see metadata.hpp) and a manifest
 // DIR/run.json. Every file is written atomically (atomic_file.hpp).
@@ -44,8 +44,17 @@ std::vector<std::string> split_list(const std::string& text) {
 }
 
 std::vector<std::string> read_analyses(Config& config) {
-  // A scene without `analyses` (e.g. one written for `delayspec floquet SCENE`) runs floquet.
-  const std::string text = config.get_string("analyses", "floquet");
+  // A scene without `analyses` (written for one command: `delayspec sweep SCENE`, ...) runs the
+  // command its keys belong to: sweep (sweep_key), converge (Ns), chart (chart_*), basin
+  // (basin_*), else floquet.
+  std::string inferred = "floquet";
+  for (const auto& [key, value] : config.values()) {
+    if (key == "sweep_key") inferred = "sweep";
+    else if (key == "Ns") inferred = "converge";
+    else if (key.rfind("chart_", 0) == 0) inferred = "chart";
+    else if (key.rfind("basin_", 0) == 0) inferred = "basin";
+  }
+  const std::string text = config.get_string("analyses", inferred);
   const std::vector<std::string> names = split_list(text);
   if (names.empty())
     throw BadInput("`analyses` is empty: list what to run, e.g. analyses = [\"floquet\"] in the scene");
