@@ -238,7 +238,7 @@ const std::vector<std::string>& contract_keys() {
       "exponents", "periods", "transient", "Ns",
       // converge, bench (command_converge.cpp, command_bench.cpp)
       "N_min", "N_max", "reference", "extrapolation_order", "extrapolation_order_step", "extrapolation_levels",
-      "solvers", "dense_memory_limit_mb",
+      "solvers", "dense_memory_limit_mb", "repeats",
       "exponents", "periods", "transient", "Ns", "qr_every", "batches",
       "sweep_key", "sweep_from", "sweep_to", "sweep_points", "section_points",
       "reference", "extrapolation_levels", "extrapolation_order", "extrapolation_order_step",  // converge
