@@ -93,6 +93,16 @@ TEST(Krylov, DelayedMathieu) { expect_backends_agree(zero_orbit_monodromy(Mathie
 
 TEST(Krylov, ImpactPeriodOneOrbit) { expect_backends_agree(impact_orbit_monodromy(250), 10); }
 
+TEST(Krylov, OddNevSplitsAConjugatePair) {
+  // The 5th and 6th multipliers of this orbit are a conjugate pair: nev = 5 keeps one half,
+  // which must be the same half as the dense sort (+imag first), with its own residual.
+  auto op = impact_orbit_monodromy(150);
+  const auto dense = solve(op, FloquetSolver::dense_lapack, 6).multipliers;
+  ASSERT_EQ(dense[5], std::conj(dense[4]));  // the case is what it claims
+  ASSERT_GT(dense[4].imag(), 0.0);
+  expect_backends_agree(op, 5);
+}
+
 TEST(Krylov, TwoMultipliersOfNearlyEqualModulus) {
   // Direct sum of two scalar linear DDEs on the same grid (block-diagonal step maps): its spectrum
   // is the union of the two spectra. The second has a = -1 + 1e-6, so the two leading (real)
