@@ -35,6 +35,7 @@ int command_run(Config& config, const Invocation& inv);
 int command_chart(Config& config, const Invocation& inv);
 int command_basin(Config& config, const Invocation& inv);
 int command_plot(Config& config, const Invocation& inv);
+int command_simulate(Config& config, const Invocation& inv);
 
 // The command table (name -> function); `run` dispatches a scene's analyses through it.
 const std::map<std::string, CommandFunction>& command_table();

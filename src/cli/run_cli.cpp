@@ -21,6 +21,7 @@ const std::map<std::string, CommandFunction>& command_table() {
       {"chart", command_chart},
       {"basin", command_basin},
       {"plot", command_plot},
+      {"simulate", command_simulate},
   };
   return table;
 }

@@ -1,0 +1,150 @@
+// delayspec simulate: trajectory, Poincare points and impact count over a time window, from the
+// model's constant initial history (simulation.hpp for what is counted).
+//
+// Keys: t_end (default 10 periods), t_start (start of the recorded window, default 0),
+// sample_every (grid points between trajectory samples, default 1), control_on_at (impact
+// model: k = 0 before this time, the scene's k after; default 0 = control throughout).
+// Output: text summary; --json one object; --out DIR writes trajectory.csv (t,x,v),
+// poincare.csv (t,x,v) and impacts.csv (t,count: cumulative impacts).
+#include <chrono>
+#include <filesystem>
+#include <iomanip>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "delayspec/simulation.hpp"
+#include "problem.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+template <int D>
+std::string columns() {
+  return D == 2 ? "t,x,v" : "t,x";
+}
+
+template <int D>
+void write_points(std::ostream& s, const std::vector<double>& t, const std::vector<Vec<D>>& y) {
+  s << std::setprecision(std::numeric_limits<double>::max_digits10);
+  s << columns<D>() << "\n";
+  for (size_t i = 0; i < t.size(); ++i) {
+    s << t[i];
+    for (int c = 0; c < D; ++c) s << "," << y[i][c];
+    s << "\n";
+  }
+}
+
+template <int D>
+nlohmann::json points_json(const std::vector<double>& t, const std::vector<Vec<D>>& y) {
+  nlohmann::json a = nlohmann::json::array();
+  for (size_t i = 0; i < t.size(); ++i) {
+    nlohmann::json row = {t[i]};
+    for (int c = 0; c < D; ++c) row.push_back(y[i][c]);
+    a.push_back(row);
+  }
+  return a;
+}
+
+}  // namespace
+
+int command_simulate(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  Problem problem = read_problem(config, 100);
+  const double period = problem.grid.period;
+  SimulationOptions options;
+  options.t_end = config.get_double("t_end", 10 * period);
+  options.t_start = config.get_double("t_start", 0);
+  options.sample_every = config.get_int("sample_every", 1);
+  const double control_on_at = config.get_double("control_on_at", 0);
+  require_finite("control_on_at", control_on_at);
+  if (control_on_at < 0) throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: must be >= 0");
+  if (control_on_at > 0 && problem.model_name != "impact")
+    throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: only for model = impact (it switches k)");
+  // A scene shared with the analysis commands (e.g. the default scene) may carry their keys.
+  for (const char* key : {"nev", "solver", "ncv", "tol", "max_restarts", "seed", "orbit", "orbit_tolerance",
+                          "orbit_max_periods", "orbit_max_iterations", "orbit_guess_periods", "exponents", "periods", "transient", "Ns"})
+    config.mark_used(key);
+  config.check_all_used();
+
+  nlohmann::json json;
+  std::ostringstream text;
+  std::visit(
+      [&](const auto& model) {
+        using Model = std::decay_t<decltype(model)>;
+        constexpr int D = Model::d;
+        const StepOptions step = step_options(problem);
+        Model before_model = model;
+        if constexpr (std::is_same_v<Model, ImpactModel>) {
+          if (control_on_at > 0) {
+            ImpactParameters p = model.parameters();
+            p.k = 0;
+            before_model = ImpactModel(p);
+            options.switch_time = control_on_at;
+          }
+        }
+        const TrapezoidStepper<Model> before(before_model, step), after(model, step);
+        Eigen::VectorXd U(problem.grid.dimension(D));
+        for (int j = 0; j <= problem.grid.M; ++j) U.template segment<D>(static_cast<long>(j) * D) = model.initial_state();
+        const SimulationRecord<D> rec = simulate(before, after, problem.grid, U, options);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+        std::vector<std::string> files;
+        if (inv.out_dir) {
+          const std::filesystem::path dir(*inv.out_dir);
+          AtomicFile traj(dir / "trajectory.csv");
+          write_points<D>(traj.stream(), rec.t, rec.y);
+          traj.commit();
+          AtomicFile poincare(dir / "poincare.csv");
+          write_points<D>(poincare.stream(), rec.poincare_t, rec.poincare_y);
+          poincare.commit();
+          AtomicFile impacts(dir / "impacts.csv");
+          impacts.stream() << std::setprecision(std::numeric_limits<double>::max_digits10) << "t,count\n";
+          for (size_t i = 0; i < rec.impact_times.size(); ++i) impacts.stream() << rec.impact_times[i] << "," << i + 1 << "\n";
+          impacts.commit();
+          files = {traj.path().string(), poincare.path().string(), impacts.path().string()};
+        }
+        if (inv.json) {
+          json["model"] = problem.model_name;
+          json["N"] = problem.N;
+          json["h"] = problem.grid.h;
+          json["events"] = problem.events;
+          json["contact_substeps"] = problem.contact_substeps;
+          json["t_start"] = options.t_start;
+          json["t_end"] = options.t_end;
+          json["steps"] = rec.steps;
+          json["control_on_at"] = control_on_at;
+          json["impacts"] = rec.impact_times.size();
+          json["impact_times"] = rec.impact_times;
+          json["poincare"] = points_json<D>(rec.poincare_t, rec.poincare_y);
+          json["columns"] = columns<D>();
+          json["samples"] = rec.t.size();
+          if constexpr (Model::has_switching) json["max_H"] = rec.max_H;
+          json["seconds"] = seconds;
+          json["files"] = files;
+        } else {
+          text << "delayspec simulate: model " << problem.model_name << ", " << problem.grid.describe() << ", events "
+               << problem.events << "\n";
+          text << "window [" << options.t_start << ", " << options.t_end << "], " << rec.steps << " steps";
+          if (control_on_at > 0) text << ", control (k) on from t = " << control_on_at;
+          text << "\n";
+          if constexpr (Model::has_switching)
+            text << "impacts (entries into H > 0): " << rec.impact_times.size() << "; max H at grid points: " << rec.max_H
+                 << "\n";
+          text << "Poincare points (t = m T): " << rec.poincare_t.size();
+          if (!rec.poincare_y.empty()) text << ", last " << rec.poincare_y.back().transpose();
+          text << "\n";
+          for (const auto& f : files) text << "wrote " << f << "\n";
+          text << "time: " << seconds << " s\n";
+        }
+      },
+      problem.model);
+  if (inv.json) inv.out << json.dump(2) << "\n";
+  else inv.out << text.str();
+  return 0;
+}
+
+}  // namespace delayspec::cli
