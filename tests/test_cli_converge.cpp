@@ -82,8 +82,11 @@ TEST(ConvergeCli, ImpactShowsEventsOnAndOffSideBySideAndWritesCsv) {
   EXPECT_EQ(j["by_events"][1]["events"], "off");
   EXPECT_EQ(j["rows"], j["by_events"][0]["rows"]);  // the contract's top level is the first variant
   // The note is never empty when no order is given: the output says why.
-  for (const auto& v : j["by_events"])
-    if (v["observed_order"].is_null()) EXPECT_FALSE(v["order_note"].get<std::string>().empty());
+  for (const auto& v : j["by_events"]) {
+    if (v["observed_order"].is_null()) {
+      EXPECT_FALSE(v["order_note"].get<std::string>().empty());
+    }
+  }
   std::ifstream csv(dir / "converge.csv");
   ASSERT_TRUE(csv.good());
   std::string line;
