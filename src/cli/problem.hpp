@@ -24,7 +24,7 @@ struct Problem {
   int orbit_period = 1;
   std::string events = "on";           // on | linear | off
   std::string jacobian = "consistent"; // consistent | frozen
-  int contact_substeps = 1;            // trapezoid sub-steps per contact piece of an event step
+  int contact_substeps = StepOptions{}.contact_substeps;  // trapezoid sub-steps per contact piece
   HistoryGrid grid;
 };
 
