@@ -127,6 +127,8 @@ TEST(CliSimulate, BadKeysExitTwoNamingThem) {
                                          {{"control_on_at=-1"}, "control_on_at"},
                                          {{"model=linear", "control_on_at=5"}, "control_on_at"},
                                          {{"contact_substeps=0"}, "contact_substeps"},
+                                         {{"events_before_control=maybe", "control_on_at=5"}, "events_before_control"},
+                                         {{"events_before_control=off"}, "events_before_control"},
                                          {{"t_ned=5"}, "t_ned"}}) {
     std::vector<std::string> args = {"simulate"};
     for (const auto& s : c.sets) {
@@ -137,4 +139,40 @@ TEST(CliSimulate, BadKeysExitTwoNamingThem) {
     EXPECT_EQ(r.status, 2) << c.named;
     EXPECT_NE(r.err.find(c.named), std::string::npos) << r.err;
   }
+}
+
+// Fig. 6.3's fair comparison: with events_before_control = on, runs that differ only in `events`
+// after control_on_at share the trajectory up to the switch bit for bit (same steps, same
+// stepper), and differ after it (the orbit impacts, and events off steps across the contacts
+// differently). Without the key the chaotic uncontrolled phase already separates them.
+TEST(CliSimulate, EventsBeforeControlGivesBothRunsTheSameStateAtTheSwitch) {
+  auto poincare = [](const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"simulate", kScene, "--set", "N=100", "--set", "k=1.4", "--set", "e=1.2609",
+                                     "--set", "x0=0", "--set", "v0=0", "--set", "control_on_at=300", "--set", "t_end=600",
+                                     "--json"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const CliResult r = run(args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(r.out)["poincare"];
+  };
+  const auto on = poincare({"--set", "events=on"});
+  const auto off = poincare({"--set", "events=off", "--set", "events_before_control=on"});
+  const auto off_throughout = poincare({"--set", "events=off"});
+  ASSERT_EQ(on.size(), off.size());
+  ASSERT_GT(on.size(), 70u);  // t = m T, T = 2 pi / 0.802 = 7.83
+  const double switch_time = 300;
+  size_t before = 0, differ_after = 0, differ_throughout = 0;
+  for (size_t i = 0; i < on.size(); ++i) {
+    const double t = on[i][0].get<double>();
+    if (t <= switch_time) {
+      ++before;
+      EXPECT_EQ(on[i], off[i]) << "t = " << t;  // identical up to and including the switch
+      differ_throughout += on[i] != off_throughout[i];
+    } else {
+      differ_after += on[i] != off[i];
+    }
+  }
+  EXPECT_GE(before, 38u);
+  EXPECT_GT(differ_after, 0u);
+  EXPECT_GT(differ_throughout, 0u);  // the key is what makes the states equal
 }

@@ -3,7 +3,10 @@
 //
 // Keys: t_end (default 10 periods), t_start (start of the recorded window, default 0),
 // sample_every (grid points between trajectory samples, default 1), control_on_at (impact
-// model: k = 0 before this time, the scene's k after; default 0 = control throughout).
+// model: k = 0 before this time, the scene's k after; default 0 = control throughout),
+// events_before_control (on | linear | off, default = events: the event handling before
+// control_on_at, so that runs differing only in `events` after the switch start from the same
+// state; the uncontrolled system is chaotic and would otherwise amplify the methods' difference).
 // Output: text summary; --json one object; --out DIR writes trajectory.csv (t,x,v),
 // poincare.csv (t,x,v) and impacts.csv (t,count: cumulative impacts).
 #include <chrono>
@@ -64,6 +67,10 @@ int command_simulate(Config& config, const Invocation& inv) {
   if (control_on_at < 0) throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: must be >= 0");
   if (control_on_at > 0 && problem.model_name != "impact")
     throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: only for model = impact (it switches k)");
+  Problem before_problem = problem;
+  before_problem.events = config.get_choice("events_before_control", problem.events, {"on", "linear", "off"});
+  if (before_problem.events != problem.events && !(control_on_at > 0))
+    throw BadInput("`events_before_control = " + before_problem.events + "`: needs control_on_at > 0");
   // A scene shared with the analysis commands (e.g. the default scene) may carry their keys.
   for (const char* key : {"nev", "solver", "ncv", "tol", "max_restarts", "seed", "orbit", "orbit_tolerance",
                           "orbit_max_periods", "orbit_max_iterations", "orbit_guess_periods", "exponents", "periods", "transient", "Ns"})
@@ -86,7 +93,7 @@ int command_simulate(Config& config, const Invocation& inv) {
             options.switch_time = control_on_at;
           }
         }
-        const TrapezoidStepper<Model> before(before_model, step), after(model, step);
+        const TrapezoidStepper<Model> before(before_model, step_options(before_problem)), after(model, step);
         Eigen::VectorXd U(problem.grid.dimension(D));
         for (int j = 0; j <= problem.grid.M; ++j) U.template segment<D>(static_cast<long>(j) * D) = model.initial_state();
         const SimulationRecord<D> rec = simulate(before, after, problem.grid, U, options);
@@ -117,6 +124,7 @@ int command_simulate(Config& config, const Invocation& inv) {
           json["t_end"] = options.t_end;
           json["steps"] = rec.steps;
           json["control_on_at"] = control_on_at;
+          json["events_before_control"] = before_problem.events;
           json["impacts"] = rec.impact_times.size();
           json["impact_times"] = rec.impact_times;
           json["poincare"] = points_json<D>(rec.poincare_t, rec.poincare_y);
@@ -129,7 +137,8 @@ int command_simulate(Config& config, const Invocation& inv) {
           text << "delayspec simulate: model " << problem.model_name << ", " << problem.grid.describe() << ", events "
                << problem.events << "\n";
           text << "window [" << options.t_start << ", " << options.t_end << "], " << rec.steps << " steps";
-          if (control_on_at > 0) text << ", control (k) on from t = " << control_on_at;
+          if (control_on_at > 0)
+            text << ", control (k) on from t = " << control_on_at << " (events " << before_problem.events << " before)";
           text << "\n";
           if constexpr (Model::has_switching)
             text << "impacts (entries into H > 0): " << rec.impact_times.size() << "; max H at grid points: " << rec.max_H

@@ -243,7 +243,7 @@ const std::vector<std::string>& contract_keys() {
       "sweep_key", "sweep_from", "sweep_to", "sweep_points", "section_points",
       "reference", "extrapolation_levels", "extrapolation_order", "extrapolation_order_step",  // converge
       "N_min", "N_max", "dense_memory_limit_mb",                                                // bench
-      "t_end", "t_start", "sample_every", "control_on_at",                                      // simulate
+      "t_end", "t_start", "sample_every", "control_on_at", "events_before_control",  // simulate
       // run, plot, chart, basin (scenes)
       "analyses", "title", "threads",
       "chart_x", "chart_y", "chart_x_range", "chart_y_range", "chart_x_points", "chart_y_points",
