@@ -6,24 +6,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "commands.hpp"
+#include "cli_test_support.hpp"
 #include "delayspec_test_paths.hpp"
 
 namespace {
 
-struct CliResult {
-  int status;
-  std::string out, err;
-};
-
-CliResult run(std::vector<std::string> args) {
-  args.insert(args.begin(), "delayspec");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  int status = delayspec::cli::run_cli(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {status, out.str(), err.str()};
-}
+using delayspec::testing::CliResult;
+using delayspec::testing::run;
 
 const std::string kScene = DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml";
 
