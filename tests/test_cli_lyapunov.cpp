@@ -2,6 +2,8 @@
 // naming key and value), files written point by point, --resume completing an interrupted sweep.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -72,6 +74,12 @@ TEST(LyapunovCli, JsonHasContractKeys) {
                           "transient", "seconds"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["exponents_per_period"].size(), 3u);
+  // the error and its two parts (lyapunov.hpp): error^2 = batch SE^2 + fluctuation bound^2
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(j["standard_error_per_period"][i].get<double>(),
+                std::hypot(j["batch_standard_error_per_period"][i].get<double>(),
+                           j["fluctuation_bound_per_period"][i].get<double>()),
+                1e-15 * j["standard_error_per_period"][i].get<double>()) << i;
   EXPECT_EQ(j["periods"], 40);
   EXPECT_EQ(j["transient"], 10);
   // period = tau = 1 by default for `linear`: per time equals per period

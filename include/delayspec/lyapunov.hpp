@@ -9,8 +9,40 @@
 // accumulated and the block is replaced by Q. The first `transient` periods (trajectory and
 // tangent block both advance, so the block has time to align with the leading Lyapunov
 // vectors) are discarded. Exponents come per stroboscopic period ("per period": one map, p
-// forcing periods when periods_per_map = p) and per unit time (divided by K h = p T), with a
-// standard error by batch means over the measured QR intervals.
+// forcing periods when periods_per_map = p) and per unit time (divided by K h = p T), with an
+// error that covers random and bounded deterministic fluctuations (below).
+//
+// Error of an exponent. Let x_1..x_I be the interval sums of log R_jj (I intervals of q =
+// qr_every periods, n = I q periods), S(i) = x_1 + .. + x_i, and the reported exponent
+// lambda = S(I) / n. Write S(i) = i q lambda_true + g(i): lambda - lambda_true = (g(I) - g(0)) / n.
+//   * Random fluctuations (chaos): g is a random walk, sd(g(I)) = sigma sqrt(n). Batch means
+//     estimate it: SE = sd(B batch means) / sqrt(B) ~ sigma / sqrt(n).
+//   * Bounded deterministic fluctuations: on a periodic orbit whose leading multipliers are a
+//     complex pair mu, conj(mu), prod R_11 = |M^n q0| = |mu|^n |S Rot(n arg mu) S^+ q0| with
+//     S = [Re v, Im v]: g oscillates with the rotation phase inside [-log cond S, log cond S]
+//     and never averages out; likewise the alignment of the block after a short transient adds
+//     a bounded excess. The error is then up to range(g) / n, and batch means miss it when the
+//     rotation per batch is near a multiple of 2 pi (every batch sees the same phase change):
+//     measured 60 SE on the impact orbit of tests/test_lyapunov.cpp.
+//   The detrended cumulative sum D(i) = S(i) - (i / I) S(I) = g(i) - g(0) - (i / I)(g(I) - g(0))
+//   is observable (D(0) = D(I) = 0). For a bounded g that goes through its range in P intervals,
+//   range_i D >= range g - (P / I) |g(I) - g(0)| >= |g(I) - g(0)| (1 - P / I), so
+//       fluctuation bound F = (max_i D(i) - min_i D(i)) / n
+//   bounds |lambda - lambda_true| up to the fraction P / I (small when the run covers many
+//   rotations or the excess dies out early). For a random walk D is a Brownian bridge whose
+//   range has mean sqrt(pi / 2) sigma sqrt(n) (Kuiper), so F ~ 1.25 SE. Reported error
+//   (standard_error_per_period, its historical name and the CLI key):
+//       error = sqrt(SE^2 + F^2).
+//   On a bounded fluctuation it is >= F, and where F falls short by the fraction P / I (an
+//   excess concentrated in the first P intervals, i.e. in the first batch) SE = |bias| exactly
+//   (one batch mean off by B |bias|, the others not: SE = |bias|), so the sum covers
+//   the bias with a margin of up to sqrt(2). On noise both parts estimate sigma / sqrt(n): the
+//   error is ~1.6 sigma / sqrt(n) (measured 1.6 on white noise), not a 1-sigma band but within
+//   a small factor of it. On chaotic runs the error measured 1.3x the batch SE (Mackey-Glass);
+//   for bounded fluctuations with a random end phase (the zero exponent of the flow direction)
+//   both SE and F overestimate the actual spread (SE by about sqrt(B), since it assumes
+//   random-walk scaling), so the error is a conservative bound there (tests/test_lyapunov.cpp).
+//   Both parts are also reported (batch_standard_error_per_period, fluctuation_bound_per_period).
 //
 // Layout (as StroboscopicMap and Monodromy): linear buffers of M + 1 + K slots for the
 // trajectory and for the block; slots 0..M hold the history at the start of a period, step l
@@ -34,11 +66,12 @@
 // Example:
 //   StroboscopicMap<LinearModel> map(TrapezoidStepper<LinearModel>(model), grid);
 //   LyapunovResult r = lyapunov_exponents(map, map.constant_history(Vec<1>(1)), LyapunovOptions{});
-//   r.per_time[0] +- r.standard_error_per_time[0]
+//   r.per_time[0] +- r.standard_error_per_time[0]   // the error of the header comment
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -64,8 +97,10 @@ struct LyapunovOptions {
 struct LyapunovResult {
   std::vector<double> per_period;                  // sum log |R_ii| / periods, largest first as computed
   std::vector<double> per_time;                    // per_period / (K h)
-  std::vector<double> standard_error_per_period;   // batch means: sd(batch means) / sqrt(batches)
-  std::vector<double> standard_error_per_time;
+  std::vector<double> standard_error_per_period;   // the error: sqrt(batch SE^2 + fluctuation bound^2) (header comment)
+  std::vector<double> standard_error_per_time;     // standard_error_per_period / (K h)
+  std::vector<double> batch_standard_error_per_period;  // batch means: sd(batch means) / sqrt(batches)
+  std::vector<double> fluctuation_bound_per_period;     // range of the detrended cumulative sum / periods
   long periods = 0, transient = 0;
   int qr_every = 1, batches = 0;
   double map_time = 0;            // K h: the time of one stroboscopic period
@@ -103,10 +138,16 @@ class TangentQR {
 // in [-1/2, 1/2) from a 64-bit mt19937 stream, the same on every platform).
 void random_block(double* block, long n, int k, std::uint64_t seed);
 
-// Mean per period and batch-means standard error from the per-interval sums of log |R_ii|
-// (interval_logs[i * k + j], intervals of `qr_every` periods each).
-void batch_statistics(const std::vector<double>& interval_logs, int k, int qr_every, int batches,
-                      std::vector<double>& mean_per_period, std::vector<double>& standard_error, int& batches_used);
+// Mean per period and its error (header comment) from the per-interval sums of log |R_ii|
+// (interval_logs[i * k + j], intervals of `qr_every` periods each; at least two intervals).
+struct LyapunovStatistics {
+  std::vector<double> mean_per_period;       // S(I) / n
+  std::vector<double> batch_standard_error;  // sd(batch means) / sqrt(batches)
+  std::vector<double> fluctuation_bound;     // (max_i D(i) - min_i D(i)) / n
+  std::vector<double> error;                 // sqrt(batch_standard_error^2 + fluctuation_bound^2)
+  int batches = 0;                           // batches used: min(batches, intervals)
+};
+LyapunovStatistics lyapunov_statistics(const std::vector<double>& interval_logs, int k, int qr_every, int batches);
 
 // Validates options against the dimension n (BadInput naming the CLI key).
 void validate_lyapunov_options(const LyapunovOptions& options, long n);
@@ -213,8 +254,12 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
     std::copy(log_r.begin(), log_r.end(), interval_logs.begin() + i * k);
   }
 
-  batch_statistics(interval_logs, k, options.qr_every, options.batches, result.per_period,
-                   result.standard_error_per_period, result.batches);
+  LyapunovStatistics stats = lyapunov_statistics(interval_logs, k, options.qr_every, options.batches);
+  result.per_period = std::move(stats.mean_per_period);
+  result.standard_error_per_period = std::move(stats.error);
+  result.batch_standard_error_per_period = std::move(stats.batch_standard_error);
+  result.fluctuation_bound_per_period = std::move(stats.fluctuation_bound);
+  result.batches = stats.batches;
   result.map_time = static_cast<double>(K) * h;
   for (int i = 0; i < k; ++i) {
     result.per_time.push_back(result.per_period[i] / result.map_time);

@@ -35,6 +35,8 @@ int command_lyapunov(Config& config, const Invocation& inv) {
     j["exponents_per_time"] = r.per_time;
     j["standard_error_per_period"] = r.standard_error_per_period;
     j["standard_error_per_time"] = r.standard_error_per_time;
+    j["batch_standard_error_per_period"] = r.batch_standard_error_per_period;
+    j["fluctuation_bound_per_period"] = r.fluctuation_bound_per_period;
     j["periods"] = r.periods;
     j["transient"] = r.transient;
     j["seconds"] = seconds;
@@ -53,7 +55,8 @@ int command_lyapunov(Config& config, const Invocation& inv) {
             << "\n";
     inv.out << r.per_period.size() << " leading Lyapunov exponents after a transient of " << r.transient
             << " periods, averaged over " << r.periods << " periods (period = " << r.map_time << " time units, QR every "
-            << r.qr_every << ", standard error from " << r.batches << " batch means):\n";
+            << r.qr_every << "; error = max(standard error of " << r.batches
+            << " batch means, range of the detrended cumulative sum / periods)):\n";
     char line[200];
     std::snprintf(line, sizeof line, "  %3s  %24s  %24s\n", "#", "per period", "per unit time");
     inv.out << line;

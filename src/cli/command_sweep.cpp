@@ -58,6 +58,8 @@ json point_record(const SweepPoint& p, const LyapunovResult& r, int d) {
   j["standard_error_per_period"] = r.standard_error_per_period;
   j["exponents_per_time"] = r.per_time;
   j["standard_error_per_time"] = r.standard_error_per_time;
+  j["batch_standard_error_per_period"] = r.batch_standard_error_per_period;
+  j["fluctuation_bound_per_period"] = r.fluctuation_bound_per_period;
   j["period_time"] = r.map_time;
   std::vector<double> x(r.section.rows());
   for (long i = 0; i < r.section.rows(); ++i) x[i] = r.section(i, 0);
