@@ -207,7 +207,7 @@ std::vector<int> match_by_proximity(const Multipliers& targets, const Multiplier
 }
 
 double correct_digits(double relative_error, double reference_precision) {
-  const double cap = -std::log10(std::max(reference_precision, kMinPrecision));
+  const double cap = -std::log10(std::max(reference_precision, kMinPrecision)) + 0.0;  // + 0.0: no "-0" at precision 1
   if (!(relative_error > 0)) return cap;
   return std::min(cap, -std::log10(relative_error));
 }
@@ -276,7 +276,7 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
   if (L >= 2)
     for (int k = 0; k < nev; ++k) {
       const Extrapolation e = richardson_extrapolate(h, track(k), options.richardson);
-      study.extrapolated.push_back({e.value, e.error_estimate, e.levels});
+      study.extrapolated.push_back({e.value, e.error_estimate, e.levels, e.note});
     }
 
   // The reference and its relative precision, per track.
@@ -289,7 +289,8 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
       precision = std::max(options.exact_precision, kMinPrecision);
     } else if (study.reference == ReferenceKind::extrapolated) {
       ref = study.extrapolated[k].value;
-      precision = std::max(study.extrapolated[k].error_estimate / std::max(std::abs(ref), scale_floor), kMinPrecision);
+      // relative; at most 1 (an infinite estimate certifies no digit)
+      precision = std::clamp(study.extrapolated[k].error_estimate / std::max(std::abs(ref), scale_floor), kMinPrecision, 1.0);
     } else {  // finest: its own error estimated from the last two levels, e ~ |x_f - x_{f-1}| / (r^p - 1)
       ref = matched[L - 1][k];
       const double r = double(options.Ns[L - 1]) / options.Ns[L - 2];
@@ -348,6 +349,12 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
     }
     const double s = slope(log_n, log_e);
     rr.column_orders.push_back(std::isfinite(s) ? std::optional<double>(-s) : std::nullopt);
+  }
+  if (L >= 2) {
+    const Extrapolation e = richardson_extrapolate(h, track(0), options.richardson);
+    rr.difference_orders.assign(e.column_orders.begin(), e.column_orders.begin() + columns);
+    rr.consistent.assign(e.column_consistent.begin(), e.column_consistent.begin() + columns);
+    rr.levels_used = e.levels;
   }
   return study;
 }

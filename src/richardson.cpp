@@ -1,6 +1,8 @@
 #include "delayspec/richardson.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -66,33 +68,110 @@ RichardsonTableau richardson_tableau(const std::vector<double>& h, const std::ve
   return tab;
 }
 
+namespace {
+
+// Weights of T[last][j] = sum_r w_r x_{last-j+r}: the first row of A^{-1}, i.e. A^T w = e_0.
+Eigen::VectorXd column_weights(const std::vector<double>& h, int last, int j, const RichardsonOptions& options) {
+  Eigen::MatrixXd A(j + 1, j + 1);
+  for (int r = 0; r <= j; ++r) {
+    A(r, 0) = 1;
+    for (int k = 1; k <= j; ++k)
+      A(r, k) = std::pow(h[last - j + r] / h[last], options.order + (k - 1) * options.order_step);
+  }
+  return A.transpose().colPivHouseholderQr().solve(Eigen::VectorXd::Unit(j + 1, 0));
+}
+
+std::string fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, format, a, b, c, d);
+  return buf;
+}
+
+}  // namespace
+
 Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::vector<std::complex<double>>& x,
                                      const RichardsonOptions& options) {
+  if (!(options.order_tolerance > 0) || !std::isfinite(options.order_tolerance))
+    throw BadInput("richardson: `order_tolerance = " + format_number(options.order_tolerance) + "`: must be > 0");
   const RichardsonTableau tab = richardson_tableau(h, x, options);
-  const auto& last = tab.T.back();
-  const int J = static_cast<int>(last.size()) - 1;
+  const int L = static_cast<int>(h.size());
+  const int top = static_cast<int>(tab.T.back().size()) - 1;  // highest column available
+  auto entry = [&](int i, int j) { return tab.T[i][j]; };
+  // Round-off of column j's entries: |sum w_i dx_i| <= eps max|x| sum|w_i|.
+  std::vector<double> noise(top + 1), amplification(top + 1);
+  for (int j = 0; j <= top; ++j) {
+    const Eigen::VectorXd w = column_weights(h, L - 1, j, options);
+    double scale = 0;
+    for (int r = 0; r <= j; ++r) scale = std::max(scale, std::abs(x[L - 1 - j + r]));
+    amplification[j] = w.cwiseAbs().sum();
+    noise[j] = options.input_precision * scale * amplification[j];
+  }
+
+  // Column checks (header comment): the last two triples of each column (or its only one).
   Extrapolation e;
-  e.value = last[J];
+  for (int j = 0; j <= top; ++j) {
+    const int entries = L - j;
+    if (entries < 3) {
+      e.column_orders.push_back(std::numeric_limits<double>::quiet_NaN());
+      e.column_consistent.push_back(-1);
+      continue;
+    }
+    const double expected = tab.remaining_order(j);
+    bool consistent = true;
+    double last_order = std::numeric_limits<double>::quiet_NaN();
+    for (int i = std::max(j, L - 4); i + 2 <= L - 1; ++i) {  // triple (i, i + 1, i + 2)
+      const double d1 = std::abs(entry(i + 1, j) - entry(i, j)), d2 = std::abs(entry(i + 2, j) - entry(i + 1, j));
+      const double r = std::sqrt(h[i] / h[i + 2]);  // geometric mean step ratio
+      const double predicted = d1 * std::pow(r, -expected);
+      const double slack = std::pow(r, options.order_tolerance);
+      consistent = consistent && d2 <= predicted * slack + 2 * noise[j] && d2 >= predicted / slack - 2 * noise[j];
+      last_order = d1 > 0 && d2 > 0 ? std::log(d1 / d2) / std::log(r) : std::numeric_limits<double>::quiet_NaN();
+    }
+    e.column_orders.push_back(last_order);
+    e.column_consistent.push_back(consistent ? 1 : 0);
+  }
+
+  int J = top;
+  if (options.check_orders)
+    for (int j = 0; j < top; ++j)
+      if (e.column_consistent[j] == 0) {
+        J = j;
+        break;
+      }
+  const bool failed = options.check_orders && e.column_consistent[J] == 0;
+  e.value = entry(L - 1, J);
   e.levels = J + 1;
   e.remaining_order = tab.remaining_order(J);
-  if (J == 0) {
-    e.error_estimate = std::numeric_limits<double>::infinity();
+  e.amplification = amplification[J];
+  const double roundoff = noise[J];
+  if (failed) {
+    // Tail of an inconsistent column: max(d_last, d_prev r^{-q}), q = the order eliminated last.
+    const double d_last = std::abs(entry(L - 1, J) - entry(L - 2, J));
+    const double d_prev = std::abs(entry(L - 2, J) - entry(L - 3, J));
+    const double q = J >= 1 ? tab.remaining_order(J - 1) : 0.0;
+    const double r = h[L - 2] / h[L - 1];
+    if (d_last > d_prev && d_last > 2 * roundoff) {
+      e.error_estimate = std::numeric_limits<double>::infinity();
+    } else {
+      e.error_estimate = std::max({d_last, d_prev * std::pow(r, -q), roundoff});
+    }
+    e.note = fmt(J == 0 ? "column %.0f (%.0f level, no extrapolation) shows order %.3g over its last entries, expected %.3g: "
+                        : "column %.0f (%.0f levels) shows order %.3g over its last entries, expected %.3g: ",
+                 J + 1.0, J + 1.0, e.column_orders[J], tab.remaining_order(J)) +
+             (J + 1 <= top ? "higher columns not used; " : "") +
+             (std::isfinite(e.error_estimate) ? "error from that column's last differences"
+                                              : "its differences grow: no error estimate");
     return e;
   }
-  // Weights of value = sum_r w_r x_{L-1-J+r}: the first row of A^{-1}, i.e. A^T w = e_0.
-  const int L = static_cast<int>(h.size());
-  Eigen::MatrixXd A(J + 1, J + 1);
-  for (int r = 0; r <= J; ++r) {
-    A(r, 0) = 1;
-    for (int k = 1; k <= J; ++k)
-      A(r, k) = std::pow(h[L - 1 - J + r] / h[L - 1], options.order + (k - 1) * options.order_step);
+  if (J == 0) {
+    e.error_estimate = std::numeric_limits<double>::infinity();
+    e.note = "one column only: no extrapolation, no error estimate";
+    return e;
   }
-  const Eigen::VectorXd w = A.transpose().colPivHouseholderQr().solve(Eigen::VectorXd::Unit(J + 1, 0));
-  double scale = 0;
-  for (int r = 0; r <= J; ++r) scale = std::max(scale, std::abs(x[L - 1 - J + r]));
-  e.amplification = w.cwiseAbs().sum();
-  const double roundoff = options.input_precision * scale * e.amplification;  // |sum w_i dx_i| <= eps max|x| sum|w_i|
-  e.error_estimate = std::max(std::abs(last[J] - last[J - 1]), roundoff);
+  e.error_estimate = std::max(std::abs(entry(L - 1, J) - entry(L - 1, J - 1)), roundoff);
+  e.note = options.check_orders ? fmt("%.0f levels: every column below shows its expected order (or has too few "
+                                      "entries to check)", J + 1.0)
+                                : fmt("%.0f levels (orders not checked)", J + 1.0);
   return e;
 }
 

@@ -66,11 +66,18 @@ TEST(Richardson, ExactOnPolynomialInHSquared) {
     // Column 1 removes h^2 only: its error is dominated by c2 h^4 (not zero), column 2 by h^6.
     EXPECT_GT(std::abs(tab.T[3][1] - x0), 1e-6);
     EXPECT_GT(std::abs(tab.T[3][2] - x0), 1e-9);
-    const Extrapolation e = richardson_extrapolate(h, v);
+    // The textbook scheme (orders not checked) uses the highest column.
+    const Extrapolation e = richardson_extrapolate(h, v, {.check_orders = false});
     EXPECT_EQ(e.levels, 4);
     EXPECT_DOUBLE_EQ(e.remaining_order, 8);
     EXPECT_DOUBLE_EQ(e.error_estimate, std::abs(tab.T[3][3] - tab.T[3][2]));  // correction >> round-off here
     EXPECT_GE(e.amplification, 1.0);  // the weights sum to 1, so their absolute values sum to >= 1
+    // Checked (the default): at these coarse steps the h^4 and h^6 terms are not small against
+    // h^2 (c2 h^2 / c1 = 0.12 at h = 0.4), so column 0 does not show order 2 within 0.3 and
+    // fewer levels are used; whatever is used, the estimate bounds the actual error.
+    const Extrapolation checked = richardson_extrapolate(h, v);
+    EXPECT_LT(checked.levels, 4);
+    EXPECT_LE(std::abs(checked.value - x0), checked.error_estimate);
   }
 }
 
@@ -88,8 +95,58 @@ TEST(Richardson, FirstOrderExpansion) {
   const std::vector<double> h{0.2, 0.1, 0.05};
   std::vector<cd> v;
   for (double s : h) v.push_back(0.9 + 0.7 * s - 2.0 * s * s);
-  const Extrapolation e = richardson_extrapolate(h, v, {.order = 1, .order_step = 1, .max_columns = 4});
+  const Extrapolation e = richardson_extrapolate(h, v, {.order = 1, .order_step = 1, .max_columns = 4, .check_orders = false});
   EXPECT_LT(std::abs(e.value - 0.9), 1e-14);
+  // Checked: the differences 0.01, 0.02 grow (the h^2 term dominates at h = 0.2): the data show
+  // no first order, so nothing is extrapolated and no error estimate is claimed.
+  const Extrapolation checked = richardson_extrapolate(h, v, {.order = 1, .order_step = 1, .max_columns = 4});
+  EXPECT_EQ(checked.levels, 1);
+  EXPECT_EQ(checked.column_consistent[0], 0);
+  EXPECT_EQ(checked.error_estimate, INFINITY);
+}
+
+// The error of an event-split step: a clean c1 h^2 plus an erratic part, here 5 % of it with a
+// sign and size that jump with N (like the event-position term with 4 contact sub-steps,
+// docs/events.md): x(N) = x0 + c1 h^2 (1 + 0.05 sin(0.731 N)), h = 1/N. There is no h^4 term to
+// eliminate; the checked scheme sees that column 1 does not converge like h^4, stops there, and
+// its estimate bounds the actual error; the textbook scheme uses all columns and claims less
+// than its actual error.
+TEST(Richardson, ErraticSecondOrderTermStopsAtTheFirstEliminationAndIsBounded) {
+  const cd x0(0.3, 0.6), c1(-2.0, 1.5);
+  std::vector<double> h;
+  std::vector<cd> v;
+  for (int N : {100, 200, 400, 800, 1600, 3200}) {
+    h.push_back(1.0 / N);
+    v.push_back(x0 + c1 * (1.0 + 0.05 * std::sin(0.731 * N)) / (double(N) * N));
+  }
+  const Extrapolation checked = richardson_extrapolate(h, v);
+  EXPECT_EQ(checked.column_consistent[0], 1);  // column 0: order 2 (the 5 % wobble moves it by < 0.3)
+  EXPECT_EQ(checked.column_consistent[1], 0);  // column 1: not order 4
+  EXPECT_EQ(checked.levels, 2);
+  EXPECT_LE(std::abs(checked.value - x0), checked.error_estimate);
+  // and the estimate is of the size of the erratic term at the finest level, not of the raw error
+  EXPECT_LT(checked.error_estimate, 0.5 * std::abs(v.back() - x0));
+  const Extrapolation textbook = richardson_extrapolate(h, v, {.check_orders = false});
+  EXPECT_EQ(textbook.levels, 4);
+  EXPECT_GT(std::abs(textbook.value - x0), textbook.error_estimate);
+}
+
+// Round-off does not stop a column: a smooth sequence whose higher columns reach the rounding
+// level of the inputs (relative 1e-14) keeps using them (consistent within the noise allowance).
+TEST(Richardson, ColumnsAtRoundOffAreNotHeldAgainst) {
+  const cd x0(1.0, 0.0);
+  std::vector<double> h;
+  std::vector<cd> v;
+  for (int N : {50, 100, 200, 400, 800, 1600}) {
+    const double s = 1.0 / N;
+    h.push_back(s);
+    // h^2 and h^4 terms plus a rounding-sized wobble (3e-15 relative, like an eigen-solver's)
+    v.push_back(x0 + 0.5 * s * s + 0.3 * s * s * s * s + cd(3e-15 * std::sin(1.3 * N), 0));
+  }
+  const Extrapolation e = richardson_extrapolate(h, v);
+  EXPECT_EQ(e.levels, 4) << e.note;
+  EXPECT_LE(std::abs(e.value - x0), e.error_estimate);
+  EXPECT_LT(std::abs(e.value - x0), 1e-13);  // the extrapolation reaches round-off
 }
 
 TEST(Richardson, BadInputNamesTheProblem) {
@@ -99,6 +156,7 @@ TEST(Richardson, BadInputNamesTheProblem) {
   EXPECT_THROW(richardson_tableau({0.1, 0.05}, {1.0, cd(NAN, 0)}), BadInput);
   EXPECT_THROW(richardson_tableau({0.1}, {1.0}, {.order = 0}), BadInput);
   EXPECT_THROW(richardson_tableau({0.1}, {1.0}, {.max_columns = 0}), BadInput);
+  EXPECT_THROW(richardson_extrapolate({0.1, 0.05}, {1.0, 1.0}, {.order_tolerance = 0}), BadInput);
   try {
     richardson_tableau({0.1, -0.05}, {1.0, 1.0});
     FAIL();

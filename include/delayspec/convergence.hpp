@@ -18,7 +18,10 @@
 //
 // Reference:
 //   exact        the exact multipliers (e.g. Lambert W for the scalar linear DDE);
-//   extrapolated Richardson on the matched levels (richardson.hpp), with its error estimate;
+//   extrapolated Richardson on the matched levels (richardson.hpp), with its error estimate; a
+//                column is used only if the column below shows its expected order (the error
+//                expansion is checked, not assumed); an infinite estimate (no estimate possible)
+//                gives the reference precision 1 (no digit certified);
 //   finest       the finest level (its error estimated from the last two levels);
 //   automatic    exact when given, else extrapolated (>= 2 levels).
 //
@@ -96,8 +99,9 @@ struct OrderReport {
 
 struct ExtrapolatedMultiplier {
   std::complex<double> value;
-  double error_estimate = 0;            // absolute (see richardson.hpp)
-  int levels = 0;
+  double error_estimate = 0;            // absolute (see richardson.hpp; infinity: no estimate possible)
+  int levels = 0;                       // Richardson levels combined (the column used, see richardson.hpp)
+  std::string note;                     // why that column
 };
 
 // Richardson columns of the leading track: columns[j][i] = T[i][j] (entries with fewer than j + 1
@@ -109,6 +113,12 @@ struct RichardsonReport {
   std::vector<std::vector<double>> errors;   // relative, NaN where the reference is not independent
   std::vector<std::optional<double>> column_orders;  // least-squares order of each column's errors
   std::vector<double> expected_orders;       // e_{j+1} for column j
+  // Reference-free, what the choice of column rests on (richardson.hpp): the order of each column
+  // from its last three entries' differences, and whether the column is consistent with its
+  // expected order (1), not (0), or too short to tell (-1).
+  std::vector<double> difference_orders;
+  std::vector<int> consistent;
+  int levels_used = 0;                       // the column the extrapolated value comes from (+1)
 };
 
 struct ConvergenceStudy {

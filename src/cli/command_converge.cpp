@@ -66,8 +66,9 @@ nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) 
     ex.push_back({{"re", e.value.real()},
                   {"im", e.value.imag()},
                   {"abs", std::abs(e.value)},
-                  {"error_estimate", e.error_estimate},
-                  {"levels", e.levels}});
+                  {"error_estimate", number_or_null(e.error_estimate)},  // null: no estimate possible
+                  {"levels", e.levels},
+                  {"note", e.note}});
   j["extrapolated"] = ex;
   nlohmann::json cols = nlohmann::json::array();
   for (size_t c = 0; c < s.richardson.columns.size(); ++c) {
@@ -76,6 +77,12 @@ nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) 
     col["expected_order"] = s.richardson.expected_orders[c];
     col["observed_order"] =
         s.richardson.column_orders[c] ? nlohmann::json(*s.richardson.column_orders[c]) : nlohmann::json(nullptr);
+    if (c < s.richardson.difference_orders.size()) {
+      col["difference_order"] = number_or_null(s.richardson.difference_orders[c]);
+      col["consistent"] = s.richardson.consistent[c] < 0 ? nlohmann::json(nullptr)
+                                                         : nlohmann::json(s.richardson.consistent[c] == 1);
+      col["used"] = static_cast<int>(c) + 1 == s.richardson.levels_used;
+    }
     nlohmann::json entries = nlohmann::json::array();
     for (size_t i = 0; i < s.richardson.columns[c].size(); ++i) {
       const auto v = s.richardson.columns[c][i];
@@ -130,6 +137,7 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
                     e.value.real(), e.value.imag(), std::abs(e.value), e.error_estimate, e.levels);
       out << line;
     }
+    out << "  (mu_1: " << s.extrapolated[0].note << ")\n";
   }
   if (s.richardson.columns.size() > 1) {
     out << "Richardson columns of mu_1 (relative error against the reference):\n  " << std::string(6, ' ');
@@ -164,7 +172,17 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
       std::snprintf(line, sizeof line, "  %10.0f", s.richardson.expected_orders[c]);
       out << line;
     }
-    out << "\n";
+    // reference-free: order of each column's last three entries, and the verdict it gives
+    out << "\n  diff. ";
+    for (size_t c = 0; c < s.richardson.difference_orders.size(); ++c) {
+      const double p = s.richardson.difference_orders[c];
+      const int ok = s.richardson.consistent[c];
+      if (std::isfinite(p)) std::snprintf(line, sizeof line, "  %8.2f %s", p, ok == 1 ? "+" : ok == 0 ? "x" : " ");
+      else std::snprintf(line, sizeof line, "  %10s", "-");
+      out << line;
+    }
+    out << "\n  (order: least squares against the reference; diff.: from the last differences of the column, + consistent"
+           " with the expected order, x not; columns after the first x are not used)\n";
   }
 }
 
