@@ -54,8 +54,9 @@
 // derivative jumps by O(h^2 |A_1 - A_2|)), and at the onset of grazing (the split itself
 // changes the trapezoid's O(h^3) local error).
 //
-// Cost: a step with no event and no near-surface turning point costs one sub-step more than
-// the plain trapezoid (the trial end is the result); an event costs ~10-60 piece evaluations.
+// Cost: a step with no event and no near-surface turning point is the plain trapezoid step
+// (m sub-steps in contact) plus the event test (H and its slope at both ends); an event costs
+// ~10-60 piece evaluations.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -100,7 +101,20 @@ class EventStepSolver {
     int count = 0;
     for (;;) {
       const int m = substeps(j);
-      const Exit exit = find_exit(a, z, j, m, count > 0);
+      Exit exit;
+      if (count == 0) {
+        // Most steps have no event: the trial piece over the whole step, with the derivative of
+        // its end at fixed ends (da = db = 0), is then the step and its map.
+        const Piece whole = piece_with_fixed_ends(0, h_, u0, dz, j, m);
+        exit = find_exit(0, u0, whole.z, j, false);
+        if (!exit.event) {
+          z = whole.z;
+          dz = whole.X;
+          break;
+        }
+      } else {
+        if (a < h_) exit = find_exit(a, z, piece_end(a, h_, z, j, m), j, true);
+      }
       const double b = exit.event ? exit.b : h_;
       const Piece piece = piece_with_tangent(a, b, z, dz, da, j, m);
       Row db = Row::Zero();  // the end of the step (b = h) and frozen split points do not move
@@ -159,9 +173,26 @@ class EventStepSolver {
     V z = za;
     for (int i = 1; i <= m; ++i) {
       const double s0 = node(a, b, m, i - 1), s1 = node(a, b, m, i);
-      z = stepper_.sub_step(t_ + s0, s1 - s0, z, w_at(s0), w_at(s1), j, j).z1;
+      z = stepper_.sub_step_state(t_ + s0, s1 - s0, z, w_at(s0), w_at(s1), j, j);
     }
     return z;
+  }
+
+  // The same piece with the derivative of its end at fixed a and b (X; Y is left zero): the
+  // chain of the sub-steps' own maps, the delayed value at node s being w(s). It equals
+  // piece_with_tangent's X when da = 0, at the cost of plain sub-steps.
+  Piece piece_with_fixed_ends(double a, double b, const V& za, const Tangent& dza, int j, int m) const {
+    Piece p{za, dza, V::Zero()};
+    for (int i = 1; i <= m; ++i) {
+      const double s0 = node(a, b, m, i - 1), s1 = node(a, b, m, i);
+      const SubStepResult<D> r = stepper_.sub_step(t_ + s0, s1 - s0, p.z, w_at(s0), w_at(s1), j, j);
+      Tangent X = r.dz0 * p.X;
+      X.template middleCols<D>(D) += (1 - s0 / h_) * r.dw0 + (1 - s1 / h_) * r.dw1;
+      X.template rightCols<D>(D) += (s0 / h_) * r.dw0 + (s1 / h_) * r.dw1;
+      p.X = X;
+      p.z = r.z1;
+    }
+    return p;
   }
 
   // The same piece with forward-mode tangents. Node s_i = (1 - c_i) a + c_i b, c_i = i/m, so
@@ -174,7 +205,7 @@ class EventStepSolver {
       const double c0 = static_cast<double>(i - 1) / m, c1 = static_cast<double>(i) / m;
       const V wl = w_at(s0), wr = w_at(s1);
       const V zl = p.z;
-      const V zr = stepper_.sub_step(t_ + s0, L, zl, wl, wr, j, j).z1;
+      const V zr = stepper_.sub_step_state(t_ + s0, L, zl, wl, wr, j, j);
       const double tl = t_ + s0, tr = t_ + s0 + L;
       const V fl = model_.f(j, tl, zl, wl), fr = model_.f(j, tr, zr, wr);
       const M Al = model_.A(j, tl, zl, wl), Ar = model_.A(j, tr, zr, wr);
@@ -264,12 +295,12 @@ class EventStepSolver {
   }
 
   // The first time in (a, h] at which the piece in region j leaves it, if any (see the header).
-  Exit find_exit(double a, const V& za, int j, int m, bool on_surface) const {
-    if (!(a < h_)) return {};
+  // zL: the piece's end if it ran to h.
+  Exit find_exit(double a, const V& za, const V& zL, int j, bool on_surface) const {
+    const int m = substeps(j);
     auto g = [&](double s) { return model_.H(piece_end(a, s, za, j, m)); };
     auto wrong = [j](double v) { return j == 1 ? v <= 0 : v > 0; };
     const double into = j == 1 ? 1 : -1;  // into * H > 0 deep inside region j
-    const V zL = piece_end(a, h_, za, j, m);
     const double ga = model_.H(za), gL = model_.H(zL);
     // A point in [a, limit) where H is on region j's side (strictly, unless it is a itself):
     // a when the piece does not start on the surface, else the deepest point (Brent).

@@ -95,49 +95,24 @@ class TrapezoidStepper {
   SubStepResult<D> sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region,
                             int right_region) const {
     const double t1 = t0 + dt;
-    const V rhs0 = z0 + 0.5 * dt * model_.f(left_region, t0, z0, w0);  // explicit half
-    // Newton on G(z) = z - rhs0 - dt/2 f_jr(t1, z, w1); for an affine f_jr one step is exact,
-    // the loop then confirms it (and detects a region change of z1 in the automatic mode).
-    V z = z0;
-    int jr = right_region == kRegionOfEndpoint ? region_of(model_, z) : right_region;
-    Eigen::PartialPivLU<M> lu;
-    constexpr int kMaxIterations = 30;
-    bool converged = false;
-    int region_changes = 0;
-    for (int it = 0; it < kMaxIterations; ++it) {
-      V g = z - rhs0 - 0.5 * dt * model_.f(jr, t1, z, w1);
-      M S = M::Identity() - 0.5 * dt * model_.A(jr, t1, z, w1);
-      lu.compute(S);
-      V dz = lu.solve(g);
-      z -= dz;
-      const double scale = 1 + z.template lpNorm<Eigen::Infinity>();
-      bool small = dz.template lpNorm<Eigen::Infinity>() <= 4 * 2.2e-16 * scale;
-      if (right_region == kRegionOfEndpoint) {
-        int j_new = region_of(model_, z);
-        if (j_new != jr) {
-          jr = j_new;
-          ++region_changes;
-          if (region_changes > 8) break;  // cycling between regions: give up (reported below)
-          continue;
-        }
-      }
-      if (small || (Model::affine_in_state && it >= 1)) {
-        converged = true;
-        break;
-      }
-    }
-    if (!converged || !z.allFinite())
-      throw NumericalFailure("trapezoid step at t = " + format_number(t0) + ", dt = " + format_number(dt) +
-                             ": implicit equation not solved (region changes " + std::to_string(region_changes) +
-                             ", state " + format_number(z[0]) + ")");
     SubStepResult<D> r;
-    r.z1 = z;
-    r.right_region = jr;
-    lu.compute(M::Identity() - 0.5 * dt * model_.A(jr, t1, z, w1));
+    Eigen::PartialPivLU<M> lu;
+    r.z1 = solve_sub_step(t0, dt, z0, w0, w1, left_region, right_region, r.right_region, lu);
+    const int jr = r.right_region;
+    // For an affine f the last Newton matrix is already S at z1 (A does not depend on z).
+    if (!Model::affine_in_state) lu.compute(M::Identity() - 0.5 * dt * model_.A(jr, t1, r.z1, w1));
     r.dz0 = lu.solve(M::Identity() + 0.5 * dt * model_.A(left_region, t0, z0, w0));
     r.dw0 = lu.solve(0.5 * dt * model_.B(left_region, t0, z0, w0));
-    r.dw1 = lu.solve(0.5 * dt * model_.B(jr, t1, z, w1));
+    r.dw1 = lu.solve(0.5 * dt * model_.B(jr, t1, r.z1, w1));
     return r;
+  }
+
+  // z1 of the same sub-step without its derivatives (event location evaluates many of these).
+  V sub_step_state(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region,
+                   int right_region) const {
+    int jr;
+    Eigen::PartialPivLU<M> lu;
+    return solve_sub_step(t0, dt, z0, w0, w1, left_region, right_region, jr, lu);
   }
 
   // One full step from t to t + h: returns u_0(t + h) and fills the step map (its exact
@@ -167,6 +142,49 @@ class TrapezoidStepper {
   const StepOptions& options() const { return options_; }
 
  private:
+  // Newton on G(z) = z - rhs0 - dt/2 f_jr(t1, z, w1). Returns z1; jr receives the right node's
+  // region and lu the factorisation of S = I - dt/2 A_jr(t1, z, w1) at the last iterate.
+  V solve_sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region, int right_region,
+                   int& jr, Eigen::PartialPivLU<M>& lu) const {
+    const double t1 = t0 + dt;
+    const V rhs0 = z0 + 0.5 * dt * model_.f(left_region, t0, z0, w0);  // explicit half
+    // For an affine f_jr one Newton step is exact. In the automatic mode (the plain, unsplit
+    // trapezoid) a second iteration confirms it and detects a region change of z1; with a
+    // fixed right region there is nothing to confirm.
+    const bool fixed_region = right_region != kRegionOfEndpoint;
+    V z = z0;
+    jr = fixed_region ? right_region : region_of(model_, z);
+    constexpr int kMaxIterations = 30;
+    bool converged = false;
+    int region_changes = 0;
+    for (int it = 0; it < kMaxIterations; ++it) {
+      V g = z - rhs0 - 0.5 * dt * model_.f(jr, t1, z, w1);
+      lu.compute(M(M::Identity() - 0.5 * dt * model_.A(jr, t1, z, w1)));
+      V dz = lu.solve(g);
+      z -= dz;
+      const double scale = 1 + z.template lpNorm<Eigen::Infinity>();
+      bool small = dz.template lpNorm<Eigen::Infinity>() <= 4 * 2.2e-16 * scale;
+      if (!fixed_region) {
+        int j_new = region_of(model_, z);
+        if (j_new != jr) {
+          jr = j_new;
+          ++region_changes;
+          if (region_changes > 8) break;  // cycling between regions: give up (reported below)
+          continue;
+        }
+      }
+      if (small || (Model::affine_in_state && (fixed_region || it >= 1))) {
+        converged = true;
+        break;
+      }
+    }
+    if (!converged || !z.allFinite())
+      throw NumericalFailure("trapezoid step at t = " + format_number(t0) + ", dt = " + format_number(dt) +
+                             ": implicit equation not solved (region changes " + std::to_string(region_changes) +
+                             ", state " + format_number(z[0]) + ")");
+    return z;
+  }
+
   Model model_;
   StepOptions options_;
 };
