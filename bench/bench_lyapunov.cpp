@@ -3,7 +3,7 @@
 // (TangentQR) against applying the period's step maps to the same block (Monodromy::apply_block),
 // plus Eigen's HouseholderQR on a column-major copy for comparison.
 //
-//   build/bench_lyapunov --benchmark_filter=Impact     # the headline run (~3 s)
+//   build/bench_lyapunov --benchmark_filter=Impact     # the headline run (~4 s, 2026-11-23)
 //   build/bench_lyapunov --benchmark_filter='QR|Apply' # the per-period parts
 #include <benchmark/benchmark.h>
 
