@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 #include <numeric>
 
 #include "delayspec/dense_spectrum.hpp"
@@ -75,7 +77,7 @@ std::string short_number(double value) {
 
 namespace {
 
-// True residuals |M v - mu v| / (|mu| |v|) of the Ritz pairs, from applying M to the Ritz
+// Absolute residuals |M v - mu v| / |v| of the Ritz pairs, from applying M to the Ritz
 // vectors (real form) in blocks of at most kChunk columns, a complex pair's two columns always in
 // the same block (bounds the extra memory to 2 kChunk vectors plus the operator's block buffer).
 template <int D>
@@ -107,7 +109,7 @@ std::vector<double> ritz_residuals(const Monodromy<D>& op, const krylov::RitzPai
       const auto Ma = Y.col(c);
       if (mu.imag() == 0) {
         // |M a - mu a| / (|mu| |a|)
-        residual[i] = (Ma - mu.real() * a).norm() / (std::abs(mu) * a.norm());
+        residual[i] = (Ma - mu.real() * a).norm() / a.norm();
         c += 1;
       } else {
         // v = a + i b, mu = al + i be:  M v - mu v = (M a - al a + be b) + i (M b - al b - be a)
@@ -115,13 +117,122 @@ std::vector<double> ritz_residuals(const Monodromy<D>& op, const krylov::RitzPai
         const auto Mb = Y.col(c + 1);
         const double al = mu.real(), be = mu.imag();
         const double re = (Ma - al * a + be * b).squaredNorm(), im = (Mb - al * b - be * a).squaredNorm();
-        residual[i] = std::sqrt(re + im) / (std::abs(mu) * std::sqrt(a.squaredNorm() + b.squaredNorm()));
+        residual[i] = std::sqrt(re + im) / std::sqrt(a.squaredNorm() + b.squaredNorm());
         c += 2;
       }
     }
     first = last;
   }
   return residual;
+}
+
+// The nev leading multipliers from the Ritz pairs: both conjugates of each complex pair, sorted
+// like the dense reference, with their relative residuals |M v - mu v| / (|mu| |v|) (absolute
+// ones in `absolute`), and vectors when asked.
+void take_leading_pairs(const krylov::RitzPairs& pairs, const std::vector<double>& residual,
+                        const FloquetOptions& options, const std::string& name, FloquetResult& result,
+                        std::vector<double>& absolute) {
+  struct Entry {
+    std::complex<double> value;
+    size_t pair;
+    bool conjugate;
+  };
+  std::vector<Entry> entries;
+  for (size_t i = 0; i < pairs.values.size(); ++i) {
+    const auto mu = pairs.values[i];
+    if (!std::isfinite(mu.real()) || !std::isfinite(mu.imag())) throw NumericalFailure(name + ": non-finite Ritz value");
+    entries.push_back({mu, i, false});
+    if (mu.imag() != 0) entries.push_back({std::conj(mu), i, true});
+  }
+  if (static_cast<int>(entries.size()) < options.nev)
+    throw NumericalFailure(name + ": only " + std::to_string(entries.size()) + " Ritz values returned for nev = " +
+                           std::to_string(options.nev));
+  std::vector<std::complex<double>> sorted;
+  for (const auto& e : entries) sorted.push_back(e.value);
+  sort_by_modulus(sorted);
+  sorted.resize(options.nev);
+  const long n = pairs.vectors.rows();
+  if (options.keep_vectors) result.subspace.resize(n, options.nev);
+  for (int k = 0; k < options.nev; ++k) {
+    const auto it =
+        std::find_if(entries.begin(), entries.end(), [&](const Entry& e) { return e.value == sorted[k]; });
+    result.multipliers.push_back(it->value);
+    absolute.push_back(residual[it->pair]);
+    result.residuals.push_back(residual[it->pair] / std::abs(it->value));
+    if (options.keep_vectors) result.subspace.col(k) = pairs.vectors.col(pairs.column[it->pair] + (it->conjugate ? 1 : 0));
+  }
+}
+
+// Indices of the relative residuals above `bound` (NaN counts as above), in order.
+std::vector<size_t> failing_pairs(const std::vector<double>& residuals, double bound) {
+  std::vector<size_t> failing;
+  for (size_t k = 0; k < residuals.size(); ++k)
+    if (!(residuals[k] <= bound)) failing.push_back(k);
+  return failing;
+}
+
+// Multipliers at the round-off level of the operator. A monodromy may have exact zeros (k = 0
+// makes the impact model an ODE: rank d; b = 0 a linear one: rank 1) or multipliers far below
+// eps |M|: no eigensolver gets their digits (rounding of one application alone makes the relative
+// residual O(1)), but a pair with |mu| <= r and |M v - mu v| / |v| <= r, r = 1e3 eps |M x| / |x|,
+// is an eigenpair of M + E with |E| ~ r, i.e. zero to working precision. Those are returned as
+// exactly 0 (the honest value: 0 +- r), residual |M v| / (|M x| / |x| |v|), and named in `note`;
+// they leave `failing`. Returns how many were zeroed.
+size_t zero_round_off_pairs(FloquetResult& r, const std::vector<double>& absolute, std::vector<size_t>& failing,
+                            double size) {
+  const double level = 1e3 * std::numeric_limits<double>::epsilon() * size;
+  std::vector<size_t> still_failing, zeroed;
+  for (size_t k : failing) {
+    if (std::abs(r.multipliers[k]) <= level && absolute[k] <= level) {
+      r.multipliers[k] = 0;
+      r.residuals[k] = absolute[k] / size;
+      zeroed.push_back(k);
+    } else {
+      still_failing.push_back(k);
+    }
+  }
+  failing.swap(still_failing);
+  if (!zeroed.empty())
+    r.note += std::string(r.note.empty() ? "" : "; ") + "multipliers " + std::to_string(zeroed.front() + 1) + ".." +
+              std::to_string(zeroed.back() + 1) + " are at the operator's round-off level (|mu| <= " +
+              format_number(level) + "): reported as 0";
+  return zeroed.size();
+}
+
+// |M x| / |x|: a lower bound of the operator's norm (within sqrt(n) of it for a random x).
+template <int D>
+double operator_size(const Monodromy<D>& op, const Eigen::VectorXd& x) {
+  Eigen::VectorXd y(op.rows());
+  op.perform_op(x.data(), y.data());
+  return y.norm() / x.norm();
+}
+
+// Why the gate failed, with the numbers of the first failing multiplier; when its modulus is at
+// the round-off level of the operator (|mu| <= 1e3 eps |M x| / |x|, x the start vector: rounding
+// of one application alone makes its relative residual O(1)), say so: no method resolves it next
+// to larger ones, and the multipliers before it are what can be asked for.
+template <int D>
+std::string residual_gate_message(const Monodromy<D>& op, const Eigen::VectorXd& start, const FloquetResult& r,
+                                  const std::vector<size_t>& failing, double bound, const std::string& name,
+                                  int first_ncv, int last_ncv) {
+  const size_t k = failing.front();
+  const std::complex<double> mu = r.multipliers[k];
+  const std::string others =
+      failing.size() > 1 ? " (and " + std::to_string(failing.size() - 1) + " more after it)" : "";
+  std::string message = name + ": multiplier " + std::to_string(k + 1) + others + " of nev = " +
+                        std::to_string(r.multipliers.size()) + ", mu = " + format_number(mu.real()) +
+                        (mu.imag() < 0 ? " - " : " + ") + format_number(std::abs(mu.imag())) +
+                        "i, fails its residual check: |M v - mu v| / (|mu| |v|) = " + format_number(r.residuals[k]) +
+                        " > bound " + krylov::short_number(bound) + " (ncv = " + std::to_string(first_ncv) +
+                        (last_ncv != first_ncv ? ", retried with ncv = " + std::to_string(last_ncv) : "") + ")";
+  const double round_off = std::numeric_limits<double>::epsilon() * operator_size(op, start);
+  if (std::abs(mu) <= 1e3 * round_off)
+    message += "; |mu| is at the round-off level of this operator (eps |M x| / |x| = " + format_number(round_off) +
+               " next to |mu_1| = " + format_number(std::abs(r.multipliers[0])) +
+               "): no eigensolver resolves it" + (k > 0 ? ", ask for fewer multipliers (nev = " + std::to_string(k) + ")" : "");
+  else
+    message += "; try a larger ncv or another solver";
+  return message;
 }
 
 template <int D>
@@ -150,44 +261,46 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
       throw BadInput("FloquetOptions::start: must be finite and not zero");
     start = options.start;
   }
-  krylov::RitzPairs pairs = options.solver == FloquetSolver::spectra
-                                ? krylov::spectra_ritz_pairs(op, settings, start)
-                                : krylov::arpack_ritz_pairs(op, settings, start);
-  const std::vector<double> residual = ritz_residuals(op, pairs);
+  const double bound = std::max(options.residual_bound, 100 * options.tolerance);
+  const std::string name = "Krylov (" + to_string(options.solver) + ")";
 
-  // Expand the pairs into both conjugates, sort like the dense reference, keep nev.
-  struct Entry {
-    std::complex<double> value;
-    size_t pair;
-    bool conjugate;
-  };
-  std::vector<Entry> entries;
-  for (size_t i = 0; i < pairs.values.size(); ++i) {
-    const auto mu = pairs.values[i];
-    if (!std::isfinite(mu.real()) || !std::isfinite(mu.imag()))
-      throw NumericalFailure("Krylov (" + to_string(options.solver) + "): non-finite Ritz value");
-    entries.push_back({mu, i, false});
-    if (mu.imag() != 0) entries.push_back({std::conj(mu), i, true});
+  // One solve, then the residual gate; on failure one retry with ncv doubled (at most n).
+  const int first_ncv = settings.ncv;
+  for (int attempt = 0;; ++attempt) {
+    krylov::RitzPairs pairs = options.solver == FloquetSolver::spectra
+                                  ? krylov::spectra_ritz_pairs(op, settings, start)
+                                  : krylov::arpack_ritz_pairs(op, settings, start);
+    const std::vector<double> residual = ritz_residuals(op, pairs);
+    FloquetResult candidate = result;
+    std::vector<double> absolute;
+    take_leading_pairs(pairs, residual, options, name, candidate, absolute);
+    std::vector<size_t> failing = failing_pairs(candidate.residuals, bound);
+    if (!failing.empty()) zero_round_off_pairs(candidate, absolute, failing, operator_size(op, start));
+    candidate.ncv = settings.ncv;
+    candidate.converged = pairs.converged;
+    candidate.iterations = pairs.iterations;
+    candidate.restarts = std::max(0, pairs.iterations - 1);
+    if (failing.empty()) {
+      if (attempt > 0)
+        candidate.note += std::string(candidate.note.empty() ? "" : "; ") + "ncv = " + std::to_string(first_ncv) +
+                          " gave a pair failing the residual gate, retried with ncv = " + std::to_string(settings.ncv) +
+                          (settings.scale != 1 ? " on M / " + format_number(settings.scale) : "");
+      result = std::move(candidate);
+      return;
+    }
+    if (attempt == 0 && options.retry_failed_gate) {
+      settings.ncv = static_cast<int>(std::min<long>(n, 2L * settings.ncv));
+      // Spectra's breakdown thresholds are absolute (krylov_spectra.cpp): the retry scales the
+      // operator to |M / s| <= 1 / sqrt(n) or so, |M x| / |x| underestimating |M| by up to sqrt(n).
+      if (options.solver == FloquetSolver::spectra) {
+        const double size = operator_size(op, start);
+        if (size > 0 && std::isfinite(size))
+          settings.scale = std::ldexp(1.0, static_cast<int>(std::lround(std::log2(size * std::sqrt(double(n))))));
+      }
+      continue;
+    }
+    throw NumericalFailure(residual_gate_message(op, start, candidate, failing, bound, name, first_ncv, settings.ncv));
   }
-  if (static_cast<int>(entries.size()) < options.nev)
-    throw NumericalFailure("Krylov (" + to_string(options.solver) + "): only " + std::to_string(entries.size()) +
-                           " Ritz values returned for nev = " + std::to_string(options.nev));
-  std::vector<std::complex<double>> sorted;
-  for (const auto& e : entries) sorted.push_back(e.value);
-  sort_by_modulus(sorted);
-  sorted.resize(options.nev);
-  if (options.keep_vectors) result.subspace.resize(n, options.nev);
-  for (int k = 0; k < options.nev; ++k) {
-    const auto it =
-        std::find_if(entries.begin(), entries.end(), [&](const Entry& e) { return e.value == sorted[k]; });
-    result.multipliers.push_back(it->value);
-    result.residuals.push_back(residual[it->pair]);
-    if (options.keep_vectors) result.subspace.col(k) = pairs.vectors.col(pairs.column[it->pair] + (it->conjugate ? 1 : 0));
-  }
-  result.ncv = settings.ncv;
-  result.converged = pairs.converged;
-  result.iterations = pairs.iterations;
-  result.restarts = std::max(0, pairs.iterations - 1);
 }
 
 }  // namespace
@@ -207,6 +320,8 @@ FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& 
       throw BadInput("`tol = " + format_number(options.tolerance) + "`: must be > 0 and finite");
     if (options.max_iterations < 1)
       throw BadInput("`max_iterations = " + std::to_string(options.max_iterations) + "`: must be >= 1");
+    if (!(options.residual_bound > 0) || !std::isfinite(options.residual_bound))
+      throw BadInput("`residual_bound = " + format_number(options.residual_bound) + "`: must be > 0 and finite");
   }
   const auto start = std::chrono::steady_clock::now();
   FloquetResult result;

@@ -18,14 +18,44 @@ namespace delayspec::krylov {
 
 namespace {
 
+// Spectra 1.0.1 decides that the Arnoldi residual f is zero (an invariant subspace: restart from a
+// fresh random vector) with ABSOLUTE thresholds (LinAlg/Arnoldi.h: max |f_i| < eps after the first
+// step, |f| < eps sqrt(n) later). For an operator of norm >> 1, e.g. a strongly unstable or
+// rank-deficient monodromy (x' = 5 x: M is rank one with mu_1 = 149), the round-off left in f is
+// far above them: the basis grows from noise, H gets a highly non-normal noise block, and its
+// eigenvalues are spurious Ritz values whose own estimates |f| |e_m^T y| look converged
+// (issue 13: -223 + 441i returned for 149.03, true residual 1.14). The residual gate of
+// floquet.cpp catches that and retries with Settings::scale > 1: Spectra then works on M / scale,
+// which puts its thresholds at the operator's round-off level; dividing by a power of two is exact,
+// so the Ritz values are mu / scale to the last bit. (Not on the first attempt: for a large n the
+// scaled thresholds are looser than needed, eps n |M x| / |x|, and every ordinary case passes
+// the gate unscaled.)
+template <int D>
+class ScaledMonodromy {
+ public:
+  using Scalar = double;
+  ScaledMonodromy(const Monodromy<D>& op, double scale) : op_(op), inverse_scale_(1 / scale) {}
+  Eigen::Index rows() const { return op_.rows(); }
+  Eigen::Index cols() const { return op_.cols(); }
+  // y = M x / scale
+  void perform_op(const double* x, double* y) const {
+    op_.perform_op(x, y);
+    if (inverse_scale_ != 1) Eigen::Map<Eigen::VectorXd>(y, op_.rows()) *= inverse_scale_;
+  }
+
+ private:
+  const Monodromy<D>& op_;
+  double inverse_scale_;
+};
+
 // GenEigsSolver plus read access to what Spectra keeps protected: the Arnoldi basis V, the
 // Ritz coefficient vectors y (Ritz vector = V y) and the residual estimates |f| |e_m^T y|.
 template <int D>
-class SpectraSolver : public Spectra::GenEigsSolver<const Monodromy<D>> {
-  using Base = Spectra::GenEigsSolver<const Monodromy<D>>;
+class SpectraSolver : public Spectra::GenEigsSolver<const ScaledMonodromy<D>> {
+  using Base = Spectra::GenEigsSolver<const ScaledMonodromy<D>>;
 
  public:
-  SpectraSolver(const Monodromy<D>& op, int nev, int ncv) : Base(op, nev, ncv) {}
+  SpectraSolver(const ScaledMonodromy<D>& op, int nev, int ncv) : Base(op, nev, ncv) {}
 
   const Eigen::MatrixXd& basis() const { return this->m_fac.matrix_V(); }
   // The nev wanted Ritz values and their coefficient vectors (ncv x nev), sorted by modulus.
@@ -50,7 +80,9 @@ class SpectraSolver : public Spectra::GenEigsSolver<const Monodromy<D>> {
 
 template <int D>
 RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eigen::VectorXd& start) {
-  SpectraSolver<D> solver(op, s.nev, s.ncv);
+  const double scale = s.scale;
+  const ScaledMonodromy<D> scaled(op, scale);
+  SpectraSolver<D> solver(scaled, s.nev, s.ncv);
   solver.init(start.data());  // Spectra starts from M * start (forces the vector into M's range)
   const Eigen::Index nconv = solver.compute(Spectra::SortRule::LargestMagn, s.max_iterations, s.tolerance,
                                             Spectra::SortRule::LargestMagn);
@@ -69,11 +101,11 @@ RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Ei
   // is completed from its conjugate).
   std::vector<Eigen::VectorXcd> coeffs;
   for (int i = 0; i < s.nev; ++i) {
-    std::complex<double> mu = solver.value(i);
+    std::complex<double> mu = solver.value(i) * scale;  // exact: scale is a power of two
     Eigen::VectorXcd y = solver.coefficients(i);
     if (mu.imag() < 0) {
       bool partner_listed = false;
-      for (int j = 0; j < s.nev; ++j) partner_listed = partner_listed || solver.value(j) == std::conj(mu);
+      for (int j = 0; j < s.nev; ++j) partner_listed = partner_listed || solver.value(j) * scale == std::conj(mu);
       if (partner_listed) continue;
       mu = std::conj(mu);
       y = y.conjugate();

@@ -62,7 +62,12 @@ INSTANTIATE_TEST_SUITE_P(Keys, LyapunovBadInput, ::testing::Values(
     BadValue{"exponents", "0"}, BadValue{"exponents", "12"}, BadValue{"exponents", "two"},
     BadValue{"periods", "1"}, BadValue{"periods", "-5"}, BadValue{"periods", "1e3"},
     BadValue{"transient", "-1"}, BadValue{"transient", "x"}, BadValue{"seed", "-3"}, BadValue{"seed", "abc"},
-    BadValue{"qr_every", "0"}, BadValue{"qr_every", "3"}, BadValue{"batches", "1"}, BadValue{"N", "0"}));
+    BadValue{"qr_every", "0"}, BadValue{"qr_every", "3"}, BadValue{"batches", "1"}, BadValue{"N", "0"},
+    // issue 13: upper bounds checked before anything is allocated (exit 2, not 1 from
+    // "cannot create std::vector"), and no wrap in a narrowing cast (2^32 + 2 -> 2)
+    BadValue{"periods", "1000000000000000000"}, BadValue{"transient", "2000000000"},
+    BadValue{"exponents", "4294967298"}, BadValue{"periods", "200000000"}, BadValue{"contact_substeps", "100000"},
+    BadValue{"N", "4294967298"}));
 // clang-format on
 
 TEST(LyapunovCli, JsonHasContractKeys) {

@@ -188,3 +188,32 @@ TEST(ConfigErrors, DirectoryIsNotAScene) {
   const std::string m = bad_input_message([] { Config::from_scene_file(std::filesystem::temp_directory_path().string()); });
   EXPECT_TRUE(contains(m, "cannot be read")) << m;
 }
+
+TEST(ConfigErrors, NonAsciiAfterABackslashInABasicStringIsRejected) {
+  // Regression (issue 13, found by the documented fuzz command): `title = """\¡"""` passed the
+  // guard and reached toml++'s undefined non-ASCII whitespace test. Also after a line-ending
+  // backslash, where toml++ tests the first character of the next line, and in "..." strings.
+  for (const char* text : {"title = \"\"\"\\\xc2\xa1\"\"\"\n", "title = \"\"\"a \\\n  \xc2\xa1x\"\"\"\n",
+                           "title = \"\"\"a \\  \r\n\n\xc2\xa1x\"\"\"\n", "title = \"\\\xc2\xa1\"\n"}) {
+    const std::string m = bad_input_message([&] { Config::from_scene_text(text, "b.toml"); });
+    EXPECT_TRUE(contains(m, "non-ASCII character after a backslash in a string (line 1")) << text << ": " << m;
+  }
+  // Escapes followed by ASCII, and non-ASCII later in the same string, stay fine.
+  Config c = Config::from_scene_text("a = \"\\\"\xc2\xa1\"\nb = \"\"\"x \\\n  y\xc2\xa1\"\"\"\nN = 2\n", "ok.toml");
+  EXPECT_EQ(c.get_string("a", ""), "\"\xc2\xa1");
+  EXPECT_EQ(c.get_string("b", ""), "x y\xc2\xa1");
+  EXPECT_EQ(c.get_int("N", 0), 2);
+}
+
+TEST(ConfigErrors, RangedIntegerChecksBeforeNarrowing) {
+  // 4294967298 = 2^32 + 2 would wrap to 2 in a cast to int before the check.
+  for (const char* bad : {"4294967298", "0", "65", "-1"}) {
+    Config c = with("exponents", bad);
+    const std::string m = bad_input_message([&] { c.get_int_in_range("exponents", 2, 1, 64); });
+    EXPECT_EQ(m, std::string("`exponents = ") + bad + "`: must be between 1 and 64");
+  }
+  Config ok = with("exponents", "64");
+  EXPECT_EQ(ok.get_int_in_range("exponents", 2, 1, 64), 64);
+  Config absent;
+  EXPECT_EQ(absent.get_int_in_range("exponents", 2, 1, 64), 2);
+}

@@ -226,3 +226,96 @@ TEST(Krylov, UserStartVectorAndInvariantSubspace) {
   bad.start = Eigen::VectorXd::Zero(op.rows());
   EXPECT_THROW(floquet_multipliers(op, bad), BadInput);
 }
+
+// ---- The residual gate (issue 13): no multiplier failing its own residual check is returned ----
+
+namespace {
+
+// The NumericalFailure message of f, or "" (and a test failure) when f does not throw one.
+template <class F>
+std::string numerical_failure_message(F&& f) {
+  try {
+    f();
+  } catch (const NumericalFailure& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected NumericalFailure";
+  return "";
+}
+
+}  // namespace
+
+TEST(KrylovResidualGate, RankOneMonodromyLeadingMultiplierIsExact) {
+  // x' = 5 x (b = 0): every step is u_0 <- g u_0, g = (1 + a h / 2) / (1 - a h / 2), and the
+  // history only shifts, so M has rank one and its one nonzero eigenvalue is g^K exactly
+  // (K = N = 50 steps, h = 1/50): 149.0337... Regression: Spectra returned -223.1 + 441.0i
+  // (true residual 1.14) with exit 0, because its absolute breakdown thresholds let the basis
+  // grow from round-off. Bound 1e-12 relative: the Ritz value of a rank-one operator is exact
+  // after one step up to the rounding of a few applications (O(K eps) = 1e-14).
+  auto op = zero_orbit_monodromy(LinearModel({.a = 5, .b = 0, .tau = 1, .period = 1}), 50);
+  const double g = (1 + 5 * 0.01) / (1 - 5 * 0.01), exact = std::pow(g, 50);
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+    SCOPED_TRACE(to_string(solver));
+    const FloquetResult r = solve(op, solver, 1);
+    ASSERT_EQ(r.multipliers.size(), 1u);
+    EXPECT_LE(std::abs(r.multipliers[0] - exact), 1e-12 * exact) << r.multipliers[0] << " vs " << exact;
+    EXPECT_LE(r.residuals[0], 1e-12);
+    // The other multipliers are exactly 0: no relative residual can be small, but each pair is
+    // an eigenpair to the operator's round-off, so it is reported as 0 and named in the note.
+    for (int nev = 2; nev <= 6; ++nev) {
+      const FloquetResult z = solve(op, solver, nev);
+      EXPECT_LE(std::abs(z.multipliers[0] - exact), 1e-12 * exact) << "nev = " << nev;
+      for (int k = 1; k < nev; ++k) EXPECT_EQ(z.multipliers[k], 0.0) << "nev = " << nev << ", k = " << k;
+      EXPECT_NE(z.note.find("multipliers 2.." + std::to_string(nev) + " are at the operator's round-off level"),
+                std::string::npos)
+          << z.note;
+    }
+    // Without the retry, Spectra's first answer is the spurious one, and the gate refuses it.
+    if (solver == FloquetSolver::spectra) {
+      FloquetOptions o;
+      o.nev = 1;
+      o.retry_failed_gate = false;
+      const std::string m = numerical_failure_message([&] { floquet_multipliers(op, o); });
+      EXPECT_NE(m.find("Krylov (spectra): multiplier 1 of nev = 1"), std::string::npos) << m;
+      EXPECT_NE(m.find("fails its residual check"), std::string::npos) << m;
+      EXPECT_NE(m.find("> bound 1e-08 (ncv = 11)"), std::string::npos) << m;
+    }
+  }
+}
+
+TEST(KrylovResidualGate, StronglyUnstableMonodromy) {
+  // x' = 50 x + 0.5 x(t - 1), N = 200: |mu_1| = 6.74e21, every other multiplier is below the
+  // round-off level eps |M| ~ 1e6 of the operator. Regression: Spectra returned 5.60e22 for
+  // mu_1 and ARPACK 5.4e5 (residual 4.8) for mu_2, both with exit 0.
+  auto op = zero_orbit_monodromy(LinearModel({.a = 50, .b = 0.5, .tau = 1, .period = 1}), 200);
+  const auto dense = solve(op, FloquetSolver::dense_lapack, 1).multipliers[0];
+  ASSERT_GT(std::abs(dense), 1e21);  // the case is what it claims
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+    SCOPED_TRACE(to_string(solver));
+    const FloquetResult r = solve(op, solver, 1);
+    // 1e-10: as expect_backends_agree (stopping rule 1e-12 times a moderate condition number)
+    EXPECT_LE(std::abs(r.multipliers[0] - dense), 1e-10 * std::abs(dense)) << r.multipliers[0] << " vs " << dense;
+    // Every other multiplier is below the round-off level (1e3 eps |M x| / |x| ~ 2e8 here): 0.
+    for (int nev = 2; nev <= 6; ++nev) {
+      const FloquetResult z = solve(op, solver, nev);
+      EXPECT_LE(std::abs(z.multipliers[0] - dense), 1e-10 * std::abs(dense)) << "nev = " << nev;
+      for (int k = 1; k < nev; ++k) EXPECT_EQ(z.multipliers[k], 0.0) << "nev = " << nev << ", k = " << k;
+    }
+  }
+}
+
+TEST(KrylovResidualGate, UnstableWithResolvableMultipliersAgreesWithDense) {
+  // x' = 5 x + 0.5 x(t - 1): unstable (|mu_1| ~ 150) and non-normal, but its next multipliers
+  // are far above the round-off level: nev = 1..6 must all pass the gate and match dense.
+  auto op = zero_orbit_monodromy(LinearModel({.a = 5, .b = 0.5, .tau = 1, .period = 1}), 50);
+  for (int nev = 1; nev <= 6; ++nev) expect_backends_agree(op, nev);
+}
+
+TEST(KrylovResidualGate, BadBoundIsBadInput) {
+  auto op = zero_orbit_monodromy(LinearModel({.a = 5, .b = 0, .tau = 1, .period = 1}), 50);
+  for (double bad : {0.0, -1.0, std::nan("")}) {
+    FloquetOptions o;
+    o.residual_bound = bad;
+    EXPECT_THROW(floquet_multipliers(op, o), BadInput) << bad;
+  }
+}

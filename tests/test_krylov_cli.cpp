@@ -3,6 +3,8 @@
 // and exit 2 naming key and value for every bad Krylov key.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -69,4 +71,30 @@ TEST(KrylovCli, BadKrylovKeysExitTwoNamingKeyAndValue) {
     EXPECT_NE(r.err.find(value), std::string::npos) << r.err;
     EXPECT_TRUE(r.out.empty());
   }
+}
+
+TEST(KrylovCli, NoMultiplierFailingItsResidualIsPrintedWithExitZero) {
+  // Issue 13 item 1, as a user ran it: x' = 5 x, N = 50. mu_1 = ((1 + 0.05) / (1 - 0.05))^50
+  // exactly (rank-one monodromy); the default solver printed -223.1 + 441.0i with exit 0.
+  const double exact = std::pow(1.05 / 0.95, 50);
+  for (const char* solver : {"spectra", "arpack"}) {
+    CliResult r = run({"floquet", "--json", "--set", "model=linear", "--set", "a=5", "--set", "b=0", "--set", "N=50",
+                       "--set", "nev=1", "--set", std::string("solver=") + solver});
+    ASSERT_EQ(r.status, 0) << r.err;
+    auto j = nlohmann::json::parse(r.out);
+    EXPECT_NEAR(j["multipliers"][0]["re"].get<double>(), exact, 1e-12 * exact) << solver;
+    EXPECT_EQ(j["multipliers"][0]["im"].get<double>(), 0.0) << solver;
+    EXPECT_LE(j["residuals"][0].get<double>(), 1e-8) << solver;
+    // nev = 2: the second multiplier is 0 (rank one), reported as exactly 0 with a note.
+    r = run({"floquet", "--json", "--set", "model=linear", "--set", "a=5", "--set", "b=0", "--set", "N=50", "--set",
+             "nev=2", "--set", std::string("solver=") + solver});
+    ASSERT_EQ(r.status, 0) << r.err;
+    j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["multipliers"][1]["abs"].get<double>(), 0.0) << solver;
+    EXPECT_NE(j["note"].get<std::string>().find("round-off level"), std::string::npos) << solver;
+  }
+  // A bad bound is bad input naming the key.
+  CliResult bad = run({"floquet", "--set", "model=linear", "--set", "N=20", "--set", "residual_bound=-1"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("`residual_bound = -1`"), std::string::npos) << bad.err;
 }

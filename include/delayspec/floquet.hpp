@@ -12,14 +12,30 @@
 // are formed and applied once more (one extra apply_block), giving the true residual
 // |M v - mu v| / (|mu| |v|) of each returned pair in FloquetResult::residuals.
 //
+// The residual gate: a returned pair counts as converged only if its true residual is at most
+//     bound = max(residual_bound, 100 tolerance)                 (default 1e-8)
+// The backends' estimate is <= tolerance and the true residual equals it up to the rounding of
+// one application and the basis' loss of orthogonality, O(eps K) ~ 1e-16 ... 1e-9 for K <= 1e7
+// steps; a pair far above its own estimate (spurious Ritz values from a basis grown out of
+// round-off, a multiplier below the operator's round-off level eps |M|) is not what Arnoldi
+// converged to. A failing pair is retried once with ncv doubled (at most n; Spectra also on a
+// scaled operator, krylov_spectra.cpp); if it still fails, NumericalFailure names the multiplier,
+// its residual and the bound. Never returned with exit 0.
+// Exception: multipliers at the operator's round-off level, |mu| <= r and |M v - mu v| <= r |v|
+// with r = 1e3 eps |M x| / |x| (exact zeros of a rank-deficient monodromy, e.g. k = 0 or b = 0,
+// or values far below eps |M|), are zero to working precision: returned as exactly 0, residual
+// |M v| / (|v| |M x| / |x|), and named in `note`.
+//
 // Example:
 //   FloquetOptions o;  o.nev = 20;  o.solver = FloquetSolver::arpack;
 //   FloquetResult r = floquet_multipliers(monodromy, o);   // r.multipliers[0] = spectral radius
 //
-// Errors: BadInput (nev < 1 or > n, ncv < nev + 2, tolerance <= 0, max_iterations < 1);
+// Errors: BadInput (nev < 1 or > n, ncv < nev + 2, tolerance <= 0, max_iterations < 1,
+// residual_bound <= 0);
 // NumericalFailure when a Krylov backend does not converge within max_iterations (the message
 // names the iterations, the converged count and the largest relative Ritz residual estimate) or
-// reports an error (ARPACK info != 0). Never a silently shorter list.
+// reports an error (ARPACK info != 0), or when a returned pair fails the residual gate.
+// Never a silently shorter list.
 // Krylov needs nev <= n - 2 (Spectra's and ARPACK's constraint); a larger nev with
 // solver = spectra | arpack runs the dense LAPACK path instead and says so in `note`.
 #include <complex>
@@ -49,6 +65,8 @@ struct FloquetOptions {
   std::uint64_t seed = 1;       // start vector = start_vector(n, seed) for both backends
   Eigen::VectorXd start;        // when non-empty: the start vector instead (n finite entries, not all 0)
   bool keep_vectors = false;    // fill FloquetResult::subspace (Krylov only)
+  double residual_bound = 1e-8; // the residual gate (header comment): max(residual_bound, 100 tolerance)
+  bool retry_failed_gate = true; // retry a pair failing the gate (false: report the backend's first answer)
 };
 
 struct FloquetResult {
@@ -63,6 +81,7 @@ struct FloquetResult {
   int iterations = 0;             // Arnoldi iterations taken (1 + restarts)
   int restarts = 0;               // implicit restarts = iterations - 1
   std::vector<double> residuals;  // per multiplier: |M v - mu v| / (|mu| |v|), from one extra application
+                                  // (a multiplier reported as 0: |M v| / (|v| |M x| / |x|), header comment)
   // keep_vectors: n x nev real basis of the invariant subspace of the returned multipliers:
   // column k = Re v_k when Im mu_k >= 0, Im v_k otherwise (a conjugate pair spans {Re v, Im v}).
   Eigen::MatrixXd subspace;

@@ -62,6 +62,12 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
   const double steps_real = std::ceil(options.t_end / grid.h - 1e-9);
   if (steps_real > 1e10) throw BadInput("`t_end = " + format_number(options.t_end) + "`: more than 1e10 steps");
   const long steps = static_cast<long>(steps_real);
+  // The trajectory is kept in memory (time and state per sample): bound it before allocating.
+  const double samples = (options.t_end - options.t_start) / grid.h / static_cast<double>(options.sample_every);
+  if (samples > 1e8)
+    throw BadInput("`t_end = " + format_number(options.t_end) + "`, `t_start = " + format_number(options.t_start) +
+                   "`, `sample_every = " + std::to_string(options.sample_every) +
+                   "`: more than 1e8 trajectory samples; raise sample_every or shorten the window");
   const long M = grid.M, m = grid.m, ring = M + 3;
   const double theta = grid.theta, c0 = 1 - theta, h = grid.h;
   std::vector<V> b(static_cast<size_t>(ring));

@@ -44,12 +44,8 @@ int command_basin(Config& config, const Invocation& inv) {
   const ParameterAxis x = read_parameter_axis(config, "basin", "x", "x0", -3, 3, 15);
   const ParameterAxis y = read_parameter_axis(config, "basin", "y", "v0", -3, 3, 15);
   if (x.name == y.name) throw BadInput("`basin_x = basin_y = " + x.name + "`: the two axes must differ");
-  const long transient = config.get_int("basin_transient", 400);
-  if (transient < 0 || transient > 100000000)
-    throw BadInput("`basin_transient = " + std::to_string(transient) + "`: must be between 0 and 1e8");
-  const long max_period = config.get_int("basin_max_period", 8);
-  if (max_period < 1 || max_period > 10000)
-    throw BadInput("`basin_max_period = " + std::to_string(max_period) + "`: must be between 1 and 10000");
+  const long transient = config.get_int_in_range("basin_transient", 400, 0, 100'000'000);
+  const long max_period = config.get_int_in_range("basin_max_period", 8, 1, 10000);
   const double tolerance = config.get_double("basin_tolerance", 1e-6);
   require_positive("basin_tolerance", tolerance);
   const int threads = read_threads(config);
@@ -58,7 +54,7 @@ int command_basin(Config& config, const Invocation& inv) {
   require_model_parameter(config, "basin_y", y.name, problem.model_name);
   config.check_all_used();
 
-  const long count = x.points * y.points;
+  const long count = grid_point_count(x, y, "basin");
   std::vector<Classification> result(static_cast<size_t>(count));
   std::vector<std::string> failure(static_cast<size_t>(count));
   Progress progress(inv.err, "basin", count, inv.quiet);

@@ -70,8 +70,7 @@ int command_bench(Config& config, const Invocation& inv) {
   FloquetOptions base = read_floquet_options(config, 10);
   const ReferenceKind reference_kind =
       parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
-  const long repeats = config.get_int("repeats", 1);
-  if (repeats < 1 || repeats > 1000) throw BadInput("`repeats = " + std::to_string(repeats) + "`: must be between 1 and 1000");
+  const long repeats = config.get_int_in_range("repeats", 1, 1, 1000);
   const double limit_mb = config.get_double("dense_memory_limit_mb", 2048);
   require_positive("dense_memory_limit_mb", limit_mb);
   config.check_all_used();

@@ -42,7 +42,7 @@ int command_chart(Config& config, const Invocation& inv) {
   require_model_parameter(config, "chart_y", y.name, problem.model_name);
   config.check_all_used();
 
-  const long count = x.points * y.points;
+  const long count = grid_point_count(x, y, "chart");
   std::vector<double> radius(static_cast<size_t>(count), NAN);
   std::vector<std::string> failure(static_cast<size_t>(count));
   Progress progress(inv.err, "chart", count, inv.quiet);

@@ -61,7 +61,7 @@ int command_simulate(Config& config, const Invocation& inv) {
   SimulationOptions options;
   options.t_end = config.get_double("t_end", 10 * period);
   options.t_start = config.get_double("t_start", 0);
-  options.sample_every = config.get_int("sample_every", 1);
+  options.sample_every = config.get_int_in_range("sample_every", 1, 1, 1'000'000'000);
   const double control_on_at = config.get_double("control_on_at", 0);
   require_finite("control_on_at", control_on_at);
   if (control_on_at < 0) throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: must be >= 0");
@@ -72,7 +72,7 @@ int command_simulate(Config& config, const Invocation& inv) {
   if (before_problem.events != problem.events && !(control_on_at > 0))
     throw BadInput("`events_before_control = " + before_problem.events + "`: needs control_on_at > 0");
   // A scene shared with the analysis commands (e.g. the default scene) may carry their keys.
-  for (const char* key : {"nev", "solver", "ncv", "tol", "max_restarts", "seed", "orbit", "orbit_tolerance",
+  for (const char* key : {"nev", "solver", "ncv", "tol", "max_restarts", "seed", "residual_bound", "orbit", "orbit_tolerance",
                           "orbit_max_periods", "orbit_max_iterations", "orbit_guess_periods", "exponents", "periods", "transient", "Ns"})
     config.mark_used(key);
   config.check_all_used();

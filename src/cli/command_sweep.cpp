@@ -90,15 +90,10 @@ int command_sweep(Config& config, const Invocation& inv) {
     if (key == reserved) throw BadInput("`sweep_key = " + key + "`: not a parameter that can be swept");
   const double from = config.require_double("sweep_from");
   const double to = config.require_double("sweep_to");
-  const long count = config.get_int("sweep_points", 11);
-  if (count < 1 || count > 1000000)
-    throw BadInput("`sweep_points = " + std::to_string(count) + "`: must be an integer between 1 and 1000000");
-  const long threads_key = config.get_int("threads", 0);
-  if (threads_key < 0 || threads_key > 4096)
-    throw BadInput("`threads = " + std::to_string(threads_key) + "`: must be 0 (all cores) or a number of threads");
-  const long section_points = config.get_int("section_points", 100);
-  if (section_points < 0 || section_points > 100000000)
-    throw BadInput("`section_points = " + std::to_string(section_points) + "`: must be an integer >= 0");
+  const long count = config.get_int_in_range("sweep_points", 11, 1, 1'000'000);
+  const long threads_key = config.get_int_in_range("threads", 0, 0, 4096);  // 0 = all cores
+  // section points are kept in memory (d doubles each) for every point of the sweep
+  const long section_points = config.get_int_in_range("section_points", 100, 0, 10'000'000);
   LyapunovOptions options = read_lyapunov_options(config, 2);
   options.section_points = section_points;
   // The swept key takes each point's value; reading the problem once with the first value

@@ -61,6 +61,9 @@ namespace {
 // toml++ sees the text is correct TOML, and it also guards against a bug of toml++ 3.3.0 (Debian
 // 12): its non-ASCII whitespace test reaches TOML_UNREACHABLE (undefined behaviour) for many
 // code points, e.g. U+00A1 or U+FEFB after `=` (found by tests/fuzz_scene.cpp, docs/fuzzing.md).
+// Inside basic strings toml++ runs the same test on the character after a backslash, and in
+// multi-line basic strings on the first character after a line-ending backslash: a non-ASCII
+// character there is rejected too (after a backslash it is invalid TOML anyway).
 void require_ascii_outside_strings(const std::string& text, const std::string& path) {
   enum class State { code, comment, basic, literal, multi_basic, multi_literal } state = State::code;
   long line = 1, column = 0;
@@ -68,6 +71,11 @@ void require_ascii_outside_strings(const std::string& text, const std::string& p
     const char c = text[i];
     ++column;
     auto starts = [&](const char* token) { return text.compare(i, std::char_traits<char>::length(token), token) == 0; };
+    auto non_ascii_at = [&](size_t j) { return j < text.size() && static_cast<unsigned char>(text[j]) >= 0x80; };
+    auto reject_after_backslash = [&]() {
+      throw BadInput("scene `" + path + "`: non-ASCII character after a backslash in a string (line " +
+                     std::to_string(line) + ", column " + std::to_string(column) + ")");
+    };
     if (c == '\n') {
       ++line;
       column = 0;
@@ -88,6 +96,7 @@ void require_ascii_outside_strings(const std::string& text, const std::string& p
       case State::comment:
         break;
       case State::basic:
+        if (c == '\\' && non_ascii_at(i + 1)) reject_after_backslash();
         if (c == '\\') ++i, ++column;  // an escape: skip the escaped character
         else if (c == '"') state = State::code;
         break;
@@ -95,7 +104,15 @@ void require_ascii_outside_strings(const std::string& text, const std::string& p
         if (c == '\'') state = State::code;
         break;
       case State::multi_basic:
-        if (c == '\\') ++i, ++column;
+        if (c == '\\') {
+          if (non_ascii_at(i + 1)) reject_after_backslash();
+          // A line-ending backslash: toml++ skips the white space and line breaks after it and
+          // tests the next character with its non-ASCII whitespace function.
+          size_t j = i + 1;
+          while (j < text.size() && (text[j] == ' ' || text[j] == '\t' || text[j] == '\r' || text[j] == '\n')) ++j;
+          if (j > i + 1 && non_ascii_at(j)) reject_after_backslash();
+          if (i + 1 < text.size() && text[i + 1] != '\n') ++i, ++column;  // skip the escaped character
+        }
         else if (starts("\"\"\"")) state = State::code, i += 2, column += 2;
         break;
       case State::multi_literal:
@@ -190,6 +207,14 @@ long Config::get_int(const std::string& key, long fallback) {
   return value;
 }
 
+long Config::get_int_in_range(const std::string& key, long fallback, long lo, long hi) {
+  const long value = get_int(key, fallback);
+  if (value < lo || value > hi)
+    throw BadInput("`" + key + " = " + std::to_string(value) + "`: must be between " + std::to_string(lo) + " and " +
+                   std::to_string(hi));
+  return value;
+}
+
 std::string Config::get_string(const std::string& key, const std::string& fallback) {
   auto text = lookup(key);
   return text ? *text : fallback;
@@ -233,7 +258,7 @@ const std::vector<std::string>& contract_keys() {
       "kappa", "delta", "eps",                                                  // mathieu
       // floquet and orbits
       "nev", "solver", "orbit", "orbit_tolerance", "orbit_max_periods", "orbit_guess_periods",
-      "orbit_max_iterations", "ncv", "tol", "max_restarts", "seed",
+      "orbit_max_iterations", "ncv", "tol", "max_restarts", "seed", "residual_bound",
       // lyapunov, converge, sweep, simulate
       "exponents", "periods", "transient", "Ns",
       // converge, bench (command_converge.cpp, command_bench.cpp)

@@ -29,6 +29,9 @@ class Config {
   double get_double(const std::string& key, double fallback);
   double require_double(const std::string& key);
   long get_int(const std::string& key, long fallback);
+  // An integer that must lie in [lo, hi], checked on the parsed value before any narrowing cast
+  // (so `4294967298` is rejected, not wrapped to 2): BadInput "`key = v`: must be between lo and hi".
+  long get_int_in_range(const std::string& key, long fallback, long lo, long hi);
   std::string get_string(const std::string& key, const std::string& fallback);
   // A value that must be one of `allowed`.
   std::string get_choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed);

@@ -4,30 +4,25 @@
 
 namespace delayspec::cli {
 
-namespace {
-
-long read_long(Config& config, const std::string& key, long fallback, long min) {
-  const long value = config.get_int(key, fallback);
-  if (value < min)
-    throw BadInput("`" + key + " = " + std::to_string(value) + "`: must be an integer >= " + std::to_string(min));
-  return value;
-}
-
-}  // namespace
-
 LyapunovOptions read_lyapunov_options(Config& config, int default_exponents) {
   LyapunovOptions o;
-  o.exponents = static_cast<int>(read_long(config, "exponents", default_exponents, 1));
-  o.periods = read_long(config, "periods", o.periods, 2);
-  o.transient = read_long(config, "transient", o.transient, 0);
-  o.seed = static_cast<std::uint64_t>(read_long(config, "seed", 1, 0));
-  o.qr_every = static_cast<int>(std::min<long>(read_long(config, "qr_every", 1, 1), INT_MAX));
-  o.batches = static_cast<int>(std::min<long>(read_long(config, "batches", o.batches, 2), INT_MAX));
-  if (o.exponents > 64)
-    throw BadInput("`exponents = " + std::to_string(o.exponents) + "`: at most 64 (only the leading ones are meant)");
+  // Bounds: at most 64 exponents (only the leading ones are meant); periods and transient at most
+  // 1e9 each, so transient + periods cannot overflow; the per-interval logs (periods / qr_every
+  // times exponents doubles) at most kMaxLogs = 1e8 (800 MB), checked before anything is allocated.
+  constexpr long kMaxPeriods = 1'000'000'000, kMaxLogs = 100'000'000;
+  o.exponents = static_cast<int>(config.get_int_in_range("exponents", default_exponents, 1, 64));
+  o.periods = config.get_int_in_range("periods", o.periods, 2, kMaxPeriods);
+  o.transient = config.get_int_in_range("transient", o.transient, 0, kMaxPeriods);
+  o.seed = static_cast<std::uint64_t>(config.get_int_in_range("seed", 1, 0, LONG_MAX));
+  o.qr_every = static_cast<int>(config.get_int_in_range("qr_every", 1, 1, kMaxPeriods));
+  o.batches = static_cast<int>(config.get_int_in_range("batches", o.batches, 2, kMaxPeriods));
   if (o.periods % o.qr_every != 0)
     throw BadInput("`periods = " + std::to_string(o.periods) + "` must be a multiple of `qr_every = " +
                    std::to_string(o.qr_every) + "`");
+  if (o.periods / o.qr_every > kMaxLogs / o.exponents)
+    throw BadInput("`periods = " + std::to_string(o.periods) + "`: with `exponents = " + std::to_string(o.exponents) +
+                   "` and `qr_every = " + std::to_string(o.qr_every) +
+                   "` the run would keep more than 1e8 logarithms (periods / qr_every * exponents <= 1e8)");
   return o;
 }
 

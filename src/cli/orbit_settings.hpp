@@ -37,7 +37,18 @@ PeriodicOrbit find_orbit(const Model& model, const Map& map, const OrbitSettings
     return zero;
   } else {
     Eigen::VectorXd U = map.constant_history(model.initial_state());
-    if (settings.method != "newton") return orbit_by_simulation(map, U, settings.simulation);
+    if (settings.method != "newton") {
+      try {
+        return orbit_by_simulation(map, U, settings.simulation);
+      } catch (const NumericalFailure& e) {
+        // The usual cause: the run from the initial history lands on another attractor (the
+        // impact model's defaults from rest are chaotic). Say what to do.
+        throw NumericalFailure(std::string(e.what()) +
+                               ". To reach a periodic orbit: `--set orbit=newton` (Newton on the periodic problem, "
+                               "finds unstable orbits too), an initial history near the orbit (x0, v0 for impact), "
+                               "or a scene that has one, e.g. data/scenes/default.toml");
+      }
+    }
     for (long i = 1; i <= settings.guess_periods; ++i) {
       U = map.apply(U);
       if (!U.allFinite())

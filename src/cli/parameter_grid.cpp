@@ -33,10 +33,16 @@ ParameterAxis read_parameter_axis(Config& config, const std::string& prefix, con
   a.min = values[0];
   a.max = values[1];
   const std::string points_key = prefix + "_" + axis + "_points";
-  a.points = config.get_int(points_key, default_points);
-  if (a.points < 2 || a.points > 100000)
-    throw BadInput("`" + points_key + " = " + std::to_string(a.points) + "`: must be between 2 and 100000");
+  a.points = config.get_int_in_range(points_key, default_points, 2, 100000);
   return a;
+}
+
+long grid_point_count(const ParameterAxis& x, const ParameterAxis& y, const std::string& prefix) {
+  constexpr long kMaxPoints = 10'000'000;
+  if (x.points > kMaxPoints / y.points)
+    throw BadInput("`" + prefix + "_x_points = " + std::to_string(x.points) + "`, `" + prefix +
+                   "_y_points = " + std::to_string(y.points) + "`: at most 1e7 grid points in all");
+  return x.points * y.points;
 }
 
 void require_model_parameter(const Config& config, const std::string& key, const std::string& name,
@@ -47,9 +53,8 @@ void require_model_parameter(const Config& config, const std::string& key, const
 
 int read_threads(Config& config) {
   const long hardware = std::max(1u, std::thread::hardware_concurrency());
-  const long threads = config.get_int("threads", 0);
-  if (threads < 0 || threads > 4096)
-    throw BadInput("`threads = " + std::to_string(threads) + "`: must be 0 (all cores) or a number of threads up to 4096");
+  // 0 = all cores
+  const long threads = config.get_int_in_range("threads", 0, 0, 4096);
   return static_cast<int>(threads == 0 ? hardware : threads);
 }
 

@@ -23,6 +23,10 @@ ParameterAxis read_parameter_axis(Config& config, const std::string& prefix, con
                                   const std::string& default_name, double default_min, double default_max,
                                   long default_points);
 
+// The number of grid points, x.points * y.points; BadInput naming both keys when it exceeds 1e7
+// (every point keeps its result in memory until the table is written).
+long grid_point_count(const ParameterAxis& x, const ParameterAxis& y, const std::string& prefix);
+
 // After read_problem(config): BadInput unless the axis names a numeric model parameter (a key
 // read_problem read, other than model and N).
 void require_model_parameter(const Config& config, const std::string& key, const std::string& name,

@@ -8,13 +8,6 @@ namespace delayspec::cli {
 
 namespace {
 
-int read_positive_int(Config& config, const std::string& key, long fallback) {
-  const long value = config.get_int(key, fallback);
-  if (value < 1 || value > INT_MAX)
-    throw BadInput("`" + key + " = " + std::to_string(value) + "`: must be an integer >= 1");
-  return static_cast<int>(value);
-}
-
 ImpactModel read_impact(Config& c) {
   ImpactParameters p;
   p.zeta = c.get_double("zeta", p.zeta);
@@ -83,14 +76,16 @@ Problem read_problem(Config& config, int default_N) {
   if (problem.model_name == "linear") problem.model = read_linear(config);
   if (problem.model_name == "mathieu") problem.model = read_mathieu(config);
   if (problem.model_name == "mackey-glass") problem.model = read_mackey_glass(config);
-  problem.N = read_positive_int(config, "N", default_N);
-  problem.orbit_period = read_positive_int(config, "orbit_period", 1);
+  // N up to 1e9 (the history alone is then 16 GB at d = 2); orbit_period and contact_substeps
+  // multiply the work per step or per period, 1000 is far beyond any use.
+  problem.N = static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000));
+  problem.orbit_period = static_cast<int>(config.get_int_in_range("orbit_period", 1, 1, 1000));
   if (problem.orbit_period != 1 && (problem.model_name == "linear" || problem.model_name == "mackey-glass"))
     throw BadInput("`orbit_period = " + std::to_string(problem.orbit_period) +
                    "`: only for forced models (impact, mathieu); for linear and mackey-glass set `period`");
   problem.events = config.get_choice("events", "on", {"on", "linear", "off"});
   problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"});
-  problem.contact_substeps = read_positive_int(config, "contact_substeps", problem.contact_substeps);
+  problem.contact_substeps = static_cast<int>(config.get_int_in_range("contact_substeps", problem.contact_substeps, 1, 1000));
   problem.grid = std::visit(
       [&](const auto& model) { return make_grid(model.tau(), model.period(), problem.N, problem.orbit_period); },
       problem.model);

@@ -1,4 +1,6 @@
 #include <exception>
+#include <new>
+#include <stdexcept>
 #include <map>
 #include <vector>
 
@@ -81,9 +83,12 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
                  .resume = resume,
                  .out = out,
                  .err = err};
+  // Exit status 0, 2 (bad input) or 3 (numerical failure, out of memory, internal error): never 1,
+  // which scripts could not tell from a crash of the shell around it.
+  Config config;
   try {
     // `plot DIR`: the positional argument is a results directory, not a scene.
-    Config config = scene.empty() || command == "plot" ? Config() : Config::from_scene_file(scene);
+    if (!scene.empty() && command != "plot") config = Config::from_scene_file(scene);
     for (const auto& a : assignments) config.set_from_assignment(a);
     // Scene-level keys (for `run`): any command may be given a scene that has them.
     config.mark_used("analyses");
@@ -96,11 +101,19 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
     err << "delayspec " << command << ": numerical failure: " << e.what() << "\n";
     return 3;
   } catch (const std::bad_alloc&) {
-    err << "delayspec " << command << ": out of memory (reduce N or use a Krylov solver)\n";
+    // The Krylov hint only where a dense solver was asked for (bench compares dense by default).
+    const std::string solver = config.values().count("solver") ? config.values().at("solver") : "";
+    const bool dense = solver.rfind("dense", 0) == 0 || command == "bench";
+    err << "delayspec " << command << ": out of memory (reduce N" << (dense ? " or use a Krylov solver" : "")
+        << ")\n";
+    return 3;
+  } catch (const std::length_error& e) {
+    err << "delayspec " << command << ": out of memory: a buffer larger than the address space (" << e.what()
+        << "); reduce N or the run's length\n";
     return 3;
   } catch (const std::exception& e) {
-    err << "delayspec " << command << ": internal error: " << e.what() << "\n";
-    return 1;
+    err << "delayspec " << command << ": internal error (please report): " << e.what() << "\n";
+    return 3;
   }
 }
 
