@@ -152,7 +152,7 @@ INSTANTIATE_TEST_SUITE_P(Keys, GridBadInput, ::testing::Values(
     BadKey{"chart", "chart_x", "b", "`chart_x = chart_y = b`"},
     BadKey{"chart", "chart_x", "zeta", "`chart_x = zeta`: not a numeric parameter of model mathieu"},
     BadKey{"chart", "chart_y", "N", "`chart_y = N`: not a numeric parameter"},
-    BadKey{"chart", "threads", "-1", "`threads = -1`: must be 0 (all cores)"},
+    BadKey{"chart", "threads", "-1", "`threads = -1`: must be between 0 and 4096"},
     BadKey{"chart", "chart_xpoints", "3", "unknown key `chart_xpoints`"},
     BadKey{"basin", "basin_transient", "-1", "`basin_transient = -1`"},
     BadKey{"basin", "basin_max_period", "0", "`basin_max_period = 0`"},
