@@ -132,7 +132,8 @@ int command_run(Config& config, const Invocation& inv) {
   // manifest) goes first and comes back last: while it is absent the set is not complete.
   std::error_code removed;
   if (fs::remove(dir / "run.json", removed); removed)
-    throw BadInput("cannot remove `" + (dir / "run.json").string() + "`: " + removed.message());
+    throw BadInput("cannot write `" + (dir / "run.json").string() + "`: cannot remove the previous one: " +
+                   removed.message());
   nlohmann::json manifest;
   manifest["analyses"] = nlohmann::json::array();
   if (!title.empty()) manifest["title"] = title;

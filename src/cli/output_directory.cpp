@@ -72,7 +72,7 @@ void OutputDirectory::note_write(const fs::path& target) {
     // Before the first new byte lands in DIR, the directory stops claiming to be complete.
     const fs::path marker = dir_ / marker_name;
     if (::unlink(marker.c_str()) != 0 && errno != ENOENT)
-      throw BadInput("cannot remove `" + marker.string() + "`: " + std::strerror(errno));
+      throw BadInput("cannot write `" + marker.string() + "`: cannot remove the previous one: " + std::strerror(errno));
     marker_removed_ = true;
   }
   if (relative.has_parent_path()) return;  // working files in subdirectories (sweep's points/) are not listed
