@@ -252,7 +252,7 @@ std::string Config::get_choice(const std::string& key, const std::string& fallba
 std::vector<long> Config::get_int_list(const std::string& key, const std::vector<long>& fallback) {
   auto join = [](const std::vector<long>& list) {
     std::string out;
-    for (long v : list) out += (out.empty() ? "" : ",") + std::to_string(v);
+    for (long v : list) out.append(out.empty() ? "" : ",").append(std::to_string(v));  // (append: GCC 12 warns falsely on "," + string)
     return out;
   };
   auto text = lookup(key);
