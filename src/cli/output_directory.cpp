@@ -34,7 +34,8 @@ fs::path normal_directory(const fs::path& dir) {
 
 OutputDirectory::OutputDirectory(fs::path dir) : dir_(normal_directory(dir)) {
   std::error_code ec;
-  if (fs::is_directory(dir_, ec)) acquire();
+  existed_ = fs::is_directory(dir_, ec);
+  if (existed_) acquire();
   previous_ = open_directory.exchange(this);
 }
 
@@ -45,9 +46,19 @@ OutputDirectory::~OutputDirectory() {
 
 void OutputDirectory::acquire() {
   if (lock_fd_ >= 0) return;
-  std::error_code ec;
-  fs::create_directories(dir_, ec);
-  if (ec) throw BadInput("cannot write `" + dir_.string() + "`: cannot create the directory: " + ec.message());
+  if (!existed_) {
+    // This run found no DIR, so it must be the one to create it: a DIR that appeared meanwhile
+    // belongs to another run (which may even have finished and released its lock already).
+    std::error_code ec;
+    if (dir_.has_parent_path()) fs::create_directories(dir_.parent_path(), ec);
+    const bool created = !ec && fs::create_directory(dir_, ec);
+    if (ec) throw BadInput("cannot write `" + dir_.string() + "`: cannot create the directory: " + ec.message());
+    if (!created)
+      throw BadInput("`--out " + dir_.string() +
+                     "`: another delayspec run created this directory after this one started; choose another "
+                     "directory");
+    existed_ = true;
+  }
   const fs::path lock_path = dir_ / lock_name;
   const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0) throw BadInput("cannot write `" + lock_path.string() + "`: " + std::strerror(errno));

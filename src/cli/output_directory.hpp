@@ -8,7 +8,8 @@
 // returns (the kernel drops it when the process dies, so a killed run leaves no stale lock). It is
 // taken when the run starts if DIR exists (before anything in DIR is read, e.g. by --resume),
 // else by the first write, which creates DIR (a run stopped by bad input creates nothing). A run
-// that finds the lock held stops with BadInput naming DIR.
+// that finds the lock held, or finds that DIR was created by someone else after it started,
+// stops with BadInput naming DIR.
 //
 // Completeness: `DIR/complete.json` is removed before the run's first write into DIR and written
 // (atomically) after its last, when the command finished (exit 0, or 3 with its failures
@@ -46,6 +47,7 @@ class OutputDirectory {
   void note_write(const std::filesystem::path& target);
 
   std::filesystem::path dir_;
+  bool existed_ = false;  // DIR existed when the run started (else the run must create it)
   int lock_fd_ = -1;
   bool marker_removed_ = false;
   std::set<std::string> files_;  // names written directly in DIR
