@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "delayspec/errors.hpp"
+#include "output_directory.hpp"
 
 namespace delayspec::cli {
 
@@ -31,6 +32,7 @@ std::filesystem::path temporary_name(const std::filesystem::path& target) {
 
 void write_file_atomically(const std::filesystem::path& target, const std::string& contents) {
   if (target.filename().empty()) throw BadInput("cannot write `" + target.string() + "`: not a file name");
+  before_output_write(target);  // the lock and the completeness marker of --out DIR
   const std::filesystem::path parent = target.parent_path().empty() ? "." : target.parent_path();
   std::error_code ec;
   std::filesystem::create_directories(parent, ec);

@@ -6,6 +6,8 @@
 // complete; at worst a hidden `.NAME.tmp-*` file remains.
 // Errors (directory missing and not creatable, disk full, permission) throw BadInput naming the
 // path and the system's reason: the user asked for an output location that cannot be written.
+// A write into the `--out` directory of the running command is first reported to its
+// OutputDirectory (output_directory.hpp: lock, completeness marker).
 //
 // Example:
 //     AtomicFile file(out_dir / "exponents.csv");

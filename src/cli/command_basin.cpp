@@ -11,6 +11,9 @@
 // (default 8), basin_tolerance (default 1e-6), threads; plus the problem keys.
 // Output: JSON {"x", "y", "rows": [{"x", "y", "period", "max_section_x"}], "counts": {period: n}};
 // with --out DIR also DIR/basin.csv: x,y,period,max_section_x in gnuplot's grid format.
+// A point whose trajectory fails (not finite, or a numerical failure of the stepper) is recorded
+// (period null, its "failure"; nan in the CSV), the others still run, and the command exits 3
+// after writing everything, as sweep does.
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -63,7 +66,8 @@ int command_basin(Config& config, const Invocation& inv) {
     point.set(x.name, format_number(x.value(i % x.points)), "basin");
     point.set(y.name, format_number(y.value(i / x.points)), "basin");
     const Problem p = read_problem(point, 50);
-    std::visit(
+    try {
+      std::visit(
         [&](const auto& model) {
           using Model = std::decay_t<decltype(model)>;
           TrapezoidStepper<Model> stepper(model, step_options(p));
@@ -87,6 +91,9 @@ int command_basin(Config& config, const Invocation& inv) {
           result[i] = c;
         },
         p.model);
+    } catch (const NumericalFailure& e) {
+      failure[i] = e.what();  // reported with the point, not fatal to the basin
+    }
     progress.add();
   });
   progress.finish();
@@ -143,7 +150,7 @@ int command_basin(Config& config, const Invocation& inv) {
     if (failed) inv.out << "  failed: " << failed << " points\n";
     inv.out << "time: " << seconds << " s\n";
   }
-  return 0;
+  return report_failed_points(inv.err, "basin", rows);
 }
 
 }  // namespace delayspec::cli

@@ -7,7 +7,9 @@
 // orbit and eigen-solver keys (nev defaults to 1 here: only |mu_1| is wanted).
 // Output: JSON {"x", "y", "x_values", "y_values", "rows": [{"x", "y", "spectral_radius"}], ...};
 // with --out DIR also DIR/chart.csv: x,y,spectral_radius, one block per y value separated by a
-// blank line (gnuplot's grid format), metadata as "#" comment lines first.
+// blank line (gnuplot's grid format), metadata as "#" comment lines first. A point that fails
+// numerically (e.g. no periodic orbit) is recorded (spectral_radius null, its "failure"; nan in
+// the CSV), the others still run, and the command exits 3 after writing everything, as sweep does.
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -117,7 +119,7 @@ int command_chart(Config& config, const Invocation& inv) {
     inv.out << "\ntime: " << seconds << " s\n";
     if (inv.out_dir) inv.out << "wrote " << (std::filesystem::path(*inv.out_dir) / "chart.csv").string() << "\n";
   }
-  return 0;
+  return report_failed_points(inv.err, "chart", rows);
 }
 
 }  // namespace delayspec::cli

@@ -2,12 +2,16 @@
 // without the key, the one command the scene's keys belong to, see read_analyses),
 // each through the command table exactly as `delayspec NAME SCENE --json` would, and writes
 // DIR/NAME.json (the command's JSON plus a "metadata" object, see metadata.hpp) and a manifest
-// DIR/run.json. Every file is written atomically (atomic_file.hpp).
+// DIR/run.json. Every file is written atomically (atomic_file.hpp). run.json is removed before the
+// first analysis runs and written after the last: it exists only for a finished run. An analysis
+// that exits 3 with its failures recorded (failed points of sweep, chart, basin) keeps its
+// file, the other analyses still run, and run exits 3; one that throws stops the run.
 //
 // The whole scene is validated before anything is computed: each analysis first runs in
 // key-collection mode (Config::collect_keys_only: it reads its keys and stops at
 // check_all_used()), then every key of the scene must be read by at least one analysis.
 // A key only one analysis reads is therefore not "unknown" to the others.
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <set>
@@ -119,10 +123,21 @@ int command_run(Config& config, const Invocation& inv) {
                    (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?"));
   }
 
-  // 2. Run the analyses; each result file appears only once it is complete.
+  bool resumable = false;
+  for (const auto& name : analyses) resumable = resumable || output_use(name).resume;
+  if (inv.resume && !resumable)
+    throw BadInput("`--resume`: no analysis of this scene has anything to resume (only sweep does)");
+
+  // 2. Run the analyses; each result file appears only once it is complete. run.json (the
+  // manifest) goes first and comes back last: while it is absent the set is not complete.
+  std::error_code removed;
+  if (fs::remove(dir / "run.json", removed); removed)
+    throw BadInput("cannot write `" + (dir / "run.json").string() + "`: cannot remove the previous one: " +
+                   removed.message());
   nlohmann::json manifest;
   manifest["analyses"] = nlohmann::json::array();
   if (!title.empty()) manifest["title"] = title;
+  int worst_status = 0;
   Progress progress(inv.err, "run", static_cast<long>(analyses.size()), inv.quiet);
   for (const auto& name : analyses) {
     Config analysis_config = config;
@@ -133,7 +148,9 @@ int command_run(Config& config, const Invocation& inv) {
     const auto start = std::chrono::steady_clock::now();
     const int status = command_table().at(name)(analysis_config, analysis);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (status != 0) return status;
+    // Exit 3 from an analysis means failures recorded in its (complete) result, as sweep, chart
+    // and basin do with failing points: keep it, run the other analyses, and exit 3 at the end.
+    worst_status = std::max(worst_status, status);
     nlohmann::json result;
     try {
       result = nlohmann::json::parse(json_out.str());
@@ -143,7 +160,8 @@ int command_run(Config& config, const Invocation& inv) {
     result["metadata"] = metadata_json(make_metadata(name, inv.scene, config, result, seconds));
     const fs::path file = dir / (name + ".json");
     write_file_atomically(file, result.dump(2) + "\n");
-    manifest["analyses"].push_back({{"name", name}, {"file", file.filename().string()}, {"seconds", seconds}});
+    manifest["analyses"].push_back(
+        {{"name", name}, {"file", file.filename().string()}, {"seconds", seconds}, {"exit_status", status}});
     if (!inv.json) inv.out << name << ": wrote " << file.string() << " (" << format_duration(seconds) << ")\n";
     progress.add();
   }
@@ -158,7 +176,7 @@ int command_run(Config& config, const Invocation& inv) {
     inv.out << "run: " << analyses.size() << " analyses in " << format_duration(wall) << "; results in "
             << dir.string() << " (plot them: delayspec plot " << dir.string() << ")\n";
   }
-  return 0;
+  return worst_status;
 }
 
 }  // namespace delayspec::cli

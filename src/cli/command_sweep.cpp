@@ -4,8 +4,9 @@
 // Points run in parallel (`threads`, default: all cores), each thread with its own stepper and
 // buffers. With --out DIR the results are kept point by point, so an interrupted sweep loses
 // only the points in flight and `--resume` completes it:
-//   DIR/sweep_settings.json     the settings of the sweep (resume refuses other settings)
-//   DIR/points/point_NNNNN.json one file per finished point, written atomically
+//   DIR/sweep_settings.json     the effective settings of the sweep (resume refuses other settings)
+//   DIR/points/point_NNNNN.json one file per finished point, written atomically, with the
+//                               settings_hash of its sweep (resume refuses a point of another sweep)
 //   DIR/exponents.csv           parameter,lambda1..k,se1..k,lambda1_per_time..,seconds
 //   DIR/section.csv             parameter,x (one row per Poincare point)
 //   DIR/sweep.json              summary (the --json output)
@@ -16,6 +17,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -45,6 +47,19 @@ struct SweepPoint {
   json result;  // the point's record (also its file)
   bool done = false;
 };
+
+// FNV-1a (64 bit) of the settings' JSON text, as 16 hex digits: a point file's label of the
+// sweep it belongs to (nlohmann::json keeps object keys sorted, so the text is canonical).
+std::string settings_hash(const json& settings) {
+  std::uint64_t hash = 14695981039346656037ull;
+  for (const unsigned char c : settings.dump()) {
+    hash ^= c;
+    hash *= 1099511628211ull;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
+}
 
 std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : "nan"; }
 
@@ -101,7 +116,6 @@ int command_sweep(Config& config, const Invocation& inv) {
   config.set(key, format_number(from), "sweep_from");
   Problem first = read_problem(config, 100);
   config.check_all_used();
-  if (inv.resume && !inv.out_dir) throw BadInput("`--resume` needs `--out DIR` (the interrupted sweep's directory)");
 
   std::vector<SweepPoint> points(static_cast<size_t>(count));
   for (long i = 0; i < count; ++i) {
@@ -115,11 +129,14 @@ int command_sweep(Config& config, const Invocation& inv) {
   }
   const int d = state_dimension(first);
 
-  // Settings of the sweep (everything but the thread count), for --resume.
+  // Settings of the sweep for --resume: the effective values (a key stated at its default equals
+  // the key left out), except the thread count (results do not depend on it) and the scene-level
+  // keys of `run` (analyses, title).
   json settings = json::object();
-  for (const auto& [k, v] : config.values())
-    if (k != "threads") settings[k] = v;
+  for (const auto& [k, v] : config.effective_values())
+    if (k != "threads" && k != "analyses" && k != "title") settings[k] = v;
   settings[key] = nullptr;  // the swept key's value is per point
+  const std::string hash = settings_hash(settings);
   std::optional<fs::path> dir;
   if (inv.out_dir) {
     dir = fs::path(*inv.out_dir);
@@ -134,24 +151,43 @@ int command_sweep(Config& config, const Invocation& inv) {
         throw BadInput("`--resume`: `" + settings_path.string() + "` is not valid JSON");
       }
       if (stored != settings) {
+        // Name each differing key with both values (a missing key shows as null).
         std::string diff;
+        auto add = [&](const std::string& k) {
+          diff += (diff.empty() ? "`" : ", `") + k + "` (now " + settings.value(k, json()).dump() + ", the sweep's " +
+                  (stored.is_object() ? stored.value(k, json()) : json()).dump() + ")";
+        };
         for (const auto& [k, v] : settings.items())
-          if (!stored.contains(k) || stored[k] != v) diff += (diff.empty() ? "" : ", ") + k;
-        for (const auto& [k, v] : stored.items())
-          if (!settings.contains(k)) diff += (diff.empty() ? "" : ", ") + k;
-        throw BadInput("`--resume`: the settings differ from the interrupted sweep in `" + diff + "`");
+          if (!stored.is_object() || !stored.contains(k) || stored[k] != v) add(k);
+        if (stored.is_object())
+          for (const auto& [k, v] : stored.items())
+            if (!settings.contains(k)) add(k);
+        throw BadInput("`--resume`: the settings differ from the interrupted sweep in " + diff);
       }
       for (SweepPoint& p : points) {
-        std::ifstream pin(point_path(*dir, p.index));
+        const fs::path path = point_path(*dir, p.index);
+        std::ifstream pin(path);
         if (!pin) continue;
+        json record;
         try {
-          json record = json::parse(pin);
+          record = json::parse(pin);
+        } catch (const std::exception&) {
+          continue;  // unreadable point file: recompute the point
+        }
+        // A point of another sweep (other settings) is never merged into this one.
+        const json stored_hash = record.is_object() ? record.value("settings_hash", json()) : json();
+        if (stored_hash != hash)
+          throw BadInput("`--resume`: `" + path.string() + "` belongs to a sweep with other settings (settings_hash " +
+                         (stored_hash.is_string() ? stored_hash.get<std::string>() : std::string("missing")) +
+                         ", this sweep " + hash + ", settings in " + settings_path.string() +
+                         "): remove the file, or resume with the settings it was computed with");
+        try {
           if (record.at("index").get<long>() == p.index && record.at("parameter").get<double>() == p.parameter) {
             p.result = record;
             p.done = true;
           }
         } catch (const std::exception&) {
-          // unreadable point file: recompute the point
+          // a point record without index/parameter: recompute the point
         }
       }
     } else {
@@ -188,6 +224,7 @@ int command_sweep(Config& config, const Invocation& inv) {
         } catch (const NumericalFailure& e) {
           p.result = {{"index", p.index}, {"parameter", p.parameter}, {"error", e.what()}};
         }
+        p.result["settings_hash"] = hash;
         if (dir) write_file_atomically(point_path(*dir, p.index), p.result.dump() + "\n");
         p.done = true;
         progress.add();

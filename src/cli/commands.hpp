@@ -40,6 +40,16 @@ int command_simulate(Config& config, const Invocation& inv);
 // The command table (name -> function); `run` dispatches a scene's analyses through it.
 const std::map<std::string, CommandFunction>& command_table();
 
+// What a command does with `--out DIR`: nothing, writes its files there (run_cli then holds the
+// directory's lock, output_directory.hpp), or reads results from there (plot); and whether it
+// continues an interrupted run with `--resume`. run_cli refuses a flag the command ignores.
+enum class OutDirUse { ignored, written, read };
+struct OutputUse {
+  OutDirUse out = OutDirUse::ignored;
+  bool resume = false;
+};
+OutputUse output_use(const std::string& command);
+
 // Runs the program: parses argv, dispatches, maps errors to exit codes. Never throws.
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -16,6 +17,14 @@
 namespace delayspec::cli {
 
 namespace {
+
+// The shortest text that reads back as the same double ("0.6", not "0.59999999999999998"): the
+// one spelling of a number in the effective settings.
+std::string canonical_number(double value) {
+  char buffer[64];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return error == std::errc() ? std::string(buffer, end) : format_number(value);
+}
 
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t");
@@ -197,7 +206,10 @@ void Config::mark_used(const std::string& key) { used_.insert(key); }
 
 double Config::get_double(const std::string& key, double fallback) {
   auto text = lookup(key);
-  if (!text) return fallback;
+  if (!text) {
+    effective_[key] = canonical_number(fallback);
+    return fallback;
+  }
   const std::string& s = *text;
   errno = 0;
   char* end = nullptr;
@@ -206,6 +218,7 @@ double Config::get_double(const std::string& key, double fallback) {
   if (s.empty() || end != s.c_str() + s.size() || (errno == ERANGE && std::abs(value) == HUGE_VAL))
     throw BadInput("`" + key + " = " + s + "`: not a number");
   if (!std::isfinite(value)) throw BadInput("`" + key + " = " + s + "`: must be a finite number");
+  effective_[key] = canonical_number(value);
   return value;
 }
 
@@ -216,13 +229,17 @@ double Config::require_double(const std::string& key) {
 
 long Config::get_int(const std::string& key, long fallback) {
   auto text = lookup(key);
-  if (!text) return fallback;
+  if (!text) {
+    effective_[key] = std::to_string(fallback);
+    return fallback;
+  }
   const std::string& s = *text;
   errno = 0;
   char* end = nullptr;
   const long value = std::strtol(s.c_str(), &end, 10);
   if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE)
     throw BadInput("`" + key + " = " + s + "`: not an integer");
+  effective_[key] = std::to_string(value);
   return value;
 }
 
@@ -236,7 +253,9 @@ long Config::get_int_in_range(const std::string& key, long fallback, long lo, lo
 
 std::string Config::get_string(const std::string& key, const std::string& fallback) {
   auto text = lookup(key);
-  return text ? *text : fallback;
+  const std::string value = text ? *text : fallback;
+  effective_[key] = value;
+  return value;
 }
 
 std::string Config::get_choice(const std::string& key, const std::string& fallback,
@@ -250,8 +269,16 @@ std::string Config::get_choice(const std::string& key, const std::string& fallba
 }
 
 std::vector<long> Config::get_int_list(const std::string& key, const std::vector<long>& fallback) {
+  auto join = [](const std::vector<long>& list) {
+    std::string out;
+    for (long v : list) out.append(out.empty() ? "" : ",").append(std::to_string(v));  // (append: GCC 12 warns falsely on "," + string)
+    return out;
+  };
   auto text = lookup(key);
-  if (!text) return fallback;
+  if (!text) {
+    effective_[key] = join(fallback);
+    return fallback;
+  }
   std::vector<long> out;
   std::stringstream ss(*text);
   std::string item;
@@ -265,6 +292,7 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
     out.push_back(value);
   }
   if (out.empty()) throw BadInput("`" + key + " = " + *text + "`: empty list");
+  effective_[key] = join(out);
   return out;
 }
 

@@ -56,9 +56,17 @@ class Config {
   // All key/value pairs, for metadata in outputs.
   const std::map<std::string, std::string>& values() const { return values_; }
 
+  // The effective settings: every key read by a typed getter so far, with the value the command
+  // used in one canonical spelling (numbers as the shortest text that reads back exactly, lists
+  // joined by ","), the fallback included when the key was not given. `b = -2.0` and `b = -2`,
+  // or a key stated at its default and the same key left out, give the same map: what --resume
+  // compares.
+  const std::map<std::string, std::string>& effective_values() const { return effective_; }
+
  private:
   std::optional<std::string> lookup(const std::string& key);
   std::map<std::string, std::string> values_;
+  std::map<std::string, std::string> effective_;
   std::map<std::string, std::string> origin_;
   mutable std::set<std::string> used_;
   bool collect_keys_only_ = false;

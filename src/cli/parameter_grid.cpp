@@ -58,4 +58,19 @@ int read_threads(Config& config) {
   return static_cast<int>(threads == 0 ? hardware : threads);
 }
 
+int report_failed_points(std::ostream& err, const std::string& command, const nlohmann::json& rows) {
+  const nlohmann::json* first = nullptr;
+  long failed = 0;
+  for (const auto& row : rows)
+    if (row.contains("failure")) {
+      if (!first) first = &row;
+      ++failed;
+    }
+  if (failed == 0) return 0;
+  err << "delayspec " << command << ": numerical failure at " << failed << " of " << rows.size()
+      << " point(s), first: (" << format_number((*first)["x"].get<double>()) << ", "
+      << format_number((*first)["y"].get<double>()) << "): " << (*first)["failure"].get<std::string>() << "\n";
+  return 3;
+}
+
 }  // namespace delayspec::cli

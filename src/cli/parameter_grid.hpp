@@ -2,7 +2,10 @@
 // The keys of a two-parameter grid (chart, basin): PREFIX_x / PREFIX_y name the parameters,
 // PREFIX_x_range / PREFIX_y_range are [min, max], PREFIX_x_points / PREFIX_y_points (>= 2) the
 // number of equally spaced values including both ends; and `threads` for running the points.
+#include <ostream>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "config.hpp"
 
@@ -35,5 +38,10 @@ void require_model_parameter(const Config& config, const std::string& key, const
 // The `threads` key (as `sweep`): 0 (the default) = the machine's hardware threads; BadInput
 // unless 0..4096.
 int read_threads(Config& config);
+
+// The exit status of a grid command whose `rows` ([{"x", "y", ..., "failure"?}]) are written:
+// 0 when no row has a "failure"; else 3 with one line on `err` (how many points failed, the first
+// one and its reason), as sweep does for its failed points.
+int report_failed_points(std::ostream& err, const std::string& command, const nlohmann::json& rows);
 
 }  // namespace delayspec::cli

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/version.hpp"
+#include "output_directory.hpp"
 
 namespace delayspec::cli {
 
@@ -28,7 +29,35 @@ const std::map<std::string, CommandFunction>& command_table() {
   return table;
 }
 
+OutputUse output_use(const std::string& command) {
+  static const std::map<std::string, OutputUse> table = {
+      {"sweep", {OutDirUse::written, true}},  // point files: --resume computes only the missing points
+      {"run", {OutDirUse::written, true}},    // passes --resume to its analyses (command_run.cpp)
+      {"converge", {OutDirUse::written, false}},
+      {"bench", {OutDirUse::written, false}},
+      {"chart", {OutDirUse::written, false}},
+      {"basin", {OutDirUse::written, false}},
+      {"simulate", {OutDirUse::written, false}},
+      {"plot", {OutDirUse::read, false}},  // `plot --out DIR` = `plot DIR`
+  };
+  auto it = table.find(command);
+  return it == table.end() ? OutputUse{} : it->second;  // floquet, lyapunov: results on stdout only
+}
+
 namespace {
+
+// Bad input in --out / --resume for `command` (BadInput naming the flag and the command).
+void check_output_flags(const std::string& command, bool out_given, const std::string& out_dir, bool resume) {
+  const OutputUse use = output_use(command);
+  if (out_given && use.out == OutDirUse::ignored)
+    throw BadInput("`--out " + out_dir + "`: `" + command +
+                   "` writes no files (its result is on stdout; `delayspec run SCENE --out DIR` keeps any "
+                   "analysis's result in a file)");
+  if (out_given && out_dir.empty()) throw BadInput("`--out ''`: the directory name is empty");
+  if (resume && !use.resume)
+    throw BadInput("`--resume`: `" + command + "` has nothing to resume (only sweep, and run with a sweep, do)");
+  if (resume && !out_given) throw BadInput("`--resume` needs `--out DIR` (the directory of the interrupted run)");
+}
 
 std::string command_list() {
   std::string list;
@@ -54,7 +83,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
       ->take_last()
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_flag("--json", json, "print exactly one JSON object on stdout");
-  app.add_option("--out", out_dir, "directory for output files");
+  CLI::Option* out_option = app.add_option("--out", out_dir, "directory for output files");
   app.add_flag("--quiet", quiet, "no progress on stderr");
   app.add_flag("--resume", resume, "continue an interrupted run in --out");
   try {
@@ -87,13 +116,19 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
   // which scripts could not tell from a crash of the shell around it.
   Config config;
   try {
+    const bool out_given = out_option->count() > 0;
+    check_output_flags(command, out_given, out_dir, resume);
     // `plot DIR`: the positional argument is a results directory, not a scene.
     if (!scene.empty() && command != "plot") config = Config::from_scene_file(scene);
     for (const auto& a : assignments) config.set_from_assignment(a);
     // Scene-level keys (for `run`): any command may be given a scene that has them.
     config.mark_used("analyses");
     config.mark_used("title");
-    return it->second(config, inv);
+    if (!inv.out_dir || output_use(command).out != OutDirUse::written) return it->second(config, inv);
+    OutputDirectory directory(*inv.out_dir);  // held until the command returns: one run per DIR
+    const int status = it->second(config, inv);
+    directory.finish(command, status);
+    return status;
   } catch (const BadInput& e) {
     err << "delayspec " << command << ": bad input: " << e.what() << "\n";
     return 2;
