@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "delayspec/errors.hpp"
+#include "key_registry.hpp"
 
 namespace delayspec::cli {
 
@@ -149,10 +150,27 @@ void Config::set(const std::string& key, const std::string& value, const std::st
   origin_[key] = origin;
 }
 
-bool Config::has(const std::string& key) const { return values_.count(key) > 0; }
+bool Config::has(const std::string& key) const {
+  note_read(key, std::nullopt);
+  return values_.count(key) > 0;
+}
+
+void Config::note_read(const std::string& key, const std::optional<std::string>& fallback) const {
+  auto it = std::find_if(reads_.begin(), reads_.end(), [&](const Read& r) { return r.key == key; });
+  if (it == reads_.end()) it = reads_.insert(reads_.end(), Read{key, std::nullopt});
+  if (fallback && !values_.count(key)) it->fallback = fallback;  // the latest reader's default counts
+}
+
+std::map<std::string, std::string> Config::effective_defaults() const {
+  std::map<std::string, std::string> out;
+  for (const auto& r : reads_)
+    if (r.fallback && !values_.count(r.key)) out[r.key] = *r.fallback;
+  return out;
+}
 
 std::optional<std::string> Config::lookup(const std::string& key) {
   used_.insert(key);
+  note_read(key, std::nullopt);
   auto it = values_.find(key);
   if (it == values_.end()) return std::nullopt;
   return it->second;
@@ -162,7 +180,10 @@ void Config::mark_used(const std::string& key) { used_.insert(key); }
 
 double Config::get_double(const std::string& key, double fallback) {
   auto text = lookup(key);
-  if (!text) return fallback;
+  if (!text) {
+    note_read(key, format_number(fallback));
+    return fallback;
+  }
   const std::string& s = *text;
   errno = 0;
   char* end = nullptr;
@@ -180,7 +201,10 @@ double Config::require_double(const std::string& key) {
 
 long Config::get_int(const std::string& key, long fallback) {
   auto text = lookup(key);
-  if (!text) return fallback;
+  if (!text) {
+    note_read(key, std::to_string(fallback));
+    return fallback;
+  }
   const std::string& s = *text;
   errno = 0;
   char* end = nullptr;
@@ -192,6 +216,7 @@ long Config::get_int(const std::string& key, long fallback) {
 
 std::string Config::get_string(const std::string& key, const std::string& fallback) {
   auto text = lookup(key);
+  if (!text) note_read(key, fallback);
   return text ? *text : fallback;
 }
 
@@ -207,7 +232,12 @@ std::string Config::get_choice(const std::string& key, const std::string& fallba
 
 std::vector<long> Config::get_int_list(const std::string& key, const std::vector<long>& fallback) {
   auto text = lookup(key);
-  if (!text) return fallback;
+  if (!text) {
+    std::string list;
+    for (long v : fallback) list += (list.empty() ? "" : ",") + std::to_string(v);
+    note_read(key, list);
+    return fallback;
+  }
   std::vector<long> out;
   std::stringstream ss(*text);
   std::string item;
@@ -222,36 +252,6 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
   }
   if (out.empty()) throw BadInput("`" + key + " = " + *text + "`: empty list");
   return out;
-}
-
-const std::vector<std::string>& contract_keys() {
-  static const std::vector<std::string> keys = {
-      // problem (problem.cpp)
-      "model", "N", "orbit_period", "events", "jacobian", "contact_substeps",
-      "zeta", "e", "a", "beta", "omega", "k", "tau_over_T", "tau", "x0", "v0",  // impact
-      "b", "period",                                                            // linear
-      "kappa", "delta", "eps",                                                  // mathieu
-      // floquet and orbits
-      "nev", "solver", "orbit", "orbit_tolerance", "orbit_max_periods", "orbit_guess_periods",
-      "orbit_max_iterations", "ncv", "tol", "max_restarts", "seed",
-      // lyapunov, converge, sweep, simulate
-      "exponents", "periods", "transient", "Ns",
-      // converge, bench (command_converge.cpp, command_bench.cpp)
-      "N_min", "N_max", "reference", "extrapolation_order", "extrapolation_order_step", "extrapolation_levels",
-      "solvers", "dense_memory_limit_mb", "repeats",
-      "exponents", "periods", "transient", "Ns", "qr_every", "batches",
-      "sweep_key", "sweep_from", "sweep_to", "sweep_points", "section_points",
-      "reference", "extrapolation_levels", "extrapolation_order", "extrapolation_order_step",  // converge
-      "N_min", "N_max", "dense_memory_limit_mb",                                                // bench
-      "t_end", "t_start", "sample_every", "control_on_at", "events_before_control",  // simulate
-      // run, plot, chart, basin (scenes)
-      "analyses", "title", "threads",
-      "chart_x", "chart_y", "chart_x_range", "chart_y_range", "chart_x_points", "chart_y_points",
-      "basin_x", "basin_y", "basin_x_range", "basin_y_range", "basin_x_points", "basin_y_points",
-      "basin_transient", "basin_max_period", "basin_tolerance", "plot_gnuplot", "plot_width", "plot_height",
-      // mackey-glass
-      "gamma", "n"};
-  return keys;
 }
 
 namespace {
@@ -294,11 +294,10 @@ void Config::check_all_used() const {
   if (collect_keys_only_) throw KeysCollected{used_};
   for (const auto& [key, value] : values_) {
     if (used_.count(key)) continue;
-    std::vector<std::string> candidates(used_.begin(), used_.end());
-    candidates.insert(candidates.end(), contract_keys().begin(), contract_keys().end());
-    const std::string suggestion = closest_key(key, candidates);
-    throw BadInput("unknown key `" + key + "` (= " + value + ", from " + origin_.at(key) + ")" +
-                   (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?"));
+    const auto model = values_.find("model");
+    throw BadInput(unread_key_message(key, "(= " + value + ", from " + origin_.at(key) + ")",
+                                      reader_.empty() ? std::vector<std::string>{} : std::vector<std::string>{reader_},
+                                      model == values_.end() ? "" : model->second, used_));
   }
 }
 
