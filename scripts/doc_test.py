@@ -19,6 +19,7 @@ Markers (HTML comments, invisible on the rendered page), on the lines before a b
 
     <!-- doc-test: set KEY=VALUE ... -->  appends `--set KEY=VALUE ...` to every command of the
                                           block but `plot` (a smaller size than the reader's)
+    <!-- doc-test: set@TEXT KEY=VALUE ... -->  the same, only to the commands containing TEXT
     <!-- doc-test: skip REASON -->        the block is not run (say why)
     <!-- doc-test: exit N -->              the block's commands must exit N (default 0)
 
@@ -73,8 +74,10 @@ def parse(doc_path):
                 if not e:
                     raise SystemExit(f"{doc_path}:{i + 1}: bad expect marker: {body}")
                 items.append(("expect", i + 1, e.groupdict()))
-            elif body.startswith("set "):
-                pending["extra"] += [a for kv in body[4:].split() for a in ("--set", kv)]
+            elif body.startswith(("set ", "set@")):
+                words = body.split()
+                only = words[0][4:] if words[0].startswith("set@") else ""
+                pending["extra"] += [(only, kv) for kv in words[1:]]
             elif body.startswith("skip"):
                 pending["skip"] = body[4:].strip() or "no reason given"
             elif body.startswith("exit "):
@@ -143,7 +146,9 @@ def run_command(words, extra, program, scratch, expected_exit, have_gnuplot, log
         if step[1:2] == ["plot"] and not have_gnuplot:
             log.append(f"  (gnuplot missing: not run) delayspec {' '.join(step[1:])}")
             continue
-        args = step[1:] + (extra if step[1:2] != ["plot"] else [])
+        args = step[1:]
+        if step[1:2] != ["plot"]:
+            args += [a for only, kv in extra if only in " ".join(step) for a in ("--set", kv)]
         start = time.monotonic()
         p = subprocess.run([program] + args, cwd=scratch, capture_output=True, text=True, timeout=600)
         log.append(f"  {time.monotonic() - start:6.1f} s  delayspec {' '.join(args)}  -> exit {p.returncode}")

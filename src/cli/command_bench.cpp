@@ -194,7 +194,7 @@ int command_bench(Config& config, const Invocation& inv) {
   if (inv.out_dir) {
     AtomicFile csv(std::filesystem::path(*inv.out_dir) / "bench.csv");
     csv.stream() << metadata_comment_lines(make_metadata("bench", inv.scene, config, nlohmann::json::object(),
-                                                           std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count())));
+                                                           std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
     csv.stream() << "# delayspec bench: model " << problem.model_name << ", nev " << base.nev << ", reference "
                  << reference_used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
                  << "error,max_error,correct_digits,deviation_from_dense,abs_mu1\n";

@@ -234,7 +234,10 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
   auto text = lookup(key);
   if (!text) {
     std::string list;
-    for (long v : fallback) list += (list.empty() ? "" : ",") + std::to_string(v);
+    for (long v : fallback) {
+      if (!list.empty()) list += ',';
+      list += std::to_string(v);
+    }
     note_read(key, list);
     return fallback;
   }

@@ -41,10 +41,9 @@ class Config {
 
   // Marks a key as known without reading it (e.g. keys of another command in a shared scene).
   void mark_used(const std::string& key);
-  // BadInput naming the first key that was given but never read, with a did-you-mean
-  // suggestion: the closest key among those read so far and contract_keys() (edit distance,
-  // case-insensitive; keys of 1-2 characters only by case, 3-4 characters at most 1 edit, longer
-  // at most 2).
+  // BadInput naming the first key that was given but never read (unread_key_message in
+  // key_registry.hpp): a key some command or model reads is "not read by READER"; any other gets
+  // a did-you-mean, the closest key read so far, else the closest known key (closest_key()).
   void check_all_used() const;
 
   // Keys read (or marked) so far.
@@ -91,7 +90,8 @@ struct KeysCollected {
   std::set<std::string> keys;
 };
 
-// The closest candidate to `key` within the threshold of check_all_used(), or "" if none.
+// The closest candidate to `key` (edit distance, case-insensitive; keys of 1-2 characters only
+// by case, 3-4 characters at most 1 edit, longer at most 2), or "" if none.
 std::string closest_key(const std::string& key, const std::vector<std::string>& candidates);
 
 }  // namespace delayspec::cli

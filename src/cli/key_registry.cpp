@@ -194,7 +194,8 @@ std::string command_keys_help(const std::string& command) {
     std::map<std::string, std::vector<std::string>> defaults;
     for (const auto& model : model_names())
       for (const auto& other : by_model.at(model))
-        if (other.key == r.key) defaults[default_text(command, other)].push_back(model);
+        if (other.key == r.key && !(r.key == "model" && model != model_names().front()))  // given by the probe
+          defaults[default_text(command, other)].push_back(model);
     std::vector<std::string> parts;
     for (const auto& [value, models] : defaults)
       parts.push_back(defaults.size() == 1 ? value : value + " (" + join(models, ", ") + ")");
@@ -214,9 +215,13 @@ std::string unread_key_message(const std::string& key, const std::string& value_
                                const std::set<std::string>& read_keys) {
   const auto known = key_readers().find(key);
   if (known == key_readers().end()) {
-    std::vector<std::string> candidates(read_keys.begin(), read_keys.end());
-    for (const auto& [k, by] : key_readers()) candidates.push_back(k);
-    const std::string suggestion = closest_key(key, candidates);
+    // The closest key this command reads, else the closest key of any command.
+    std::string suggestion = closest_key(key, std::vector<std::string>(read_keys.begin(), read_keys.end()));
+    if (suggestion.empty()) {
+      std::vector<std::string> all;
+      for (const auto& [k, by] : key_readers()) all.push_back(k);
+      suggestion = closest_key(key, all);
+    }
     return "unknown key `" + key + "` " + value_note + (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?");
   }
   // A key of another command or model: say so, not a did-you-mean to a different key; only a
