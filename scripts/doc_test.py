@@ -12,7 +12,8 @@ continuations and dropping a trailing `# comment`) that starts with `build/delay
 expected output), is run with the built program, no shell involved: the line is split with
 shlex and passed as arguments. Every other line (git, sudo bash scripts/..., cmake) is shown
 to the reader only. `cp -r SRC DST && build/delayspec ...` is supported (the copy is done here,
-inside the scratch directory). Commands run in order, in a scratch directory holding `data/` and
+inside the scratch directory). Commands run in order, one document after the other, each
+document in a fresh scratch directory (a reader at the repository root) holding `data/` and
 `docs/` of the source tree (read-only use) and the `out/` directories the commands write.
 
 Markers (HTML comments, invisible on the rendered page), on the lines before a block:
@@ -22,6 +23,9 @@ Markers (HTML comments, invisible on the rendered page), on the lines before a b
     <!-- doc-test: set@TEXT KEY=VALUE ... -->  the same, only to the commands containing TEXT
     <!-- doc-test: skip REASON -->        the block is not run (say why)
     <!-- doc-test: exit N -->              the block's commands must exit N (default 0)
+    <!-- doc-test: help COMMAND -->        the next ```text block is the key list that
+                                          `delayspec COMMAND --help` prints (docs/cli.md);
+                                          `--update` rewrites such blocks from the program
 
 and anywhere after the block whose output it checks (it is checked once the blocks before it
 have run):
@@ -62,7 +66,7 @@ class Block:
 
 def parse(doc_path):
     """The runnable blocks and the expectations of one document, in document order."""
-    items, pending = [], {"extra": [], "skip": None, "exit": 0}
+    items, pending = [], {"extra": [], "skip": None, "exit": 0, "help": None}
     lines = open(doc_path, encoding="utf-8").read().split("\n")
     i = 0
     while i < len(lines):
@@ -82,17 +86,27 @@ def parse(doc_path):
                 pending["skip"] = body[4:].strip() or "no reason given"
             elif body.startswith("exit "):
                 pending["exit"] = int(body[5:])
+            elif body.startswith("help "):
+                pending["help"] = body[5:].strip()
             else:
                 raise SystemExit(f"{doc_path}:{i + 1}: unknown doc-test marker: {body}")
-        if line.strip() == "```sh":
+        if line.strip() == "```text" and pending["help"]:
+            start = i + 1
+            i += 1
+            while i < len(lines) and lines[i].strip() != "```":
+                i += 1
+            items.append(("help", start, (pending["help"], start, i)))
+            pending["help"] = None
+        elif line.strip() == "```sh":
             block = Block(doc_path, i + 1)
             block.extra, block.skip, block.exit = pending["extra"], pending["skip"], pending["exit"]
-            pending = {"extra": [], "skip": None, "exit": 0}
+            pending = {"extra": [], "skip": None, "exit": 0, "help": None}
             body = []
             i += 1
             while i < len(lines) and lines[i].strip() != "```":
                 body.append(lines[i])
                 i += 1
+            pending["help"] = None
             block.commands = commands_of(body)
             if block.commands:
                 items.append(("block", block.line, block))
@@ -171,6 +185,31 @@ def split_and(words):
     return steps
 
 
+def help_keys(program, command):
+    """The key list of `delayspec COMMAND --help` (the lines after "Keys read by")."""
+    out = subprocess.run([program, command, "--help"], capture_output=True, text=True, timeout=60).stdout
+    lines = out.split("\n")
+    first = next(i for i, l in enumerate(lines) if l.startswith("Keys read by"))
+    return [l for l in lines[first:] if l.strip()]
+
+
+def check_help(doc_path, helps, program, update):
+    """Compares (or with update rewrites) the help blocks of one document; returns failures."""
+    lines = open(doc_path, encoding="utf-8").read().split("\n")
+    failures = []
+    for command, start, end in reversed(helps):  # from the end: rewriting keeps earlier indices
+        want = help_keys(program, command)
+        if lines[start:end] != want:
+            if update:
+                lines[start:end] = want
+            else:
+                failures.append(f"{doc_path}:{start}: the key list of `{command}` differs from "
+                                f"`delayspec {command} --help` (run scripts/doc_test.py --update)")
+    if update:
+        open(doc_path, "w", encoding="utf-8").write("\n".join(lines))
+    return failures
+
+
 def lookup(data, path):
     for part in path.split("."):
         if isinstance(data, list):
@@ -184,18 +223,30 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--delayspec", required=True, help="the built program")
     parser.add_argument("--source", required=True, help="the source tree (docs, data)")
-    parser.add_argument("docs", nargs="*", default=["README.md", "docs/tutorial.md"])
+    parser.add_argument("--update", action="store_true",
+                        help="rewrite the help blocks (docs/cli.md) from the program, run nothing")
+    parser.add_argument("docs", nargs="*", default=["README.md", "docs/tutorial.md", "docs/cli.md"])
     a = parser.parse_args()
     program = os.path.abspath(a.delayspec)
     have_gnuplot = shutil.which("gnuplot") is not None
     failures, log = [], []
-    with tempfile.TemporaryDirectory(prefix="delayspec_doc_test_") as scratch:
-        for sub in ("data", "docs"):
-            os.symlink(os.path.join(os.path.abspath(a.source), sub), os.path.join(scratch, sub))
-        for doc in a.docs:
+    for doc in a.docs:
+        where = os.path.join(a.source, doc)
+        helps = [item for kind, _, item in parse(where) if kind == "help"]
+        failures += check_help(where, helps, program, a.update)
+        if helps:
+            log.append(f"{doc}: {len(helps)} key lists compared with --help")
+    if a.update:
+        return 0
+    for doc in a.docs:
+        with tempfile.TemporaryDirectory(prefix="delayspec_doc_test_") as scratch:
+            for sub in ("data", "docs"):
+                os.symlink(os.path.join(os.path.abspath(a.source), sub), os.path.join(scratch, sub))
             where = os.path.join(a.source, doc)
             log.append(f"{doc}:")
             for kind, line, item in parse(where):
+                if kind == "help":
+                    continue
                 if kind == "expect":
                     try:
                         with open(os.path.join(scratch, item["file"]), encoding="utf-8") as f:
