@@ -8,7 +8,7 @@ packages=(
   libopenblas-dev liblapack-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
-  gnuplot-nox ccache
+  gnuplot-nox ccache python3
 )
 missing=()
 for p in "${packages[@]}"; do

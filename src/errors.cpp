@@ -2,13 +2,22 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 
 namespace delayspec {
 
 std::string format_number(double value) {
+  // The shortest text that reads back as the same double ("0.7", not "0.69999999999999996";
+  // "10", not "1e+01"): exact, and what a person would have typed.
   char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  return buffer;
+  std::string best;
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+    const bool exact = !std::isfinite(value) || std::strtod(buffer, nullptr) == value;
+    if (exact && (best.empty() || std::string(buffer).size() < best.size())) best = buffer;
+  }
+  return best;
 }
 
 void require_finite(const char* name, double value) {

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli_test_support.hpp"
+#include "delayspec_test_paths.hpp"
 
 namespace {
 
@@ -23,6 +24,15 @@ std::string read(const fs::path& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+// A CSV without its "# ..." metadata lines.
+std::string without_comments(const std::string& csv) {
+  std::string out, line;
+  std::stringstream ss(csv);
+  while (std::getline(ss, line))
+    if (line.rfind("#", 0) != 0) out += line + "\n";
+  return out;
 }
 
 fs::path fresh_dir(const std::string& name) {
@@ -151,10 +161,14 @@ TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
   EXPECT_EQ(j["points"][1]["section_x"].size(), 4u);
   for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "sweep_settings.json"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
-  const std::string csv = read(dir / "exponents.csv");
+  // the metadata comment lines first (docs/formats.md), then the table
+  const std::string with_metadata = read(dir / "exponents.csv");
+  EXPECT_EQ(with_metadata.rfind("# delayspec ", 0), 0u);
+  EXPECT_NE(with_metadata.find("\n# sweep_key = "), std::string::npos);
+  const std::string csv = without_comments(with_metadata);
   EXPECT_EQ(csv.substr(0, csv.find('\n')), "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 points
-  const std::string section = read(dir / "section.csv");
+  const std::string section = without_comments(read(dir / "section.csv"));
   EXPECT_EQ(std::count(section.begin(), section.end(), '\n'), 1 + 3 * 4);
   // the same directory again without --resume is refused
   CliResult again = run(args);
@@ -186,10 +200,10 @@ TEST(SweepCli, ResumeCompletesAnInterruptedSweep) {
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["points_computed_now"], 3);
-  // the seconds column differs between runs; compare everything else
+  // the seconds column and the metadata (wall time) differ between runs; compare everything else
   auto strip_seconds = [](const std::string& csv) {
     std::string out;
-    std::stringstream ss(csv);
+    std::stringstream ss(without_comments(csv));
     std::string line;
     while (std::getline(ss, line)) out += line.substr(0, line.rfind(',')) + "\n";
     return out;
@@ -208,4 +222,19 @@ TEST(SweepCli, ResumeNeedsAnOutDirectoryWithASweep) {
   CliResult r = run(args);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("sweep_settings.json"), std::string::npos) << r.err;
+}
+
+TEST(LyapunovCli, DefaultSceneWorksWithEveryCommandItCouldMean) {
+  // Issue 13: the shipped default.toml (floquet's nev and solver in it) is shared by the
+  // commands; its keys of other commands are not errors. On the command line they still are.
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/default.toml";
+  CliResult r = run({"lyapunov", scene, "--set", "N=20", "--set", "periods=20", "--set", "transient=0"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run({"simulate", scene, "--set", "N=20", "--set", "t_end=10"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run({"bench", scene, "--set", "Ns=20", "--set", "solvers=dense", "--set", "nev=2"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run({"lyapunov", scene, "--set", "N=20", "--set", "periods=20", "--set", "nev=4"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("`nev` (= 4, from --set) is not read by lyapunov"), std::string::npos) << r.err;
 }

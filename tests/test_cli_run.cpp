@@ -101,7 +101,7 @@ INSTANTIATE_TEST_SUITE_P(Paths, RunCliBadInput, ::testing::Values(
     RunBadInput{"far_analysis", {"--set", "analyses=eigenfaces"}, "unknown analysis `eigenfaces` (available: "},
     RunBadInput{"twice", {"--set", "analyses=floquet,floquet"}, "`floquet` is listed twice"},
     RunBadInput{"recursive", {"--set", "analyses=run"}, "`run` is a command, not an analysis"},
-    RunBadInput{"unknown_key", {"--set", "nevv=4"}, "unknown key `nevv` (= 4): no analysis of this scene reads it; did you mean `nev`?"},
+    RunBadInput{"unknown_key", {"--set", "nevv=4"}, "unknown key `nevv` (= 4); did you mean `nev`?"},
     RunBadInput{"bad_value", {"--set", "N=zero"}, "`N = zero`: not an integer"}));
 // clang-format on
 

@@ -205,7 +205,8 @@ TEST(ConfigErrors, NonAsciiAfterABackslashInABasicStringIsRejected) {
   // second input, shortened).
   using namespace std::string_literals;  // "..."s keeps the embedded NULs of the fuzzer's input
   for (const std::string& text : {"ma = 0RRR;s\x04'''''''\x00\x00" "cobii\"\"\"\"\\\xc2\xa1'''\n"s,
-                                  "x = 0'\xc2\xa1'\n"s, "x = true\"\xc2\xa1\"\n"s}) {
+                                  "x = 0'\xc2\xa1'\n"s, "x = true\"\xc2\xa1\"\n"s,
+                                  "ma = 0\"\".\"RRRE\xc4\xbd" "E0\x00\x00\x00" "EEE\n"s}) {
     const std::string m = bad_input_message([&] { Config::from_scene_text(text, "q.toml"); });
     EXPECT_TRUE(contains(m, "non-ASCII character outside a string or comment (line 1")) << m;
   }

@@ -90,7 +90,8 @@ TEST(CliSimulate, JsonAndCsvFiles) {
   EXPECT_EQ(j["impacts"].get<size_t>(), j["impact_times"].size());
   std::ifstream traj(dir / "trajectory.csv");
   std::string header, line;
-  std::getline(traj, header);
+  while (std::getline(traj, header) && header.rfind("#", 0) == 0) {
+  }  // the metadata lines (docs/formats.md)
   EXPECT_EQ(header, "t,x,v");
   long rows = 0;
   double first_t = -1;

@@ -21,7 +21,8 @@ class NumericalFailure : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Formats a double for error messages with enough digits to identify it.
+// Formats a double with the fewest digits that read back as the same double (messages,
+// metadata, values passed on as text).
 std::string format_number(double value);
 
 // Throws BadInput("`name = value`: must be finite") when value is NaN or infinite.

@@ -14,6 +14,7 @@
 // step maps, shared by the solvers of one N), peak_bytes (memory_probe.hpp: what the solve added
 // at its peak), error (relative, leading multiplier), max_error (over the nev), correct_digits,
 // deviation_from_dense (max |mu_k - mu_k^dense| / |mu_1^dense| at the same N, when dense ran).
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -28,6 +29,7 @@
 #include "level_runner.hpp"
 #include "lyapunov_settings.hpp"  // state_dimension
 #include "memory_probe.hpp"
+#include "metadata.hpp"
 #include "output.hpp"
 #include "progress.hpp"
 
@@ -60,7 +62,10 @@ nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlo
 }  // namespace
 
 int command_bench(Config& config, const Invocation& inv) {
-  if (config.has("solver"))
+  const auto command_start = std::chrono::steady_clock::now();
+  // bench compares several solvers: `solver` on the command line is a mistake; in a scene shared
+  // with floquet it is floquet's key (ignored here).
+  if (config.has("solver") && config.origin("solver") == "--set")
     throw BadInput("`solver = " + config.get_string("solver", "") + "`: bench compares several: use `solvers` (a comma list)");
   Problem problem = read_problem(config, 100);
   const OrbitSettings orbit_settings = read_orbit_settings(config);
@@ -189,6 +194,8 @@ int command_bench(Config& config, const Invocation& inv) {
 
   if (inv.out_dir) {
     AtomicFile csv(std::filesystem::path(*inv.out_dir) / "bench.csv");
+    csv.stream() << metadata_comment_lines(make_metadata("bench", inv.scene, config, nlohmann::json::object(),
+                                                           std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
     csv.stream() << "# delayspec bench: model " << problem.model_name << ", nev " << base.nev << ", reference "
                  << reference_used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
                  << "error,max_error,correct_digits,deviation_from_dense,abs_mu1\n";

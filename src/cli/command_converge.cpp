@@ -6,6 +6,7 @@
 // finest | auto; solver; extrapolation_order, extrapolation_order_step, extrapolation_levels;
 // events (a comma list: for the impact model `on,off` by default, side by side); the problem's
 // and the orbit's keys.
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "delayspec/floquet.hpp"
 #include "floquet_settings.hpp"
 #include "level_runner.hpp"
+#include "metadata.hpp"
 #include "lyapunov_settings.hpp"  // state_dimension
 #include "output.hpp"
 #include "problem.hpp"
@@ -189,6 +191,7 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
 }  // namespace
 
 int command_converge(Config& config, const Invocation& inv) {
+  const auto command_start = std::chrono::steady_clock::now();
   // events may be a list here (side by side); the problem reads the first of them.
   const bool switching_default = config.get_string("model", "impact") == "impact";
   const std::vector<std::string> events =
@@ -256,12 +259,15 @@ int command_converge(Config& config, const Invocation& inv) {
 
   if (inv.out_dir) {
     const std::filesystem::path dir(*inv.out_dir);
+    const std::string header = metadata_comment_lines(make_metadata(
+        "converge", inv.scene, config, nlohmann::json::object(),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
     AtomicFile rows(dir / "converge.csv");
-    rows.stream() << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver)
+    rows.stream() << header << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver)
                   << "\nevents,N,track,re,im,abs,error,correct_digits,seconds,operator_applications\n";
     rows.stream().precision(17);
     AtomicFile rich(dir / "converge_richardson.csv");
-    rich.stream() << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";
+    rich.stream() << header << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";
     rich.stream().precision(17);
     for (size_t v = 0; v < studies.size(); ++v) {
       const auto& s = studies[v];

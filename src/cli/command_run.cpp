@@ -20,6 +20,7 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "delayspec/errors.hpp"
+#include "key_registry.hpp"
 #include "metadata.hpp"
 #include "progress.hpp"
 
@@ -47,17 +48,24 @@ std::vector<std::string> split_list(const std::string& text) {
   return out;
 }
 
-std::vector<std::string> read_analyses(Config& config) {
-  // A scene without `analyses` (written for one command: `delayspec sweep SCENE`, ...) runs the
-  // command its keys belong to: sweep (sweep_key), converge (Ns), chart (chart_*), basin
-  // (basin_*), else floquet.
-  std::string inferred = "floquet";
-  for (const auto& [key, value] : config.values()) {
-    if (key == "sweep_key") inferred = "sweep";
-    else if (key == "Ns") inferred = "converge";
-    else if (key.rfind("chart_", 0) == 0) inferred = "chart";
-    else if (key.rfind("basin_", 0) == 0) inferred = "basin";
+// A scene without `analyses` (written for one command: `delayspec sweep SCENE`, ...) runs the
+// command that reads every key of the scene, found by probing the commands in this order of
+// preference (key_registry.hpp): floquet for a scene of model keys only, simulate for fig6_3's
+// control_on_at, sweep for sweep_key, ... When none reads them all: floquet, whose key check
+// then names the key.
+std::string inferred_analysis(const Config& config) {
+  for (const char* name : {"floquet", "lyapunov", "converge", "simulate", "sweep", "chart", "basin", "bench"}) {
+    if (!command_table().count(name)) continue;
+    std::set<std::string> read = {"analyses", "title"};
+    for (const auto& r : probe_reads(name, config)) read.insert(r.key);
+    if (std::all_of(config.values().begin(), config.values().end(), [&](const auto& kv) { return read.count(kv.first) > 0; }))
+      return name;
   }
+  return "floquet";
+}
+
+std::vector<std::string> read_analyses(Config& config) {
+  const std::string inferred = config.has("analyses") ? "" : inferred_analysis(config);
   const std::string text = config.get_string("analyses", inferred);
   const std::vector<std::string> names = split_list(text);
   if (names.empty())
@@ -84,12 +92,12 @@ std::vector<std::string> read_analyses(Config& config) {
   return names;
 }
 
-// Runs `name` in key-collection mode and returns the keys it reads.
-std::set<std::string> keys_read_by(const std::string& name, const Config& config, const Invocation& inv) {
+// Runs `name` in key-collection mode and returns the keys it reads (or marks as its own).
+std::set<std::string> keys_read_by(const std::string& name, const Config& config) {
   Config probe = config;
   probe.collect_keys_only(true);
   std::ostringstream sink_out, sink_err;
-  Invocation dry{.command = name, .scene = inv.scene, .json = true, .out_dir = std::nullopt, .quiet = true,
+  Invocation dry{.command = name, .scene = std::nullopt, .json = true, .out_dir = std::nullopt, .quiet = true,
                  .resume = false, .out = sink_out, .err = sink_err};
   try {
     command_table().at(name)(probe, dry);
@@ -101,27 +109,32 @@ std::set<std::string> keys_read_by(const std::string& name, const Config& config
 
 }  // namespace
 
+RunPlan plan_run(Config& config) {
+  RunPlan plan;
+  plan.analyses = read_analyses(config);
+  plan.known_keys = {"analyses", "title"};
+  for (const auto& name : plan.analyses) {
+    const std::set<std::string> keys = keys_read_by(name, config);
+    plan.known_keys.insert(keys.begin(), keys.end());
+  }
+  for (const auto& [key, value] : config.values()) {
+    if (plan.known_keys.count(key)) continue;
+    const auto model = config.values().find("model");
+    throw BadInput(unread_key_message(key, "(= " + value + ")", plan.analyses,
+                                      model == config.values().end() ? "" : model->second, plan.known_keys));
+  }
+  return plan;
+}
+
 int command_run(Config& config, const Invocation& inv) {
   const auto run_start = std::chrono::steady_clock::now();
-  const std::vector<std::string> analyses = read_analyses(config);
+  // 1. Validate the whole scene before computing anything.
+  const RunPlan plan = plan_run(config);
+  const std::vector<std::string>& analyses = plan.analyses;
+  const std::set<std::string>& known = plan.known_keys;
   const std::string title = config.get_string("title", "");
   if (!inv.out_dir) throw BadInput("`delayspec run` needs --out DIR: the directory the results are written to");
   const fs::path dir = *inv.out_dir;
-
-  // 1. Validate the whole scene before computing anything.
-  std::set<std::string> known = {"analyses", "title"};
-  for (const auto& name : analyses) {
-    const std::set<std::string> keys = keys_read_by(name, config, inv);
-    known.insert(keys.begin(), keys.end());
-  }
-  for (const auto& [key, value] : config.values()) {
-    if (known.count(key)) continue;
-    std::vector<std::string> candidates(known.begin(), known.end());
-    candidates.insert(candidates.end(), contract_keys().begin(), contract_keys().end());
-    const std::string suggestion = closest_key(key, candidates);
-    throw BadInput("unknown key `" + key + "` (= " + value + "): no analysis of this scene reads it" +
-                   (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?"));
-  }
 
   bool resumable = false;
   for (const auto& name : analyses) resumable = resumable || output_use(name).resume;
@@ -157,7 +170,7 @@ int command_run(Config& config, const Invocation& inv) {
     } catch (const nlohmann::json::exception& e) {
       throw std::runtime_error("analysis `" + name + "` printed no single JSON object: " + e.what());
     }
-    result["metadata"] = metadata_json(make_metadata(name, inv.scene, config, result, seconds));
+    result["metadata"] = metadata_json(make_metadata(name, inv.scene, analysis_config, result, seconds));
     const fs::path file = dir / (name + ".json");
     write_file_atomically(file, result.dump(2) + "\n");
     manifest["analyses"].push_back(

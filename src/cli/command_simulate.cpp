@@ -19,6 +19,7 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "delayspec/simulation.hpp"
+#include "metadata.hpp"
 #include "problem.hpp"
 
 namespace delayspec::cli {
@@ -102,14 +103,19 @@ int command_simulate(Config& config, const Invocation& inv) {
         std::vector<std::string> files;
         if (inv.out_dir) {
           const std::filesystem::path dir(*inv.out_dir);
+          const std::string header = metadata_comment_lines(make_metadata(
+              "simulate", inv.scene, config,
+              {{"N", problem.N}, {"events", problem.events}, {"jacobian", problem.jacobian}}, seconds));
           AtomicFile traj(dir / "trajectory.csv");
+          traj.stream() << header;
           write_points<D>(traj.stream(), rec.t, rec.y);
           traj.commit();
           AtomicFile poincare(dir / "poincare.csv");
+          poincare.stream() << header;
           write_points<D>(poincare.stream(), rec.poincare_t, rec.poincare_y);
           poincare.commit();
           AtomicFile impacts(dir / "impacts.csv");
-          impacts.stream() << std::setprecision(std::numeric_limits<double>::max_digits10) << "t,count\n";
+          impacts.stream() << header << std::setprecision(std::numeric_limits<double>::max_digits10) << "t,count\n";
           for (size_t i = 0; i < rec.impact_times.size(); ++i) impacts.stream() << rec.impact_times[i] << "," << i + 1 << "\n";
           impacts.commit();
           files = {traj.path().string(), poincare.path().string(), impacts.path().string()};

@@ -30,6 +30,7 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "lyapunov_settings.hpp"
+#include "metadata.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
 
@@ -284,8 +285,11 @@ int command_sweep(Config& config, const Invocation& inv) {
   summary["failed"] = failed;
   summary["seconds"] = seconds;
   if (dir) {
-    write_file_atomically(*dir / "exponents.csv", exponents_csv.str());
-    write_file_atomically(*dir / "section.csv", section_csv.str());
+    OutputMetadata metadata = make_metadata("sweep", inv.scene, config, summary, seconds);
+    metadata.parameters.erase(key);  // the swept key's value is per row (`sweep_key` names it)
+    const std::string header = metadata_comment_lines(metadata);
+    write_file_atomically(*dir / "exponents.csv", header + exponents_csv.str());
+    write_file_atomically(*dir / "section.csv", header + section_csv.str());
     write_file_atomically(*dir / "sweep.json", summary.dump(1) + "\n");
   }
 

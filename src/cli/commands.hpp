@@ -7,7 +7,9 @@
 #include <map>
 #include <optional>
 #include <ostream>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "config.hpp"
 
@@ -36,6 +38,15 @@ int command_chart(Config& config, const Invocation& inv);
 int command_basin(Config& config, const Invocation& inv);
 int command_plot(Config& config, const Invocation& inv);
 int command_simulate(Config& config, const Invocation& inv);
+
+// `run`'s check of a scene before anything computes: the analyses it lists (without `analyses`,
+// the one command that reads all its keys), each run in key-collection mode; every key of the
+// scene must be read by one of them. BadInput naming the first problem.
+struct RunPlan {
+  std::vector<std::string> analyses;
+  std::set<std::string> known_keys;  // read by at least one analysis (or scene-level)
+};
+RunPlan plan_run(Config& config);
 
 // The command table (name -> function); `run` dispatches a scene's analyses through it.
 const std::map<std::string, CommandFunction>& command_table();

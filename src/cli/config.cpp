@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include "delayspec/errors.hpp"
+#include "key_registry.hpp"
 
 namespace delayspec::cli {
 
@@ -58,7 +59,7 @@ void flatten(const toml::table& table, Config& config, const std::string& path, 
       continue;
     }
     if (!seen.insert(key).second) throw BadInput(path + ": key `" + key + "` is given twice");
-    config.set(key, to_text(node, key, path), path);
+    config.set_from_scene(key, to_text(node, key, path), path);
   }
 }
 
@@ -74,14 +75,20 @@ namespace {
 // multi-line basic strings on the first character after a line-ending backslash: a non-ASCII
 // character there is rejected too (after a backslash it is invalid TOML anyway).
 // A quote starts a string only where TOML allows one (after `=`, `[`, `{`, `,`, `.` or at the
-// start of a line, white space aside): toml++ classifies a bare value by scanning up to ~127
-// characters to the next space, `,`, `]`, `}` or `#`, running the same test on each, so
-// `x = 0'''\u00a1` must not hide the U+00A1 behind a "string" that TOML does not have there
-// (found by the fuzzer in 6 s once the backslash case was closed).
+// start of a line, white space aside), and never inside a bare value: toml++ classifies a bare
+// value (one not starting with a quote, `[` or `{`) by scanning up to ~127 characters to the next
+// space, `,`, `]`, `}` or `#`, running the same test on each, so `x = 0'''\u00a1` or
+// `x = 0""."\u00a1` must not hide the U+00A1 behind a "string" that TOML does not have there
+// (both found by the fuzzer, within seconds, once the backslash case was closed). This rejects a
+// few invalid files more than toml++ would, never a valid one.
 void require_ascii_outside_strings(const std::string& text, const std::string& path) {
   enum class State { code, comment, basic, literal, multi_basic, multi_literal } state = State::code;
   long line = 1, column = 0;
-  char last = '\n';  // the last character in code state other than space or tab
+  char last = '\n';         // the last character in code state other than space or tab
+  bool bare_value = false;  // inside a bare value (toml++ scans it to a terminator)
+  auto terminates_bare_value = [](char t) {
+    return t == ' ' || t == '\t' || t == '\r' || t == ',' || t == ']' || t == '}' || t == '#';
+  };
   auto may_open_string = [&]() {
     return last == '=' || last == '[' || last == '{' || last == ',' || last == '.' || last == '\n';
   };
@@ -98,7 +105,7 @@ void require_ascii_outside_strings(const std::string& text, const std::string& p
       ++line;
       column = 0;
       if (state == State::comment || state == State::basic || state == State::literal) state = State::code;
-      if (state == State::code) last = '\n';
+      if (state == State::code) last = '\n', bare_value = false;
       continue;
     }
     switch (state) {
@@ -106,6 +113,17 @@ void require_ascii_outside_strings(const std::string& text, const std::string& p
         if (static_cast<unsigned char>(c) >= 0x80)
           throw BadInput("scene `" + path + "`: non-ASCII character outside a string or comment (line " +
                          std::to_string(line) + ", column " + std::to_string(column) + ")");
+        if (bare_value && !terminates_bare_value(c)) {
+          last = c;  // quotes included: no string starts inside a bare value
+          break;
+        }
+        bare_value = false;
+        if ((last == '=' || last == '[' || last == ',') && c != ' ' && c != '\t' && c != '"' && c != '\'' &&
+            c != '[' && c != '{' && !terminates_bare_value(c) && c != '\r') {
+          bare_value = true;  // a value not starting with a quote, `[` or `{`
+          last = c;
+          break;
+        }
         if (c == '#') state = State::comment;
         else if ((c == '"' || c == '\'') && !may_open_string()) last = c;  // not a string in TOML: stays code
         else if (starts("\"\"\"")) state = State::multi_basic, i += 2, column += 2;
@@ -188,15 +206,38 @@ void Config::set_from_assignment(const std::string& assignment) {
   set(key, trim(assignment.substr(eq + 1)), "--set");
 }
 
+void Config::set_from_scene(const std::string& key, const std::string& value, const std::string& path) {
+  set(key, value, path);
+  scene_keys_.insert(key);
+}
+
 void Config::set(const std::string& key, const std::string& value, const std::string& origin) {
   values_[key] = value;
   origin_[key] = origin;
+  scene_keys_.erase(key);
 }
 
-bool Config::has(const std::string& key) const { return values_.count(key) > 0; }
+bool Config::has(const std::string& key) const {
+  note_read(key, std::nullopt);
+  return values_.count(key) > 0;
+}
+
+void Config::note_read(const std::string& key, const std::optional<std::string>& fallback) const {
+  auto it = std::find_if(reads_.begin(), reads_.end(), [&](const Read& r) { return r.key == key; });
+  if (it == reads_.end()) it = reads_.insert(reads_.end(), Read{key, std::nullopt});
+  if (fallback && !values_.count(key)) it->fallback = fallback;  // the latest reader's default counts
+}
+
+std::map<std::string, std::string> Config::effective_defaults() const {
+  std::map<std::string, std::string> out;
+  for (const auto& r : reads_)
+    if (r.fallback && !values_.count(r.key)) out[r.key] = *r.fallback;
+  return out;
+}
 
 std::optional<std::string> Config::lookup(const std::string& key) {
   used_.insert(key);
+  note_read(key, std::nullopt);
   auto it = values_.find(key);
   if (it == values_.end()) return std::nullopt;
   return it->second;
@@ -208,6 +249,7 @@ double Config::get_double(const std::string& key, double fallback) {
   auto text = lookup(key);
   if (!text) {
     effective_[key] = canonical_number(fallback);
+    note_read(key, format_number(fallback));
     return fallback;
   }
   const std::string& s = *text;
@@ -231,6 +273,7 @@ long Config::get_int(const std::string& key, long fallback) {
   auto text = lookup(key);
   if (!text) {
     effective_[key] = std::to_string(fallback);
+    note_read(key, std::to_string(fallback));
     return fallback;
   }
   const std::string& s = *text;
@@ -254,6 +297,7 @@ long Config::get_int_in_range(const std::string& key, long fallback, long lo, lo
 std::string Config::get_string(const std::string& key, const std::string& fallback) {
   auto text = lookup(key);
   const std::string value = text ? *text : fallback;
+  if (!text) note_read(key, fallback);
   effective_[key] = value;
   return value;
 }
@@ -277,6 +321,7 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
   auto text = lookup(key);
   if (!text) {
     effective_[key] = join(fallback);
+    note_read(key, join(fallback));
     return fallback;
   }
   std::vector<long> out;
@@ -294,36 +339,6 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
   if (out.empty()) throw BadInput("`" + key + " = " + *text + "`: empty list");
   effective_[key] = join(out);
   return out;
-}
-
-const std::vector<std::string>& contract_keys() {
-  static const std::vector<std::string> keys = {
-      // problem (problem.cpp)
-      "model", "N", "orbit_period", "events", "jacobian", "contact_substeps",
-      "zeta", "e", "a", "beta", "omega", "k", "tau_over_T", "tau", "x0", "v0",  // impact
-      "b", "period",                                                            // linear
-      "kappa", "delta", "eps",                                                  // mathieu
-      // floquet and orbits
-      "nev", "solver", "orbit", "orbit_tolerance", "orbit_max_periods", "orbit_guess_periods",
-      "orbit_max_iterations", "ncv", "tol", "max_restarts", "seed", "residual_bound",
-      // lyapunov, converge, sweep, simulate
-      "exponents", "periods", "transient", "Ns",
-      // converge, bench (command_converge.cpp, command_bench.cpp)
-      "N_min", "N_max", "reference", "extrapolation_order", "extrapolation_order_step", "extrapolation_levels",
-      "solvers", "dense_memory_limit_mb", "repeats",
-      "exponents", "periods", "transient", "Ns", "qr_every", "batches",
-      "sweep_key", "sweep_from", "sweep_to", "sweep_points", "section_points",
-      "reference", "extrapolation_levels", "extrapolation_order", "extrapolation_order_step",  // converge
-      "N_min", "N_max", "dense_memory_limit_mb",                                                // bench
-      "t_end", "t_start", "sample_every", "control_on_at", "events_before_control",  // simulate
-      // run, plot, chart, basin (scenes)
-      "analyses", "title", "threads",
-      "chart_x", "chart_y", "chart_x_range", "chart_y_range", "chart_x_points", "chart_y_points",
-      "basin_x", "basin_y", "basin_x_range", "basin_y_range", "basin_x_points", "basin_y_points",
-      "basin_transient", "basin_max_period", "basin_tolerance", "plot_gnuplot", "plot_width", "plot_height",
-      // mackey-glass
-      "gamma", "n"};
-  return keys;
 }
 
 namespace {
@@ -380,11 +395,14 @@ void Config::check_all_used() const {
   if (collect_keys_only_) throw KeysCollected{used_};
   for (const auto& [key, value] : values_) {
     if (used_.count(key)) continue;
-    std::vector<std::string> candidates(used_.begin(), used_.end());
-    candidates.insert(candidates.end(), contract_keys().begin(), contract_keys().end());
-    const std::string suggestion = closest_key(key, candidates);
-    throw BadInput("unknown key `" + shortened(key) + "` (= " + shortened(value) + ", from " + origin_.at(key) + ")" +
-                   (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?"));
+    // A scene file is shared by the commands (the default scene carries floquet's nev and solver
+    // and is run with lyapunov, simulate, ...): a key of another command given there is not an
+    // error. On the command line (--set) every key must be one this command reads.
+    if (scene_keys_.count(key) && key_readers().count(key)) continue;
+    const auto model = values_.find("model");
+    throw BadInput(unread_key_message(shortened(key), "(= " + shortened(value) + ", from " + origin_.at(key) + ")",
+                                      reader_.empty() ? std::vector<std::string>{} : std::vector<std::string>{reader_},
+                                      model == values_.end() ? "" : model->second, used_));
   }
 }
 

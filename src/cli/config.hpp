@@ -2,7 +2,10 @@
 // Config: the flat key -> value settings of one command, from a scene file (TOML) and then
 // `--set KEY=VALUE` overrides, applied in order. Typed getters validate and name the key and
 // the value in every error (BadInput, exit status 2). Every key read is marked; keys nobody
-// read are reported as unknown by check_all_used().
+// read are reported as unknown by check_all_used(). Every read also records the key with the
+// default the reader fell back to (reads()): that record is the one source of which keys a
+// command reads, for its --help, for the unknown-key message and for the effective defaults in
+// result metadata (key_registry.hpp, metadata.hpp).
 //
 // Scene files: top-level `key = value` pairs; tables ([model], [floquet], ...) may group keys
 // for readability and are flattened (a key may appear only once in the whole file).
@@ -24,8 +27,15 @@ class Config {
   // Applies "KEY=VALUE" (BadInput when there is no '=' or the key is empty).
   void set_from_assignment(const std::string& assignment);
   void set(const std::string& key, const std::string& value, const std::string& origin);
+  // A value read from the scene file `path`: a key of another command there is not an error
+  // (check_all_used), since a scene is shared by the commands.
+  void set_from_scene(const std::string& key, const std::string& value, const std::string& path);
 
+  // Whether the key is given. Also records the key as read (without a default): a command that
+  // asks knows the key.
   bool has(const std::string& key) const;
+  // Where the key's value came from: the scene file's path, "--set", or a command that set it.
+  const std::string& origin(const std::string& key) const { return origin_.at(key); }
   double get_double(const std::string& key, double fallback);
   double require_double(const std::string& key);
   long get_int(const std::string& key, long fallback);
@@ -39,14 +49,28 @@ class Config {
 
   // Marks a key as known without reading it (e.g. keys of another command in a shared scene).
   void mark_used(const std::string& key);
-  // BadInput naming the first key that was given but never read, with a did-you-mean
-  // suggestion: the closest key among those read so far and contract_keys() (edit distance,
-  // case-insensitive; keys of 1-2 characters only by case, 3-4 characters at most 1 edit, longer
-  // at most 2).
+  // BadInput naming the first key that was given but never read (unread_key_message in
+  // key_registry.hpp): a key some command or model reads is "not read by READER"; any other gets
+  // a did-you-mean, the closest key read so far, else the closest known key (closest_key()).
   void check_all_used() const;
 
   // Keys read (or marked) so far.
   const std::set<std::string>& used_keys() const { return used_; }
+
+  // One key a getter or has() asked for, in the order of the first request: `fallback` is the
+  // default the getter fell back to (as text), or none when the key was given or only asked
+  // about with has() / require_double().
+  struct Read {
+    std::string key;
+    std::optional<std::string> fallback;
+  };
+  const std::vector<Read>& reads() const { return reads_; }
+  // Keys read but not given, with the default used: the effective defaults of a run.
+  std::map<std::string, std::string> effective_defaults() const;
+
+  // The command reading this Config, for messages ("`nev` is not read by lyapunov").
+  void set_reader(const std::string& command) { reader_ = command; }
+  const std::string& reader() const { return reader_; }
 
   // Key collection for `delayspec run`: a scene validated before any analysis computes. When
   // on, check_all_used() throws KeysCollected (carrying the keys read so far) instead of
@@ -65,10 +89,15 @@ class Config {
 
  private:
   std::optional<std::string> lookup(const std::string& key);
+  // Records a read of `key`; `fallback` when the key is absent and the getter has a default.
+  void note_read(const std::string& key, const std::optional<std::string>& fallback) const;
   std::map<std::string, std::string> values_;
   std::map<std::string, std::string> effective_;
   std::map<std::string, std::string> origin_;
+  std::set<std::string> scene_keys_;  // keys whose value comes from the scene file (not overridden)
   mutable std::set<std::string> used_;
+  mutable std::vector<Read> reads_;
+  std::string reader_;
   bool collect_keys_only_ = false;
 };
 
@@ -78,11 +107,8 @@ struct KeysCollected {
   std::set<std::string> keys;
 };
 
-// Every key any command reads (the CLI contract plus documented extensions). A command that
-// adds a key adds it here too, so that a typo of it gets a suggestion from every command.
-const std::vector<std::string>& contract_keys();
-
-// The closest candidate to `key` within the threshold of check_all_used(), or "" if none.
+// The closest candidate to `key` (edit distance, case-insensitive; keys of 1-2 characters only
+// by case, 3-4 characters at most 1 edit, longer at most 2), or "" if none.
 std::string closest_key(const std::string& key, const std::vector<std::string>& candidates);
 
 }  // namespace delayspec::cli

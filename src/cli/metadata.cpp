@@ -23,6 +23,7 @@ OutputMetadata make_metadata(const std::string& command, const std::optional<std
   m.command = command;
   m.scene = scene;
   m.parameters = config.values();
+  m.defaults = config.effective_defaults();
   m.wall_seconds = wall_seconds;
   auto text = [&](const char* key, const std::string& fallback) {
     if (result.is_object() && result.contains(key) && result[key].is_string()) return result[key].get<std::string>();
@@ -42,9 +43,11 @@ OutputMetadata make_metadata(const std::string& command, const std::optional<std
 nlohmann::json metadata_json(const OutputMetadata& m) {
   nlohmann::json j;
   j["delayspec_version"] = DELAYSPEC_VERSION;
+  j["source_revision"] = DELAYSPEC_REVISION;
   j["command"] = m.command;
   j["scene"] = m.scene ? nlohmann::json(*m.scene) : nlohmann::json(nullptr);
   j["parameters"] = m.parameters;
+  j["defaults"] = m.defaults;
   if (m.N > 0) j["N"] = m.N;
   j["events"] = m.events;
   j["jacobian"] = m.jacobian;
@@ -67,9 +70,12 @@ std::string one_line(std::string s) {
 std::string metadata_comment_lines(const OutputMetadata& m) {
   std::ostringstream out;
   out << "# delayspec " << DELAYSPEC_VERSION << "\n";
+  out << "# source_revision: " << DELAYSPEC_REVISION << "\n";
   out << "# command: " << m.command << "\n";
   out << "# scene: " << (m.scene ? one_line(*m.scene) : "(none)") << "\n";
   for (const auto& [key, value] : m.parameters) out << "# " << one_line(key) << " = " << one_line(value) << "\n";
+  for (const auto& [key, value] : m.defaults)
+    out << "# default: " << one_line(key) << " = " << one_line(value) << "\n";
   if (m.N > 0) out << "# N: " << m.N << "\n";
   out << "# events: " << m.events << "\n";
   out << "# jacobian: " << m.jacobian << "\n";

@@ -3,16 +3,21 @@
 // into --out): what was computed, with which parameters, by which version, in how long.
 //
 // JSON files get a "metadata" object:
-//     {"delayspec_version": "0.1.0", "command": "floquet", "scene": "data/scenes/default.toml",
+//     {"delayspec_version": "0.1.0", "source_revision": "b054d7f-dirty",
+//      "command": "floquet", "scene": "data/scenes/default.toml",
 //      "parameters": {"N": "200", "k": "0.2", ...},   // every key given (scene + --set), as text
+//      "defaults": {"solver": "spectra", ...},        // every other key the command read, with
+//                                                     // the default it used (Config::effective_defaults)
 //      "N": 200, "events": "on", "jacobian": "consistent",
 //      "wall_seconds": 1.23, "finished_utc": "2026-11-22T04:00:00Z"}
 // CSV files start with the same content as comment lines (gnuplot, numpy.loadtxt and
 // pandas.read_csv(comment='#') skip them):
 //     # delayspec 0.1.0
+//     # source_revision: b054d7f-dirty
 //     # command: floquet
 //     # scene: data/scenes/default.toml
-//     # N = 200
+//     # N = 200                    (one line per key given)
+//     # default: solver = spectra  (one line per key read with its default)
 //     ...
 #include <optional>
 #include <string>
@@ -27,6 +32,7 @@ struct OutputMetadata {
   std::string command;
   std::optional<std::string> scene;
   std::map<std::string, std::string> parameters;  // Config::values()
+  std::map<std::string, std::string> defaults;    // Config::effective_defaults()
   // Resolved discretisation: taken from the result (its "N", "events", "jacobian") when it has
   // them, else from the parameters, else the defaults.
   long N = 0;

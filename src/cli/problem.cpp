@@ -69,9 +69,14 @@ StepOptions step_options(const Problem& problem) {
   return options;
 }
 
+const std::vector<std::string>& model_names() {
+  static const std::vector<std::string> names = {"impact", "linear", "mathieu", "mackey-glass"};
+  return names;
+}
+
 Problem read_problem(Config& config, int default_N) {
   Problem problem;
-  problem.model_name = config.get_choice("model", "impact", {"impact", "linear", "mathieu", "mackey-glass"});
+  problem.model_name = config.get_choice("model", model_names().front(), model_names());
   if (problem.model_name == "impact") problem.model = read_impact(config);
   if (problem.model_name == "linear") problem.model = read_linear(config);
   if (problem.model_name == "mathieu") problem.model = read_mathieu(config);

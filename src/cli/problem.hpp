@@ -4,6 +4,7 @@
 // Config; every key it reads is documented in the CLI contract.
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "config.hpp"
 #include "delayspec/grid.hpp"
@@ -30,6 +31,9 @@ struct Problem {
 
 // The stepper options (events, jacobian, ...) the problem asks for.
 StepOptions step_options(const Problem& problem);
+
+// The built-in models, the default first (the values of the key `model`).
+const std::vector<std::string>& model_names();
 
 // Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps;
 // builds the grid.

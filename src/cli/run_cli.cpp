@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/version.hpp"
+#include "key_registry.hpp"
 #include "output_directory.hpp"
 
 namespace delayspec::cli {
@@ -90,6 +91,8 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     out << app.help();
+    if (command_table().count(command)) out << command_keys_help(command);
+    else out << "\n`delayspec COMMAND --help` lists the keys COMMAND reads, with their defaults.\n";
     return 0;
   } catch (const CLI::CallForVersion& e) {
     out << "delayspec " << DELAYSPEC_VERSION << "\n";
@@ -121,6 +124,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
     // `plot DIR`: the positional argument is a results directory, not a scene.
     if (!scene.empty() && command != "plot") config = Config::from_scene_file(scene);
     for (const auto& a : assignments) config.set_from_assignment(a);
+    config.set_reader(command);
     // Scene-level keys (for `run`): any command may be given a scene that has them.
     config.mark_used("analyses");
     config.mark_used("title");

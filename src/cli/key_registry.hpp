@@ -1,0 +1,45 @@
+#pragma once
+// Which keys each command reads, with their defaults, found by running the command itself in
+// key-collection mode (Config::collect_keys_only) for every model: Config records each key a
+// getter asks for and the default it falls back to (Config::reads()), so this registry cannot
+// drift from the code. It serves `delayspec COMMAND --help`, the unknown-key message ("`nev` is
+// not read by lyapunov" for a key of another command, a did-you-mean for a misspelt one), and
+// `run`, which finds the command a scene without `analyses` belongs to.
+//
+// The only hand-kept part is the one-line meaning of each key (key_meanings()); a test checks
+// that every key some command reads has one and that no meaning is left for a key nobody reads.
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+#include "commands.hpp"
+
+namespace delayspec::cli {
+
+// The keys `command` reads given `config` (its scene and --set values), stopping right before
+// the command's work. A BadInput the command raises while validating (e.g. chart's default axes
+// with a model that lacks them) ends the probe: the keys read up to there are returned.
+std::vector<Config::Read> probe_reads(const std::string& command, Config config);
+
+// For every key some command reads: command -> the models with which it reads the key.
+using KeyReaders = std::map<std::string, std::map<std::string, std::set<std::string>>>;
+const KeyReaders& key_readers();
+
+// One line per key: what it means (with its unit or range where that helps).
+const std::map<std::string, std::string>& key_meanings();
+
+// The keys `command` reads, its defaults and their meanings (the tail of `COMMAND --help`):
+// keys every model shares first, then the keys of each model.
+std::string command_keys_help(const std::string& command);
+
+// The message for a given key nobody read. `readers`: the commands that read the Config (empty:
+// unknown); `model`: the model given ("" = the default). A key some command reads is "not read
+// by READERS" (naming who reads it); any other key is "unknown", with a did-you-mean among
+// `read_keys` and every known key.
+std::string unread_key_message(const std::string& key, const std::string& value_note,
+                               const std::vector<std::string>& readers, const std::string& model,
+                               const std::set<std::string>& read_keys);
+
+}  // namespace delayspec::cli
