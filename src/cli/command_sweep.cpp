@@ -8,6 +8,7 @@
 //   DIR/points/point_NNNNN.json one file per finished point, written atomically
 //   DIR/exponents.csv           parameter,lambda1..k,se1..k,lambda1_per_time..,seconds
 //   DIR/section.csv             parameter,x (one row per Poincare point)
+// (both after the metadata comment lines, which name the swept key: `# sweep_key = K`)
 //   DIR/sweep.json              summary (the --json output)
 // The last three are written (atomically) only when every point is done.
 // Exponents are per stroboscopic period (the paper's unit); *_per_time divide by period_time.
@@ -28,6 +29,7 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "lyapunov_settings.hpp"
+#include "metadata.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
 
@@ -252,8 +254,13 @@ int command_sweep(Config& config, const Invocation& inv) {
   summary["failed"] = failed;
   summary["seconds"] = seconds;
   if (dir) {
-    write_file_atomically(*dir / "exponents.csv", exponents_csv.str());
-    write_file_atomically(*dir / "section.csv", section_csv.str());
+    // The files carry the metadata header (it names the swept key: `plot` labels the x axis
+    // with it); the swept key's own value is per row, so it is not a metadata line.
+    OutputMetadata metadata = make_metadata("sweep", inv.scene, config, summary, seconds);
+    metadata.parameters.erase(key);
+    const std::string header = metadata_comment_lines(metadata);
+    write_file_atomically(*dir / "exponents.csv", header + exponents_csv.str());
+    write_file_atomically(*dir / "section.csv", header + section_csv.str());
     write_file_atomically(*dir / "sweep.json", summary.dump(1) + "\n");
   }
 
