@@ -68,6 +68,26 @@ void require_header(const ResultTable& t, const std::vector<std::string>& expect
   }
 }
 
+// chart.csv and basin.csv are grids (gnuplot's image): one block of rows per y, separated by
+// blank lines, every block as long as the first. gnuplot rejects anything else with a message
+// that names neither the file nor the line.
+void require_grid(const ResultTable& t) {
+  size_t first_size = 0, size = 0, block_start = 0;
+  for (size_t i = 0; i <= t.rows.size(); ++i) {
+    if (i < t.rows.size() && !t.rows[i].empty()) {
+      if (size++ == 0) block_start = i;
+      continue;
+    }
+    if (size == 0) continue;
+    if (first_size == 0) first_size = size;
+    if (size != first_size)
+      throw BadInput(t.where(block_start) + ": the block of rows starting here has " + std::to_string(size) +
+                     " rows, the first has " + std::to_string(first_size) +
+                     " (a grid: one block per y value, separated by blank lines, all of one length)");
+    size = 0;
+  }
+}
+
 // "N = 200" of a title from a table's metadata (the `# N = ...` line of a given N), else "default".
 std::string title_N(const ResultTable& t) {
   const double N = t.metadata_number("N", NAN);
@@ -110,6 +130,7 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
   const ResultTable t = read_result_table(file, [](const std::string& c) { return c == "spectral_radius"; });
   require_header(t, {"X", "Y", "spectral_radius"});
   require_rows(t);
+  require_grid(t);
   std::string rows;
   bool any_radius = false;
   for (const auto& row : t.rows) {
@@ -141,6 +162,7 @@ void plot_basin(FigureRenderer& renderer, const fs::path& file) {
       read_result_table(file, [](const std::string& c) { return c == "period" || c == "max_section_x"; });
   require_header(t, {"X", "Y", "period"});
   require_rows(t);
+  require_grid(t);
   // Fixed colours per period (an rgbimage, so that a period has the same colour in every figure):
   // 0 (no period found: chaotic or longer) black, then a qualitative palette.
   static const int rgb[10][3] = {{17, 17, 17},  {31, 119, 180}, {44, 160, 44},  {148, 103, 189}, {140, 86, 75},
