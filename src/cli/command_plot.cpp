@@ -50,44 +50,6 @@ bool present(const fs::path& dir, const std::string& name) {
   return true;
 }
 
-// A figure needs at least one row to draw.
-void require_rows(const ResultTable& t) {
-  if (t.data_rows() == 0) throw BadInput("`" + t.path.string() + "`: no data rows (only a header)");
-}
-
-// The header must start with `expected` (comma-separated names; "X", "Y" match any name).
-void require_header(const ResultTable& t, const std::vector<std::string>& expected) {
-  bool ok = t.columns.size() >= expected.size();
-  for (size_t i = 0; ok && i < expected.size(); ++i) ok = expected[i] == "X" || expected[i] == "Y" || t.columns[i] == expected[i];
-  if (!ok) {
-    std::string want, got;
-    for (const auto& e : expected) want += (want.empty() ? "" : ",") + e;
-    for (const auto& c : t.columns) got += (got.empty() ? "" : ",") + c;
-    throw BadInput("`" + t.path.string() + "`: header `" + (got.size() > 80 ? got.substr(0, 77) + "..." : got) +
-                   "`: expected columns " + want);
-  }
-}
-
-// chart.csv and basin.csv are grids (gnuplot's image): one block of rows per y, separated by
-// blank lines, every block as long as the first. gnuplot rejects anything else with a message
-// that names neither the file nor the line.
-void require_grid(const ResultTable& t) {
-  size_t first_size = 0, size = 0, block_start = 0;
-  for (size_t i = 0; i <= t.rows.size(); ++i) {
-    if (i < t.rows.size() && !t.rows[i].empty()) {
-      if (size++ == 0) block_start = i;
-      continue;
-    }
-    if (size == 0) continue;
-    if (first_size == 0) first_size = size;
-    if (size != first_size)
-      throw BadInput(t.where(block_start) + ": the block of rows starting here has " + std::to_string(size) +
-                     " rows, the first has " + std::to_string(first_size) +
-                     " (a grid: one block per y value, separated by blank lines, all of one length)");
-    size = 0;
-  }
-}
-
 // "N = 200" of a title from a table's metadata (the `# N = ...` line of a given N), else "default".
 std::string title_N(const ResultTable& t) {
   const double N = t.metadata_number("N", NAN);
@@ -128,9 +90,9 @@ void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
 // contour.
 void plot_chart(FigureRenderer& renderer, const fs::path& file) {
   const ResultTable t = read_result_table(file, [](const std::string& c) { return c == "spectral_radius"; });
-  require_header(t, {"X", "Y", "spectral_radius"});
-  require_rows(t);
-  require_grid(t);
+  t.require_header({"X", "Y", "spectral_radius"});
+  t.require_rows();
+  t.require_grid();
   std::string rows;
   bool any_radius = false;
   for (const auto& row : t.rows) {
@@ -160,9 +122,9 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
 void plot_basin(FigureRenderer& renderer, const fs::path& file) {
   const ResultTable t =
       read_result_table(file, [](const std::string& c) { return c == "period" || c == "max_section_x"; });
-  require_header(t, {"X", "Y", "period"});
-  require_rows(t);
-  require_grid(t);
+  t.require_header({"X", "Y", "period"});
+  t.require_rows();
+  t.require_grid();
   // Fixed colours per period (an rgbimage, so that a period has the same colour in every figure):
   // 0 (no period found: chaotic or longer) black, then a qualitative palette.
   static const int rgb[10][3] = {{17, 17, 17},  {31, 119, 180}, {44, 160, 44},  {148, 103, 189}, {140, 86, 75},
@@ -335,8 +297,8 @@ void plot_exponents(FigureRenderer& renderer, const fs::path& dir) {
     lambda.push_back(l);
     se.push_back(t.column("se" + std::to_string(i)));  // -1: no error bars
   }
-  require_header(t, {"parameter", "lambda1"});
-  require_rows(t);
+  t.require_header({"parameter", "lambda1"});
+  t.require_rows();
   const std::string label = sweep_label(dir, t);
   std::ostringstream gp, plot;
   const char* colours[] = {"#000000", "#d62728", "#1f77b4", "#9467bd", "#8c564b", "#e377c2"};
@@ -361,8 +323,8 @@ void plot_exponents(FigureRenderer& renderer, const fs::path& dir) {
 // section.csv (sweep): parameter,x -> bifurcation diagram.
 void plot_bifurcation(FigureRenderer& renderer, const fs::path& dir) {
   const ResultTable t = read_result_table(dir / "section.csv");
-  require_header(t, {"parameter", "x"});
-  require_rows(t);
+  t.require_header({"parameter", "x"});
+  t.require_rows();
   const std::string label = sweep_label(dir, t);
   std::string rows;
   for (const auto& row : t.rows)
@@ -414,7 +376,7 @@ void plot_phase(FigureRenderer& renderer, const fs::path& dir) {
   const ResultTable trajectory = read_result_table(dir / "trajectory.csv");
   const int x = trajectory.column("x"), v = trajectory.column("v");
   if (x < 0 || v < 0) return;  // a scalar model: no phase plane
-  require_rows(trajectory);
+  trajectory.require_rows();
   bool thin = false;
   std::ostringstream gp;
   gp << gnuplot_datablock("trajectory", thinned(trajectory, x, v, 200000, &thin));
@@ -440,7 +402,7 @@ void plot_phase(FigureRenderer& renderer, const fs::path& dir) {
 // impacts.csv (simulate: t,count) -> cumulative impacts against time (paper Fig. 6.3).
 void plot_impacts(FigureRenderer& renderer, const fs::path& dir) {
   const ResultTable t = read_result_table(dir / "impacts.csv");
-  require_header(t, {"t", "count"});
+  t.require_header({"t", "count"});
   std::ostringstream gp;
   // No impact at all is a result (a flat line at 0), not an error.
   gp << gnuplot_datablock("impacts", t.data_rows() > 0 ? thinned(t, 0, 1, 200000, nullptr) : "0 0\n");
@@ -468,7 +430,8 @@ int command_plot(Config& config, const Invocation& inv) {
   std::string dir_text = inv.scene.value_or(inv.out_dir.value_or(""));
   if (dir_text.empty()) throw BadInput("`delayspec plot` needs a results directory: delayspec plot DIR");
   const fs::path dir = dir_text;
-  if (!fs::is_directory(dir)) throw BadInput("`" + dir.string() + "`: not a directory (expected a results directory)");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw BadInput("`" + dir.string() + "`: not a directory (expected a results directory)");
 
   FigureRenderer renderer(dir, settings, inv.json ? nullptr : &inv.out);
   // The JSON documents live here; JsonFields and the speed sources point into them.

@@ -86,6 +86,35 @@ size_t ResultTable::data_rows() const {
   return n;
 }
 
+void ResultTable::require_header(const std::vector<std::string>& expected) const {
+  bool ok = columns.size() >= expected.size();
+  for (size_t i = 0; ok && i < expected.size(); ++i) ok = expected[i] == "X" || expected[i] == "Y" || columns[i] == expected[i];
+  if (!ok)
+    throw BadInput("`" + path.string() + "`: header `" + shown(joined(columns)) + "`: expected columns " + joined(expected));
+}
+
+void ResultTable::require_rows() const {
+  if (data_rows() == 0) throw BadInput("`" + path.string() + "`: no data rows (only a header)");
+}
+
+void ResultTable::require_grid() const {
+  size_t first_size = 0, size = 0, block_start = 0;
+  for (size_t i = 0; i <= rows.size(); ++i) {
+    if (i < rows.size() && !rows[i].empty()) {
+      if (size++ == 0) block_start = i;
+      continue;
+    }
+    if (size == 0) continue;  // (a separator after a separator, or the end after one)
+    if (first_size == 0) first_size = size;
+    // gnuplot would reject it too, with a message naming neither the file nor the line.
+    if (size != first_size)
+      throw BadInput(where(block_start) + ": the block of rows starting here has " + std::to_string(size) +
+                     " rows, the first has " + std::to_string(first_size) +
+                     " (a grid: one block per y value, separated by blank lines, all of one length)");
+    size = 0;
+  }
+}
+
 std::string ResultTable::where(size_t row) const { return line_of(path, row < row_lines.size() ? row_lines[row] : 0); }
 
 ResultTable read_result_table(const fs::path& path, const std::function<bool(const std::string&)>& nan_allowed) {

@@ -44,6 +44,15 @@ struct ResultTable {
   std::string metadata_text(const std::string& key, const std::string& fallback) const;
   // The number of non-empty rows.
   size_t data_rows() const;
+
+  // Shape checks of a figure's input, BadInput naming the file (and line) when they fail:
+  // the header starts with `expected` ("X", "Y" stand for any name);
+  void require_header(const std::vector<std::string>& expected) const;
+  // there is at least one row to draw;
+  void require_rows() const;
+  // the rows are a grid (chart, basin: gnuplot's image): one block per y value, separated by
+  // blank lines, every block as long as the first.
+  void require_grid() const;
 };
 
 // Reads a CSV table. Every row must have as many cells as the header and every cell must be a
