@@ -162,7 +162,7 @@ TEST(PlotCli, MetadataTextIsNeverExecuted) {
   // closing quote) is drawn as text and runs nothing.
   const std::string evil_line = "a'; " + touch + "; '`touch " + marker.string() + "`@evil \\";
   const std::string evil = evil_line + "\n" + touch + "\\";  // (a CSV line cannot hold the newline)
-  write(dir / "chart.csv", "# model = " + evil_line + "\n# N = 10\n" + "x'; " + touch + "; b',y`touch " +
+  write(dir / "chart.csv", "# model = " + evil_line + "\n# N = 10\n" + "'x'; " + touch + "; b',y`touch " +
                                marker.string() + "`,spectral_radius\n0,0,0.5\n1,0,1.5\n\n0,1,0.7\n1,1,nan\n");
   write(dir / "floquet.json", nlohmann::json{{"model", evil}, {"solver", evil}, {"N", 4},
                                              {"multipliers", {{{"re", 0.5}, {"im", 0.1}}}}}
@@ -177,8 +177,9 @@ TEST(PlotCli, MetadataTextIsNeverExecuted) {
   EXPECT_FALSE(fs::exists(marker));
   for (const char* name : {"chart", "multipliers", "bifurcation", "convergence", "speed_error"})
     EXPECT_EQ(head(dir / "plots" / (std::string(name) + ".png"), 4), "\x89PNG") << name;
-  // The quote is gnuplot's doubled quote inside one literal; the newline became a space.
-  EXPECT_NE(read(dir / "plots" / "chart.gp").find("set xlabel 'x''; system"), std::string::npos);
+  // Every quote is drawn as U+2019 inside one literal (a label starting with a quote included:
+  // gnuplot misreads its own '' escape there); the newline became a space.
+  EXPECT_NE(read(dir / "plots" / "chart.gp").find("set xlabel '\u2019x\u2019; system"), std::string::npos);
 }
 
 // A hex-float value (as a run given `--set e=0x1...` records it, at full precision) plots, as

@@ -28,7 +28,7 @@ std::string gnuplot_string(const std::string& text) {
   std::string out = "'";
   for (const char c : text) {
     const auto byte = static_cast<unsigned char>(c);
-    if (c == '\'') out += "''";
+    if (c == '\'') out += "\u2019";  // (not gnuplot's '' escape: see the header)
     else if (byte < 0x20 || byte == 0x7f) out += ' ';
     else out += c;
   }

@@ -17,7 +17,9 @@ namespace delayspec::cli {
 // value: a missing point) when not finite.
 std::string gnuplot_number(double value);
 
-// `text` as a single-quoted gnuplot string: a quote is doubled ('' is gnuplot's escape), control
+// `text` as a single-quoted gnuplot string: a quote becomes the typographic ’ (U+2019), since
+// gnuplot's own escape, a doubled quote, is misread at the start of a string (gnuplot 5.4 reads
+// '''a' as '' followed by 'a': a syntax error in a label that starts with a quote); control
 // characters (newline, carriage return, NUL, ...) become spaces so that the literal stays on its
 // line. Backslashes stay as they are: inside single quotes gnuplot reads them literally, and the
 // literal never ends a line (its closing quote does).
