@@ -1,7 +1,9 @@
 // `delayspec plot`: renders PNG and SVG (gnuplot) from result files, atomically, and rejects
 // bad directories and settings with exit 2.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -111,4 +113,261 @@ TEST(PlotCli, RendersSweepSimulateConvergeAndBenchFiles) {
     EXPECT_EQ(head(dir / "plots" / (std::string(name) + ".png"), 8), std::string("\x89PNG\r\n\x1a\n", 8)) << name;
     EXPECT_NE(head(dir / "plots" / (std::string(name) + ".svg"), 400).find("<svg"), std::string::npos) << name;
   }
+}
+
+namespace {
+
+void write(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A small valid trajectory (simulate's t,x,v) for the phase figure.
+const char* const kTrajectory = "t,x,v\n0,0,1\n0.1,0.1,0.99\n0.2,0.2,0.96\n";
+
+}  // namespace
+
+// Issue 13 item 2: text of a results file reaches gnuplot only as a number we print or an inert
+// string. On main, `# e = 1; system "touch MARKER"` ran the shell command.
+TEST(PlotCli, MetadataTextIsNeverExecuted) {
+  const fs::path dir = fresh_dir("inject");
+  const fs::path marker = dir / "pwned";
+  const std::string touch = "system \"touch " + marker.string() + "\"";
+  // A value that must be a number (the impact boundary e): exit 2 naming the value.
+  write(dir / "basin.csv", "# model = impact\n# e = 1; " + touch + "; x=1\nx0,v0,period,max_section_x\n"
+                           "1,0,1,0.5\n2,0,2,0.5\n\n1,1,1,0.5\n2,1,0,0.5\n");
+  CliResult basin = run({"plot", dir.string()});
+  EXPECT_EQ(basin.status, 2) << basin.err;
+  EXPECT_NE(basin.err.find("metadata `e = 1; system"), std::string::npos) << basin.err;
+  EXPECT_NE(basin.err.find("not a finite number"), std::string::npos) << basin.err;
+  EXPECT_FALSE(fs::exists(marker));
+  fs::remove(dir / "basin.csv");
+
+  // The same through simulate.json's metadata (written by `run`), read for the phase figure.
+  write(dir / "trajectory.csv", kTrajectory);
+  write(dir / "simulate.json", nlohmann::json{{"metadata", {{"parameters", {{"e", "1; " + touch}}}}}}.dump());
+  CliResult phase = run({"plot", dir.string()});
+  EXPECT_EQ(phase.status, 2) << phase.err;
+  EXPECT_NE(phase.err.find("`metadata.parameters.e`"), std::string::npos) << phase.err;
+  EXPECT_FALSE(fs::exists(marker));
+  fs::remove(dir / "simulate.json");
+  fs::remove(dir / "trajectory.csv");
+
+  // Text that really is text (titles, axis labels): every way out of a gnuplot string we know of
+  // (a quote, a backquote command substitution, an @macro, a newline, a backslash before the
+  // closing quote) is drawn as text and runs nothing.
+  const std::string evil_line = "a'; " + touch + "; '`touch " + marker.string() + "`@evil \\";
+  const std::string evil = evil_line + "\n" + touch + "\\";  // (a CSV line cannot hold the newline)
+  write(dir / "chart.csv", "# model = " + evil_line + "\n# N = 10\n" + "'x'; " + touch + "; b',y`touch " +
+                               marker.string() + "`,spectral_radius\n0,0,0.5\n1,0,1.5\n\n0,1,0.7\n1,1,nan\n");
+  write(dir / "floquet.json", nlohmann::json{{"model", evil}, {"solver", evil}, {"N", 4},
+                                             {"multipliers", {{{"re", 0.5}, {"im", 0.1}}}}}
+                                  .dump());
+  write(dir / "section.csv", "# sweep_key = " + evil_line + "\nparameter,x\n0,0.1\n0.5,0.2\n");
+  write(dir / "converge.json", nlohmann::json{{"reference", evil}, {"events", evil},
+                                              {"rows", {{{"N", 10}, {"error", 1e-3}, {"seconds", 0.1}, {"solver", evil}},
+                                                        {{"N", 20}, {"error", 2e-4}, {"seconds", 0.2}}}}}
+                                   .dump());
+  CliResult text = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
+  EXPECT_EQ(text.status, 0) << text.err;
+  EXPECT_FALSE(fs::exists(marker));
+  for (const char* name : {"chart", "multipliers", "bifurcation", "convergence", "speed_error"})
+    EXPECT_EQ(head(dir / "plots" / (std::string(name) + ".png"), 4), "\x89PNG") << name;
+  // Every quote is drawn as U+2019 inside one literal (a label starting with a quote included:
+  // gnuplot misreads its own '' escape there); the newline became a space.
+  EXPECT_NE(read(dir / "plots" / "chart.gp").find("set xlabel '\u2019x\u2019; system"), std::string::npos);
+}
+
+// A hex-float value (as a run given `--set e=0x1...` records it, at full precision) plots, as
+// the decimal number it is: 0x1.428f5c28f5c29p+0 is the double nearest 1.26.
+TEST(PlotCli, HexFloatMetadataPlots) {
+  const fs::path dir = fresh_dir("hexfloat");
+  CliResult b = run({"basin", "--out", dir.string(), "--quiet", "--set", "e=0x1.428f5c28f5c29p+0", "--set", "N=10",
+                     "--set", "basin_x_points=2", "--set", "basin_y_points=2", "--set", "basin_transient=5"});
+  ASSERT_EQ(b.status, 0) << b.err;
+  ASSERT_NE(read(dir / "basin.csv").find("# e = 0x1.428f5c28f5c29p+0\n"), std::string::npos);
+  CliResult p = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_NE(read(dir / "plots" / "basin.gp").find("set arrow from 1.26, graph 0 to 1.26, graph 1"), std::string::npos);
+
+  // The same value in simulate.json's metadata (the phase figure's boundary).
+  write(dir / "trajectory.csv", kTrajectory);
+  write(dir / "simulate.json", R"({"metadata": {"parameters": {"e": "0x1.428f5c28f5c29p+0"}}})");
+  p = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_NE(read(dir / "plots" / "phase.gp").find("set arrow from 1.26, graph 0"), std::string::npos);
+}
+
+struct BadFile {
+  const char* name;      // the file in the results directory
+  const char* contents;  // JSON or CSV
+  const char* message;   // what the error must name
+};
+void PrintTo(const BadFile& b, std::ostream* os) { *os << b.name << ": " << b.contents; }
+
+// Issue 13 items 3 and 4: a result file of the wrong shape is bad input (exit 2) naming the file
+// and the field or line. On main: exit 1 (nlohmann type errors) for the JSON cases; for the short
+// CSV rows a heap over-read, invented points and exit 0.
+class PlotBadFile : public ::testing::TestWithParam<BadFile> {};
+
+TEST_P(PlotBadFile, IsBadInputNamingTheFieldOrLine) {
+  const BadFile& b = GetParam();
+  const fs::path dir = fresh_dir("badfile");
+  write(dir / b.name, b.contents);
+  const std::string name = b.name;
+  if (name == "simulate.json" || name == "poincare.csv") write(dir / "trajectory.csv", kTrajectory);
+  if (name == "sweep.json") write(dir / "section.csv", "parameter,x\n0,0.1\n");
+  CliResult r = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(b.name), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(b.message), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "plots" / "multipliers.png"));
+}
+
+// clang-format off
+INSTANTIATE_TEST_SUITE_P(Json, PlotBadFile, ::testing::Values(
+    BadFile{"floquet.json", "{}", "`multipliers`: missing"},
+    BadFile{"floquet.json", "[1, 2]", "the top level: expected an object, found array"},
+    BadFile{"floquet.json", R"({"multipliers": "oops"})", "`multipliers`: expected a list, found string"},
+    BadFile{"floquet.json", R"({"multipliers": [1]})", "`multipliers[0]`: expected an object, found number"},
+    BadFile{"floquet.json", R"({"multipliers": [{"re": "1", "im": 0}]})", "`multipliers[0].re`: expected a number, found string \"1\""},
+    BadFile{"floquet.json", R"({"multipliers": [{"re": 1}]})", "`multipliers[0].im`: missing"},
+    BadFile{"floquet.json", R"({"multipliers": [{"re": 1e308, "im": 1e308}]})", "too large to draw"},
+    BadFile{"floquet.json", R"({"multipliers": [], "N": "forty"})", "`N`: expected a number, found string"},
+    BadFile{"floquet.json", R"({"multipliers": [], "model": 3})", "`model`: expected a string, found number"},
+    BadFile{"converge.json", "{}", "`rows`: missing"},
+    BadFile{"converge.json", R"({"rows": {"N": 10}})", "`rows`: expected a list, found object"},
+    BadFile{"converge.json", R"({"rows": [{"N": 10, "error": "small"}]})", "`rows[0].error`: expected a number"},
+    BadFile{"converge.json", R"({"rows": [{"N": 10, "error": [true]}]})", "`rows[0].error[0]`: expected a number, found boolean"},
+    BadFile{"converge.json", R"({"rows": [{"N": 0, "error": 1e-3}]})", "`rows[0].N`: must be > 0"},
+    BadFile{"converge.json", R"({"rows": [{"error": 1e-3}]})", "`rows[0].N`: missing"},
+    BadFile{"converge.json", R"({"by_events": [{"rows": [{"N": 10, "error": 1e-3}]}, 7]})", "`by_events[1]`: expected an object"},
+    BadFile{"converge.json", R"({"rows": [{"N": 10, "error": 1e-3}], "reference": ["x"]})", "`reference`: expected a string"},
+    BadFile{"bench.json", R"({"rows": [{"N": 10, "error": 1e-3, "seconds": "fast"}]})", "`rows[0].seconds`: expected a number"},
+    BadFile{"bench.json", R"({"rows": [{"N": 10, "error": 1e-3, "seconds": 1, "solver": {}}]})", "`rows[0].solver`: expected a string"},
+    BadFile{"simulate.json", R"({"metadata": {"parameters": {"e": [1.26]}}})", "`metadata.parameters.e`: expected a string"},
+    BadFile{"simulate.json", R"({"metadata": "none"})", "`metadata`: expected an object"},
+    BadFile{"sweep.json", R"({"sweep_key": 3})", "`sweep_key`: expected a string"}));
+
+INSTANTIATE_TEST_SUITE_P(Csv, PlotBadFile, ::testing::Values(
+    // rows shorter or longer than the header: the line is named (line numbers count metadata lines)
+    BadFile{"chart.csv", "x,y,spectral_radius\n0,0,0.5\n1,0\n", "chart.csv` line 3: 2 cells, expected 3"},
+    BadFile{"chart.csv", "# N = 10\nx,y,spectral_radius\n0,0,0.5,7\n", "chart.csv` line 3: 4 cells, expected 3"},
+    BadFile{"chart.csv", "x,y,spectral_radius\n0,0,\n", "line 2, column `spectral_radius`: `` is not a number"},
+    BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,1,0.5\n\n0,1,1\n", "basin.csv` line 4: 3 cells, expected 4"},
+    BadFile{"basin.csv", "x0,v0,period\n0,0\n", "line 2: 2 cells, expected 3"},
+    BadFile{"exponents.csv", "parameter,lambda1,lambda2,se1,se2,seconds\n0,0.1,-0.2\n", "line 2: 3 cells, expected 6"},
+    BadFile{"section.csv", "parameter,x\n0\n", "line 2: 1 cells, expected 2"},
+    BadFile{"trajectory.csv", "t,x,v\n0,0,1\n0.1,0.1\n", "line 3: 2 cells, expected 3"},
+    BadFile{"impacts.csv", "t,count\n0,0,0\n", "line 2: 3 cells, expected 2"},
+    // cells that are not finite numbers, and nan outside the result columns of failed points
+    BadFile{"chart.csv", "x,y,spectral_radius\n0,0,oops\n", "column `spectral_radius`: `oops` is not a number"},
+    BadFile{"chart.csv", "x,y,spectral_radius\n0,0,inf\n", "`inf` is not a finite number"},
+    BadFile{"chart.csv", "x,y,spectral_radius\nnan,0,0.5\n", "column `x`: `nan`: nan is allowed only in the result columns"},
+    BadFile{"chart.csv", "x,y,spectral_radius\n0,0,1e999\n", "`1e999` is not a finite number"},
+    BadFile{"exponents.csv", "parameter,lambda1,se1\nnan,0.1,0.01\n", "column `parameter`: `nan`"},
+    BadFile{"trajectory.csv", "t,x,v\n0,nan,1\n", "column `x`: `nan`"},
+    BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,2.5,0.5\n", "line 2: period `2.5`: expected a whole number"},
+    BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,1e300,0.5\n", "period `1.0000000000000001e+300`"},
+    BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,-1,0.5\n", "period `-1`"},
+    // grids (chart, basin): blocks of one length; on main gnuplot's "Unexpected line of data in matrix"
+    BadFile{"chart.csv", "x,y,spectral_radius\n0,0,0.5\n1,0,1.2\n\n0,1,0.7\n", "line 5: the block of rows starting here has 1 rows, the first has 2"},
+    BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,1,0.5\n\n0,1,1,0.5\n1,1,1,0.5\n", "basin.csv` line 4: the block"},
+    // headers
+    BadFile{"chart.csv", "x,y\n0,0\n", "expected columns X,Y,spectral_radius"},
+    BadFile{"chart.csv", "x,y,spectral_radius\n", "no data rows"},
+    BadFile{"chart.csv", "# only metadata\n", "no header line"},
+    BadFile{"exponents.csv", "k,lambda1\n0,0.1\n", "expected columns parameter,lambda1"},
+    BadFile{"poincare.csv", "t,x,v\n0,0,1,5\n", "poincare.csv` line 2"}));
+// clang-format on
+
+// A nan spectral radius (a failed chart point) is documented and drawn as a gap; a chart where
+// every point failed has nothing to draw: exit 3 (the chart's numerical failure), saying so.
+TEST(PlotCli, FailedChartPoints) {
+  const fs::path dir = fresh_dir("failedpoints");
+  write(dir / "chart.csv", "x,y,spectral_radius\n0,0,0.5\n1,0,nan\n\n0,1,1.5\n1,1,0.9\n");
+  CliResult some = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
+  EXPECT_EQ(some.status, 0) << some.err;
+  EXPECT_NE(read(dir / "plots" / "chart.gp").find("1 0 NaN\n"), std::string::npos);
+  write(dir / "chart.csv", "x,y,spectral_radius\n0,0,nan\n1,0,nan\n");
+  CliResult all = run({"plot", dir.string()});
+  EXPECT_EQ(all.status, 3) << all.err;
+  EXPECT_NE(all.err.find("every point failed"), std::string::npos) << all.err;
+}
+
+// Issue 13 item 3: gnuplot failing is exit 3 with the reason; a plot_gnuplot that is no program
+// is the user's input (exit 2); gnuplot not installed (the default name not found) is exit 3.
+// On main the first two cases exited 1 ("internal error").
+TEST(PlotCli, GnuplotFailureIsExit3) {
+  const fs::path dir = fresh_dir("gnuplotfails");
+  write(dir / "floquet.json", R"({"multipliers": [{"re": 0.5, "im": 0}]})");
+  CliResult fails = run({"plot", dir.string(), "--set", "plot_gnuplot=/bin/false"});
+  EXPECT_EQ(fails.status, 3) << fails.err;
+  EXPECT_NE(fails.err.find("gnuplot failed (exit status 1)"), std::string::npos) << fails.err;
+
+  // A program that succeeds but writes no image, and one killed by a signal.
+  const fs::path silent = dir / "silent.sh", killed = dir / "killed.sh";
+  write(silent, "#!/bin/sh\nexit 0\n");
+  write(killed, "#!/bin/sh\nkill -KILL $$\n");
+  for (const auto& p : {silent, killed}) fs::permissions(p, fs::perms::owner_all);
+  CliResult none = run({"plot", dir.string(), "--set", "plot_gnuplot=" + silent.string()});
+  EXPECT_EQ(none.status, 3) << none.err;
+  EXPECT_NE(none.err.find("gnuplot wrote no image"), std::string::npos) << none.err;
+  CliResult signal = run({"plot", dir.string(), "--set", "plot_gnuplot=" + killed.string()});
+  EXPECT_EQ(signal.status, 3) << signal.err;
+  EXPECT_NE(signal.err.find("exit status 137"), std::string::npos) << signal.err;  // 128 + SIGKILL
+
+  CliResult not_a_program = run({"plot", dir.string(), "--set", "plot_gnuplot=" + dir.string()});
+  EXPECT_EQ(not_a_program.status, 2) << not_a_program.err;
+  EXPECT_NE(not_a_program.err.find("`plot_gnuplot = "), std::string::npos) << not_a_program.err;
+
+  // The default `gnuplot` not on the PATH: not the user's input, exit 3 saying what to install.
+  const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  ::setenv("PATH", (dir / "empty").c_str(), 1);
+  CliResult missing = run({"plot", dir.string()});
+  ::setenv("PATH", path.c_str(), 1);
+  EXPECT_EQ(missing.status, 3) << missing.err;
+  EXPECT_NE(missing.err.find("install it"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(dir / "plots" / "multipliers.png"));
+  for (const auto& entry : fs::directory_iterator(dir / "plots"))
+    EXPECT_EQ(entry.path().extension(), ".gp") << "left behind: " << entry.path();
+}
+
+// Issue 13 item 12: the speed figure's x axis is the relative error of the complex mu_1 (what
+// converge and bench report), not the error of |mu_1|; sweep figures name the swept key, read
+// from the metadata header sweep writes; old files without it fall back to "parameter".
+TEST(PlotCli, FiguresLabelWhatIsPlotted) {
+  const fs::path dir = fresh_dir("labels");
+  CliResult s = run({"sweep", "--out", dir.string(), "--quiet", "--set", "model=linear", "--set", "sweep_key=b",
+                     "--set", "sweep_from=-2", "--set", "sweep_to=-1", "--set", "sweep_points=2", "--set", "N=10",
+                     "--set", "periods=20", "--set", "transient=0", "--set", "section_points=2"});
+  ASSERT_EQ(s.status, 0) << s.err;
+  fs::remove(dir / "sweep.json");  // the CSV's own metadata names the key
+  write(dir / "bench.json", R"({"rows": [{"N": 10, "solver": "dense", "seconds": 0.01, "error": 1e-3},
+      {"N": 20, "solver": "dense", "seconds": 0.02, "error": 2e-4}]})");
+  CliResult p = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_NE(read(dir / "plots" / "exponents.gp").find("set xlabel 'b'\n"), std::string::npos);
+  EXPECT_NE(read(dir / "plots" / "bifurcation.gp").find("set xlabel 'b'\n"), std::string::npos);
+  const std::string speed = read(dir / "plots" / "speed_error.gp");
+  EXPECT_NE(speed.find("set xlabel 'relative error of complex {/Symbol m}_1'"), std::string::npos) << speed;
+  EXPECT_EQ(speed.find("|{/Symbol m}_1|"), std::string::npos) << speed;
+
+  const fs::path old = fresh_dir("labels_old");
+  write(old / "section.csv", "parameter,x\n0,0.1\n0.5,0.2\n");
+  ASSERT_EQ(run({"plot", old.string(), "--set", "plot_width=200", "--set", "plot_height=150"}).status, 0);
+  EXPECT_NE(read(old / "plots" / "bifurcation.gp").find("set xlabel 'parameter'\n"), std::string::npos);
+}
+
+// A FIFO (or any non-regular file) where a result file is expected would block the read forever.
+TEST(PlotCli, NonRegularInputIsBadInput) {
+  const fs::path dir = fresh_dir("fifo");
+  ASSERT_EQ(::mkfifo((dir / "chart.csv").c_str(), 0600), 0);
+  CliResult r = run({"plot", dir.string()});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("chart.csv`: not a regular file"), std::string::npos) << r.err;
 }

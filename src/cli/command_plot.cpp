@@ -8,28 +8,28 @@
 //   floquet.json              -> multipliers: the complex plane, unit circle
 //   chart.csv                 -> chart: spectral radius over the parameter plane, |mu_1| = 1 contour
 //   basin.csv                 -> basin: attractor period over the initial-history plane, x = e line
-//   converge.json             -> convergence: error against h, log-log, with h and h^2 guides;
-//                                speed_error: seconds against error
+//   converge.json             -> convergence: relative error of mu_1 against h, log-log, with h and
+//                                h^2 guides; speed_error: seconds against that error
 //   bench.json                -> speed_error (bench rows)
 //   exponents.csv (sweep)     -> exponents: against the swept parameter, error bars, zero line
 //   section.csv (sweep)       -> bifurcation: Poincare-section x against the swept parameter
 //   trajectory.csv, poincare.csv (simulate) -> phase: portrait with Poincare points and x = e
 //   impacts.csv (simulate)    -> impacts: cumulative impact count against time
 // Keys: plot_gnuplot (the program, default "gnuplot"), plot_width, plot_height (pixels of the PNG).
-#include <sys/wait.h>
-
-#include <chrono>
+//
+// The inputs are read strictly (plot_inputs.hpp): a file of the wrong shape is bad input (exit 2)
+// naming the file and the line or field; values reach the scripts only as numbers we print or as
+// quoted gnuplot strings (gnuplot_script.hpp), so no text of a result file is ever executed.
+// Exit status: 0 figures written, 2 bad input, 3 gnuplot failed or is not installed.
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <functional>
 #include <map>
 #include <sstream>
 
-#include "atomic_file.hpp"
 #include "commands.hpp"
 #include "delayspec/errors.hpp"
+#include "gnuplot_script.hpp"
+#include "plot_inputs.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -40,277 +40,164 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-struct PlotSettings {
-  std::string gnuplot = "gnuplot";
-  long width = 900, height = 700;
-};
-
-// A table read from one of delayspec's CSV files: "# key = value" metadata lines, a header line,
-// rows of numbers; blank lines (grid-block separators) kept as empty rows.
-struct Table {
-  std::map<std::string, std::string> metadata;
-  std::vector<std::string> columns;
-  std::vector<std::vector<double>> rows;  // empty row = block separator
-  int column(const std::string& name) const {
-    for (size_t i = 0; i < columns.size(); ++i)
-      if (columns[i] == name) return static_cast<int>(i);
-    return -1;
-  }
-};
-
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string item;
-  while (std::getline(ss, item, sep)) out.push_back(item);
-  return out;
+// Whether DIR/NAME is there to plot. Something that is not a regular file (a directory, a FIFO
+// that would block the read) is bad input.
+bool present(const fs::path& dir, const std::string& name) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(dir / name, ec);
+  if (!fs::exists(status)) return false;
+  if (!fs::is_regular_file(status)) throw BadInput("`" + (dir / name).string() + "`: not a regular file");
+  return true;
 }
 
-Table read_table(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw BadInput("cannot read `" + path.string() + "`");
-  Table t;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.rfind("#", 0) == 0) {
-      const auto eq = line.find(" = ");
-      if (eq != std::string::npos) t.metadata[line.substr(2, eq - 2)] = line.substr(eq + 3);
-      continue;
-    }
-    if (line.empty()) {
-      if (!t.rows.empty() && !t.rows.back().empty()) t.rows.emplace_back();
-      continue;
-    }
-    if (t.columns.empty()) {
-      t.columns = split(line, ',');
-      continue;
-    }
-    std::vector<double> row;
-    for (const auto& cell : split(line, ',')) {
-      char* end = nullptr;
-      const double v = std::strtod(cell.c_str(), &end);
-      row.push_back(end == cell.c_str() ? NAN : v);
-    }
-    t.rows.push_back(row);
-  }
-  if (t.columns.empty()) throw BadInput("`" + path.string() + "`: no header line (expected column names)");
-  return t;
+// "N = 200" of a title from a table's metadata (the `# N = ...` line of a given N), else "default".
+std::string title_N(const ResultTable& t) {
+  const double N = t.metadata_number("N", NAN);
+  return std::isnan(N) ? std::string("default") : gnuplot_number(N);
 }
-
-Json read_json(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw BadInput("cannot read `" + path.string() + "`");
-  try {
-    return Json::parse(in);
-  } catch (const Json::exception& e) {
-    throw BadInput("`" + path.string() + "`: not JSON: " + e.what());
-  }
-}
-
-std::string number(double v) {
-  if (!std::isfinite(v)) return "NaN";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
-// gnuplot string literal in single quotes ('' escapes a quote).
-std::string quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
-  return out + "'";
-}
-
-// A datablock: $name << EOD ... EOD.
-std::string datablock(const std::string& name, const std::string& rows) { return "$" + name + " << EOD\n" + rows + "EOD\n"; }
-
-std::string parameter(const std::map<std::string, std::string>& p, const std::string& key, const std::string& fallback) {
-  auto it = p.find(key);
-  return it == p.end() ? fallback : it->second;
-}
-
-class Plotter {
- public:
-  Plotter(fs::path dir, PlotSettings settings, const Invocation& inv)
-      : dir_(std::move(dir)), plots_(fs::absolute(dir_) / "plots"), settings_(std::move(settings)), inv_(inv) {}
-
-  // Writes NAME.gp (the body plots once; the header sets the PNG terminal, a footer replots as
-  // SVG), runs gnuplot, renames the images into place.
-  void figure(const std::string& name, const std::string& body) {
-    const fs::path png = plots_ / (name + ".png"), svg = plots_ / (name + ".svg");
-    const fs::path png_tmp = plots_ / ("." + name + ".png.tmp"), svg_tmp = plots_ / ("." + name + ".svg.tmp");
-    std::ostringstream gp;
-    gp << "# delayspec plot: " << name << " (run: gnuplot " << name << ".gp; writes " << name << ".png and " << name
-       << ".svg)\n";
-    gp << "png_file = " << quoted(png.filename().string()) << "\nsvg_file = " << quoted(svg.filename().string()) << "\n";
-    gp << "if (exists('DELAYSPEC_PNG')) png_file = DELAYSPEC_PNG; svg_file = DELAYSPEC_SVG\n";
-    gp << "set terminal pngcairo size " << settings_.width << "," << settings_.height
-       << " enhanced font 'sans,12' background rgb 'white'\nset output png_file\n";
-    gp << body;
-    gp << "set terminal svg size " << settings_.width << "," << settings_.height
-       << " enhanced font 'sans,12' background rgb 'white'\nset output svg_file\nreplot\nunset output\n";
-    const fs::path script = plots_ / (name + ".gp");
-    write_file_atomically(script, gp.str());
-    // Run in plots/ so that the script's relative names work; the temporaries become the images.
-    const std::string command = "cd " + shell_quoted(plots_.string()) + " && " + shell_quoted(settings_.gnuplot) +
-                                " -e " + shell_quoted("DELAYSPEC_PNG=" + quoted(png_tmp.filename().string()) +
-                                                      "; DELAYSPEC_SVG=" + quoted(svg_tmp.filename().string())) +
-                                " " + shell_quoted(script.filename().string()) + " 2>" +
-                                shell_quoted("." + name + ".log");  // relative to plots/ (the cd)
-    const int status = std::system(command.c_str());
-    const fs::path log = plots_ / ("." + name + ".log");
-    std::string log_text;
-    {
-      std::ifstream in(log);
-      std::stringstream ss;
-      ss << in.rdbuf();
-      log_text = ss.str();
-    }
-    std::error_code ec;
-    fs::remove(log, ec);
-    if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) == 127)
-      throw BadInput("cannot run gnuplot (`plot_gnuplot = " + settings_.gnuplot +
-                     "`): install it (Debian: gnuplot-nox, scripts/setup-debian.sh)");
-    if (WEXITSTATUS(status) != 0 || !fs::exists(png_tmp) || !fs::exists(svg_tmp)) {
-      fs::remove(png_tmp, ec);
-      fs::remove(svg_tmp, ec);
-      throw std::runtime_error("gnuplot failed on " + script.string() + ":\n" + log_text);
-    }
-    fs::rename(png_tmp, png);
-    fs::rename(svg_tmp, svg);
-    written_.push_back(png.string());
-    written_.push_back(svg.string());
-    if (!inv_.json) inv_.out << "plot: " << png.string() << " (and .svg, .gp)\n";
-  }
-
-  const std::vector<std::string>& written() const { return written_; }
-  const fs::path& dir() const { return dir_; }
-
- private:
-  static std::string shell_quoted(const std::string& s) {
-    std::string out = "'";
-    for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
-  }
-  fs::path dir_, plots_;
-  PlotSettings settings_;
-  const Invocation& inv_;
-  std::vector<std::string> written_;
-};
 
 // ---- the figures ----
 
-void plot_multipliers(Plotter& plotter, const Json& j) {
+// floquet.json: multipliers [{re, im, ...}] -> the complex plane with the unit circle.
+void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   std::string rows;
   double radius = 1;
-  for (const auto& m : j.at("multipliers")) {
-    rows += number(m.at("re").get<double>()) + " " + number(m.at("im").get<double>()) + "\n";
-    radius = std::max(radius, m.at("abs").get<double>());
+  const JsonField multipliers = j.at("multipliers");
+  for (const JsonField& m : multipliers.elements()) {
+    const double re = m.at("re").number(), im = m.at("im").number();
+    rows += gnuplot_number(re) + " " + gnuplot_number(im) + "\n";
+    radius = std::max(radius, std::hypot(re, im));
   }
+  if (!(radius < 1e300)) multipliers.fail("a modulus of " + format_number(radius) + " is too large to draw");
   const double r = 1.1 * radius;
+  const double N = j.number_or("N", NAN);
   std::ostringstream gp;
-  gp << datablock("mu", rows);
-  gp << "set title " << quoted("Floquet multipliers: model " + j.value("model", std::string("?")) + ", N = " +
-                               std::to_string(j.value("N", 0)) + ", solver " + j.value("solver", std::string("?")))
+  gp << gnuplot_datablock("mu", rows);
+  gp << "set title "
+     << gnuplot_string("Floquet multipliers: model " + j.text_or("model", "?") + ", N = " +
+                       (std::isnan(N) ? std::string("?") : gnuplot_number(N)) + ", solver " + j.text_or("solver", "?"))
      << "\n";
   gp << "set size ratio -1\nset grid\nset xlabel 'Re {/Symbol m}'\nset ylabel 'Im {/Symbol m}'\n";
-  gp << "set xrange [" << -r << ":" << r << "]\nset yrange [" << -r << ":" << r << "]\n";
+  gp << "set xrange [" << gnuplot_number(-r) << ":" << gnuplot_number(r) << "]\nset yrange [" << gnuplot_number(-r)
+     << ":" << gnuplot_number(r) << "]\n";
   gp << "set parametric\nset trange [0:2*pi]\nset key top right\n";
   gp << "plot cos(t), sin(t) with lines lc rgb '#1f77b4' lw 1.5 title 'unit circle', \\\n"
         "     $mu using 1:2 with points pt 7 ps 1.2 lc rgb '#d62728' title 'multipliers'\n";
-  plotter.figure("multipliers", gp.str());
+  renderer.figure("multipliers", gp.str());
 }
 
-void plot_chart(Plotter& plotter, const Table& t) {
-  if (t.columns.size() < 3) throw BadInput("chart.csv: expected columns x,y,spectral_radius");
+// chart.csv: X,Y,spectral_radius (nan: a failed point, left blank) -> image with the |mu_1| = 1
+// contour.
+void plot_chart(FigureRenderer& renderer, const fs::path& file) {
+  const ResultTable t = read_result_table(file, [](const std::string& c) { return c == "spectral_radius"; });
+  t.require_header({"X", "Y", "spectral_radius"});
+  t.require_rows();
+  t.require_grid();
   std::string rows;
-  for (const auto& row : t.rows)
-    rows += row.empty() ? "\n" : number(row[0]) + " " + number(row[1]) + " " + number(row[2]) + "\n";
+  bool any_radius = false;
+  for (const auto& row : t.rows) {
+    rows += row.empty() ? "\n" : gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(row[2]) + "\n";
+    any_radius = any_radius || (!row.empty() && !std::isnan(row[2]));
+  }
+  // gnuplot cannot draw a chart without one value: say why instead of its "all points undefined".
+  if (!any_radius) throw NumericalFailure("`" + file.string() + "`: every point failed (spectral_radius nan): nothing to draw");
   std::ostringstream gp;
-  gp << datablock("chart", rows);
+  gp << gnuplot_datablock("chart", rows);
   gp << "set table $boundary\nset contour base\nset cntrparam levels discrete 1.0\nunset surface\n"
         "splot $chart using 1:2:3 with lines\nunset table\nunset contour\nset surface\n";
-  gp << "set title " << quoted("Spectral radius |{/Symbol m}_1|, model " + parameter(t.metadata, "model", "?") +
-                               ", N = " + parameter(t.metadata, "N", "default") + " (white line: |{/Symbol m}_1| = 1)")
+  gp << "set title "
+     << gnuplot_string("Spectral radius |{/Symbol m}_1|, model " + t.metadata_text("model", "?") + ", N = " +
+                       title_N(t) + " (white line: |{/Symbol m}_1| = 1)")
      << "\n";
-  gp << "set xlabel " << quoted(t.columns[0]) << "\nset ylabel " << quoted(t.columns[1]) << "\n";
+  gp << "set xlabel " << gnuplot_string(t.columns[0]) << "\nset ylabel " << gnuplot_string(t.columns[1]) << "\n";
   gp << "set cblabel '|{/Symbol m}_1| (clipped at 2)'\nset cbrange [0:2]\n"
         "set palette defined (0 '#08306b', 0.5 '#4292c6', 0.999 '#c6dbef', 1.001 '#fee391', 1.5 '#fb6a4a', 2 '#67000d')\n";
   gp << "set autoscale fix\nset key off\n";
   gp << "plot $chart using 1:2:($3 > 2 ? 2 : $3) with image, $boundary using 1:2 with lines lc rgb 'white' lw 2\n";
-  plotter.figure("chart", gp.str());
+  renderer.figure("chart", gp.str());
 }
 
-void plot_basin(Plotter& plotter, const Table& t) {
-  if (t.columns.size() < 3) throw BadInput("basin.csv: expected columns x,y,period");
+// basin.csv: X,Y,period,max_section_x (nan, nan: a failed point) -> period colours over the
+// initial-history plane.
+void plot_basin(FigureRenderer& renderer, const fs::path& file) {
+  const ResultTable t =
+      read_result_table(file, [](const std::string& c) { return c == "period" || c == "max_section_x"; });
+  t.require_header({"X", "Y", "period"});
+  t.require_rows();
+  t.require_grid();
   // Fixed colours per period (an rgbimage, so that a period has the same colour in every figure):
   // 0 (no period found: chaotic or longer) black, then a qualitative palette.
   static const int rgb[10][3] = {{17, 17, 17},  {31, 119, 180}, {44, 160, 44},  {148, 103, 189}, {140, 86, 75},
                                  {214, 39, 40}, {255, 127, 14}, {188, 189, 34}, {227, 119, 194}, {127, 127, 127}};
   std::string rows;
-  std::map<int, long> present;
-  for (const auto& row : t.rows) {
+  std::map<long, long> present;  // period (-1: failed) -> points
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    const auto& row = t.rows[i];
     if (row.empty()) {
       rows += "\n";
       continue;
     }
-    const int period = std::isfinite(row[2]) ? static_cast<int>(row[2]) : -1;
+    if (!std::isnan(row[2]) && !(row[2] >= 0 && row[2] <= 1e9 && row[2] == std::floor(row[2])))
+      throw BadInput(t.where(i) + ": period `" + format_number(row[2]) + "`: expected a whole number >= 0 (or nan)");
+    const long period = std::isnan(row[2]) ? -1 : static_cast<long>(row[2]);
     const int* c = period >= 0 ? rgb[period % 10] : rgb[9];
-    rows += number(row[0]) + " " + number(row[1]) + " " + std::to_string(c[0]) + " " + std::to_string(c[1]) + " " +
-            std::to_string(c[2]) + "\n";
+    rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + std::to_string(c[0]) + " " +
+            std::to_string(c[1]) + " " + std::to_string(c[2]) + "\n";
     ++present[period];
   }
   std::ostringstream gp;
-  gp << datablock("basin", rows);
-  gp << "set title " << quoted("Basins of attraction, model " + parameter(t.metadata, "model", "?") + ", k = " +
-                               parameter(t.metadata, "k", "0") + ", N = " + parameter(t.metadata, "N", "default"))
+  gp << gnuplot_datablock("basin", rows);
+  gp << "set title "
+     << gnuplot_string("Basins of attraction, model " + t.metadata_text("model", "?") + ", k = " +
+                       gnuplot_number(t.metadata_number("k", 0)) + ", N = " + title_N(t))
      << "\n";
-  gp << "set xlabel " << quoted(t.columns[0]) << "\nset ylabel " << quoted(t.columns[1]) << "\n";
+  gp << "set xlabel " << gnuplot_string(t.columns[0]) << "\nset ylabel " << gnuplot_string(t.columns[1]) << "\n";
   gp << "set autoscale fix\nset key outside right top box opaque\nset style fill solid 1.0\n";
   std::ostringstream legend;
   for (const auto& [period, n] : present) {
     const int* c = period >= 0 ? rgb[period % 10] : rgb[9];
     char colour[16];
     std::snprintf(colour, sizeof colour, "#%02x%02x%02x", c[0], c[1], c[2]);
-    const std::string label = period < 0   ? "failed"
+    const std::string label = period < 0    ? "failed"
                               : period == 0 ? "no period (chaotic?)"
                                             : "period " + std::to_string(period);
-    legend << ", \\\n     NaN with boxes lc rgb '" << colour << "' title " << quoted(label + " (" + std::to_string(n) + ")");
+    legend << ", \\\n     NaN with boxes lc rgb '" << colour << "' title "
+           << gnuplot_string(label + " (" + std::to_string(n) + ")");
   }
   std::string impact_line;
-  if (t.columns[0] == "x0" && parameter(t.metadata, "model", "impact") == "impact") {
-    const std::string e = parameter(t.metadata, "e", "1.26");
+  if (t.columns[0] == "x0" && t.metadata_text("model", "impact") == "impact") {
+    const std::string e = gnuplot_number(t.metadata_number("e", 1.26));
     gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#00bfff' lw 3 front\n";
     impact_line = ", \\\n     NaN with lines lc rgb '#00bfff' lw 3 title 'impact boundary x = e'";
   }
   gp << "plot $basin using 1:2:3:4:5 with rgbimage notitle" << legend.str() << impact_line << "\n";
-  plotter.figure("basin", gp.str());
+  renderer.figure("basin", gp.str());
 }
 
-// The first multiplier's error of a converge/bench row: a number, or the first of an array.
-double first_error(const Json& row) {
-  if (!row.contains("error") || row["error"].is_null()) return NAN;
-  const Json& e = row["error"];
-  if (e.is_number()) return e.get<double>();
-  if (e.is_array() && !e.empty() && e[0].is_number()) return e[0].get<double>();
-  return NAN;
+// The leading multiplier's error of a converge/bench row: `error`, a number or a list whose first
+// entry is plotted; NaN when absent or null (no error to draw).
+double first_error(const JsonField& row) {
+  const auto e = row.find("error");
+  if (!e) return NAN;
+  if (!e->is_array()) return e->number();
+  const std::vector<JsonField> errors = e->elements();
+  return errors.empty() || errors[0].is_null() ? NAN : errors[0].number();
 }
 
 // The studies of a converge result: one per events variant ("by_events"), else the top level.
-std::vector<std::pair<std::string, Json>> convergence_studies(const Json& j) {
-  std::vector<std::pair<std::string, Json>> out;
-  if (j.contains("by_events") && j["by_events"].is_array()) {
-    for (const auto& s : j["by_events"]) out.emplace_back("events = " + s.value("events", std::string("?")), s);
+std::vector<std::pair<std::string, JsonField>> convergence_studies(const JsonField& j) {
+  std::vector<std::pair<std::string, JsonField>> out;
+  if (const auto by_events = j.find("by_events")) {
+    for (const JsonField& s : by_events->elements()) out.emplace_back("events = " + s.text_or("events", "?"), s);
   } else {
-    out.emplace_back(j.contains("events") && j["events"].is_string() ? "events = " + j["events"].get<std::string>()
-                                                                      : "error",
-                     j);
+    const auto events = j.find("events");
+    out.emplace_back(events ? "events = " + events->text() : "error", j);
   }
   return out;
 }
 
-void plot_convergence(Plotter& plotter, const Json& j) {
+// converge.json -> relative error of mu_1 against h, log-log, with slope-1 and slope-2 guides.
+void plot_convergence(FigureRenderer& renderer, const JsonField& j) {
   const char* colours[] = {"#d62728", "#1f77b4", "#2ca02c", "#9467bd"};
   std::ostringstream gp, plot;
   double h0 = NAN, e0 = NAN;
@@ -318,221 +205,265 @@ void plot_convergence(Plotter& plotter, const Json& j) {
   int block = 0;
   for (const auto& [label, study] : convergence_studies(j)) {
     std::string rows;
-    for (const auto& row : study.at("rows")) {
-      const double N = row.at("N").get<double>();
-      has_h = has_h && row.contains("h");
-      const double h = row.contains("h") ? row["h"].get<double>() : 1.0 / N;
+    for (const JsonField& row : study.at("rows").elements()) {
+      const auto h_field = row.find("h");
+      has_h = has_h && h_field.has_value();
+      double h;
+      if (h_field) {
+        h = h_field->number();
+      } else {
+        const double N = row.at("N").number();
+        if (!(N > 0)) row.at("N").fail("must be > 0 (h = 1/N is drawn when a row has no h)");
+        h = 1.0 / N;
+      }
       const double e = first_error(row);
-      if (!(e > 0)) continue;
-      rows += number(h) + " " + number(e) + "\n";
+      if (!(e > 0) || !(h > 0)) continue;  // a log-log figure: zero or negative cannot be drawn
+      rows += gnuplot_number(h) + " " + gnuplot_number(e) + "\n";
       if (std::isnan(h0) || e > e0) h0 = h, e0 = e;  // guides through the largest error
     }
     if (rows.empty()) continue;
     std::string name("c");
     name.append(std::to_string(block));
-    gp << datablock(name, rows);
+    gp << gnuplot_datablock(name, rows);
     plot << (block == 0 ? "plot " : ", \\\n     ") << "$" << name << " using 1:2 with linespoints pt 7 lw 2 lc rgb '"
-         << colours[block % 4] << "' title " << quoted(label);
+         << colours[block % 4] << "' title " << gnuplot_string(label);
     ++block;
   }
-  if (block == 0) throw BadInput("converge.json: no row with a positive error to plot");
-  gp << "set title " << quoted("Convergence of the leading multiplier (reference: " +
-                               j.value("reference", std::string("?")) + ")")
+  if (block == 0) throw BadInput("`converge.json`: no row with a positive error and h to plot");
+  gp << "set title "
+     << gnuplot_string("Convergence of the leading multiplier (reference: " + j.text_or("reference", "?") + ")")
      << "\n";
   gp << "set logscale xy\nset grid\nset format y '10^{%L}'\nset key bottom right\n";
-  gp << "set xlabel " << quoted(has_h ? "h" : "1/N (h = tau/N)") << "\nset ylabel 'error of {/Symbol m}_1'\n";
-  gp << "h0 = " << number(h0) << "; e0 = " << number(e0) << "\n";
+  gp << "set xlabel " << gnuplot_string(has_h ? "h" : "1/N (h = tau/N)")
+     << "\nset ylabel 'relative error of complex {/Symbol m}_1'\n";
+  gp << "h0 = " << gnuplot_number(h0) << "; e0 = " << gnuplot_number(e0) << "\n";
   gp << plot.str() << ", \\\n     e0*(x/h0) with lines dt 2 lc rgb '#555555' title 'slope 1 (h)', \\\n"
      << "     e0*(x/h0)**2 with lines dt 3 lc rgb '#000000' title 'slope 2 (h^2)'\n";
-  plotter.figure("convergence", gp.str());
+  renderer.figure("convergence", gp.str());
 }
 
-void plot_speed_error(Plotter& plotter, const std::vector<std::pair<std::string, Json>>& sources) {
+// converge.json and bench.json -> seconds against the relative error of mu_1, one line per solver
+// (bench) or events variant (converge).
+void plot_speed_error(FigureRenderer& renderer, const std::vector<std::pair<std::string, JsonField>>& sources) {
   std::ostringstream gp, plot;
   int block = 0;
   for (const auto& [source, whole] : sources) {
-    std::vector<std::pair<std::string, Json>> parts;
+    std::vector<std::pair<std::string, JsonField>> parts;
     if (source == "converge") parts = convergence_studies(whole);
     else parts.emplace_back(source, whole);
     for (const auto& [label, j] : parts) {
       std::map<std::string, std::string> by_solver;
-      for (const auto& row : j.at("rows")) {
+      for (const JsonField& row : j.at("rows").elements()) {
         const double e = first_error(row);
-        const double s = row.value("seconds", NAN);
+        const double s = row.number_or("seconds", NAN);
         if (!(e > 0) || !(s > 0)) continue;
-        const std::string solver = row.contains("solver") && row["solver"].is_string()
-                                       ? source + ": " + row["solver"].get<std::string>()
-                                       : source + ": " + label;
-        by_solver[solver] += number(e) + " " + number(s) + " " + number(row.value("N", 0.0)) + "\n";
+        const std::string solver = source + ": " + row.text_or("solver", label);
+        by_solver[solver] += gnuplot_number(e) + " " + gnuplot_number(s) + " " + gnuplot_number(row.number_or("N", 0)) + "\n";
       }
       for (const auto& [solver, rows] : by_solver) {
         std::string name("s");  // (append: GCC 12 warns falsely on "s" + string)
         name.append(std::to_string(block++));
-        gp << datablock(name, rows);
+        gp << gnuplot_datablock(name, rows);
         plot << (plot.tellp() > 0 ? ", \\\n     " : "plot ") << "$" << name
-             << " using 1:2 with linespoints pt 7 lw 2 title " << quoted(solver);
+             << " using 1:2 with linespoints pt 7 lw 2 title " << gnuplot_string(solver);
       }
     }
   }
   if (block == 0) return;
   gp << "set title 'Speed against error'\nset logscale xy\nset grid\nset format x '10^{%L}'\n"
-        "set xlabel 'error of |{/Symbol m}_1|'\nset ylabel 'seconds'\nset key top right\n";
+        "set xlabel 'relative error of complex {/Symbol m}_1'\nset ylabel 'seconds'\nset key top right\n";
   gp << plot.str() << "\n";
-  plotter.figure("speed_error", gp.str());
+  renderer.figure("speed_error", gp.str());
 }
 
-std::string sweep_label(const fs::path& dir) {
-  if (!fs::exists(dir / "sweep.json")) return "parameter";
-  const Json j = read_json(dir / "sweep.json");
-  return j.contains("sweep_key") && j["sweep_key"].is_string() ? j["sweep_key"].get<std::string>() : "parameter";
+// The swept key of a sweep's tables, for the x axis: the `# sweep_key = K` metadata line of the
+// CSV (sweep writes it), else sweep.json's sweep_key, else "parameter" (older files).
+std::string sweep_label(const fs::path& dir, const ResultTable& t) {
+  const std::string from_csv = t.metadata_text("sweep_key", "");
+  if (!from_csv.empty()) return from_csv;
+  if (!present(dir, "sweep.json")) return "parameter";
+  const Json doc = read_json_file(dir / "sweep.json");
+  return JsonField(doc, "sweep.json", "").text_or("sweep_key", "parameter");
 }
 
-// exponents.csv (sweep): parameter,lambda1..k,se1..k,... -> exponents against the parameter with
-// standard-error bars and the zero line.
-void plot_exponents(Plotter& plotter, const Table& t, const std::string& label) {
+// exponents.csv (sweep): parameter,lambda1..k,se1..k,... (nan: a failed point) -> exponents
+// against the swept parameter with standard-error bars and the zero line.
+void plot_exponents(FigureRenderer& renderer, const fs::path& dir) {
+  const ResultTable t = read_result_table(dir / "exponents.csv", [](const std::string& c) { return c != "parameter"; });
   std::vector<int> lambda, se;
   for (int i = 1;; ++i) {
     const int l = t.column("lambda" + std::to_string(i));
     if (l < 0) break;
     lambda.push_back(l);
-    se.push_back(t.column("se" + std::to_string(i)));
+    se.push_back(t.column("se" + std::to_string(i)));  // -1: no error bars
   }
-  if (lambda.empty() || t.column("parameter") != 0) throw BadInput("exponents.csv: expected columns parameter,lambda1,...");
+  t.require_header({"parameter", "lambda1"});
+  t.require_rows();
+  const std::string label = sweep_label(dir, t);
   std::ostringstream gp, plot;
   const char* colours[] = {"#000000", "#d62728", "#1f77b4", "#9467bd", "#8c564b", "#e377c2"};
   for (size_t i = 0; i < lambda.size(); ++i) {
     std::string rows;
-    for (const auto& row : t.rows)
-      if (!row.empty() && static_cast<int>(row.size()) > lambda[i])
-        rows += number(row[0]) + " " + number(row[lambda[i]]) + " " + number(se[i] >= 0 ? row[se[i]] : 0) + "\n";
+    for (const auto& row : t.rows)  // (every row has every column: read_result_table checks)
+      if (!row.empty())
+        rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[lambda[i]]) + " " +
+                gnuplot_number(se[i] >= 0 ? row[se[i]] : 0) + "\n";
     std::string name("l");  // (append: GCC 12 warns falsely on "l" + string)
     name.append(std::to_string(i + 1));
-    gp << datablock(name, rows);
+    gp << gnuplot_datablock(name, rows);
     plot << (i == 0 ? "plot " : ", \\\n     ") << "$" << name << " using 1:2:3 with yerrorlines pt 7 ps 0.5 lc rgb '"
          << colours[i % 6] << "' title '{/Symbol l}_" << i + 1 << "'";
   }
-  gp << "set title " << quoted("Lyapunov exponents per period against " + label + " (zero line green)") << "\n";
-  gp << "set xlabel " << quoted(label) << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
+  gp << "set title " << gnuplot_string("Lyapunov exponents per period against " + label + " (zero line green)") << "\n";
+  gp << "set xlabel " << gnuplot_string(label) << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
   gp << plot.str() << ", \\\n     0 with lines lc rgb '#2ca02c' lw 2 title 'zero'\n";
-  plotter.figure("exponents", gp.str());
+  renderer.figure("exponents", gp.str());
 }
 
 // section.csv (sweep): parameter,x -> bifurcation diagram.
-void plot_bifurcation(Plotter& plotter, const Table& t, const std::string& label) {
-  if (t.columns.size() < 2) throw BadInput("section.csv: expected columns parameter,x");
+void plot_bifurcation(FigureRenderer& renderer, const fs::path& dir) {
+  const ResultTable t = read_result_table(dir / "section.csv");
+  t.require_header({"parameter", "x"});
+  t.require_rows();
+  const std::string label = sweep_label(dir, t);
   std::string rows;
   for (const auto& row : t.rows)
-    if (row.size() >= 2) rows += number(row[0]) + " " + number(row[1]) + "\n";
+    if (!row.empty()) rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + "\n";
   std::ostringstream gp;
-  gp << datablock("section", rows);
-  gp << "set title " << quoted("Bifurcation diagram: x on the Poincare section against " + label) << "\n";
-  gp << "set xlabel " << quoted(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
+  gp << gnuplot_datablock("section", rows);
+  gp << "set title " << gnuplot_string("Bifurcation diagram: x on the Poincare section against " + label) << "\n";
+  gp << "set xlabel " << gnuplot_string(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
   gp << "plot $section using 1:2 with points pt 7 ps 0.3 lc rgb '#000000'\n";
-  plotter.figure("bifurcation", gp.str());
+  renderer.figure("bifurcation", gp.str());
 }
 
 // The impact boundary e of a simulate result: from DIR/simulate.json's metadata (run) or the
-// CSV's metadata lines, else the paper's 1.26.
-std::string impact_boundary(const fs::path& dir, const Table& t) {
-  if (fs::exists(dir / "simulate.json")) {
-    const Json j = read_json(dir / "simulate.json");
-    if (j.contains("metadata") && j["metadata"].contains("parameters") && j["metadata"]["parameters"].contains("e"))
-      return j["metadata"]["parameters"]["e"].get<std::string>();
+// CSV's metadata lines, else the paper's 1.26. Always parsed as a number (a hex float included).
+double impact_boundary(const fs::path& dir, const ResultTable& t) {
+  if (present(dir, "simulate.json")) {
+    const Json doc = read_json_file(dir / "simulate.json");
+    const JsonField j(doc, "simulate.json", "");
+    if (const auto metadata = j.find("metadata"))
+      if (const auto parameters = metadata->find("parameters"))
+        if (const auto e = parameters->find("e")) {
+          // The parameters are recorded as text; a JSON number is accepted too.
+          if (e->is_number()) return e->number();
+          const auto value = parse_number(e->text());
+          if (!value || !std::isfinite(*value)) e->fail("`" + e->text().substr(0, 60) + "`: not a finite number");
+          return *value;
+        }
   }
-  return parameter(t.metadata, "e", "1.26");
+  return t.metadata_number("e", 1.26);
 }
 
 // Rows of columns (a, b), at most max_rows of them (evenly thinned: a figure, not the data).
-std::string thinned(const Table& t, int a, int b, size_t max_rows, bool* was_thinned) {
-  size_t n = 0;
-  for (const auto& row : t.rows) n += !row.empty();
+std::string thinned(const ResultTable& t, int a, int b, size_t max_rows, bool* was_thinned) {
+  const size_t n = t.data_rows();
   const size_t stride = n > max_rows ? (n + max_rows - 1) / max_rows : 1;
   if (was_thinned) *was_thinned = stride > 1;
   std::string rows;
   size_t i = 0;
   for (const auto& row : t.rows) {
-    if (row.empty() || static_cast<int>(row.size()) <= std::max(a, b)) continue;
-    if (i++ % stride == 0) rows += number(row[a]) + " " + number(row[b]) + "\n";
+    if (row.empty()) continue;
+    if (i++ % stride == 0) rows += gnuplot_number(row[a]) + " " + gnuplot_number(row[b]) + "\n";
   }
   return rows;
 }
 
 // trajectory.csv + poincare.csv (simulate: t,x,v) -> phase portrait with the section points and
 // the impact boundary x = e.
-void plot_phase(Plotter& plotter, const fs::path& dir) {
-  const Table trajectory = read_table(dir / "trajectory.csv");
+void plot_phase(FigureRenderer& renderer, const fs::path& dir) {
+  const ResultTable trajectory = read_result_table(dir / "trajectory.csv");
   const int x = trajectory.column("x"), v = trajectory.column("v");
   if (x < 0 || v < 0) return;  // a scalar model: no phase plane
+  trajectory.require_rows();
   bool thin = false;
   std::ostringstream gp;
-  gp << datablock("trajectory", thinned(trajectory, x, v, 200000, &thin));
+  gp << gnuplot_datablock("trajectory", thinned(trajectory, x, v, 200000, &thin));
   std::string section_plot;
-  if (fs::exists(dir / "poincare.csv")) {
-    const Table poincare = read_table(dir / "poincare.csv");
-    gp << datablock("section", thinned(poincare, poincare.column("x"), poincare.column("v"), 200000, nullptr));
-    section_plot = ", \\\n     $section using 1:2 with points pt 7 ps 0.8 lc rgb '#000000' title 'Poincare points'";
+  if (present(dir, "poincare.csv")) {
+    const ResultTable poincare = read_result_table(dir / "poincare.csv");
+    const int px = poincare.require_column("x", "t,x,v"), pv = poincare.require_column("v", "t,x,v");
+    if (poincare.data_rows() > 0) {
+      gp << gnuplot_datablock("section", thinned(poincare, px, pv, 200000, nullptr));
+      section_plot = ", \\\n     $section using 1:2 with points pt 7 ps 0.8 lc rgb '#000000' title 'Poincare points'";
+    }
   }
-  const std::string e = impact_boundary(dir, trajectory);
-  gp << "set title " << quoted(std::string("Phase portrait") + (thin ? " (trajectory thinned for drawing)" : "")) << "\n";
+  const std::string e = gnuplot_number(impact_boundary(dir, trajectory));
+  gp << "set title " << gnuplot_string(std::string("Phase portrait") + (thin ? " (trajectory thinned for drawing)" : ""))
+     << "\n";
   gp << "set xlabel 'x'\nset ylabel 'v = dx/dt'\nset grid\nset key outside bottom center horizontal\n";
   gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#1f77b4' lw 2 front\n";
   gp << "plot $trajectory using 1:2 with lines lc rgb '#999999' title 'trajectory'" << section_plot
-     << ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title 'impact boundary x = e = " << e << "'\n";
-  plotter.figure("phase", gp.str());
+     << ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title " << gnuplot_string("impact boundary x = e = " + e) << "\n";
+  renderer.figure("phase", gp.str());
 }
 
 // impacts.csv (simulate: t,count) -> cumulative impacts against time (paper Fig. 6.3).
-void plot_impacts(Plotter& plotter, const fs::path& dir) {
-  const Table t = read_table(dir / "impacts.csv");
-  if (t.columns.size() < 2) throw BadInput("impacts.csv: expected columns t,count");
+void plot_impacts(FigureRenderer& renderer, const fs::path& dir) {
+  const ResultTable t = read_result_table(dir / "impacts.csv");
+  t.require_header({"t", "count"});
   std::ostringstream gp;
-  gp << datablock("impacts", thinned(t, 0, 1, 200000, nullptr));
+  // No impact at all is a result (a flat line at 0), not an error.
+  gp << gnuplot_datablock("impacts", t.data_rows() > 0 ? thinned(t, 0, 1, 200000, nullptr) : "0 0\n");
   gp << "set title 'Number of impacts against time'\nset xlabel 't'\nset ylabel 'impacts (cumulative)'\n"
         "set grid\nset key off\n";
   gp << "plot $impacts using 1:2 with steps lw 2 lc rgb '#d62728'\n";
-  plotter.figure("impacts", gp.str());
+  renderer.figure("impacts", gp.str());
 }
 
 }  // namespace
 
 int command_plot(Config& config, const Invocation& inv) {
-  PlotSettings settings;
-  settings.gnuplot = config.get_string("plot_gnuplot", settings.gnuplot);
+  GnuplotSettings settings;
+  settings.program_given = config.has("plot_gnuplot");
+  settings.program = config.get_string("plot_gnuplot", settings.program);
   settings.width = config.get_int("plot_width", settings.width);
   settings.height = config.get_int("plot_height", settings.height);
   if (settings.width < 100 || settings.width > 10000)
     throw BadInput("`plot_width = " + std::to_string(settings.width) + "`: must be between 100 and 10000");
   if (settings.height < 100 || settings.height > 10000)
     throw BadInput("`plot_height = " + std::to_string(settings.height) + "`: must be between 100 and 10000");
+  if (settings.program.empty()) throw BadInput("`plot_gnuplot = `: empty (the gnuplot program to run)");
   config.check_all_used();
   // The directory: `delayspec plot DIR` (the positional argument) or --out DIR.
   std::string dir_text = inv.scene.value_or(inv.out_dir.value_or(""));
   if (dir_text.empty()) throw BadInput("`delayspec plot` needs a results directory: delayspec plot DIR");
   const fs::path dir = dir_text;
-  if (!fs::is_directory(dir)) throw BadInput("`" + dir.string() + "`: not a directory (expected a results directory)");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw BadInput("`" + dir.string() + "`: not a directory (expected a results directory)");
 
-  Plotter plotter(dir, settings, inv);
-  std::vector<std::pair<std::string, Json>> speed_sources;
-  if (fs::exists(dir / "floquet.json")) plot_multipliers(plotter, read_json(dir / "floquet.json"));
-  if (fs::exists(dir / "chart.csv")) plot_chart(plotter, read_table(dir / "chart.csv"));
-  if (fs::exists(dir / "basin.csv")) plot_basin(plotter, read_table(dir / "basin.csv"));
-  if (fs::exists(dir / "exponents.csv")) plot_exponents(plotter, read_table(dir / "exponents.csv"), sweep_label(dir));
-  if (fs::exists(dir / "section.csv")) plot_bifurcation(plotter, read_table(dir / "section.csv"), sweep_label(dir));
-  if (fs::exists(dir / "trajectory.csv")) plot_phase(plotter, dir);
-  if (fs::exists(dir / "impacts.csv")) plot_impacts(plotter, dir);
-  if (fs::exists(dir / "converge.json")) {
-    Json j = read_json(dir / "converge.json");
-    plot_convergence(plotter, j);
+  FigureRenderer renderer(dir, settings, inv.json ? nullptr : &inv.out);
+  // The JSON documents live here; JsonFields and the speed sources point into them.
+  Json floquet, converge, bench;
+  std::vector<std::pair<std::string, JsonField>> speed_sources;
+  if (present(dir, "floquet.json")) {
+    floquet = read_json_file(dir / "floquet.json");
+    plot_multipliers(renderer, JsonField(floquet, "floquet.json", ""));
+  }
+  if (present(dir, "chart.csv")) plot_chart(renderer, dir / "chart.csv");
+  if (present(dir, "basin.csv")) plot_basin(renderer, dir / "basin.csv");
+  if (present(dir, "exponents.csv")) plot_exponents(renderer, dir);
+  if (present(dir, "section.csv")) plot_bifurcation(renderer, dir);
+  if (present(dir, "trajectory.csv")) plot_phase(renderer, dir);
+  if (present(dir, "impacts.csv")) plot_impacts(renderer, dir);
+  if (present(dir, "converge.json")) {
+    converge = read_json_file(dir / "converge.json");
+    const JsonField j(converge, "converge.json", "");
+    plot_convergence(renderer, j);
     speed_sources.emplace_back("converge", j);
   }
-  if (fs::exists(dir / "bench.json")) speed_sources.emplace_back("bench", read_json(dir / "bench.json"));
-  if (!speed_sources.empty()) plot_speed_error(plotter, speed_sources);
+  if (present(dir, "bench.json")) {
+    bench = read_json_file(dir / "bench.json");
+    speed_sources.emplace_back("bench", JsonField(bench, "bench.json", ""));
+  }
+  if (!speed_sources.empty()) plot_speed_error(renderer, speed_sources);
 
-  if (plotter.written().empty())
+  if (renderer.written().empty())
     throw BadInput("`" + dir.string() +
                    "`: nothing to plot (looked for floquet.json, chart.csv, basin.csv, converge.json, bench.json, "
                    "exponents.csv, section.csv, trajectory.csv, impacts.csv; see docs/formats.md)");
-  if (inv.json) inv.out << Json{{"directory", dir.string()}, {"files", plotter.written()}}.dump(2) << "\n";
+  if (inv.json) inv.out << Json{{"directory", dir.string()}, {"files", renderer.written()}}.dump(2) << "\n";
   return 0;
 }
 

@@ -9,6 +9,7 @@
 //                               settings_hash of its sweep (resume refuses a point of another sweep)
 //   DIR/exponents.csv           parameter,lambda1..k,se1..k,lambda1_per_time..,seconds
 //   DIR/section.csv             parameter,x (one row per Poincare point)
+// (both after the metadata comment lines, which name the swept key: `# sweep_key = K`)
 //   DIR/sweep.json              summary (the --json output)
 // The last three are written (atomically) only when every point is done.
 // Exponents are per stroboscopic period (the paper's unit); *_per_time divide by period_time.
@@ -285,8 +286,10 @@ int command_sweep(Config& config, const Invocation& inv) {
   summary["failed"] = failed;
   summary["seconds"] = seconds;
   if (dir) {
+    // The files carry the metadata header (it names the swept key: `plot` labels the x axis
+    // with it); the swept key's own value is per row, so it is not a metadata line.
     OutputMetadata metadata = make_metadata("sweep", inv.scene, config, summary, seconds);
-    metadata.parameters.erase(key);  // the swept key's value is per row (`sweep_key` names it)
+    metadata.parameters.erase(key);
     const std::string header = metadata_comment_lines(metadata);
     write_file_atomically(*dir / "exponents.csv", header + exponents_csv.str());
     write_file_atomically(*dir / "section.csv", header + section_csv.str());
