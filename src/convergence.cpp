@@ -554,19 +554,18 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
     if (worst <= o.target) {
       study.target_met = true;
       study.stopped_by = "target";
-      study.stop_note = "target " + format_number(o.target) + " met at N = " + std::to_string(o.Ns.back()) +
-                        ": largest relative error estimate " + format_number(worst);
+      study.stop_note = fmt("target %.3g met at N = %.0f: largest relative error estimate %.3g", o.target,
+                            o.Ns.back(), worst);
       return study;
     }
     study.target_met = false;
-    const std::string unmet = "largest relative error estimate " +
-                              (std::isfinite(worst) ? format_number(worst) : std::string("none (no estimate)")) +
-                              " > target " + format_number(o.target);
+    const std::string unmet = (std::isfinite(worst) ? fmt("largest relative error estimate %.3g", worst)
+                                                    : std::string("no error estimate")) +
+                              fmt(" > target %.3g", o.target);
     const int last = o.Ns.back();
     if (last > o.max_N / 2) {
       study.stopped_by = "converge_max_N";
-      study.stop_note = "converge_max_N = " + std::to_string(o.max_N) + " reached (next N would be " +
-                        std::to_string(2L * last) + "): " + unmet;
+      study.stop_note = fmt("converge_max_N = %.0f reached (the next N would be %.0f): ", o.max_N, 2.0 * last) + unmet;
       return study;
     }
     // The next level's cost: the last one's times the growth of the last doubling (at least 2).
@@ -576,9 +575,10 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
     const double predicted = t_last * growth, spent = total_seconds();
     if (spent + predicted > o.max_seconds) {
       study.stopped_by = "converge_max_seconds";
-      study.stop_note = "converge_max_seconds = " + format_number(o.max_seconds) + ": the next level (N = " +
-                        std::to_string(2 * last) + ") would take about " + fmt("%.3g", predicted) + " s after " +
-                        fmt("%.3g", spent) + " s spent: " + unmet;
+      study.stop_note = fmt("converge_max_seconds = %.3g: the next level (N = %.0f) would take about %.3g s after %.3g s "
+                            "spent: ",
+                            o.max_seconds, 2.0 * last, predicted, spent) +
+                        unmet;
       return study;
     }
     const int N = 2 * last;
