@@ -449,9 +449,12 @@ double multiplier_accuracy(std::complex<double> mu, double relative_residual, lo
                            double spectral_radius) {
   constexpr double eps = std::numeric_limits<double>::epsilon();
   const double modulus = std::abs(mu);
-  // |r| = |M v - mu v| / |v|; dense (no residual): the QR algorithm's backward error n eps |M|
-  const double residual = std::isfinite(relative_residual) ? relative_residual * modulus
-                                                           : static_cast<double>(n) * eps * spectral_radius;
+  // |r| = |M v - mu v| / |v|, not below the rounding of computing M v (eps |M|, |M| >= |mu_1|: a
+  // multiplier at round-off, even one reported as 0, is known to that much only); dense (no
+  // residual): the QR algorithm's backward error n eps |M|
+  const double residual = std::isfinite(relative_residual)
+                              ? std::max(relative_residual * modulus, eps * spectral_radius)
+                              : static_cast<double>(n) * eps * spectral_radius;
   const double kappa = 10 * std::sqrt(static_cast<double>(n));  // measured 0.4 .. 3.0 sqrt(n) (header)
   return kappa * residual + static_cast<double>(steps) * eps * modulus;
 }

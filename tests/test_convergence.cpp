@@ -202,13 +202,16 @@ TEST(Richardson, InputErrorsSetTheFloorOfTheEstimate) {
   EXPECT_THROW(richardson_extrapolate(h, v, {}, {1e-12, 1e-12, NAN, 1e-12, 1e-12}), BadInput);
 }
 
-// multiplier_accuracy is 10 sqrt(n) |r| + steps eps |mu| (convergence.hpp, with the measurements).
+// multiplier_accuracy is 10 sqrt(n) max(|r|, eps |mu_1|) + steps eps |mu| (convergence.hpp, with
+// the measurements).
 TEST(Richardson, MultiplierAccuracyFormula) {
   const double eps = std::numeric_limits<double>::epsilon();
   // |mu| = 0.5, relative residual 2e-15 -> |r| = 1e-15; n = 400 -> kappa 200; 1000 steps
   EXPECT_NEAR(multiplier_accuracy(cd(0.3, 0.4), 2e-15, 400, 1000, 0.9), 200 * 1e-15 + 1000 * eps * 0.5, 1e-28);
   // no residual (dense): |r| = n eps |mu_1|
   EXPECT_NEAR(multiplier_accuracy(0.5, NAN, 400, 1000, 0.9), 200 * 400 * eps * 0.9 + 1000 * eps * 0.5, 1e-26);
+  // a multiplier reported as 0 (at round-off) is still known only to the rounding of M v: not 0
+  EXPECT_NEAR(multiplier_accuracy(0.0, 0.0, 400, 1000, 0.9), 200 * eps * 0.9, 1e-30);
 }
 
 TEST(Richardson, BadInputNamesTheProblem) {

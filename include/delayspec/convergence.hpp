@@ -95,15 +95,17 @@ using RetryFunction = std::function<std::optional<LevelResult>(int N, int count,
 //     time; measured on the dense monodromies (linear a = -1 b = -2 and a = -1 b = 0.5, Mathieu
 //     delta = 1 and 3; N = 50, 200; eight leading multipliers): kappa = 0.4 .. 3.0 sqrt(n),
 //     growing like sqrt(n) (the history's Euclidean norm against a point evaluation). Taken as
-//     kappa <= 10 sqrt(n). Dense (no residual): |r| <= n eps |mu_1|, the backward error of the QR
-//     algorithm with the spectral radius for the norm.
+//     kappa <= 10 sqrt(n). |r| is taken no smaller than eps |mu_1| (spectral_radius), the rounding
+//     of computing M v itself (a multiplier at round-off, even one reported as 0, is known to that
+//     much only). Dense (no residual): |r| <= n eps |mu_1|, the backward error of the QR algorithm
+//     with the spectral radius for the norm.
 //   the operator's own rounding: M_float is a product of `steps` step maps whose coefficients each
 //     carry a relative rounding error; their product, and its eigenvalues, a relative
 //     error up to steps * eps. Measured against the exact eigenvalues of the discrete linear DDE
 //     (its characteristic polynomial in 50 digits, mpmath): 0.04 .. 0.19 steps * eps |mu|,
 //     growing linearly with steps; the residual does not see it (|r| stayed at 2e-15 while the
 //     error grew to 6e-14 at N = 800).
-// accuracy = 10 sqrt(n) |r| + steps eps |mu|.
+// accuracy = 10 sqrt(n) max(|r|, eps |mu_1|) + steps eps |mu|.
 double multiplier_accuracy(std::complex<double> mu, double relative_residual, long n, long steps,
                            double spectral_radius);
 
