@@ -1,7 +1,9 @@
 #include "delayspec/convergence.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -55,6 +57,28 @@ void validate(const ConvergenceOptions& o) {
                    std::to_string(o.Ns.size()));
   if (o.reference == ReferenceKind::automatic && o.exact.empty() && o.Ns.size() < 2)
     throw BadInput("convergence study: no exact multipliers and one N only: give at least two N");
+  if (!(o.target >= 0 && o.target < 1))
+    throw BadInput("`converge_target = " + format_number(o.target) +
+                   "`: must be a relative error in (0, 1) (0: no target)");
+  if (o.target > 0 && o.max_N < o.Ns.back())
+    throw BadInput("`converge_max_N = " + std::to_string(o.max_N) + "`: below the largest N of `Ns`, " +
+                   std::to_string(o.Ns.back()));
+  if (!(o.max_seconds > 0) || !std::isfinite(o.max_seconds))
+    throw BadInput("`converge_max_seconds = " + format_number(o.max_seconds) + "`: must be > 0 and finite");
+}
+
+// Why a study cannot go on: every level that failed, with its reason.
+std::string failures_text(const std::vector<int>& Ns, const std::vector<LevelResult>& levels) {
+  std::string text;
+  for (size_t i = 0; i < levels.size(); ++i)
+    if (!levels[i].failure.empty()) text += "\n  N = " + std::to_string(Ns[i]) + ": " + levels[i].failure;
+  return text;
+}
+
+std::string fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
+  char buf[240];
+  std::snprintf(buf, sizeof buf, format, a, b, c, d);
+  return buf;
 }
 
 // Settledness of a list of pair orders (design 1.5: pre-asymptotic behaviour must be said).
@@ -227,17 +251,24 @@ MatchedErrors errors_against(const Multipliers& values, const Multipliers& refer
   return out;
 }
 
-ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, const ConvergenceOptions& options) {
-  validate(options);
+namespace {
+
+// The analysis of successful levels (levels[i] at options.Ns[i], options validated).
+ConvergenceStudy analyse_levels(const std::vector<LevelResult>& levels, const ConvergenceOptions& options) {
   const size_t L = options.Ns.size();
   const int nev = options.nev;
   if (levels.size() != L)
     throw BadInput("analyse_convergence: " + std::to_string(levels.size()) + " levels for " + std::to_string(L) + " N");
-  for (size_t i = 0; i < L; ++i)
+  for (size_t i = 0; i < L; ++i) {
     if (static_cast<int>(levels[i].multipliers.size()) < nev)
       throw NumericalFailure("convergence study: N = " + std::to_string(options.Ns[i]) + " gave " +
                              std::to_string(levels[i].multipliers.size()) + " multipliers, " + std::to_string(nev) +
                              " are tracked (nev)");
+    if (!levels[i].accuracy.empty() && levels[i].accuracy.size() != levels[i].multipliers.size())
+      throw BadInput("convergence study: N = " + std::to_string(options.Ns[i]) + " gave " +
+                     std::to_string(levels[i].accuracy.size()) + " accuracies for " +
+                     std::to_string(levels[i].multipliers.size()) + " multipliers");
+  }
 
   ConvergenceStudy study;
   study.reference = options.reference;
@@ -256,12 +287,18 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
   }
   // Match from the finest level down: each level against the next finer one.
   std::vector<Multipliers> matched(L);
+  std::vector<std::vector<double>> accuracy(L);  // of the matched values
   Multipliers targets = anchors;
   for (size_t step = 0; step < L; ++step) {
     const size_t i = L - 1 - step;
     const std::vector<int> a = match_by_proximity(targets, levels[i].multipliers);
     matched[i].resize(nev);
-    for (int k = 0; k < nev; ++k) matched[i][k] = levels[i].multipliers[a[k]];
+    accuracy[i].resize(nev);
+    for (int k = 0; k < nev; ++k) {
+      matched[i][k] = levels[i].multipliers[a[k]];
+      accuracy[i][k] = levels[i].accuracy.empty() ? options.richardson.input_precision * std::abs(matched[i][k])
+                                                  : levels[i].accuracy[a[k]];
+    }
     targets = matched[i];
   }
   auto track = [&](int k) {
@@ -269,13 +306,18 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
     for (size_t i = 0; i < L; ++i) x[i] = matched[i][k];
     return x;
   };
+  auto track_accuracy = [&](int k) {
+    std::vector<double> a(L);
+    for (size_t i = 0; i < L; ++i) a[i] = accuracy[i][k];
+    return a;
+  };
   std::vector<double> h(L);
   for (size_t i = 0; i < L; ++i) h[i] = 1.0 / options.Ns[i];  // relative step: h = tau / N
 
   // Extrapolated multipliers (every study with >= 2 levels reports them).
   if (L >= 2)
     for (int k = 0; k < nev; ++k) {
-      const Extrapolation e = richardson_extrapolate(h, track(k), options.richardson);
+      const Extrapolation e = richardson_extrapolate(h, track(k), options.richardson, track_accuracy(k));
       study.extrapolated.push_back({e.value, e.error_estimate, e.levels, e.note});
     }
 
@@ -305,6 +347,7 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
   for (size_t i = 0; i < L; ++i) {
     ConvergenceRow row;
     row.N = options.Ns[i];
+    row.note = levels[i].note;
     row.multipliers = matched[i];
     row.seconds = levels[i].seconds;
     row.operator_applications = levels[i].operator_applications;
@@ -351,7 +394,7 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
     rr.column_orders.push_back(std::isfinite(s) ? std::optional<double>(-s) : std::nullopt);
   }
   if (L >= 2) {
-    const Extrapolation e = richardson_extrapolate(h, track(0), options.richardson);
+    const Extrapolation e = richardson_extrapolate(h, track(0), options.richardson, track_accuracy(0));
     rr.difference_orders.assign(e.column_orders.begin(), e.column_orders.begin() + columns);
     rr.consistent.assign(e.column_consistent.begin(), e.column_consistent.begin() + columns);
     rr.levels_used = e.levels;
@@ -359,11 +402,204 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
   return study;
 }
 
-ConvergenceStudy run_convergence_study(const LevelFunction& level, const ConvergenceOptions& options) {
+}  // namespace
+
+ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, const ConvergenceOptions& options) {
   validate(options);
+  if (levels.size() != options.Ns.size())
+    throw BadInput("analyse_convergence: " + std::to_string(levels.size()) + " levels for " +
+                   std::to_string(options.Ns.size()) + " N");
+  // The successful levels are analysed; the failed ones are reported in the rows.
+  std::vector<LevelResult> ok;
+  ConvergenceOptions sub = options;
+  sub.Ns.clear();
+  for (size_t i = 0; i < levels.size(); ++i)
+    if (levels[i].failure.empty()) ok.push_back(levels[i]), sub.Ns.push_back(options.Ns[i]);
+  const bool exact = options.reference == ReferenceKind::exact ||
+                     (options.reference == ReferenceKind::automatic && static_cast<int>(options.exact.size()) >= options.nev);
+  const size_t needed = exact ? 1 : 2;
+  if (ok.size() < needed)
+    throw NumericalFailure("convergence study: " + std::to_string(ok.size()) + " of " + std::to_string(levels.size()) +
+                           " levels succeeded, " + std::to_string(needed) + " needed" +
+                           (exact ? "" : " without an exact reference") + "; the failures:" +
+                           failures_text(options.Ns, levels));
+  ConvergenceStudy study = analyse_levels(ok, sub);
+  std::vector<ConvergenceRow> rows;
+  size_t next = 0;
+  for (size_t i = 0; i < levels.size(); ++i) {
+    if (levels[i].failure.empty()) {
+      rows.push_back(std::move(study.rows[next++]));
+      continue;
+    }
+    ConvergenceRow row;
+    row.N = options.Ns[i];
+    row.failure = levels[i].failure;
+    row.note = levels[i].note;
+    row.error = kNaN;
+    row.seconds = levels[i].seconds;
+    row.operator_applications = levels[i].operator_applications;
+    study.seconds += row.seconds;
+    rows.push_back(std::move(row));
+  }
+  study.rows = std::move(rows);
+  return study;
+}
+
+double multiplier_accuracy(std::complex<double> mu, double relative_residual, long n, long steps,
+                           double spectral_radius) {
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double modulus = std::abs(mu);
+  // |r| = |M v - mu v| / |v|, not below the rounding of computing M v (eps |M|, |M| >= |mu_1|: a
+  // multiplier at round-off, even one reported as 0, is known to that much only); dense (no
+  // residual): the QR algorithm's backward error n eps |M|
+  const double residual = std::isfinite(relative_residual)
+                              ? std::max(relative_residual * modulus, eps * spectral_radius)
+                              : static_cast<double>(n) * eps * spectral_radius;
+  const double kappa = 10 * std::sqrt(static_cast<double>(n));  // measured 0.4 .. 3.0 sqrt(n) (header)
+  return kappa * residual + static_cast<double>(steps) * eps * modulus;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// One call of a level (or retry) function; a NumericalFailure becomes a failed level.
+template <class Call>
+auto call_level(const Call& call) -> decltype(call()) {
+  const auto start = Clock::now();
+  try {
+    return call();
+  } catch (const NumericalFailure& e) {
+    LevelResult r;
+    r.failure = e.what();
+    r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return r;
+  }
+}
+
+// Index of the successful level nearest in log N to level i (-1: none).
+int nearest_success(const std::vector<int>& Ns, const std::vector<LevelResult>& levels, size_t i) {
+  int best = -1;
+  double distance = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j < levels.size(); ++j) {
+    const double d = std::abs(std::log(double(Ns[j]) / Ns[i]));
+    if (levels[j].failure.empty() && d < distance) best = static_cast<int>(j), distance = d;
+  }
+  return best;
+}
+
+// Retries failed level i from the successful level `from`; keeps the first failure in the reason.
+void retry_level(const RetryFunction& retry, const std::vector<int>& Ns, std::vector<LevelResult>& levels, size_t i,
+                 int from, int count) {
+  std::optional<LevelResult> again = call_level([&] { return retry(Ns[i], count, Ns[from]); });
+  if (!again) return;  // no other way: the first failure stands
+  LevelResult r = std::move(*again);
+  r.seconds += levels[i].seconds;  // the failed attempt cost time too
+  if (r.failure.empty()) {
+    if (r.note.empty()) r.note = "retried from N = " + std::to_string(Ns[from]) + " after: " + levels[i].failure;
+  } else {
+    r.failure = levels[i].failure + "; retried from N = " + std::to_string(Ns[from]) + ": " + r.failure;
+  }
+  levels[i] = std::move(r);
+}
+
+// The largest relative error estimate of the tracked extrapolated multipliers (infinity: none).
+double worst_relative_estimate(const ConvergenceStudy& s) {
+  if (s.extrapolated.empty()) return std::numeric_limits<double>::infinity();
+  double worst = 0;
+  for (const auto& e : s.extrapolated) {
+    const double scale = std::abs(e.value);
+    const double rel = scale > 0 ? e.error_estimate / scale : std::numeric_limits<double>::infinity();
+    worst = std::max(worst, std::isnan(rel) ? std::numeric_limits<double>::infinity() : rel);
+  }
+  return worst;
+}
+
+}  // namespace
+
+ConvergenceStudy run_convergence_study(const LevelFunction& level, const ConvergenceOptions& options,
+                                       const RetryFunction& retry) {
+  validate(options);
+  const int count = options.nev + options.extra;
+  ConvergenceOptions o = options;  // o.Ns grows towards the target
   std::vector<LevelResult> levels;
-  for (int N : options.Ns) levels.push_back(level(N, options.nev + options.extra));
-  return analyse_convergence(levels, options);
+  for (int N : o.Ns) levels.push_back(call_level([&] { return level(N, count); }));
+
+  // Retries: nearest to a success first, each failed level once.
+  if (retry) {
+    std::vector<bool> retried(levels.size(), false);
+    for (;;) {
+      int best = -1, from = -1;
+      double distance = std::numeric_limits<double>::infinity();
+      for (size_t i = 0; i < levels.size(); ++i) {
+        if (levels[i].failure.empty() || retried[i]) continue;
+        const int j = nearest_success(o.Ns, levels, i);
+        if (j < 0) continue;
+        const double d = std::abs(std::log(double(o.Ns[j]) / o.Ns[i]));
+        if (d < distance) best = static_cast<int>(i), from = j, distance = d;
+      }
+      if (best < 0) break;
+      retried[best] = true;
+      retry_level(retry, o.Ns, levels, best, from, count);
+    }
+  }
+  ConvergenceStudy study = analyse_convergence(levels, o);
+  if (!(o.target > 0)) return study;
+
+  // Towards the target: double N while the estimate is above it and the limits allow.
+  auto total_seconds = [&] {
+    double t = 0;
+    for (const auto& l : levels) t += l.seconds;
+    return t;
+  };
+  for (;;) {
+    const double worst = worst_relative_estimate(study);
+    if (worst <= o.target) {
+      study.target_met = true;
+      study.stopped_by = "target";
+      study.stop_note = fmt("target %.3g met at N = %.0f: largest relative error estimate %.3g", o.target,
+                            o.Ns.back(), worst);
+      return study;
+    }
+    study.target_met = false;
+    const std::string unmet = (std::isfinite(worst) ? fmt("largest relative error estimate %.3g", worst)
+                                                    : std::string("no error estimate")) +
+                              fmt(" > target %.3g", o.target);
+    const int last = o.Ns.back();
+    if (last > o.max_N / 2) {
+      study.stopped_by = "converge_max_N";
+      study.stop_note = fmt("converge_max_N = %.0f reached (the next N would be %.0f): ", o.max_N, 2.0 * last) + unmet;
+      return study;
+    }
+    // The next level's cost: the last one's times the growth of the last doubling (at least 2).
+    const double t_last = levels.back().seconds;
+    const double t_prev = levels.size() >= 2 ? levels[levels.size() - 2].seconds : 0;
+    const double growth = t_prev > 0 ? std::max(2.0, t_last / t_prev) : 2.0;
+    const double predicted = t_last * growth, spent = total_seconds();
+    if (spent + predicted > o.max_seconds) {
+      study.stopped_by = "converge_max_seconds";
+      study.stop_note = fmt("converge_max_seconds = %.3g: the next level (N = %.0f) would take about %.3g s after %.3g s "
+                            "spent: ",
+                            o.max_seconds, 2.0 * last, predicted, spent) +
+                        unmet;
+      return study;
+    }
+    const int N = 2 * last;
+    o.Ns.push_back(N);
+    levels.push_back(call_level([&] { return level(N, count); }));
+    if (!levels.back().failure.empty() && retry) {
+      const int from = nearest_success(o.Ns, levels, levels.size() - 1);
+      if (from >= 0) retry_level(retry, o.Ns, levels, levels.size() - 1, from, count);
+    }
+    study = analyse_convergence(levels, o);
+    if (!levels.back().failure.empty()) {
+      const double now = worst_relative_estimate(study);
+      study.target_met = now <= o.target;
+      study.stopped_by = "failure";
+      study.stop_note = "level N = " + std::to_string(N) + " failed (" + levels.back().failure + ")";
+      return study;
+    }
+  }
 }
 
 }  // namespace delayspec

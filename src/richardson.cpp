@@ -90,21 +90,31 @@ std::string fmt(const char* format, double a, double b = 0, double c = 0, double
 }  // namespace
 
 Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::vector<std::complex<double>>& x,
-                                     const RichardsonOptions& options) {
+                                     const RichardsonOptions& options, const std::vector<double>& input_errors) {
   if (!(options.order_tolerance > 0) || !std::isfinite(options.order_tolerance))
     throw BadInput("richardson: `order_tolerance = " + format_number(options.order_tolerance) + "`: must be > 0");
   const RichardsonTableau tab = richardson_tableau(h, x, options);
   const int L = static_cast<int>(h.size());
+  if (!input_errors.empty() && input_errors.size() != h.size())
+    throw BadInput("richardson: " + std::to_string(input_errors.size()) + " input errors for " + std::to_string(L) +
+                   " levels");
+  std::vector<double> accuracy(L);  // a_i: absolute accuracy of x_i
+  for (int i = 0; i < L; ++i) {
+    accuracy[i] = input_errors.empty() ? options.input_precision * std::abs(x[i]) : input_errors[i];
+    if (!(accuracy[i] >= 0))
+      throw BadInput("richardson: input error " + std::to_string(i) + " = " + format_number(accuracy[i]) +
+                     ": must be >= 0");
+  }
   const int top = static_cast<int>(tab.T.back().size()) - 1;  // highest column available
   auto entry = [&](int i, int j) { return tab.T[i][j]; };
-  // Round-off of column j's entries: |sum w_i dx_i| <= eps max|x| sum|w_i|.
+  // Round-off of column j's finest entry: |sum_r w_r dx_r| <= sum_r |w_r| a_r (the coarser entries
+  // of the column, made of coarser levels, carry no more).
   std::vector<double> noise(top + 1), amplification(top + 1);
   for (int j = 0; j <= top; ++j) {
     const Eigen::VectorXd w = column_weights(h, L - 1, j, options);
-    double scale = 0;
-    for (int r = 0; r <= j; ++r) scale = std::max(scale, std::abs(x[L - 1 - j + r]));
     amplification[j] = w.cwiseAbs().sum();
-    noise[j] = options.input_precision * scale * amplification[j];
+    noise[j] = 0;
+    for (int r = 0; r <= j; ++r) noise[j] += std::abs(w(r)) * accuracy[L - 1 - j + r];
   }
 
   // Column checks (header comment): the last two triples of each column (or its only one).
@@ -131,10 +141,11 @@ Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::ve
     e.column_consistent.push_back(consistent ? 1 : 0);
   }
 
+  // J: the first column not shown consistent (inconsistent or unchecked), else the highest.
   int J = top;
   if (options.check_orders)
     for (int j = 0; j < top; ++j)
-      if (e.column_consistent[j] == 0) {
+      if (e.column_consistent[j] != 1) {
         J = j;
         break;
       }
@@ -143,7 +154,8 @@ Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::ve
   e.levels = J + 1;
   e.remaining_order = tab.remaining_order(J);
   e.amplification = amplification[J];
-  const double roundoff = noise[J];
+  e.roundoff = noise[J];
+  const double roundoff = e.roundoff;
   if (failed) {
     // Tail of an inconsistent column: max(d_last, d_prev r^{-q}), q = the order eliminated last.
     const double d_last = std::abs(entry(L - 1, J) - entry(L - 2, J));
@@ -163,15 +175,19 @@ Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::ve
                                               : "its differences grow: no error estimate");
     return e;
   }
-  if (J == 0) {
+  if (J == 0) {  // column 0 unchecked (fewer than three levels) or the only one
     e.error_estimate = std::numeric_limits<double>::infinity();
-    e.note = "one column only: no extrapolation, no error estimate";
+    e.note = L < 3 ? fmt("%.0f level(s): the order cannot be checked (three levels needed): no extrapolation, no error "
+                         "estimate", L)
+                   : "one column only: no extrapolation, no error estimate";
     return e;
   }
   e.error_estimate = std::max(std::abs(entry(L - 1, J) - entry(L - 1, J - 1)), roundoff);
-  e.note = options.check_orders ? fmt("%.0f levels: every column below shows its expected order (or has too few "
-                                      "entries to check)", J + 1.0)
-                                : fmt("%.0f levels (orders not checked)", J + 1.0);
+  e.note = !options.check_orders ? fmt("%.0f levels (orders not checked)", J + 1.0)
+           : J < top              ? fmt("%.0f levels: every column below shows its expected order; column %.0f has too "
+                                        "few entries to check, so it is not built upon (more N would allow more levels)",
+                                        J + 1.0, J + 1.0)
+                                  : fmt("%.0f levels: every column below shows its expected order", J + 1.0);
   return e;
 }
 

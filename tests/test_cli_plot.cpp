@@ -272,7 +272,7 @@ INSTANTIATE_TEST_SUITE_P(Csv, PlotBadFile, ::testing::Values(
     BadFile{"exponents.csv", "parameter,lambda1,se1\nnan,0.1,0.01\n", "column `parameter`: `nan`"},
     BadFile{"trajectory.csv", "t,x,v\n0,nan,1\n", "column `x`: `nan`"},
     BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,2.5,0.5\n", "line 2: period `2.5`: expected a whole number"},
-    BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,1e300,0.5\n", "period `1.0000000000000001e+300`"},
+    BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,1e300,0.5\n", "period `1e+300`"},
     BadFile{"basin.csv", "x0,v0,period,max_section_x\n0,0,-1,0.5\n", "period `-1`"},
     // grids (chart, basin): blocks of one length; on main gnuplot's "Unexpected line of data in matrix"
     BadFile{"chart.csv", "x,y,spectral_radius\n0,0,0.5\n1,0,1.2\n\n0,1,0.7\n", "line 5: the block of rows starting here has 1 rows, the first has 2"},

@@ -10,6 +10,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <map>
+#include <optional>
 
 #include "delayspec/convergence.hpp"
 #include "delayspec/dense_spectrum.hpp"
@@ -85,9 +88,16 @@ TEST(Richardson, TwoLevelsOnGeometricStepsIsTheTextbookFormula) {
   // (4 x(h/2) - x(h)) / 3 for order 2 and ratio 2, to rounding (1e-15 relative).
   const std::vector<double> h{0.1, 0.05};
   const std::vector<cd> v{cd(1.3, 0.2), cd(1.27, 0.21)};
-  const Extrapolation e = richardson_extrapolate(h, v);
+  const Extrapolation e = richardson_extrapolate(h, v, {.check_orders = false});
   EXPECT_LT(std::abs(e.value - (4.0 * v[1] - v[0]) / 3.0), 4e-16);
   EXPECT_NEAR(e.error_estimate, std::abs(v[1] - v[0]) / 3, 1e-15);
+  // Checked (the default): two levels cannot show the order (three are needed), so nothing is
+  // built on it: the finest value, no error estimate, and the note says why.
+  const Extrapolation checked = richardson_extrapolate(h, v);
+  EXPECT_EQ(checked.levels, 1);
+  EXPECT_EQ(checked.value, v[1]);
+  EXPECT_EQ(checked.error_estimate, INFINITY);
+  EXPECT_NE(checked.note.find("cannot be checked"), std::string::npos) << checked.note;
 }
 
 TEST(Richardson, FirstOrderExpansion) {
@@ -147,6 +157,61 @@ TEST(Richardson, ColumnsAtRoundOffAreNotHeldAgainst) {
   EXPECT_EQ(e.levels, 4) << e.note;
   EXPECT_LE(std::abs(e.value - x0), e.error_estimate);
   EXPECT_LT(std::abs(e.value - x0), 1e-13);  // the extrapolation reaches round-off
+}
+
+// Three levels of the PWSDDE period-2 orbit (data/scenes/pwsdde-period2.toml, nev = 2, mu_1 at
+// N = 100, 200, 400; `delayspec converge data/scenes/pwsdde-period2.toml --set Ns=100,200,400`).
+// Reference: the same command with Ns = 100 .. 6400 (7 levels): 0.327612853329794, its error
+// estimate 7.4e-8. Column 0 shows order 1.85 on its one triple (consistent within 0.3), but
+// column 1 (two entries) cannot be checked, and it really converges at order 2.2, not 4 (the
+// 7-level table): eliminating h^4 from it claimed 1.7e-6 for an error of 6.1e-6. The checked
+// scheme stops at column 1 and its claim bounds the error.
+TEST(Richardson, UncheckedColumnIsNotBuiltUpon) {
+  const std::vector<double> h{1.0 / 100, 1.0 / 200, 1.0 / 400};
+  const std::vector<cd> v{0.32670876588626596, 0.32737148756643847, 0.3275558332693079};
+  const double reference = 0.327612853329794, reference_error = 7.4e-8;
+  const Extrapolation e = richardson_extrapolate(h, v);
+  EXPECT_EQ(e.column_consistent[0], 1);
+  EXPECT_EQ(e.column_consistent[1], -1);
+  EXPECT_EQ(e.levels, 2) << e.note;
+  EXPECT_LE(std::abs(e.value - reference) + reference_error, e.error_estimate) << e.note;
+  // What this guards against: the textbook scheme builds on column 1 and claims less than its error.
+  const Extrapolation textbook = richardson_extrapolate(h, v, {.check_orders = false});
+  EXPECT_EQ(textbook.levels, 3);
+  EXPECT_GT(std::abs(textbook.value - reference) - reference_error, textbook.error_estimate);
+}
+
+// The accuracy of the inputs is the floor of the estimate: sum_i |w_i| a_i. A sequence exact to
+// the last bit in h^2, h^4 (every column consistent; the top correction is at rounding level)
+// claims at least the amplified accuracy given, and a wrong-sized or negative list is bad input.
+TEST(Richardson, InputErrorsSetTheFloorOfTheEstimate) {
+  std::vector<double> h;
+  std::vector<cd> v;
+  for (int N : {50, 100, 200, 400, 800}) {
+    h.push_back(1.0 / N);
+    v.push_back(1.0 + 0.5 / (double(N) * N));
+  }
+  const std::vector<double> a(5, 1e-12);  // as if each value were known to 1e-12 only
+  const Extrapolation e = richardson_extrapolate(h, v, {}, a);
+  EXPECT_GE(e.error_estimate, 1e-12 * e.amplification * (1 - 1e-12)) << e.note;  // sum |w_i| a_i, a_i equal
+  EXPECT_DOUBLE_EQ(e.roundoff, 1e-12 * e.amplification);
+  const Extrapolation plain = richardson_extrapolate(h, v);  // default: 1e-14 |x_i|
+  EXPECT_LT(plain.error_estimate, e.error_estimate);
+  EXPECT_THROW(richardson_extrapolate(h, v, {}, {1e-12, 1e-12}), BadInput);
+  EXPECT_THROW(richardson_extrapolate(h, v, {}, {1e-12, 1e-12, -1, 1e-12, 1e-12}), BadInput);
+  EXPECT_THROW(richardson_extrapolate(h, v, {}, {1e-12, 1e-12, NAN, 1e-12, 1e-12}), BadInput);
+}
+
+// multiplier_accuracy is 10 sqrt(n) max(|r|, eps |mu_1|) + steps eps |mu| (convergence.hpp, with
+// the measurements).
+TEST(Richardson, MultiplierAccuracyFormula) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  // |mu| = 0.5, relative residual 2e-15 -> |r| = 1e-15; n = 400 -> kappa 200; 1000 steps
+  EXPECT_NEAR(multiplier_accuracy(cd(0.3, 0.4), 2e-15, 400, 1000, 0.9), 200 * 1e-15 + 1000 * eps * 0.5, 1e-28);
+  // no residual (dense): |r| = n eps |mu_1|
+  EXPECT_NEAR(multiplier_accuracy(0.5, NAN, 400, 1000, 0.9), 200 * 400 * eps * 0.9 + 1000 * eps * 0.5, 1e-26);
+  // a multiplier reported as 0 (at round-off) is still known only to the rounding of M v: not 0
+  EXPECT_NEAR(multiplier_accuracy(0.0, 0.0, 400, 1000, 0.9), 200 * eps * 0.9, 1e-30);
 }
 
 TEST(Richardson, BadInputNamesTheProblem) {
@@ -304,6 +369,187 @@ TEST(ConvergenceStudyInput, BadOptionsNameTheKey) {
   o.nev = 2;  // the level gives one value only
   EXPECT_THROW(run_convergence_study(level, o), NumericalFailure);
   EXPECT_THROW(parse_reference_kind("best"), BadInput);
+}
+
+// ---------------- Failed levels ----------------
+
+namespace {
+
+// x(N) = 0.8 + 3 h^2 - 20 h^4 (h = 1/N) and a second track 0.3 - h^2; the level at each N of
+// `failing` throws NumericalFailure; seconds = N / 1000 (a level that cost time).
+LevelFunction failing_levels(std::vector<int> failing) {
+  return [failing](int N, int count) {
+    for (int f : failing)
+      if (f == N) throw NumericalFailure("orbit by simulation: not settled at N = " + std::to_string(N));
+    const double h = 1.0 / N;
+    LevelResult r;
+    r.multipliers = {0.8 + 3 * h * h - 20 * h * h * h * h, 0.3 - h * h};
+    if (static_cast<int>(r.multipliers.size()) > count) r.multipliers.resize(count);
+    r.seconds = N / 1000.0;
+    return r;
+  };
+}
+
+}  // namespace
+
+// The first level fails; its retry is called once, with the nearest level that succeeded, and
+// its result (here: the values, with a note) takes the place of the failure.
+TEST(FailedLevels, RetriedFromTheNearestSuccess) {
+  ConvergenceOptions o;
+  o.Ns = {25, 50, 100, 200, 400};
+  o.nev = 2;
+  o.extra = 0;
+  std::vector<std::pair<int, int>> calls;
+  const LevelFunction good = failing_levels({});
+  const RetryFunction retry = [&](int N, int count, int from_N) -> std::optional<LevelResult> {
+    calls.emplace_back(N, from_N);
+    LevelResult r = good(N, count);
+    r.note = "from " + std::to_string(from_N);
+    return r;
+  };
+  const ConvergenceStudy s = run_convergence_study(failing_levels({25}), o, retry);
+  ASSERT_EQ(calls.size(), 1u);
+  EXPECT_EQ(calls[0], std::make_pair(25, 50));
+  ASSERT_EQ(s.rows.size(), 5u);
+  EXPECT_TRUE(s.rows[0].failure.empty()) << s.rows[0].failure;
+  EXPECT_EQ(s.rows[0].note, "from 50");
+  EXPECT_EQ(s.rows[0].multipliers.size(), 2u);
+  EXPECT_NEAR(s.rows[0].multipliers[0].real(), 0.8 + 3.0 / 625 - 20.0 / 390625, 1e-15);
+}
+
+// Retries go nearest-first, so failing neighbours are recovered one from the other: 25, 50 and
+// 100 fail, 200 and 400 succeed: 100 from 200, then 50 from 100, then 25 from 50, each once.
+TEST(FailedLevels, RetriesChainFromTheNearestSuccessOutwards) {
+  ConvergenceOptions o;
+  o.Ns = {25, 50, 100, 200, 400};
+  o.nev = 2;
+  o.extra = 0;
+  std::vector<std::pair<int, int>> calls;
+  const RetryFunction retry = [&](int N, int count, int from_N) -> std::optional<LevelResult> {
+    calls.emplace_back(N, from_N);
+    return failing_levels({})(N, count);
+  };
+  const ConvergenceStudy s = run_convergence_study(failing_levels({25, 50, 100}), o, retry);
+  const std::vector<std::pair<int, int>> expected{{100, 200}, {50, 100}, {25, 50}};
+  EXPECT_EQ(calls, expected);
+  for (const auto& row : s.rows) EXPECT_TRUE(row.failure.empty()) << row.N;
+}
+
+// A level that fails everywhere is a row with its reason (the first failure and the retry's),
+// no multipliers and a NaN error, and the rest of the study is analysed without it; a retry that
+// declines (nullopt) leaves the first failure as it was.
+TEST(FailedLevels, ALevelThatFailsEverywhereIsReportedNotFatal) {
+  ConvergenceOptions o;
+  o.Ns = {25, 50, 100, 200, 400};
+  o.nev = 2;
+  o.extra = 0;
+  const RetryFunction fails_again = [](int N, int, int) -> std::optional<LevelResult> {
+    throw NumericalFailure("orbit by Newton: not converged at N = " + std::to_string(N));
+  };
+  const ConvergenceStudy s = run_convergence_study(failing_levels({50}), o, fails_again);
+  ASSERT_EQ(s.rows.size(), 5u);
+  const ConvergenceRow& bad = s.rows[1];
+  EXPECT_EQ(bad.N, 50);
+  EXPECT_NE(bad.failure.find("not settled at N = 50"), std::string::npos) << bad.failure;
+  EXPECT_NE(bad.failure.find("retried from N = "), std::string::npos) << bad.failure;  // 25 or 100: equally near
+  EXPECT_NE(bad.failure.find("Newton: not converged"), std::string::npos) << bad.failure;
+  EXPECT_TRUE(bad.multipliers.empty());
+  EXPECT_TRUE(std::isnan(bad.error));
+  // the analysis uses the four others: Richardson over N = 25, 100, 200, 400
+  EXPECT_EQ(s.richardson.Ns, (std::vector<int>{25, 100, 200, 400}));
+  ASSERT_EQ(s.extrapolated.size(), 2u);
+  EXPECT_LE(std::abs(s.extrapolated[0].value - 0.8), s.extrapolated[0].error_estimate);
+  EXPECT_TRUE(s.rows[0].failure.empty() && s.rows[2].failure.empty());
+
+  const RetryFunction declines = [](int, int, int) -> std::optional<LevelResult> { return std::nullopt; };
+  const ConvergenceStudy d = run_convergence_study(failing_levels({50}), o, declines);
+  EXPECT_EQ(d.rows[1].failure, "orbit by simulation: not settled at N = 50");
+}
+
+// Too few levels left: NumericalFailure naming every failure (two are needed without an exact
+// reference, one with it).
+TEST(FailedLevels, TooFewLevelsLeftIsANumericalFailureNamingThem) {
+  ConvergenceOptions o;
+  o.Ns = {25, 50};
+  o.nev = 2;
+  o.extra = 0;
+  try {
+    run_convergence_study(failing_levels({25}), o);
+    FAIL() << "one level left without an exact reference";
+  } catch (const NumericalFailure& e) {
+    EXPECT_NE(std::string(e.what()).find("N = 25: orbit by simulation: not settled"), std::string::npos) << e.what();
+  }
+  o.reference = ReferenceKind::exact;
+  o.exact = {0.8, 0.3};
+  const ConvergenceStudy s = run_convergence_study(failing_levels({25}), o);  // one is enough against exact values
+  EXPECT_EQ(s.rows.size(), 2u);
+  EXPECT_THROW(run_convergence_study(failing_levels({25, 50}), o), NumericalFailure);
+}
+
+// ---------------- Target ----------------
+
+// x(N) above: the estimate falls with N; from Ns = 10, 20, 40 the study doubles N until every
+// tracked multiplier's relative estimate is <= 1e-10, and the claim still bounds the truth.
+TEST(Target, KeepsDoublingUntilTheEstimateMeetsIt) {
+  ConvergenceOptions o;
+  o.Ns = {10, 20, 40};
+  o.nev = 2;
+  o.extra = 0;
+  o.target = 1e-10;
+  const ConvergenceStudy s = run_convergence_study(failing_levels({}), o);
+  ASSERT_TRUE(s.target_met.has_value());
+  EXPECT_TRUE(*s.target_met) << s.stop_note;
+  EXPECT_EQ(s.stopped_by, "target");
+  EXPECT_GT(s.rows.size(), 3u);
+  EXPECT_EQ(s.rows.back().N, 10 << (s.rows.size() - 1));  // doubling
+  const Multipliers truth{0.8, 0.3};
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_LE(s.extrapolated[k].error_estimate, 1e-10 * std::abs(s.extrapolated[k].value)) << k;
+    EXPECT_LE(std::abs(s.extrapolated[k].value - truth[k]), s.extrapolated[k].error_estimate) << k;
+  }
+  // Without a target the study is Ns and says so.
+  o.target = 0;
+  const ConvergenceStudy plain = run_convergence_study(failing_levels({}), o);
+  EXPECT_EQ(plain.rows.size(), 3u);
+  EXPECT_FALSE(plain.target_met.has_value());
+  EXPECT_EQ(plain.stopped_by, "Ns");
+}
+
+TEST(Target, StopsAtTheLimitsAndSaysWhich) {
+  ConvergenceOptions o;
+  o.Ns = {10, 20, 40};
+  o.nev = 2;
+  o.extra = 0;
+  o.target = 1e-14;  // below what these levels can claim (their own round-off floor)
+  o.max_N = 160;
+  const ConvergenceStudy n = run_convergence_study(failing_levels({}), o);
+  EXPECT_EQ(n.stopped_by, "converge_max_N");
+  EXPECT_FALSE(*n.target_met);
+  EXPECT_EQ(n.rows.back().N, 160);
+  EXPECT_NE(n.stop_note.find("converge_max_N = 160"), std::string::npos) << n.stop_note;
+  // seconds = N / 1000: 0.07 s spent, the next level (N = 80) predicted 0.04 * max(2, 0.04 / 0.02) = 0.08 s
+  o.max_N = 51200;
+  o.max_seconds = 0.1;
+  const ConvergenceStudy t = run_convergence_study(failing_levels({}), o);
+  EXPECT_EQ(t.stopped_by, "converge_max_seconds");
+  EXPECT_FALSE(*t.target_met);
+  EXPECT_EQ(t.rows.back().N, 40);
+  EXPECT_NE(t.stop_note.find("N = 80"), std::string::npos) << t.stop_note;
+  // a new level that fails (and cannot be retried) ends the study
+  o.max_seconds = 600;
+  const ConvergenceStudy f = run_convergence_study(failing_levels({80}), o);
+  EXPECT_EQ(f.stopped_by, "failure");
+  EXPECT_EQ(f.rows.back().N, 80);
+  EXPECT_FALSE(f.rows.back().failure.empty());
+  // bad limits
+  o.target = 1.5;
+  EXPECT_THROW(run_convergence_study(failing_levels({}), o), BadInput);
+  o.target = 1e-8;
+  o.max_N = 20;  // below the largest N of Ns
+  EXPECT_THROW(run_convergence_study(failing_levels({}), o), BadInput);
+  o.max_N = 1000;
+  o.max_seconds = NAN;
+  EXPECT_THROW(run_convergence_study(failing_levels({}), o), BadInput);
 }
 
 // ---------------- Real models, dense LAPACK ----------------

@@ -35,6 +35,25 @@
 //   Settled when the last (up to 3) pair orders spread by at most `settled_spread`; only then is
 //   `observed` set (the slope over the levels of those pairs). Otherwise it stays empty and `note`
 //   says that the sequence is pre-asymptotic, with the numbers.
+//
+// Accuracy of the inputs. Each level may give the absolute accuracy of each multiplier
+// (LevelResult::accuracy, multiplier_accuracy below); the extrapolation's error estimate never
+// goes below that accuracy amplified by the extrapolation weights (richardson.hpp), so a study
+// at round-off still gets a finite, honest estimate.
+//
+// Failed levels. A level may fail (LevelResult::failure, or a NumericalFailure thrown by the
+// level function, which is caught and recorded). After the first pass over Ns, each failed level
+// is retried once through the RetryFunction (when given), nearest (in log N) to a level that
+// succeeded first, with that level's N: the CLI starts Newton for the periodic orbit there from
+// the neighbour's orbit. A level that still fails stays in the rows with its reason and is left
+// out of the analysis; the study needs one successful level with an exact reference, else two
+// (NumericalFailure naming every failure otherwise).
+//
+// Target (options.target > 0). After Ns, N keeps doubling until the relative error estimate of
+// every tracked extrapolated multiplier, error_estimate_k / |mu_k|, is <= target, or the next N
+// would exceed max_N, or the next level would not finish within max_seconds of the study's
+// total (its cost predicted from the last level's, times the growth of the last doubling, at
+// least 2), or a new level fails; `stopped_by` says which.
 #include <complex>
 #include <functional>
 #include <optional>
@@ -56,10 +75,39 @@ struct LevelResult {
   Multipliers multipliers;         // the leading multipliers (any order; matching does not rely on it)
   double seconds = 0;              // what the level cost (wall time)
   long operator_applications = 0;  // single-vector applications of the monodromy
+  std::vector<double> accuracy;    // absolute accuracy of each multiplier (empty: the Richardson default,
+                                   // RichardsonOptions::input_precision |mu|)
+  std::string failure;             // non-empty: the level failed, why (multipliers are then ignored)
+  std::string note;                // how it was computed when that is worth saying (e.g. a retry)
 };
 
 // The leading `count` multipliers at resolution N.
 using LevelFunction = std::function<LevelResult(int N, int count)>;
+// A failed level once more, knowing that the level at from_N succeeded (see the header comment);
+// nullopt: no other way to compute this level (its first failure stands).
+using RetryFunction = std::function<std::optional<LevelResult>(int N, int count, int from_N)>;
+
+// Absolute accuracy of a multiplier mu computed by an eigen-solver from a monodromy of dimension n
+// that is a product of `steps` step maps, given its true relative residual |M v - mu v| / (|mu| |v|)
+// (FloquetResult::residuals; NaN when the solver gives none, the dense path):
+//   eigen-solver:  |mu_computed - mu(M_float)| <= kappa |r|, |r| = residual |mu|, kappa = 1 / |y^H x|
+//     the eigenvalue's condition number (unit left / right vectors), first order. Not known at run
+//     time; measured on the dense monodromies (linear a = -1 b = -2 and a = -1 b = 0.5, Mathieu
+//     delta = 1 and 3; N = 50, 200; eight leading multipliers): kappa = 0.4 .. 3.0 sqrt(n),
+//     growing like sqrt(n) (the history's Euclidean norm against a point evaluation). Taken as
+//     kappa <= 10 sqrt(n). |r| is taken no smaller than eps |mu_1| (spectral_radius), the rounding
+//     of computing M v itself (a multiplier at round-off, even one reported as 0, is known to that
+//     much only). Dense (no residual): |r| <= n eps |mu_1|, the backward error of the QR algorithm
+//     with the spectral radius for the norm.
+//   the operator's own rounding: M_float is a product of `steps` step maps whose coefficients each
+//     carry a relative rounding error; their product, and its eigenvalues, a relative
+//     error up to steps * eps. Measured against the exact eigenvalues of the discrete linear DDE
+//     (its characteristic polynomial in 50 digits, mpmath): 0.04 .. 0.19 steps * eps |mu|,
+//     growing linearly with steps; the residual does not see it (|r| stayed at 2e-15 while the
+//     error grew to 6e-14 at N = 800).
+// accuracy = 10 sqrt(n) max(|r|, eps |mu_1|) + steps eps |mu|.
+double multiplier_accuracy(std::complex<double> mu, double relative_residual, long n, long steps,
+                           double spectral_radius);
 
 enum class ReferenceKind { exact, extrapolated, finest, automatic };
 // "exact", "extrapolated", "finest", "auto"; BadInput otherwise.
@@ -75,10 +123,17 @@ struct ConvergenceOptions {
   double exact_precision = 1e-14;   // relative accuracy of `exact`
   RichardsonOptions richardson;     // the error expansion (order 2, step 2: trapezoid, smooth)
   double settled_spread = 0.3;      // pair orders within this band count as settled
+  // Target (header comment); 0: none, the study is Ns.
+  double target = 0;                // relative error estimate wanted of every tracked multiplier
+  int max_N = 51200;                // no level beyond this N
+  double max_seconds = 600;         // total wall time of the levels
 };
 
 struct ConvergenceRow {
   int N = 0;
+  std::string failure;                  // non-empty: the level failed (then the vectors below are empty
+                                        // and error is NaN)
+  std::string note;                     // LevelResult::note
   Multipliers multipliers;              // matched: multipliers[k] is track k
   std::vector<double> errors;           // relative error of each track
   std::vector<double> correct_digits;   // LRE of each track, capped
@@ -122,7 +177,7 @@ struct RichardsonReport {
 };
 
 struct ConvergenceStudy {
-  std::vector<ConvergenceRow> rows;
+  std::vector<ConvergenceRow> rows;                    // every level, failed ones included, by N
   ReferenceKind reference = ReferenceKind::automatic;  // the one used (never automatic)
   Multipliers reference_values;                        // per track
   std::vector<double> reference_precision;             // relative, per track
@@ -131,14 +186,24 @@ struct ConvergenceStudy {
   std::vector<ExtrapolatedMultiplier> extrapolated;    // per track (empty with one level)
   RichardsonReport richardson;                         // of track 0
   double seconds = 0;                                  // sum over the levels
+  // The target (options.target > 0): met or not, and what ended the study: "target",
+  // "converge_max_N", "converge_max_seconds", "failure"; "Ns" without a target. stop_note says it
+  // in words with the numbers.
+  std::optional<bool> target_met;
+  std::string stopped_by = "Ns";
+  std::string stop_note;
 };
 
-// Runs the level function at every N of options.Ns (count = nev + extra) and analyses the
-// results. BadInput: empty or non-increasing Ns, nev < 1, reference exact without exact values,
-// extrapolated/finest with one level. NumericalFailure: a level returns fewer than nev values.
-ConvergenceStudy run_convergence_study(const LevelFunction& level, const ConvergenceOptions& options);
+// Runs the level function at every N of options.Ns (count = nev + extra), retries failed levels,
+// continues towards options.target, and analyses the results. BadInput: empty or non-increasing
+// Ns, nev < 1, reference exact without exact values, extrapolated/finest with one level, a bad
+// target / max_N / max_seconds. NumericalFailure: a successful level returns fewer than nev
+// values, or too few levels succeed (header comment).
+ConvergenceStudy run_convergence_study(const LevelFunction& level, const ConvergenceOptions& options,
+                                       const RetryFunction& retry = {});
 
-// The analysis part alone, for levels computed elsewhere (levels[i] belongs to options.Ns[i]).
+// The analysis part alone, for levels computed elsewhere (levels[i] belongs to options.Ns[i]);
+// failed levels are reported and left out. The target fields are left as "Ns".
 ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, const ConvergenceOptions& options);
 
 // Relative errors and capped LRE of `values` against `reference` (matched by proximity;

@@ -22,17 +22,22 @@
 //     entries with differences d1 (coarser), d2 and step ratio r (geometric mean over the
 //     three levels), d2 = d1 r^{-e_{j+1}}. The column is consistent when its last two triples
 //     (or its only one) satisfy d1 r^{-e-tol} - 2 noise <= d2 <= d1 r^{-e+tol} + 2 noise,
-//     tol = order_tolerance, noise = input_precision * max|x| * sum|w| (an entry's round-off;
-//     at the round-off floor any column passes, and further columns change nothing).
-//     A column with fewer than three entries cannot be checked and is not held against.
-//   * The value is the finest entry of column J, J = the first column found inconsistent (all
-//     columns below it are consistent or unchecked), or the highest column if none is.
-//     Why a consistent column j - 1 justifies column j: eliminating h^e from a sequence whose
+//     tol = order_tolerance, noise = sum_i |w_i| a_i (an entry's round-off: w the weights of
+//     the entry, a_i the accuracy of input i, `input_errors` or input_precision |x_i|; at the
+//     round-off floor any column passes, and further columns change nothing).
+//     A column with fewer than three entries cannot be checked.
+//   * The value is the finest entry of column J, J = the first column that is not consistent
+//     (inconsistent, or too short to check), or the highest column if all are consistent.
+//     Only a consistent column is built upon: an unchecked column's order is not known, and
+//     eliminating the next term from it is what made 3 levels of the PWSDDE period-2 orbit
+//     claim 1.7e-6 for a value off by 6.1e-6 (the unchecked two-level column converged at
+//     order 2.2, not 4).
+//     Why a consistent column J - 1 justifies column J: eliminating h^e from a sequence whose
 //     error is really C h^p leaves the fraction |1 - (r^p - 1) / (r^e - 1)| of it: at most 31 %
 //     for |p - e| <= 0.3, r = 2, e = 2 (less for higher e), so the last correction
 //     |T[L-1][J] - T[L-1][J-1]| (the error of T[L-1][J-1]) still exceeds the remaining error
 //     of T[L-1][J] by 2x or more: that is the error estimate when column J is consistent or
-//     unchecked (the textbook estimate).
+//     unchecked (the textbook estimate), never below the round-off of T[L-1][J].
 //   * When column J itself is inconsistent, its error is estimated from its own last entries:
 //     E = max(d_last, d_prev r^{-q}), q = e_J the order eliminated last (0 for J = 0). If the
 //     column converges at least at first order from here on (each later difference at most
@@ -56,8 +61,9 @@ struct RichardsonOptions {
   double order = 2;       // e_1: the leading error exponent
   double order_step = 2;  // e_{k+1} - e_k
   int max_columns = 4;    // at most this many levels are combined in one entry
-  // Relative accuracy of each input value (eigen-solver round-off): the extrapolation amplifies it
-  // by sum_i |w_i| (value = sum_i w_i x_i), which bounds the error estimate from below.
+  // Relative accuracy of each input value when richardson_extrapolate gets no `input_errors`: the
+  // extrapolation amplifies it by sum_i |w_i| (value = sum_i w_i x_i), which bounds the error
+  // estimate from below.
   double input_precision = 1e-14;
   bool check_orders = true;      // use a column only if the column below shows its expected order (above)
   double order_tolerance = 0.3;  // |observed - expected| order allowed by that check
@@ -75,7 +81,7 @@ struct RichardsonTableau {
 struct Extrapolation {
   std::complex<double> value;   // the finest entry of the column used: T[L-1][J] (J: header comment)
   double error_estimate = 0;    // max(|T[L-1][J] - T[L-1][J-1]|, the correction the last column made,
-                                //     input_precision * max|x_i| * sum_i |w_i|, the amplified round-off);
+                                //     sum_i |w_i| a_i, the amplified accuracy of the inputs);
                                 // when column J is inconsistent: max(that column's tail estimate,
                                 // round-off); infinity when J = 0 and column 0 cannot be checked, or
                                 // when column J's differences grow
@@ -84,6 +90,7 @@ struct Extrapolation {
   std::vector<int> column_consistent; // per column: 1 consistent, 0 inconsistent, -1 not checkable
   std::string note;                   // why column J, in words with the numbers
   double amplification = 1;     // sum_i |w_i| of value = sum_i w_i x_i
+  double roundoff = 0;          // sum_i |w_i| a_i of value: the floor of error_estimate
   int levels = 0;               // levels combined in value (J + 1)
   double remaining_order = 0;   // the error exponent of value, e_{J+1}, if the expansion holds
 };
@@ -93,8 +100,11 @@ struct Extrapolation {
 RichardsonTableau richardson_tableau(const std::vector<double>& h, const std::vector<std::complex<double>>& x,
                                      const RichardsonOptions& options = {});
 
-// The best entry of the tableau and its error estimate (see Extrapolation).
+// The best entry of the tableau and its error estimate (see Extrapolation). input_errors[i], when
+// given (one per level, >= 0), is the absolute accuracy of x[i] (e.g. multiplier_accuracy,
+// convergence.hpp); empty: options.input_precision |x_i|. BadInput: wrong size, negative or NaN.
 Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::vector<std::complex<double>>& x,
-                                     const RichardsonOptions& options = {});
+                                     const RichardsonOptions& options = {},
+                                     const std::vector<double>& input_errors = {});
 
 }  // namespace delayspec

@@ -163,7 +163,11 @@ int command_bench(Config& config, const Invocation& inv) {
       for (const auto& r : rows)
         if (r.solver == best && r.status == "ok") {
           co.Ns.push_back(r.N);
-          levels.push_back({r.multipliers, r.seconds, r.operator_applications});
+          LevelResult level;
+          level.multipliers = r.multipliers;
+          level.seconds = r.seconds;
+          level.operator_applications = r.operator_applications;
+          levels.push_back(std::move(level));
         }
       const ConvergenceStudy s = analyse_convergence(levels, co);
       ref = s.reference_values;

@@ -4,12 +4,21 @@
 // Keys: Ns (comma list) or N_min/N_max (doubling); nev, solver (default spectra), ncv, tol,
 // max_restarts, seed (floquet_settings.hpp); reference = exact | extrapolated |
 // finest | auto; solver; extrapolation_order, extrapolation_order_step, extrapolation_levels;
-// events (a comma list: for the impact model `on,off` by default, side by side); the problem's
-// and the orbit's keys.
+// converge_target (a relative error: keep doubling N until every tracked multiplier's estimate
+// meets it), converge_max_N, converge_max_seconds (its limits); events (a comma list: for the
+// impact model `on,off` by default, side by side); the problem's and the orbit's keys.
+//
+// A level whose orbit cannot be found (simulation does not settle: e.g. an orbit that is
+// spuriously unstable at a coarse N) is retried with Newton from the orbit of the nearest level
+// that succeeded, prolonged to its N (level_runner.hpp); a level that still fails is a row with
+// its reason (`failure`), not the end of the study (convergence.hpp).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <set>
 
 #include "atomic_file.hpp"
 #include "commands.hpp"
@@ -30,6 +39,12 @@ namespace {
 
 nlohmann::json number_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
+// A failure message on one line (for a CSV comment).
+std::string one_line(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  return text;
+}
+
 nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) {
   nlohmann::json j;
   j["events"] = events;
@@ -40,6 +55,8 @@ nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) 
   for (const auto& r : s.rows) {
     nlohmann::json row;
     row["N"] = r.N;
+    if (!r.failure.empty()) row["failure"] = r.failure;  // then multipliers [] and error null
+    if (!r.note.empty()) row["note"] = r.note;
     row["multipliers"] = multipliers_json(r.multipliers);
     row["error"] = number_or_null(r.error);
     row["errors"] = nlohmann::json::array();
@@ -99,6 +116,9 @@ nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) 
   }
   j["richardson"] = cols;
   j["seconds"] = s.seconds;
+  j["target_met"] = s.target_met ? nlohmann::json(*s.target_met) : nlohmann::json(nullptr);
+  j["stopped_by"] = s.stopped_by;
+  if (!s.stop_note.empty()) j["stop_note"] = s.stop_note;
   return j;
 }
 
@@ -111,6 +131,11 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
   out << line;
   for (size_t i = 0; i < s.rows.size(); ++i) {
     const auto& r = s.rows[i];
+    if (!r.failure.empty()) {
+      std::snprintf(line, sizeof line, "  %6d  %10.4f  failed: ", r.N, r.seconds);
+      out << line << r.failure << "\n";
+      continue;
+    }
     std::string order = "";
     for (size_t k = 0; k < s.order.pair_N.size(); ++k)
       if (s.order.pair_N[k] == r.N) {
@@ -121,6 +146,8 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
                   r.operator_applications, std::abs(r.multipliers[0]), r.error, r.correct_digits[0], order.c_str());
     out << line;
   }
+  for (const auto& r : s.rows)
+    if (r.failure.empty() && !r.note.empty()) out << "  N = " << r.N << ": " << r.note << "\n";
   out << "observed order (" << s.order.basis << " based): ";
   if (s.order.observed) {
     std::snprintf(line, sizeof line, "%.3f", *s.order.observed);
@@ -184,9 +211,72 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
       out << line;
     }
     out << "\n  (order: least squares against the reference; diff.: from the last differences of the column, + consistent"
-           " with the expected order, x not; columns after the first x are not used)\n";
+           " with the expected order, x not; columns after the first that is not + are not used)\n";
   }
+  if (!s.stop_note.empty()) out << "stopped: " << s.stop_note << "\n";
 }
+
+// A level of the study: orbit, monodromy, multipliers and their accuracy (convergence.hpp). The
+// orbits of the levels that succeeded are kept (states of one map, a few MB at most) so that a
+// level whose orbit failed can be retried with Newton from its nearest neighbour's.
+class ConvergeLevels {
+ public:
+  ConvergeLevels(const Problem& problem, std::string events, const OrbitSettings& orbit,
+                 const FloquetOptions& solver, Progress& progress)
+      : problem_(problem), events_(std::move(events)), orbit_(orbit), solver_(solver), progress_(progress) {}
+
+  LevelResult level(int N, int count) { return run(N, count, nullptr); }
+
+  // Only a level whose orbit failed is worth a second try; any other failure stands.
+  std::optional<LevelResult> retry(int N, int count, int from_N) {
+    if (!orbit_failed_.count(N) || !sequences_.count(from_N)) return std::nullopt;
+    return run(N, count, &sequences_.at(from_N), from_N);
+  }
+
+ private:
+  LevelResult run(int N, int count, const Eigen::VectorXd* guess, int from_N = 0) {
+    LevelResult r;
+    const auto start = std::chrono::steady_clock::now();
+    bool orbit_found = false;
+    Eigen::VectorXd sequence;
+    try {
+      with_monodromy(
+          problem_, events_, orbit_, N,
+          [&](const auto& op, const PeriodicOrbit&, double) {
+            orbit_found = true;
+            FloquetOptions fo = solver_;
+            fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
+            const FloquetResult f = floquet_multipliers(op, fo);
+            r.multipliers = f.multipliers;
+            r.operator_applications = f.operator_applications;
+            const double radius = f.multipliers.empty() ? 0.0 : std::abs(f.multipliers.front());
+            for (size_t k = 0; k < f.multipliers.size(); ++k)
+              r.accuracy.push_back(multiplier_accuracy(f.multipliers[k], k < f.residuals.size() ? f.residuals[k] : NAN,
+                                                       op.rows(), op.grid().K, radius));
+          },
+          {guess, &sequence});
+      if (sequence.size() > 0) sequences_[N] = std::move(sequence);
+      if (guess) r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);
+    } catch (const NumericalFailure& e) {
+      r = {};
+      r.failure = e.what();
+      if (!orbit_found) orbit_failed_.insert(N);
+      failed_[N] = r.failure;
+    }
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    progress_.add();
+    return r;
+  }
+
+  const Problem& problem_;
+  std::string events_;
+  const OrbitSettings& orbit_;
+  const FloquetOptions& solver_;
+  Progress& progress_;
+  std::map<int, Eigen::VectorXd> sequences_;  // N -> orbit states of one map, levels that succeeded
+  std::set<int> orbit_failed_;                // N whose orbit (not the eigen-solve) failed
+  std::map<int, std::string> failed_;         // N -> why it failed
+};
 
 }  // namespace
 
@@ -216,6 +306,22 @@ int command_converge(Config& config, const Invocation& inv) {
   base.richardson.max_columns = static_cast<int>(config.get_int("extrapolation_levels", 4));
   if (base.richardson.max_columns < 1)
     throw BadInput("`extrapolation_levels = " + std::to_string(base.richardson.max_columns) + "`: must be >= 1");
+  base.target = config.get_double("converge_target", 0);
+  const long max_N = config.get_int("converge_max_N", base.max_N);
+  base.max_seconds = config.get_double("converge_max_seconds", base.max_seconds);
+  if (!config.has("converge_target"))
+    for (const char* key : {"converge_max_N", "converge_max_seconds"})
+      if (config.has(key))
+        throw BadInput("`" + std::string(key) + " = " + config.get_string(key, "") +
+                       "`: a limit of `converge_target`, which is not given");
+  if (config.has("converge_target") && !(base.target > 0))
+    throw BadInput("`converge_target = " + config.get_string("converge_target", "") + "`: must be > 0");
+  if (max_N < 1 || max_N > 10000000)
+    throw BadInput("`converge_max_N = " + std::to_string(max_N) + "`: must be between 1 and 1e7");
+  base.max_N = static_cast<int>(max_N);
+  if (!(base.max_seconds > 0) || !std::isfinite(base.max_seconds) || base.max_seconds > 1e7)
+    throw BadInput("`converge_max_seconds = " + config.get_string("converge_max_seconds", "") +
+                   "`: must be > 0 and at most 1e7");
   config.check_all_used();
 
   const int d = state_dimension(problem);
@@ -231,7 +337,8 @@ int command_converge(Config& config, const Invocation& inv) {
                    "` has no exact multipliers (use extrapolated or finest)");
 
   std::vector<ConvergenceStudy> studies;
-  Progress progress(inv.err, "converge", static_cast<long>(base.Ns.size() * events.size()), inv.quiet);
+  Progress progress(inv.err, "converge", base.target > 0 ? 0 : static_cast<long>(base.Ns.size() * events.size()),
+                    inv.quiet);
   for (const std::string& ev : events) {
     ConvergenceOptions options = base;
     // Without event handling a step across the switching surface is first order (design 1.5):
@@ -239,21 +346,10 @@ int command_converge(Config& config, const Invocation& inv) {
     const bool first_order = switching && ev == "off";
     options.richardson.order = order_given ? x_order : first_order ? 1 : 2;
     options.richardson.order_step = step_given ? x_step : first_order ? 1 : 2;
-    LevelFunction level = [&](int N, int count) {
-      LevelResult r;
-      const auto start = std::chrono::steady_clock::now();
-      with_monodromy(problem, ev, orbit_settings, N, [&](const auto& op, const PeriodicOrbit&, double) {
-        FloquetOptions fo = solver_options;
-        fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
-        const FloquetResult f = floquet_multipliers(op, fo);
-        r.multipliers = f.multipliers;
-        r.operator_applications = f.operator_applications;
-      });
-      r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      progress.add();
-      return r;
-    };
-    studies.push_back(run_convergence_study(level, options));
+    ConvergeLevels levels(problem, ev, orbit_settings, solver_options, progress);
+    studies.push_back(run_convergence_study(
+        [&](int N, int count) { return levels.level(N, count); }, options,
+        [&](int N, int count, int from_N) { return levels.retry(N, count, from_N); }));
   }
   progress.finish();
 
@@ -263,8 +359,12 @@ int command_converge(Config& config, const Invocation& inv) {
         "converge", inv.scene, config, nlohmann::json::object(),
         std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
     AtomicFile rows(dir / "converge.csv");
-    rows.stream() << header << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver)
-                  << "\nevents,N,track,re,im,abs,error,correct_digits,seconds,operator_applications\n";
+    rows.stream() << header << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver) << "\n";
+    for (size_t v = 0; v < studies.size(); ++v)  // failed levels have no multipliers: named here
+      for (const auto& r : studies[v].rows)
+        if (!r.failure.empty())
+          rows.stream() << "# events " << events[v] << ", N = " << r.N << " failed: " << one_line(r.failure) << "\n";
+    rows.stream() << "events,N,track,re,im,abs,error,correct_digits,seconds,operator_applications\n";
     rows.stream().precision(17);
     AtomicFile rich(dir / "converge_richardson.csv");
     rich.stream() << header << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";
@@ -312,11 +412,17 @@ int command_converge(Config& config, const Invocation& inv) {
       inv.out << line;
     }
     inv.out << "\n";
-    for (size_t i = 0; i < base.Ns.size(); ++i) {
-      std::snprintf(line, sizeof line, "  %6d", base.Ns[i]);
+    std::set<int> all_N;  // with a target the variants may end at different N
+    for (const auto& s : studies)
+      for (const auto& r : s.rows) all_N.insert(r.N);
+    for (int N : all_N) {
+      std::snprintf(line, sizeof line, "  %6d", N);
       inv.out << line;
       for (const auto& s : studies) {
-        std::snprintf(line, sizeof line, "  %13.3e (%5.2f)", s.rows[i].error, s.rows[i].correct_digits[0]);
+        const auto r = std::find_if(s.rows.begin(), s.rows.end(), [&](const ConvergenceRow& x) { return x.N == N; });
+        if (r == s.rows.end()) std::snprintf(line, sizeof line, "  %22s", "-");
+        else if (!r->failure.empty()) std::snprintf(line, sizeof line, "  %22s", "failed");
+        else std::snprintf(line, sizeof line, "  %13.3e (%5.2f)", r->error, r->correct_digits[0]);
         inv.out << line;
       }
       inv.out << "\n";

@@ -24,11 +24,27 @@ std::vector<std::string> read_word_list(Config& config, const std::string& key, 
 // The exact leading multipliers when the model has them (linear: Lambert W), else empty.
 std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count);
 
+// The states of a periodic orbit over one map, x = (u_0, ..., u_{K-1}), u_l = y(l h), d each
+// (PeriodicOrbitProblem's unknowns), carried to another resolution: the K_to states at l h_to
+// over the same map period, by periodic linear interpolation (u_{l+K} = u_l). A Newton guess for
+// the orbit at another N: its distance to that orbit is O(h^2) plus the orbit's own change with N.
+// BadInput: d < 1, K_to < 1, or x.size() not a positive multiple of d.
+Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, long K_to);
+
+// How with_monodromy finds the orbit, beyond the orbit settings.
+struct LevelOrbit {
+  // in: when set, Newton (orbit_by_newton) from this sequence (another level's orbit, any K:
+  // prolonged) instead of the configured method.
+  const Eigen::VectorXd* newton_guess = nullptr;
+  // out: when set, the orbit's states over one map (nonlinear models; left empty for linear ones).
+  Eigen::VectorXd* sequence = nullptr;
+};
+
 // Builds the problem at resolution N with the given events mode, finds its periodic orbit and
 // calls fn(monodromy, orbit, setup_seconds). fn is generic in the Monodromy<D> type.
 template <class Fn>
 void with_monodromy(const Problem& problem, const std::string& events, const OrbitSettings& orbit_settings, int N,
-                    Fn&& fn) {
+                    Fn&& fn, const LevelOrbit& level_orbit = {}) {
   std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
@@ -39,7 +55,19 @@ void with_monodromy(const Problem& problem, const std::string& events, const Orb
         p.grid = make_grid(model.tau(), model.period(), N, problem.orbit_period);
         TrapezoidStepper<Model> stepper(model, step_options(p));
         StroboscopicMap<Model> map(stepper, p.grid);
-        const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
+        PeriodicOrbit orbit;
+        if constexpr (!Model::is_linear) {
+          if (level_orbit.newton_guess) {
+            const Eigen::VectorXd guess = prolong_periodic_sequence(*level_orbit.newton_guess, Model::d, p.grid.K);
+            orbit = orbit_by_newton(map, guess, orbit_settings.newton);
+          } else {
+            orbit = find_orbit(model, map, orbit_settings);
+          }
+          if (level_orbit.sequence)
+            *level_orbit.sequence = PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
+        } else {
+          orbit = find_orbit(model, map, orbit_settings);
+        }
         auto monodromy = map.monodromy(orbit.history);
         const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         fn(monodromy, orbit, setup);
