@@ -211,10 +211,9 @@ double operator_size(const Monodromy<D>& op, const Eigen::VectorXd& x) {
 // the round-off level of the operator (|mu| <= 1e3 eps |M x| / |x|, x the start vector: rounding
 // of one application alone makes its relative residual O(1)), say so: no method resolves it next
 // to larger ones, and the multipliers before it are what can be asked for.
-template <int D>
-std::string residual_gate_message(const Monodromy<D>& op, const Eigen::VectorXd& start, const FloquetResult& r,
-                                  const std::vector<size_t>& failing, double bound, const std::string& name,
-                                  int first_ncv, int last_ncv) {
+// `size` = operator_size(op, start).
+std::string residual_gate_message(double size, const FloquetResult& r, const std::vector<size_t>& failing,
+                                  double bound, const std::string& name, int first_ncv, int last_ncv) {
   const size_t k = failing.front();
   const std::complex<double> mu = r.multipliers[k];
   const std::string others =
@@ -225,7 +224,7 @@ std::string residual_gate_message(const Monodromy<D>& op, const Eigen::VectorXd&
                         "i, fails its residual check: |M v - mu v| / (|mu| |v|) = " + format_number(r.residuals[k]) +
                         " > bound " + krylov::short_number(bound) + " (ncv = " + std::to_string(first_ncv) +
                         (last_ncv != first_ncv ? ", retried with ncv = " + std::to_string(last_ncv) : "") + ")";
-  const double round_off = std::numeric_limits<double>::epsilon() * operator_size(op, start);
+  const double round_off = std::numeric_limits<double>::epsilon() * size;
   if (std::abs(mu) <= 1e3 * round_off)
     message += "; |mu| is at the round-off level of this operator (eps |M x| / |x| = " + format_number(round_off) +
                " next to |mu_1| = " + format_number(std::abs(r.multipliers[0])) +
@@ -266,6 +265,7 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
 
   // One solve, then the residual gate; on failure one retry with ncv doubled (at most n).
   const int first_ncv = settings.ncv;
+  double size = -1;  // operator_size(op, start), computed on the first failing pair
   for (int attempt = 0;; ++attempt) {
     krylov::RitzPairs pairs = options.solver == FloquetSolver::spectra
                                   ? krylov::spectra_ritz_pairs(op, settings, start)
@@ -275,7 +275,11 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
     std::vector<double> absolute;
     take_leading_pairs(pairs, residual, options, name, candidate, absolute);
     std::vector<size_t> failing = failing_pairs(candidate.residuals, bound);
-    if (!failing.empty()) zero_round_off_pairs(candidate, absolute, failing, operator_size(op, start));
+    // |M x| / |x| costs one application: only when a pair fails, and once per solve.
+    if (!failing.empty()) {
+      if (size < 0) size = operator_size(op, start);
+      zero_round_off_pairs(candidate, absolute, failing, size);
+    }
     candidate.ncv = settings.ncv;
     candidate.converged = pairs.converged;
     candidate.iterations = pairs.iterations;
@@ -292,14 +296,11 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
       settings.ncv = static_cast<int>(std::min<long>(n, 2L * settings.ncv));
       // Spectra's breakdown thresholds are absolute (krylov_spectra.cpp): the retry scales the
       // operator to |M / s| <= 1 / sqrt(n) or so, |M x| / |x| underestimating |M| by up to sqrt(n).
-      if (options.solver == FloquetSolver::spectra) {
-        const double size = operator_size(op, start);
-        if (size > 0 && std::isfinite(size))
-          settings.scale = std::ldexp(1.0, static_cast<int>(std::lround(std::log2(size * std::sqrt(double(n))))));
-      }
+      if (options.solver == FloquetSolver::spectra && size > 0 && std::isfinite(size))
+        settings.scale = std::ldexp(1.0, static_cast<int>(std::lround(std::log2(size * std::sqrt(double(n))))));
       continue;
     }
-    throw NumericalFailure(residual_gate_message(op, start, candidate, failing, bound, name, first_ncv, settings.ncv));
+    throw NumericalFailure(residual_gate_message(size, candidate, failing, bound, name, first_ncv, settings.ncv));
   }
 }
 

@@ -1,6 +1,7 @@
 // `delayspec plot`: renders PNG and SVG (gnuplot) from result files, atomically, and rejects
 // bad directories and settings with exit 2.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <sys/stat.h>
 
 #include <cstdlib>
@@ -27,7 +28,8 @@ std::string head(const fs::path& p, size_t n) {
 }
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_plot_" + name);
+  // per process: ctest -j runs the cases of a parameterised test at the same time
+  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_plot_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

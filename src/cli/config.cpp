@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -18,14 +17,6 @@
 namespace delayspec::cli {
 
 namespace {
-
-// The shortest text that reads back as the same double ("0.6", not "0.59999999999999998"): the
-// one spelling of a number in the effective settings.
-std::string canonical_number(double value) {
-  char buffer[64];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
-  return error == std::errc() ? std::string(buffer, end) : format_number(value);
-}
 
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t");
@@ -248,7 +239,7 @@ void Config::mark_used(const std::string& key) { used_.insert(key); }
 double Config::get_double(const std::string& key, double fallback) {
   auto text = lookup(key);
   if (!text) {
-    effective_[key] = canonical_number(fallback);
+    effective_[key] = format_number(fallback);
     note_read(key, format_number(fallback));
     return fallback;
   }
@@ -260,7 +251,7 @@ double Config::get_double(const std::string& key, double fallback) {
   if (s.empty() || end != s.c_str() + s.size() || (errno == ERANGE && std::abs(value) == HUGE_VAL))
     throw BadInput("`" + key + " = " + s + "`: not a number");
   if (!std::isfinite(value)) throw BadInput("`" + key + " = " + s + "`: must be a finite number");
-  effective_[key] = canonical_number(value);
+  effective_[key] = format_number(value);
   return value;
 }
 
