@@ -15,15 +15,22 @@
 namespace delayspec {
 
 FloquetSolver parse_floquet_solver(const std::string& name) {
+  if (name == "auto") return FloquetSolver::automatic;
   if (name == "spectra") return FloquetSolver::spectra;
   if (name == "arpack") return FloquetSolver::arpack;
   if (name == "dense" || name == "dense-lapack") return FloquetSolver::dense_lapack;
   if (name == "dense-eigen") return FloquetSolver::dense_eigen;
-  throw BadInput("`solver = " + name + "`: must be one of spectra, arpack, dense, dense-eigen, dense-lapack");
+  throw BadInput("`solver = " + name + "`: must be one of auto, spectra, arpack, dense, dense-eigen, dense-lapack");
+}
+
+FloquetSolver choose_floquet_solver(long n) {
+  if (n <= 100) return FloquetSolver::dense_lapack;
+  return n < 2000 ? FloquetSolver::spectra : FloquetSolver::arpack;
 }
 
 std::string to_string(FloquetSolver solver) {
   switch (solver) {
+    case FloquetSolver::automatic: return "auto";
     case FloquetSolver::spectra: return "spectra";
     case FloquetSolver::arpack: return "arpack";
     case FloquetSolver::dense_eigen: return "dense-eigen";
@@ -326,13 +333,18 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
 }  // namespace
 
 template <int D>
-FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& options) {
+FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& requested) {
   const long n = op.rows();
+  FloquetOptions options = requested;
+  // Krylov options are checked when a Krylov backend may run (auto included), whatever auto picks.
+  const bool krylov_requested = options.solver == FloquetSolver::spectra || options.solver == FloquetSolver::arpack ||
+                                options.solver == FloquetSolver::automatic;
+  if (options.solver == FloquetSolver::automatic) options.solver = choose_floquet_solver(n);
   if (options.nev < 1 || options.nev > n)
     throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " +
                    std::to_string(n));
   const bool krylov = options.solver == FloquetSolver::spectra || options.solver == FloquetSolver::arpack;
-  if (krylov) {
+  if (krylov_requested) {
     if (options.ncv != 0 && options.ncv < options.nev + 2)
       throw BadInput("`ncv = " + std::to_string(options.ncv) + "`: must be 0 (automatic) or >= nev + 2 = " +
                      std::to_string(options.nev + 2));
@@ -353,6 +365,7 @@ FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& 
     solver = FloquetSolver::dense_lapack;
   }
   switch (solver) {
+    case FloquetSolver::automatic:  // resolved above
     case FloquetSolver::spectra:
     case FloquetSolver::arpack:
       krylov_solve(op, options, result);

@@ -276,6 +276,7 @@ TEST(KrylovResidualGate, RankOneMonodromyLeadingMultiplierIsExact) {
     if (solver == FloquetSolver::spectra) {
       FloquetOptions o;
       o.nev = 1;
+      o.solver = FloquetSolver::spectra;
       o.retry_failed_gate = false;
       const std::string m = numerical_failure_message([&] { floquet_multipliers(op, o); });
       const bool refused = m.find("Krylov (spectra): multiplier 1 of nev = 1") != std::string::npos &&

@@ -49,15 +49,21 @@
 
 namespace delayspec {
 
-enum class FloquetSolver { spectra, arpack, dense_eigen, dense_lapack };
+enum class FloquetSolver { automatic, spectra, arpack, dense_eigen, dense_lapack };
 
-// "spectra", "arpack", "dense" (= dense_lapack), "dense-eigen", "dense-lapack"; BadInput otherwise.
+// "auto", "spectra", "arpack", "dense" (= dense_lapack), "dense-eigen", "dense-lapack"; BadInput otherwise.
 FloquetSolver parse_floquet_solver(const std::string& name);
 std::string to_string(FloquetSolver solver);
 
+// solver = auto: the backend measured fastest for the operator's size (docs/benchmarks.md,
+// "Choosing the eigensolver"): dense LAPACK for n <= 100 (all eigenvalues, no Krylov constraint,
+// as fast as Krylov there), Spectra for n < 2000, ARPACK from n = 2000 on (its BLAS dgemv
+// orthogonalisation: 1.2x Spectra at n = 8000, 3x at n = 128000, 2.9x at n = 2e6, nev = 20).
+FloquetSolver choose_floquet_solver(long n);
+
 struct FloquetOptions {
   int nev = 6;                              // multipliers wanted
-  FloquetSolver solver = FloquetSolver::spectra;
+  FloquetSolver solver = FloquetSolver::automatic;  // choose_floquet_solver(n)
   // Krylov only:
   int ncv = 0;                  // Krylov subspace dimension; 0 = default_ncv(nev, n); clamped to n
   double tolerance = 1e-12;     // relative Ritz residual at which a pair counts as converged
