@@ -78,6 +78,11 @@ TEST(PlotCli, BadInputPaths) {
   CliResult width = run({"plot", empty.string(), "--set", "plot_width=5"});
   EXPECT_EQ(width.status, 2);
   EXPECT_NE(width.err.find("`plot_width = 5`"), std::string::npos) << width.err;
+  // 2^32 + 300 wraps to 300 in a cast to int: the range is checked on the value as given.
+  CliResult wrapped = run({"plot", empty.string(), "--set", "plot_height=4294967596"});
+  EXPECT_EQ(wrapped.status, 2);
+  EXPECT_NE(wrapped.err.find("`plot_height = 4294967596`: must be between 100 and 10000"), std::string::npos)
+      << wrapped.err;
 
   const fs::path dir = fresh_dir("nognuplot");
   std::ofstream(dir / "floquet.json") << R"({"model": "linear", "N": 4, "solver": "dense",

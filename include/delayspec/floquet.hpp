@@ -87,6 +87,13 @@ struct FloquetResult {
   Eigen::MatrixXd subspace;
 };
 
+// The options' rules for an n x n monodromy, each in one place, named by the CLI keys:
+// 1 <= nev <= n; for Krylov also ncv = 0 or ncv >= nev + 2, tolerance > 0 and finite,
+// max_iterations >= 1, residual_bound > 0 and finite. BadInput "`key = v`: must be ..." otherwise.
+// floquet_multipliers() calls it first; a command calls it before its heavy work (the orbit) to
+// fail fast. (Krylov's nev <= n - 2 is not a rule: a larger nev runs the dense path.)
+void validate_floquet_options(const FloquetOptions& options, long n);
+
 // The nev leading multipliers. See the header comment for errors.
 template <int D>
 FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& options);

@@ -82,8 +82,12 @@
 
 namespace delayspec {
 
+// The most tangent vectors a run carries: the QR kernel keeps one row of the block in stack
+// buffers of this size (lyapunov.cpp); only leading exponents are meant.
+inline constexpr int kMaxTangentVectors = 64;
+
 struct LyapunovOptions {
-  int exponents = 2;         // k: tangent vectors (exponents wanted), 1 <= k <= min(n, 64)
+  int exponents = 2;         // k: tangent vectors (exponents wanted), 1 <= k <= min(n, kMaxTangentVectors)
   long periods = 1000;       // stroboscopic periods averaged (a multiple of qr_every)
   long transient = 100;      // periods discarded first (>= 0)
   std::uint64_t seed = 1;    // initial tangent block: a fixed pseudo-random n x k block, orthonormalised

@@ -303,11 +303,10 @@ int command_converge(Config& config, const Invocation& inv) {
   const double x_step = config.get_double("extrapolation_order_step", 2);
   require_positive("extrapolation_order", x_order);
   require_positive("extrapolation_order_step", x_step);
-  base.richardson.max_columns = static_cast<int>(config.get_int("extrapolation_levels", 4));
-  if (base.richardson.max_columns < 1)
-    throw BadInput("`extrapolation_levels = " + std::to_string(base.richardson.max_columns) + "`: must be >= 1");
+  // More columns than levels is harmless (the table stops at the levels); the bound keeps the cast exact.
+  base.richardson.max_columns = static_cast<int>(config.get_int_in_range("extrapolation_levels", 4, 1, 1000));
   base.target = config.get_double("converge_target", 0);
-  const long max_N = config.get_int("converge_max_N", base.max_N);
+  base.max_N = static_cast<int>(config.get_int_in_range("converge_max_N", base.max_N, 1, 10'000'000));
   base.max_seconds = config.get_double("converge_max_seconds", base.max_seconds);
   if (!config.has("converge_target"))
     for (const char* key : {"converge_max_N", "converge_max_seconds"})
@@ -316,9 +315,6 @@ int command_converge(Config& config, const Invocation& inv) {
                        "`: a limit of `converge_target`, which is not given");
   if (config.has("converge_target") && !(base.target > 0))
     throw BadInput("`converge_target = " + config.get_string("converge_target", "") + "`: must be > 0");
-  if (max_N < 1 || max_N > 10000000)
-    throw BadInput("`converge_max_N = " + std::to_string(max_N) + "`: must be between 1 and 1e7");
-  base.max_N = static_cast<int>(max_N);
   if (!(base.max_seconds > 0) || !std::isfinite(base.max_seconds) || base.max_seconds > 1e7)
     throw BadInput("`converge_max_seconds = " + config.get_string("converge_max_seconds", "") +
                    "`: must be > 0 and at most 1e7");
@@ -328,9 +324,7 @@ int command_converge(Config& config, const Invocation& inv) {
   long n_min = 0;
   std::visit([&](const auto& m) { n_min = make_grid(m.tau(), m.period(), base.Ns.front(), problem.orbit_period).dimension(d); },
              problem.model);
-  if (base.nev > n_min)
-    throw BadInput("`nev = " + std::to_string(base.nev) + "`: more than the dimension n = " + std::to_string(n_min) +
-                   " at the coarsest N = " + std::to_string(base.Ns.front()));
+  validate_floquet_options(solver_options, n_min);  // at the coarsest N, the smallest n
   base.exact = exact_multipliers(problem, base.nev + base.extra);
   if (base.reference == ReferenceKind::exact && base.exact.empty())
     throw BadInput("`reference = exact`: model `" + problem.model_name +

@@ -19,8 +19,7 @@ int command_floquet(Config& config, const Invocation& inv) {
   const FloquetOptions options = read_floquet_options(config);
   config.check_all_used();
   const long n = std::visit([&](const auto& m) { return problem.grid.dimension(std::decay_t<decltype(m)>::d); }, problem.model);
-  if (options.nev < 1 || options.nev > n)
-    throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " + std::to_string(n));
+  validate_floquet_options(options, n);  // before the orbit: fail fast
 
   nlohmann::json json;
   FloquetResult result;

@@ -30,12 +30,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Analyses that are planned commands of delayspec but may be missing from this build.
-const std::set<std::string>& planned_analyses() {
-  static const std::set<std::string> names = {"simulate", "lyapunov", "sweep", "converge", "bench", "chart", "basin"};
-  return names;
-}
-
 std::vector<std::string> split_list(const std::string& text) {
   std::vector<std::string> out;
   std::stringstream ss(text);
@@ -81,9 +75,6 @@ std::vector<std::string> read_analyses(Config& config) {
     if (name == "run" || name == "plot")
       throw BadInput("`analyses = " + text + "`: `" + name + "` is a command, not an analysis");
     if (command_table().count(name)) continue;
-    if (planned_analyses().count(name))
-      throw BadInput("`analyses = " + text + "`: analysis `" + name + "` is not available in this build (available: " +
-                     available_list + ")");
     const std::string suggestion = closest_key(name, available);
     throw BadInput("`analyses = " + text + "`: unknown analysis `" + name + "`" +
                    (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?") + " (available: " +

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "delayspec/errors.hpp"
+#include "delayspec/lyapunov.hpp"  // kMaxTangentVectors
 #include "problem.hpp"
 
 namespace delayspec::cli {
@@ -118,7 +119,7 @@ const std::map<std::string, std::string>& key_meanings() {
       {"max_restarts", "Krylov: implicit restarts allowed (more: exit 3), 0..1000000"},
       {"seed", "seed of the random start vector (Krylov) or initial tangent block (Lyapunov)"},
       // lyapunov (lyapunov_settings.cpp), sweep
-      {"exponents", "Lyapunov exponents wanted, 1..64"},
+      {"exponents", "Lyapunov exponents wanted, 1.." + std::to_string(kMaxTangentVectors)},
       {"periods", "Lyapunov: periods averaged (a multiple of qr_every), >= 2"},
       {"transient", "Lyapunov: periods discarded first, >= 0"},
       {"qr_every", "Lyapunov: periods between QR factorisations"},

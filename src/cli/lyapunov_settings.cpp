@@ -6,11 +6,11 @@ namespace delayspec::cli {
 
 LyapunovOptions read_lyapunov_options(Config& config, int default_exponents) {
   LyapunovOptions o;
-  // Bounds: at most 64 exponents (only the leading ones are meant); periods and transient at most
+  // Bounds: at most kMaxTangentVectors exponents (lyapunov.hpp); periods and transient at most
   // 1e9 each, so transient + periods cannot overflow; the per-interval logs (periods / qr_every
   // times exponents doubles) at most kMaxLogs = 1e8 (800 MB), checked before anything is allocated.
   constexpr long kMaxPeriods = 1'000'000'000, kMaxLogs = 100'000'000;
-  o.exponents = static_cast<int>(config.get_int_in_range("exponents", default_exponents, 1, 64));
+  o.exponents = static_cast<int>(config.get_int_in_range("exponents", default_exponents, 1, kMaxTangentVectors));
   o.periods = config.get_int_in_range("periods", o.periods, 2, kMaxPeriods);
   o.transient = config.get_int_in_range("transient", o.transient, 0, kMaxPeriods);
   o.seed = static_cast<std::uint64_t>(config.get_int_in_range("seed", 1, 0, LONG_MAX));
