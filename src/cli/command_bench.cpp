@@ -27,7 +27,6 @@
 #include "delayspec/floquet.hpp"
 #include "floquet_settings.hpp"
 #include "level_runner.hpp"
-#include "lyapunov_settings.hpp"  // state_dimension
 #include "memory_probe.hpp"
 #include "metadata.hpp"
 #include "output.hpp"
@@ -82,10 +81,9 @@ int command_bench(Config& config, const Invocation& inv) {
 
   std::vector<FloquetSolver> solvers;
   for (const auto& s : solver_names) solvers.push_back(parse_floquet_solver(s));
-  const int d = state_dimension(problem);
-  long n_min = 0;  // the dimension at the coarsest N, the smallest
-  std::visit([&](const auto& m) { n_min = make_grid(m.tau(), m.period(), Ns.front(), problem.orbit_period).dimension(d); },
-             problem.model);
+  Problem coarsest = problem;
+  coarsest.N = Ns.front();
+  const long n_min = coarsest.dimension();  // the dimension at the coarsest N, the smallest
   validate_floquet_options(base, n_min);
   // A Krylov row with nev > n - 2 would run the dense path (floquet.hpp): not a comparison.
   const bool krylov_listed = std::any_of(solvers.begin(), solvers.end(), [](FloquetSolver s) { return !is_dense(s); });
@@ -220,7 +218,7 @@ int command_bench(Config& config, const Invocation& inv) {
   if (inv.json) {
     nlohmann::json j;
     j["model"] = problem.model_name;
-    j["events"] = problem.events;
+    j["events"] = to_string(problem.events);
     j["nev"] = base.nev;
     j["reference"] = reference_used;
     if (!reference_note.empty()) j["reference_note"] = reference_note;

@@ -28,7 +28,6 @@
 #include "floquet_settings.hpp"
 #include "level_runner.hpp"
 #include "metadata.hpp"
-#include "lyapunov_settings.hpp"  // state_dimension
 #include "output.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
@@ -221,9 +220,9 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
 // level whose orbit failed can be retried with Newton from its nearest neighbour's.
 class ConvergeLevels {
  public:
-  ConvergeLevels(const Problem& problem, std::string events, const OrbitSettings& orbit,
-                 const FloquetOptions& solver, Progress& progress)
-      : problem_(problem), events_(std::move(events)), orbit_(orbit), solver_(solver), progress_(progress) {}
+  ConvergeLevels(const Problem& problem, EventMode events, const OrbitSettings& orbit, const FloquetOptions& solver,
+                 Progress& progress)
+      : problem_(problem), events_(events), orbit_(orbit), solver_(solver), progress_(progress) {}
 
   LevelResult level(int N, int count) { return run(N, count, nullptr); }
 
@@ -269,7 +268,7 @@ class ConvergeLevels {
   }
 
   const Problem& problem_;
-  std::string events_;
+  EventMode events_;
   const OrbitSettings& orbit_;
   const FloquetOptions& solver_;
   Progress& progress_;
@@ -285,7 +284,7 @@ int command_converge(Config& config, const Invocation& inv) {
   // events may be a list here (side by side); the problem reads the first of them.
   const bool switching_default = config.get_string("model", "impact") == "impact";
   const std::vector<std::string> events =
-      read_word_list(config, "events", switching_default ? "on,off" : "on", {"on", "linear", "off"});
+      read_word_list(config, "events", switching_default ? "on,off" : "on", event_mode_names());
   config.set("events", events.front(), "converge");
   Problem problem = read_problem(config, 100);
   const bool switching =
@@ -320,10 +319,9 @@ int command_converge(Config& config, const Invocation& inv) {
                    "`: must be > 0 and at most 1e7");
   config.check_all_used();
 
-  const int d = state_dimension(problem);
-  long n_min = 0;
-  std::visit([&](const auto& m) { n_min = make_grid(m.tau(), m.period(), base.Ns.front(), problem.orbit_period).dimension(d); },
-             problem.model);
+  Problem coarsest = problem;
+  coarsest.N = base.Ns.front();
+  const long n_min = coarsest.dimension();
   validate_floquet_options(solver_options, n_min);  // at the coarsest N, the smallest n
   base.exact = exact_multipliers(problem, base.nev + base.extra);
   if (base.reference == ReferenceKind::exact && base.exact.empty())
@@ -340,7 +338,7 @@ int command_converge(Config& config, const Invocation& inv) {
     const bool first_order = switching && ev == "off";
     options.richardson.order = order_given ? x_order : first_order ? 1 : 2;
     options.richardson.order_step = step_given ? x_step : first_order ? 1 : 2;
-    ConvergeLevels levels(problem, ev, orbit_settings, solver_options, progress);
+    ConvergeLevels levels(problem, parse_event_mode(ev), orbit_settings, solver_options, progress);
     studies.push_back(run_convergence_study(
         [&](int N, int count) { return levels.level(N, count); }, options,
         [&](int N, int count, int from_N) { return levels.retry(N, count, from_N); }));

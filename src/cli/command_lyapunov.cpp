@@ -17,7 +17,7 @@ int command_lyapunov(Config& config, const Invocation& inv) {
   Problem problem = read_problem(config, 100);
   LyapunovOptions options = read_lyapunov_options(config, 2);
   config.check_all_used();
-  const long n = problem.grid.dimension(state_dimension(problem));
+  const long n = problem.dimension();
   validate_lyapunov_options(options, n);
 
   Progress progress(inv.err, "lyapunov", options.transient + options.periods, inv.quiet);
@@ -46,12 +46,12 @@ int command_lyapunov(Config& config, const Invocation& inv) {
     j["batches"] = r.batches;
     j["seed"] = options.seed;
     j["steps"] = r.steps;
-    j["h"] = problem.grid.h;
-    j["events"] = problem.events;
-    j["jacobian"] = problem.jacobian;
+    j["h"] = problem.grid().h;
+    j["events"] = to_string(problem.events);
+    j["jacobian"] = to_string(problem.jacobian);
     inv.out << j.dump(2) << "\n";
   } else {
-    inv.out << "delayspec lyapunov: model " << problem.model_name << ", " << problem.grid.describe() << ", n = " << n
+    inv.out << "delayspec lyapunov: model " << problem.model_name << ", " << problem.grid().describe() << ", n = " << n
             << "\n";
     inv.out << r.per_period.size() << " leading Lyapunov exponents after a transient of " << r.transient
             << " periods, averaged over " << r.periods << " periods (period = " << r.map_time << " time units, QR every "

@@ -127,9 +127,9 @@ int command_sweep(Config& config, const Invocation& inv) {
     Config point_config = config;
     point_config.set(key, format_number(p.parameter), "sweep point " + std::to_string(i));
     p.problem = read_problem(point_config, 100);  // BadInput here names the key and the value
-    validate_lyapunov_options(options, p.problem.grid.dimension(state_dimension(p.problem)));
+    validate_lyapunov_options(options, p.problem.dimension());
   }
-  const int d = state_dimension(first);
+  const int d = first.state_dimension();
 
   // Settings of the sweep for --resume: the effective values (a key stated at its default equals
   // the key left out), except the thread count (results do not depend on it) and the scene-level
@@ -279,8 +279,8 @@ int command_sweep(Config& config, const Invocation& inv) {
   summary["qr_every"] = options.qr_every;
   summary["seed"] = options.seed;
   summary["section_points"] = section_points;
-  summary["events"] = first.events;
-  summary["jacobian"] = first.jacobian;
+  summary["events"] = to_string(first.events);
+  summary["jacobian"] = to_string(first.jacobian);
   summary["threads"] = thread_count;
   summary["points_computed_now"] = todo.size();
   summary["failed"] = failed;

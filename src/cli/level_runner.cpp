@@ -29,8 +29,11 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
     if (Ns[i] <= Ns[i - 1])
       throw BadInput(what + ": must be strictly increasing (" + std::to_string(Ns[i - 1]) + " then " +
                      std::to_string(Ns[i]) + ")");
-  for (int N : Ns)  // fail fast on an N the grid cannot take
-    std::visit([&](const auto& m) { make_grid(m.tau(), m.period(), N, problem.orbit_period); }, problem.model);
+  for (int N : Ns) {  // fail fast on an N the grid cannot take
+    Problem at_N = problem;
+    at_N.N = N;
+    at_N.grid();
+  }
   return Ns;
 }
 

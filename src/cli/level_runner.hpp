@@ -43,36 +43,32 @@ struct LevelOrbit {
 // Builds the problem at resolution N with the given events mode, finds its periodic orbit and
 // calls fn(monodromy, orbit, setup_seconds). fn is generic in the Monodromy<D> type.
 template <class Fn>
-void with_monodromy(const Problem& problem, const std::string& events, const OrbitSettings& orbit_settings, int N,
-                    Fn&& fn, const LevelOrbit& level_orbit = {}) {
-  std::visit(
-      [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        const auto start = std::chrono::steady_clock::now();
-        Problem p = problem;
-        p.events = events;
-        p.N = N;
-        p.grid = make_grid(model.tau(), model.period(), N, problem.orbit_period);
-        TrapezoidStepper<Model> stepper(model, step_options(p));
-        StroboscopicMap<Model> map(stepper, p.grid);
-        PeriodicOrbit orbit;
-        if constexpr (!Model::is_linear) {
-          if (level_orbit.newton_guess) {
-            const Eigen::VectorXd guess = prolong_periodic_sequence(*level_orbit.newton_guess, Model::d, p.grid.K);
-            orbit = orbit_by_newton(map, guess, orbit_settings.newton);
-          } else {
-            orbit = find_orbit(model, map, orbit_settings);
-          }
-          if (level_orbit.sequence)
-            *level_orbit.sequence = PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
-        } else {
-          orbit = find_orbit(model, map, orbit_settings);
-        }
-        auto monodromy = map.monodromy(orbit.history);
-        const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        fn(monodromy, orbit, setup);
-      },
-      problem.model);
+void with_monodromy(const Problem& problem, EventMode events, const OrbitSettings& orbit_settings, int N, Fn&& fn,
+                    const LevelOrbit& level_orbit = {}) {
+  const auto start = std::chrono::steady_clock::now();
+  Problem p = problem;
+  p.events = events;
+  p.N = N;
+  with_map(p, [&](const auto& model, const auto& map) {
+    using Model = std::decay_t<decltype(model)>;
+    using Map = std::decay_t<decltype(map)>;
+    PeriodicOrbit orbit;
+    if constexpr (!Model::is_linear) {
+      if (level_orbit.newton_guess) {
+        const Eigen::VectorXd guess = prolong_periodic_sequence(*level_orbit.newton_guess, Model::d, map.grid().K);
+        orbit = orbit_by_newton(map, guess, orbit_settings.newton);
+      } else {
+        orbit = find_orbit(model, map, orbit_settings);
+      }
+      if (level_orbit.sequence)
+        *level_orbit.sequence = PeriodicOrbitProblem<Map>(map).sequence_from_history(orbit.history);
+    } else {
+      orbit = find_orbit(model, map, orbit_settings);
+    }
+    auto monodromy = map.monodromy(orbit.history);
+    const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fn(monodromy, orbit, setup);
+  });
 }
 
 }  // namespace delayspec::cli

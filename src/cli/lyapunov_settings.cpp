@@ -27,17 +27,9 @@ LyapunovOptions read_lyapunov_options(Config& config, int default_exponents) {
 }
 
 LyapunovResult run_lyapunov(const Problem& problem, const LyapunovOptions& options) {
-  return std::visit(
-      [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        StroboscopicMap<Model> map(TrapezoidStepper<Model>(model, step_options(problem)), problem.grid);
-        return lyapunov_exponents(map, map.constant_history(model.initial_state()), options);
-      },
-      problem.model);
-}
-
-int state_dimension(const Problem& problem) {
-  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::d; }, problem.model);
+  return with_map(problem, [&](const auto& model, const auto& map) {
+    return lyapunov_exponents(map, map.constant_history(model.initial_state()), options);
+  });
 }
 
 }  // namespace delayspec::cli
