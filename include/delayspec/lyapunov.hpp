@@ -171,8 +171,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   if (!U0.allFinite()) throw BadInput("lyapunov_exponents: the initial history is not finite");
 
   const auto start = std::chrono::steady_clock::now();
-  const long M = grid.M, m = grid.m, K = grid.K, spp = grid.steps_per_period;
-  const double theta = grid.theta, c0 = 1 - theta, h = grid.h;
+  const long M = grid.M, K = grid.K, spp = grid.steps_per_period;
   const int k = options.exponents;
   const long stride = static_cast<long>(D) * k;  // one slot of the block
   const Stepper& stepper = map.stepper();
@@ -205,15 +204,13 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   // One stroboscopic period, trajectory and block fused; afterwards the trajectory history is
   // back in slots 0..M and the (unnormalised) block in slots K..K+M.
   auto advance = [&](bool record) {
+    auto slot = [&traj](long i) -> const V& { return traj[i]; };
     for (long l = 0; l < K; ++l) {
-      const long j = M + l - m;  // delayed slot at the step's start
-      const V w0 = theta == 0 ? traj[j] : V(c0 * traj[j] + theta * traj[j - 1]);
-      const V w1 = theta == 0 ? traj[j + 1] : V(c0 * traj[j + 1] + theta * traj[j]);
-      const double t = static_cast<double>(l % spp) * h;
-      traj[M + l + 1] = stepper.step(t, h, traj[M + l], w0, w1, step_map);
-      // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors
-      step_block<D>(step_map, block.data() + (M + l) * stride, block.data() + j * stride, k, theta,
-                    block.data() + (M + l + 1) * stride);
+      const DelayTap<V> tap = grid.delay_tap<V>(l, slot);
+      traj[M + l + 1] = stepper.step(tap.t, grid.h, traj[M + l], tap.w0, tap.w1, step_map);
+      // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same tap)
+      step_block<D>(step_map, block.data() + (M + l) * stride, block.data() + grid.delayed_slot(l) * stride, k,
+                    grid.theta, block.data() + (M + l + 1) * stride);
       if (record && (l + 1) % spp == 0 && section_count < options.section_points)
         result.section.row(section_count++) = traj[M + l + 1].transpose();
     }
@@ -264,7 +261,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   result.batch_standard_error_per_period = std::move(stats.batch_standard_error);
   result.fluctuation_bound_per_period = std::move(stats.fluctuation_bound);
   result.batches = stats.batches;
-  result.map_time = static_cast<double>(K) * h;
+  result.map_time = static_cast<double>(K) * grid.h;
   for (int i = 0; i < k; ++i) {
     result.per_time.push_back(result.per_period[i] / result.map_time);
     result.standard_error_per_time.push_back(result.standard_error_per_period[i] / result.map_time);
