@@ -329,8 +329,7 @@ TEST(ConvergeCli, LevelThatFailsEverywhereIsReportedAndTheStudyGoesOn) {
 }
 
 TEST(ConvergeCli, ImpactShowsEventsOnAndOffSideBySideAndWritesCsv) {
-  const auto dir = std::filesystem::temp_directory_path() / "delayspec_test_converge_out";
-  std::filesystem::remove_all(dir);
+  const auto dir = delayspec::testing::fresh_dir("converge_out");
   CliResult r = run({"converge", std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/default.toml", "--json", "--out",
                      dir.string(), "--set", "Ns=100,200,400", "--set", "nev=2"});
   ASSERT_EQ(r.status, 0) << r.err;

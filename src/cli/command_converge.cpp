@@ -36,7 +36,6 @@ namespace delayspec::cli {
 
 namespace {
 
-nlohmann::json number_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
 // A failure message on one line (for a CSV comment).
 std::string one_line(std::string text) {

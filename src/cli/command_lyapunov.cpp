@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "lyapunov_settings.hpp"
+#include "output.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
 
@@ -27,21 +28,14 @@ int command_lyapunov(Config& config, const Invocation& inv) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (inv.json) {
-    nlohmann::json j;
+    nlohmann::json j = lyapunov_json(r);
     j["model"] = problem.model_name;
     j["N"] = problem.N;
     j["dimension"] = n;
-    j["exponents_per_period"] = r.per_period;
-    j["exponents_per_time"] = r.per_time;
-    j["standard_error_per_period"] = r.standard_error_per_period;
-    j["standard_error_per_time"] = r.standard_error_per_time;
-    j["batch_standard_error_per_period"] = r.batch_standard_error_per_period;
-    j["fluctuation_bound_per_period"] = r.fluctuation_bound_per_period;
     j["periods"] = r.periods;
     j["transient"] = r.transient;
     j["seconds"] = seconds;
     j["qr_seconds"] = r.qr_seconds;
-    j["period_time"] = r.map_time;
     j["qr_every"] = r.qr_every;
     j["batches"] = r.batches;
     j["seed"] = options.seed;

@@ -35,7 +35,7 @@ const Probes& all_probes() {
   static const Probes probes = [] {
     Probes p;
     for (const auto& [command, fn] : command_table())
-      for (const auto& model : model_names()) p[command][model] = probe_reads(command, probe_config(command, model));
+      for (const auto& model : model_names()) p[command][model] = probe_command(command, probe_config(command, model)).reads;
     return p;
   }();
   return probes;
@@ -55,7 +55,7 @@ std::string default_text(const std::string& command, const Config::Read& r) {
 
 }  // namespace
 
-std::vector<Config::Read> probe_reads(const std::string& command, Config config) {
+Probe probe_command(const std::string& command, Config config, OnBadInput on_bad_input) {
   config.collect_keys_only(true);
   std::ostringstream sink_out, sink_err;
   Invocation dry{.command = command, .scene = std::nullopt, .json = true, .out_dir = std::nullopt, .quiet = true,
@@ -63,9 +63,12 @@ std::vector<Config::Read> probe_reads(const std::string& command, Config config)
   try {
     command_table().at(command)(config, dry);
   } catch (const KeysCollected&) {
+    // the keys it carries are config.used_keys()
   } catch (const BadInput&) {
+    if (on_bad_input == OnBadInput::rethrow) throw;
   }
-  return config.reads();
+  // (a command that never checked its keys, as every command should: what it read)
+  return {config.reads(), config.used_keys()};
 }
 
 const KeyReaders& key_readers() {
