@@ -31,7 +31,8 @@
 //   bounds |lambda - lambda_true| up to the fraction P / I (small when the run covers many
 //   rotations or the excess dies out early). For a random walk D is a Brownian bridge whose
 //   range has mean sqrt(pi / 2) sigma sqrt(n) (Kuiper), so F ~ 1.25 SE. Reported error
-//   (standard_error_per_period, its historical name and the CLI key):
+//   (LyapunovResult::error_per_period; the JSON key keeps its historical name
+//   standard_error_per_period):
 //       error = sqrt(SE^2 + F^2).
 //   On a bounded fluctuation it is >= F, and where F falls short by the fraction P / I (an
 //   excess concentrated in the first P intervals, i.e. in the first batch) SE = |bias| exactly
@@ -50,10 +51,10 @@
 // in place; Q is written back to slots 0..M and the trajectory slots are moved down. All
 // buffers are allocated once per call.
 //
-// QR interval. With qr_every = m > 1 the block is not re-orthonormalised for m periods, so its
-// columns separate by the ratio of the Floquet/Lyapunov growth factors over m periods; the
+// QR interval. With qr_every = q > 1 the block is not re-orthonormalised for q periods, so its
+// columns separate by the ratio of the Floquet/Lyapunov growth factors over q periods; the
 // k-th column then keeps only about 16 - log10(R_11 / R_kk) digits, and a large enough growth
-// overflows. The run therefore checks every QR of an interval m > 1: if max_i |log R_ii| > 300
+// overflows. The run therefore checks every QR of an interval q > 1: if max_i |log R_ii| > 300
 // (entries near 1e130, halfway to overflow) or R_11 / R_kk > 1e8 (fewer than 8 digits left in
 // the k-th direction) it stops with NumericalFailure asking for a smaller qr_every. With
 // qr_every = 1 (the default) no such check applies: any loss is then a property of one period
@@ -66,7 +67,7 @@
 // Example:
 //   StroboscopicMap<LinearModel> map(TrapezoidStepper<LinearModel>(model), grid);
 //   LyapunovResult r = lyapunov_exponents(map, map.constant_history(Vec<1>(1)), LyapunovOptions{});
-//   r.per_time[0] +- r.standard_error_per_time[0]   // the error of the header comment
+//   r.per_time[0] +- r.error_per_time[0]   // the error of the header comment
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -101,8 +102,8 @@ struct LyapunovOptions {
 struct LyapunovResult {
   std::vector<double> per_period;                  // sum log |R_ii| / periods, largest first as computed
   std::vector<double> per_time;                    // per_period / (K h)
-  std::vector<double> standard_error_per_period;   // the error: sqrt(batch SE^2 + fluctuation bound^2) (header comment)
-  std::vector<double> standard_error_per_time;     // standard_error_per_period / (K h)
+  std::vector<double> error_per_period;   // the error: sqrt(batch SE^2 + fluctuation bound^2) (header comment)
+  std::vector<double> error_per_time;     // error_per_period / (K h)
   std::vector<double> batch_standard_error_per_period;  // batch means: sd(batch means) / sqrt(batches)
   std::vector<double> fluctuation_bound_per_period;     // range of the detrended cumulative sum / periods
   long periods = 0, transient = 0;
@@ -257,14 +258,14 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
 
   LyapunovStatistics stats = lyapunov_statistics(interval_logs, k, options.qr_every, options.batches);
   result.per_period = std::move(stats.mean_per_period);
-  result.standard_error_per_period = std::move(stats.error);
+  result.error_per_period = std::move(stats.error);
   result.batch_standard_error_per_period = std::move(stats.batch_standard_error);
   result.fluctuation_bound_per_period = std::move(stats.fluctuation_bound);
   result.batches = stats.batches;
   result.map_time = static_cast<double>(K) * grid.h;
   for (int i = 0; i < k; ++i) {
     result.per_time.push_back(result.per_period[i] / result.map_time);
-    result.standard_error_per_time.push_back(result.standard_error_per_period[i] / result.map_time);
+    result.error_per_time.push_back(result.error_per_period[i] / result.map_time);
   }
   result.periods = options.periods;
   result.transient = options.transient;

@@ -8,7 +8,7 @@
 //   z1 = z0 + dt/2 [ f_jl(t0, z0, w0) + f_jr(t0 + dt, z1, w1) ]          (*)
 //
 // so that an event (a crossing of H = 0) can split it into pieces with explicit regions
-// (event handling: see the events extension). The derivative of (*) is
+// (event handling: event_step.hpp). The derivative of (*) is
 //
 //   dz1 = S^{-1} [ (I + dt/2 A_l) dz0 + dt/2 B_l dw0 + dt/2 B_r dw1 ],   S = I - dt/2 A_r.
 #include <array>

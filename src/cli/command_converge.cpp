@@ -287,7 +287,7 @@ int command_converge(Config& config, const Invocation& inv) {
   config.set("events", events.front(), "converge");
   Problem problem = read_problem(config, 100);
   const bool switching =
-      std::visit([](const auto& m) { return std::decay_t<decltype(m)>::has_switching; }, problem.model);
+      std::visit([](const auto& model) { return std::decay_t<decltype(model)>::has_switching; }, problem.model);
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   ConvergenceOptions base;
   base.Ns = read_N_list(config, problem, 25, 400);

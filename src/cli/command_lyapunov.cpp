@@ -56,7 +56,7 @@ int command_lyapunov(Config& config, const Invocation& inv) {
     inv.out << line;
     for (size_t i = 0; i < r.per_period.size(); ++i) {
       std::snprintf(line, sizeof line, "  %3zu  %+.6e +- %.1e  %+.6e +- %.1e\n", i + 1, r.per_period[i],
-                    r.standard_error_per_period[i], r.per_time[i], r.standard_error_per_time[i]);
+                    r.error_per_period[i], r.per_time[i], r.error_per_time[i]);
       inv.out << line;
     }
     inv.out << "time: " << seconds << " s (QR " << r.qr_seconds << " s)\n";

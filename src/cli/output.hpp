@@ -17,7 +17,8 @@ namespace delayspec::cli {
 nlohmann::json number_or_null(double x);
 
 // The exponents and their errors, the fields `lyapunov --json` and each `sweep` point share:
-// exponents_per_period, standard_error_per_period, exponents_per_time, standard_error_per_time,
+// exponents_per_period, standard_error_per_period (= error_per_period, the historical key),
+// exponents_per_time, standard_error_per_time,
 // batch_standard_error_per_period, fluctuation_bound_per_period, period_time.
 nlohmann::json lyapunov_json(const LyapunovResult& r);
 

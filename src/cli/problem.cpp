@@ -70,11 +70,11 @@ StepOptions step_options(const Problem& problem) {
 }
 
 HistoryGrid Problem::grid() const {
-  return std::visit([&](const auto& m) { return make_grid(m.tau(), m.period(), N, orbit_period); }, model);
+  return std::visit([&](const auto& mod) { return make_grid(mod.tau(), mod.period(), N, orbit_period); }, model);
 }
 
 int Problem::state_dimension() const {
-  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::d; }, model);
+  return std::visit([](const auto& mod) { return std::decay_t<decltype(mod)>::d; }, model);
 }
 
 std::string to_string(EventMode mode) {
