@@ -67,9 +67,12 @@
 #include "delayspec/model.hpp"
 #include "delayspec/scalar_search.hpp"
 #include "delayspec/step_map.hpp"
-#include "delayspec/stepper.hpp"
+#include "delayspec/step_options.hpp"
 
 namespace delayspec {
+
+template <class Model>
+class TrapezoidStepper;  // stepper.hpp: its sub_step() and options() are what a split step uses
 
 namespace detail {
 

@@ -46,6 +46,7 @@
 #include <Eigen/Core>
 
 #include "delayspec/monodromy.hpp"
+#include "delayspec/multipliers.hpp"
 
 namespace delayspec {
 
