@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "delayspec/block_kernel.hpp"
+#include "delayspec/detail/block_kernel.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {

@@ -77,10 +77,10 @@
 
 #include <Eigen/Core>
 
-#include "delayspec/block_kernel.hpp"
+#include "delayspec/detail/block_kernel.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/stroboscopic_map.hpp"
-#include "delayspec/tangent_qr.hpp"
+#include "delayspec/detail/tangent_qr.hpp"
 
 namespace delayspec {
 

@@ -37,7 +37,7 @@
 
 #include "delayspec/errors.hpp"
 #include "delayspec/periodic_orbit.hpp"
-#include "delayspec/sparse_lu.hpp"
+#include "delayspec/detail/sparse_lu.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec {

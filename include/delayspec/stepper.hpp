@@ -18,7 +18,7 @@
 #include <Eigen/LU>
 
 #include "delayspec/errors.hpp"
-#include "delayspec/event_step.hpp"  // event_step(), called by step()
+#include "delayspec/detail/event_step.hpp"  // event_step(), called by step()
 #include "delayspec/model.hpp"
 #include "delayspec/step_map.hpp"
 #include "delayspec/step_options.hpp"

@@ -65,7 +65,7 @@
 
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
-#include "delayspec/scalar_search.hpp"
+#include "delayspec/detail/scalar_search.hpp"
 #include "delayspec/step_map.hpp"
 #include "delayspec/step_options.hpp"
 
