@@ -56,8 +56,10 @@ int command_chart(Config& config, const Invocation& inv) {
     const FloquetOptions options = read_floquet_options(point, 1);
     try {
       with_map(p, [&](const auto& model, const auto& map) {
-        const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
-        const FloquetResult r = floquet_multipliers(map.monodromy(orbit.history), options);
+        using Model = std::decay_t<decltype(model)>;
+        OrbitLinearisation<Model::d> at_orbit;
+        find_orbit(model, map, orbit_settings, &at_orbit);
+        const FloquetResult r = floquet_multipliers(Monodromy<Model::d>(map.grid(), std::move(at_orbit.maps)), options);
         radius[i] = std::abs(r.multipliers.at(0));
       });
     } catch (const NumericalFailure& e) {

@@ -25,10 +25,15 @@ int command_floquet(Config& config, const Invocation& inv) {
   FloquetResult result;
   PeriodicOrbit orbit;
   ContactSummary contacts;
+  double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
   with_map(problem, [&](const auto& model, const auto& map) {
-    orbit = find_orbit(model, map, orbit_settings);
-    contacts = orbit_contacts(model, map, orbit);
-    auto monodromy = map.monodromy(orbit.history);
+    using Model = std::decay_t<decltype(model)>;
+    const auto orbit_start = std::chrono::steady_clock::now();
+    OrbitLinearisation<Model::d> at_orbit;  // the monodromy and states at the orbit
+    orbit = find_orbit(model, map, orbit_settings, &at_orbit);
+    orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
+    contacts = orbit_contacts(model, std::move(at_orbit.states));
+    const Monodromy<Model::d> monodromy(map.grid(), std::move(at_orbit.maps));
     result = floquet_multipliers(monodromy, options);
   });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -40,6 +45,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["solver"] = result.solver;
     json["multipliers"] = multipliers_json(result.multipliers);
     json["seconds"] = seconds;
+    json["orbit_seconds"] = orbit_seconds;
     json["eigensolver_seconds"] = result.seconds;
     json["operator_applications"] = result.operator_applications;
     json["converged"] = result.converged;
