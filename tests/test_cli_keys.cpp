@@ -48,7 +48,7 @@ TEST(CommandHelp, ListsTheKeysTheCommandReadsWithDefaults) {
 TEST(CommandHelp, ModelKeysAreListedPerModel) {
   CliResult r = run({"floquet", "--help"});
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* line : {"nev = 6", "solver = spectra", "tol = 1e-12", " with model = impact:", "zeta = 0.01",
+  for (const char* line : {"nev = 6", "solver = auto", "tol = 1e-12", " with model = impact:", "zeta = 0.01",
                            " with model = linear:", "a = -1", " with model = mathieu:", "kappa = 0.1",
                            " with model = mackey-glass:", "gamma = 0.1"})
     EXPECT_TRUE(contains(r.out, line)) << line << "\n" << r.out;

@@ -189,7 +189,7 @@ std::string rule_broken(const FloquetOptions& o, long n) {
 
 TEST(FloquetOptionsRules, EachBoundAtItsEdgeWithOneMessage) {
   const long n = 21;
-  FloquetOptions o;  // defaults: nev 6, spectra, ncv 0, tol 1e-12, 300 iterations, bound 1e-8
+  FloquetOptions o;  // defaults: nev 6, auto, ncv 0, tol 1e-12, 300 iterations, bound 1e-8
   EXPECT_EQ(rule_broken(o, n), "");
   o.nev = 0;
   EXPECT_EQ(rule_broken(o, n), "`nev = 0`: must be between 1 and the dimension n = 21");
@@ -200,11 +200,13 @@ TEST(FloquetOptionsRules, EachBoundAtItsEdgeWithOneMessage) {
   o.solver = FloquetSolver::dense_lapack;
   EXPECT_EQ(rule_broken(o, n), "");
 
-  FloquetOptions k;  // the Krylov-only rules, and that dense ignores them
+  FloquetOptions k;  // the Krylov rules, for auto (which may pick Krylov) too, and dense ignoring them
+  ASSERT_EQ(k.solver, FloquetSolver::automatic);
   k.ncv = k.nev + 1;
   EXPECT_EQ(rule_broken(k, n), "`ncv = 7`: must be 0 (automatic) or >= nev + 2 = 8");
   k.ncv = k.nev + 2;
   EXPECT_EQ(rule_broken(k, n), "");
+  k.solver = FloquetSolver::spectra;
   k.tolerance = 0;
   EXPECT_EQ(rule_broken(k, n), "`tol = 0`: must be > 0 and finite");
   k.tolerance = INFINITY;
@@ -331,6 +333,7 @@ TEST(KrylovResidualGate, RankOneMonodromyLeadingMultiplierIsExact) {
     if (solver == FloquetSolver::spectra) {
       FloquetOptions o;
       o.nev = 1;
+      o.solver = FloquetSolver::spectra;
       o.retry_failed_gate = false;
       const std::string m = numerical_failure_message([&] { floquet_multipliers(op, o); });
       const bool refused = m.find("Krylov (spectra): multiplier 1 of nev = 1") != std::string::npos &&

@@ -1,7 +1,7 @@
 // delayspec converge: h-convergence study of the leading Floquet multipliers (CLI contract,
 // design.md 1.8). Library part: include/delayspec/convergence.hpp.
 //
-// Keys: Ns (comma list) or N_min/N_max (doubling); nev, solver (default spectra), ncv, tol,
+// Keys: Ns (comma list) or N_min/N_max (doubling); nev, solver (default auto), ncv, tol,
 // max_restarts, seed (floquet_settings.hpp); reference = exact | extrapolated |
 // finest | auto; solver; extrapolation_order, extrapolation_order_step, extrapolation_levels;
 // converge_target (a relative error: keep doubling N until every tracked multiplier's estimate

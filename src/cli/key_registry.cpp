@@ -116,7 +116,7 @@ const std::map<std::string, std::string>& key_meanings() {
       {"orbit_guess_periods", "newton, auto, shooting: periods simulated from the initial history before the guess"},
       {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this; one level below 8x it"},
       {"nev", "multipliers wanted, >= 1"},
-      {"solver", "eigensolver: spectra, arpack (Krylov), dense (= dense-lapack), dense-eigen"},
+      {"solver", "eigensolver: auto (dense n <= 100, spectra n < 2000, else arpack), spectra, arpack, dense, dense-eigen"},
       {"ncv", "Krylov subspace dimension; 0 = max(2 nev + 1, nev + 10), at most n"},
       {"tol", "Krylov: converged when residual estimate <= tol max(|mu|, eps^(2/3))"},
       {"residual_bound", "Krylov: a returned pair needs a true residual |M v - mu v| / (|mu| |v|) <= max(residual_bound, 100 tol) (else retried, then exit 3)"},
