@@ -39,6 +39,24 @@ std::string to_string(FloquetSolver solver) {
   return "?";
 }
 
+void validate_floquet_options(const FloquetOptions& options, long n) {
+  if (options.nev < 1 || options.nev > n)
+    throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " +
+                   std::to_string(n));
+  // The Krylov options are checked whenever a Krylov backend may run (auto included, whatever
+  // it picks): a bad ncv is an error of the request, not of the size that hides it.
+  if (options.solver == FloquetSolver::dense_eigen || options.solver == FloquetSolver::dense_lapack) return;
+  if (options.ncv != 0 && options.ncv < options.nev + 2)
+    throw BadInput("`ncv = " + std::to_string(options.ncv) + "`: must be 0 (automatic) or >= nev + 2 = " +
+                   std::to_string(options.nev + 2));
+  if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
+    throw BadInput("`tol = " + format_number(options.tolerance) + "`: must be > 0 and finite");
+  if (options.max_iterations < 1)
+    throw BadInput("`max_iterations = " + std::to_string(options.max_iterations) + "`: must be >= 1");
+  if (!(options.residual_bound > 0) || !std::isfinite(options.residual_bound))
+    throw BadInput("`residual_bound = " + format_number(options.residual_bound) + "`: must be > 0 and finite");
+}
+
 int default_ncv(int nev, long n) {
   const long ncv = std::max(2L * nev + 1, static_cast<long>(nev) + 10);
   return static_cast<int>(std::min(ncv, n));
@@ -335,26 +353,10 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
 template <int D>
 FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& requested) {
   const long n = op.rows();
+  validate_floquet_options(requested, n);
   FloquetOptions options = requested;
-  // Krylov options are checked when a Krylov backend may run (auto included), whatever auto picks.
-  const bool krylov_requested = options.solver == FloquetSolver::spectra || options.solver == FloquetSolver::arpack ||
-                                options.solver == FloquetSolver::automatic;
   if (options.solver == FloquetSolver::automatic) options.solver = choose_floquet_solver(n);
-  if (options.nev < 1 || options.nev > n)
-    throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " +
-                   std::to_string(n));
   const bool krylov = options.solver == FloquetSolver::spectra || options.solver == FloquetSolver::arpack;
-  if (krylov_requested) {
-    if (options.ncv != 0 && options.ncv < options.nev + 2)
-      throw BadInput("`ncv = " + std::to_string(options.ncv) + "`: must be 0 (automatic) or >= nev + 2 = " +
-                     std::to_string(options.nev + 2));
-    if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
-      throw BadInput("`tol = " + format_number(options.tolerance) + "`: must be > 0 and finite");
-    if (options.max_iterations < 1)
-      throw BadInput("`max_iterations = " + std::to_string(options.max_iterations) + "`: must be >= 1");
-    if (!(options.residual_bound > 0) || !std::isfinite(options.residual_bound))
-      throw BadInput("`residual_bound = " + format_number(options.residual_bound) + "`: must be > 0 and finite");
-  }
   const auto start = std::chrono::steady_clock::now();
   FloquetResult result;
   const long applications_before = op.applications();

@@ -46,6 +46,7 @@
 #include <Eigen/Core>
 
 #include "delayspec/monodromy.hpp"
+#include "delayspec/multipliers.hpp"
 
 namespace delayspec {
 
@@ -92,6 +93,13 @@ struct FloquetResult {
   // column k = Re v_k when Im mu_k >= 0, Im v_k otherwise (a conjugate pair spans {Re v, Im v}).
   Eigen::MatrixXd subspace;
 };
+
+// The options' rules for an n x n monodromy, each in one place, named by the CLI keys:
+// 1 <= nev <= n; for Krylov and auto also ncv = 0 or ncv >= nev + 2, tolerance > 0 and finite,
+// max_iterations >= 1, residual_bound > 0 and finite. BadInput "`key = v`: must be ..." otherwise.
+// floquet_multipliers() calls it first; a command calls it before its heavy work (the orbit) to
+// fail fast. (Krylov's nev <= n - 2 is not a rule: a larger nev runs the dense path.)
+void validate_floquet_options(const FloquetOptions& options, long n);
 
 // The nev leading multipliers. See the header comment for errors.
 template <int D>

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "delayspec/errors.hpp"
+#include "delayspec/lyapunov.hpp"  // kMaxTangentVectors
 #include "problem.hpp"
 
 namespace delayspec::cli {
@@ -34,7 +35,7 @@ const Probes& all_probes() {
   static const Probes probes = [] {
     Probes p;
     for (const auto& [command, fn] : command_table())
-      for (const auto& model : model_names()) p[command][model] = probe_reads(command, probe_config(command, model));
+      for (const auto& model : model_names()) p[command][model] = probe_command(command, probe_config(command, model)).reads;
     return p;
   }();
   return probes;
@@ -54,7 +55,7 @@ std::string default_text(const std::string& command, const Config::Read& r) {
 
 }  // namespace
 
-std::vector<Config::Read> probe_reads(const std::string& command, Config config) {
+Probe probe_command(const std::string& command, Config config, OnBadInput on_bad_input) {
   config.collect_keys_only(true);
   std::ostringstream sink_out, sink_err;
   Invocation dry{.command = command, .scene = std::nullopt, .json = true, .out_dir = std::nullopt, .quiet = true,
@@ -62,9 +63,12 @@ std::vector<Config::Read> probe_reads(const std::string& command, Config config)
   try {
     command_table().at(command)(config, dry);
   } catch (const KeysCollected&) {
+    // the keys it carries are config.used_keys()
   } catch (const BadInput&) {
+    if (on_bad_input == OnBadInput::rethrow) throw;
   }
-  return config.reads();
+  // (a command that never checked its keys, as every command should: what it read)
+  return {config.reads(), config.used_keys()};
 }
 
 const KeyReaders& key_readers() {
@@ -119,7 +123,7 @@ const std::map<std::string, std::string>& key_meanings() {
       {"max_restarts", "Krylov: implicit restarts allowed (more: exit 3), 0..1000000"},
       {"seed", "seed of the random start vector (Krylov) or initial tangent block (Lyapunov)"},
       // lyapunov (lyapunov_settings.cpp), sweep
-      {"exponents", "Lyapunov exponents wanted, 1..64"},
+      {"exponents", "Lyapunov exponents wanted, 1.." + std::to_string(kMaxTangentVectors)},
       {"periods", "Lyapunov: periods averaged (a multiple of qr_every), >= 2"},
       {"transient", "Lyapunov: periods discarded first, >= 0"},
       {"qr_every", "Lyapunov: periods between QR factorisations"},
