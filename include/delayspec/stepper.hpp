@@ -94,8 +94,11 @@ class TrapezoidStepper {
  private:
   // Newton on G(z) = z - rhs0 - dt/2 f_jr(t1, z, w1). Returns z1; jr receives the right node's
   // region and lu the factorisation of S = I - dt/2 A_jr(t1, z, w1) at the last iterate.
-  V solve_sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region, int right_region,
-                   int& jr, detail::SmallSolve<D>& lu) const {
+  // Always inlined into its callers: GCC can then evaluate a model's sin/cos(t0) once for f and A
+  // at the left node (-fno-math-errno); measured 6 % of a Mathieu Lyapunov run.
+  [[gnu::always_inline]] inline V solve_sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1,
+                                                 int left_region, int right_region, int& jr,
+                                                 detail::SmallSolve<D>& lu) const {
     const double t1 = t0 + dt;
     const V rhs0 = z0 + 0.5 * dt * model_.f(left_region, t0, z0, w0);  // explicit half
     // For an affine f_jr one Newton step is exact. In the automatic mode (the plain, unsplit
