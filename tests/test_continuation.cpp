@@ -192,6 +192,30 @@ TEST(Continuation, GrazingOfImpactOrbitAtFreeAmplitude) {
   EXPECT_LE(std::abs(all[0].extrapolated - A), all[0].error_estimate) << all[0].note;
 }
 
+TEST(Continuation, StepThatCannotBeReducedEndsTheBranchWithThePointReached) {
+  // The model does not exist for p > 0.5 (BadInput from the factory): the branch from p = 0.1
+  // towards 1 shrinks its step at the edge until it is below step_min.
+  ContinuationOptions o;
+  o.from = 0.1;
+  o.to = 1;
+  o.N = 20;
+  auto model_at = [](double p) {
+    if (p > 0.5) throw BadInput("`p = " + format_number(p) + "`: must be <= 0.5");
+    return SaddleNodeDelayModel{p, 0.5};
+  };
+  const ContinuationResult r =
+      continue_orbit<SaddleNodeDelayModel>(model_at, Eigen::VectorXd::Constant(20, std::sqrt(0.1)), o);
+  EXPECT_EQ(r.end, "failure");
+  ASSERT_GE(r.points.size(), 2u);
+  EXPECT_LE(r.points.back().parameter, 0.5);
+  // the branch went as far as the edge allows: beyond 0.4 (its steps are at most 0.09)
+  EXPECT_GT(r.points.back().parameter, 0.4);
+  EXPECT_NE(r.failure.find("step below continue_step_min"), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("at parameter " + format_number(r.points.back().parameter)), std::string::npos) << r.failure;
+  EXPECT_NE(r.failure.find("must be <= 0.5"), std::string::npos) << r.failure;
+  for (const auto& pt : r.points) EXPECT_NEAR(pt.measures.max[0], std::sqrt(pt.parameter), 1e-9);
+}
+
 TEST(Continuation, BadInputAndFailures) {
   auto model_at = [](double b) { return LinearModel({-1, b, 1, 1}); };
   ContinuationOptions o;

@@ -37,7 +37,10 @@
 // `failure` set: the point reached and the reason (the points so far are kept).
 //
 // End of the branch: the first point past `to`, or back past `from` after a fold, is replaced
-// by the point at exactly that end (Newton with p fixed); or max_points points.
+// by the point at exactly that end (Newton with p fixed); or max_points points. A predictor past
+// `to` is first shortened to land on it. A parameter value the model rejects (BadInput from the
+// model factory, e.g. a negative damping) counts as a failed corrector: the step shrinks, and the
+// branch ends at the edge of the model's domain with `failure` set.
 //
 // At every point: the leading multipliers (floquet.hpp, the options' nev and solver), the number
 // of unstable ones (|mu| > 1), the orbit's measures (OrbitMeasures).
@@ -265,6 +268,9 @@ class PeriodicBranch {
         linearise(x, p, F, Fx, Fp);
       } catch (const NumericalFailure& e) {
         why = std::string("residual not computable at ") + format_number(p) + " (" + e.what() + ")";
+        return std::nullopt;
+      } catch (const BadInput& e) {  // p (or p +- delta) outside the model's domain
+        why = std::string("the model rejects parameter ") + format_number(p) + " (" + e.what() + ")";
         return std::nullopt;
       }
       const double r = F.lpNorm<Eigen::Infinity>();
@@ -545,8 +551,12 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
       if (st) {
         result.newton_iterations += st->iterations;
         ++result.krylov_solves;
-        pt = branch.evaluate(*st, result.krylov_seconds);
-        g = test(*pt);
+        try {
+          pt = branch.evaluate(*st, result.krylov_seconds);
+          g = test(*pt);
+        } catch (const NumericalFailure& e) {
+          reason = e.what();
+        }
       }
       if (!pt || !std::isfinite(g)) {
         // Taken as the positive side (for grazing the side in contact, where the discrete problem
@@ -598,6 +608,9 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
   double ds = o.step;
   result.end = "max_points";
   while (static_cast<long>(result.points.size()) < o.max_points) {
+    // A predictor past `to` is shortened to land on it (the model may not exist beyond).
+    if ((current->p + ds * current->tp - o.to) * direction > 0 && std::abs(current->tp) > 0.1)
+      ds = std::max((o.to - current->p) / current->tp, o.step_min);
     std::string reason;
     std::optional<State> next = point_along(*current, ds, reason);
     if (next && branch.dot(next->tx, next->tp, current->tx, current->tp) < 0) {
@@ -639,7 +652,15 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
       last = true;
       result.end = past_to >= 0 ? "to" : "from";
     }
-    ContinuationPoint point = branch.evaluate(*next, result.krylov_seconds);
+    ContinuationPoint point;
+    try {
+      point = branch.evaluate(*next, result.krylov_seconds);
+    } catch (const NumericalFailure& e) {
+      result.end = "failure";
+      result.failure = "multipliers at parameter " + format_number(next->p) + " (after point " +
+                       std::to_string(result.points.size() - 1) + "): " + e.what();
+      break;
+    }
     point.step = ds;
     const ContinuationPoint& previous = result.points.back();
     if (o.locate) {
