@@ -83,7 +83,7 @@ TEST(KeyRegistry, EveryKeyReadHasAMeaningAndEveryMeaningIsRead) {
 TEST(UnreadKey, KeyOfAnotherCommandSaysItIsNotRead) {
   CliResult r = run({"lyapunov", "--set", "nev=4", "--set", "model=linear"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_TRUE(contains(r.err, "`nev` (= 4, from --set) is not read by lyapunov (it is a key of bench, chart, "
+  EXPECT_TRUE(contains(r.err, "`nev` (= 4, from --set) is not read by lyapunov (it is a key of bench, chart, continue, "
                               "converge, floquet")) << r.err;
   EXPECT_TRUE(contains(r.err, "`delayspec lyapunov --help` lists the keys it reads")) << r.err;
   EXPECT_FALSE(contains(r.err, "did you mean")) << r.err;
