@@ -32,8 +32,9 @@
 // Step control (Newton's convergence): a corrector that converges in <= 3 iterations grows the
 // next step by 1.5 (at most step_max); 6 or more shrink it by 0.7; one that fails (not converged
 // in newton.max_iterations, the residual growing, a singular matrix, a step the stepper cannot
-// take) or whose tangent turns by more than ~37 degrees (cos < 0.8: a jump to another branch is
-// the usual cause) is retried with half the step. A step below step_min ends the branch with
+// take), whose tangent turns by more than ~37 degrees (cos < 0.8: a jump to another branch is
+// the usual cause), or whose secant turns back against the previous one (a corner of a piecewise-
+// smooth branch, where the branch would retrace itself) is retried with half the step. A step below step_min ends the branch with
 // `failure` set: the point reached and the reason (the points so far are kept).
 //
 // End of the branch: the first point past `to`, or back past `from` after a fold, is replaced
@@ -43,10 +44,16 @@
 // branch ends at the edge of the model's domain with `failure` set.
 //
 // At every point: the leading multipliers (floquet.hpp, the options' nev and solver), the number
-// of unstable ones (|mu| > 1), the orbit's measures (OrbitMeasures).
+// of unstable ones (|mu| > 1), the orbit's measures (OrbitMeasures). When the eigensolver fails
+// (a pair failing its residual gate: in practice one of the smallest, |mu| ~ 1e-7, of a nearly
+// rank-deficient monodromy) it is retried with one multiplier fewer, down to one; such a point
+// has fewer than nev multipliers.
 //
 // Detection between consecutive points a, b (counts of multipliers outside the unit circle):
-//   fold             the number of real multipliers > 1 changes parity;
+//   fold             the parameter turns (dp/ds changes sign; located where dp/ds = 0, which for
+//                    the discrete problem is where F_x is singular, a multiplier +1; at a corner of
+//                    a piecewise-smooth branch there is none, and the note says so), or the
+//                    number of real multipliers > 1 changes parity (a branch point);
 //   period-doubling  the number of real multipliers < -1 changes parity;
 //   neimark-sacker   the number of non-real multipliers outside the circle changes and so does
 //                    the number of unstable ones (a real pair becoming complex outside the
@@ -120,6 +127,7 @@ struct ContinuationPoint {
   int newton_iterations = 0;  // corrector iterations that produced the point
   double step = 0;            // arclength step from the previous point (0 for the first)
   double residual = 0;        // |F|_inf at the point
+  double tangent_p = 0;       // dp/ds of the unit tangent (oriented along the branch): 0 at a fold
 };
 
 struct Bifurcation {
@@ -362,10 +370,25 @@ class PeriodicBranch {
     point.parameter = s.p;
     point.newton_iterations = s.iterations;
     point.residual = s.residual;
+    point.tangent_p = s.tp;
     const Map map = map_at(s.p);
     PeriodicOrbitProblem<Map> problem(map);
     const auto start = std::chrono::steady_clock::now();
-    const FloquetResult r = floquet_multipliers(map.monodromy(problem.history(s.x)), o_.floquet);
+    const auto monodromy = map.monodromy(problem.history(s.x));
+    // A pair failing the residual gate is nearly always one of the smallest requested (|mu| ~ 1e-7
+    // on a nearly rank-deficient monodromy, far below anything that crosses the circle): retried
+    // with one multiplier fewer, down to one; the point has then fewer multipliers.
+    FloquetOptions floquet = o_.floquet;
+    FloquetResult r;
+    for (;;) {
+      try {
+        r = floquet_multipliers(monodromy, floquet);
+        break;
+      } catch (const NumericalFailure&) {
+        if (floquet.nev <= 1) throw;
+        --floquet.nev;
+      }
+    }
     krylov_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     point.multipliers = r.multipliers;
     for (const auto& mu : r.multipliers) point.unstable += std::abs(mu) > 1;
@@ -497,11 +520,13 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
   };
 
   // Locates a bifurcation of `type` between base (point a) and b at arclength s_b along base's tangent.
-  auto locate = [&](BifurcationType type, const State& base, const ContinuationPoint& pa, const ContinuationPoint& pb,
-                    double s_b, long after) {
+  auto locate = [&](BifurcationType type, bool by_tangent, const State& base, const ContinuationPoint& pa,
+                    const ContinuationPoint& pb, double s_b, long after) {
     const auto locate_start = std::chrono::steady_clock::now();
     auto test = [&](const ContinuationPoint& pt) {
-      return type == BifurcationType::grazing ? pt.measures.max_H : cd::multiplier_test(type, pt.multipliers);
+      if (type == BifurcationType::grazing) return pt.measures.max_H;
+      if (by_tangent) return pt.tangent_p;  // a turning point: dp/ds through 0
+      return cd::multiplier_test(type, pt.multipliers);
     };
     Bifurcation bif;
     bif.type = type;
@@ -512,6 +537,33 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
       ContinuationPoint point;
     };
     Sample neg{0, test(pa), pa.parameter, pa}, pos{s_b, test(pb), pb.parameter, pb};
+    // A long segment may hold more than the one crossing (a pair colliding on the real axis, the
+    // multiplier nearest +-1 not being the one that crosses): bisect on the detection counts,
+    // which are exact, until the test function changes sign over the sub-segment.
+    const auto changes_here = [&](const ContinuationPoint& x, const ContinuationPoint& y) {
+      if (by_tangent) return (x.tangent_p > 0) != (y.tangent_p > 0);
+      const auto found = cd::detected_changes(cd::unstable_counts(x.multipliers), cd::unstable_counts(y.multipliers));
+      return std::find(found.begin(), found.end(), type) != found.end();
+    };
+    while (type != BifurcationType::grazing && !(neg.g * pos.g < 0) && bif.evaluations < 60 &&
+           std::abs(pos.p - neg.p) > o.tolerance) {
+      const double s = 0.5 * (neg.s + pos.s);
+      std::string reason;
+      std::optional<State> st = point_along(base, s, reason);
+      ++bif.evaluations;
+      if (!st) break;
+      result.newton_iterations += st->iterations;
+      ++result.krylov_solves;
+      ContinuationPoint mid;
+      try {
+        mid = branch.evaluate(*st, result.krylov_seconds);
+      } catch (const NumericalFailure&) {
+        break;
+      }
+      const Sample m{s, test(mid), mid.parameter, mid};
+      if (changes_here(neg.point, mid)) pos = m;  // (neg, pos) keep the order of s until the sign change
+      else neg = m;
+    }
     if (neg.g > 0) std::swap(neg, pos);
     std::optional<Sample> prev_neg;  // the negative sample before `neg`
     double g_neg = neg.g, g_pos = pos.g;  // Illinois: possibly halved copies
@@ -600,12 +652,16 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
       bif.angle = NAN;
     } else if (std::isfinite(cd::multiplier_test(type, best.multipliers, &critical))) {
       bif.angle = std::abs(std::arg(critical));
+      if (by_tangent && std::abs(critical - 1.0) > 1e-6)
+        bif.note += std::string(bif.note.empty() ? "" : "; ") + "a turning point with no multiplier at +1 (nearest " +
+                    format_number(critical.real()) + "): a nonsmooth fold";
     }
     result.bifurcations.push_back(std::move(bif));
     result.locate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - locate_start).count();
   };
 
   double ds = o.step;
+  std::optional<State> previous_state;  // the point before `current`
   result.end = "max_points";
   while (static_cast<long>(result.points.size()) < o.max_points) {
     // A predictor past `to` is shortened to land on it (the model may not exist beyond).
@@ -622,6 +678,21 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
                format_number(std::acos(std::clamp(branch.dot(next->tx, next->tp, current->tx, current->tp), -1.0, 1.0))) +
                " rad";
       next.reset();
+    }
+    if (next && previous_state) {
+      // The branch must not turn back on itself: consecutive secants at an angle above 90 degrees
+      // (at a smooth fold the state keeps moving and the secants turn by O(ds)). Seen at a corner
+      // of a piecewise-smooth branch (an impact grazing with |mu| -> 1), where the corrector beyond
+      // the corner lands on the same branch behind it and the branch would retrace itself.
+      const Eigen::VectorXd d1x = current->x - previous_state->x, d2x = next->x - current->x;
+      const double d1p = current->p - previous_state->p, d2p = next->p - current->p;
+      const double cosine = branch.dot(d1x, d1p, d2x, d2p) /
+                            std::sqrt(branch.dot(d1x, d1p, d1x, d1p) * branch.dot(d2x, d2p, d2x, d2p));
+      if (cosine < 0) {
+        reason = "the branch turns back on itself (consecutive secants at " +
+                 format_number(std::acos(std::clamp(cosine, -1.0, 1.0))) + " rad: a corner, not a smooth fold)";
+        next.reset();
+      }
     }
     if (!next) {
       ds *= 0.5;
@@ -646,8 +717,8 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
                                                 reason, result.newton_seconds);
       if (end) {
         if (branch.dot(end->tx, end->tp, next->tx, next->tp) < 0) end->tx = -end->tx, end->tp = -end->tp;
+        s_b = branch.dot(current->tx, current->tp, end->x - current->x, end->p - current->p);
         next = std::move(end);
-        s_b = branch.dot(current->tx, current->tp, next->x - current->x, next->p - current->p);
       }
       last = true;
       result.end = past_to >= 0 ? "to" : "from";
@@ -666,13 +737,21 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
     if (o.locate) {
       std::vector<BifurcationType> found =
           cd::detected_changes(cd::unstable_counts(previous.multipliers), cd::unstable_counts(point.multipliers));
+      // A turning point of the parameter is a fold, located where dp/ds = 0 (for the discrete
+      // problem exactly where F_x is singular: a multiplier +1, or at a corner of a piecewise-
+      // smooth branch none); a multiplier through +1 without one (a branch point) by the multiplier.
+      const bool turning = (previous.tangent_p > 0) != (point.tangent_p > 0);
+      if (turning && std::find(found.begin(), found.end(), BifurcationType::fold) == found.end())
+        found.push_back(BifurcationType::fold);
       if constexpr (Model::has_switching)
         if ((previous.measures.max_H > 0) != (point.measures.max_H > 0)) found.push_back(BifurcationType::grazing);
       const ContinuationPoint a = previous;
       for (BifurcationType type : found)
-        locate(type, *current, a, point, s_b, static_cast<long>(result.points.size()) - 1);
+        locate(type, turning && type == BifurcationType::fold, *current, a, point, s_b,
+               static_cast<long>(result.points.size()) - 1);
     }
     const int iterations = next->iterations;
+    previous_state = std::move(current);
     current = std::move(next);
     add_point(std::move(point));
     if (last) break;
