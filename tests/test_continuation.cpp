@@ -9,6 +9,8 @@
 #include "delayspec/continuation.hpp"
 #include "delayspec/model_impact.hpp"
 #include "delayspec/model_linear.hpp"
+#include "delayspec/model_mathieu.hpp"
+#include "test_support.hpp"
 
 namespace delayspec {
 namespace {
@@ -190,6 +192,36 @@ TEST(Continuation, GrazingOfImpactOrbitAtFreeAmplitude) {
   ASSERT_EQ(all.size(), 1u);
   EXPECT_NEAR(all[0].observed_order, 2, 0.1);
   EXPECT_LE(std::abs(all[0].extrapolated - A), all[0].error_estimate) << all[0].note;
+}
+
+// The delayed Mathieu equation (kappa = 0.1, delta = 2, eps = 1) loses stability near b = -1.41
+// as b decreases through a real multiplier -1. Checked against the dense LAPACK spectrum of the
+// same discretisation at the located b (a different eigensolver on the assembled matrix: the
+// location is where that spectrum holds -1), and the order in N.
+TEST(Continuation, PeriodDoublingOfDelayedMathieuAtMultiplierMinusOne) {
+  const std::vector<int> Ns = {100, 200, 400};
+  std::vector<std::vector<Bifurcation>> by_N;
+  for (int N : Ns) {
+    ContinuationOptions o;
+    o.from = -1.3;
+    o.to = -1.5;
+    o.N = N;
+    o.tolerance = 1e-12;
+    auto model_at = [](double b) { return MathieuModel({0.1, 2, 1, b}); };
+    const ContinuationResult r = continue_orbit<MathieuModel>(model_at, Eigen::VectorXd::Zero(2 * N), o);
+    ASSERT_EQ(r.end, "to") << r.failure;
+    ASSERT_EQ(r.bifurcations.size(), 1u) << "N = " << N;
+    const Bifurcation& pd = r.bifurcations[0];
+    EXPECT_EQ(pd.type, BifurcationType::period_doubling);
+    EXPECT_NEAR(pd.angle, pi, 1e-12);
+    // |mu + 1| <= tolerance |d mu / d b| (O(1)) + the eigensolvers' accuracy (~1e-12)
+    const auto dense = testing::dense_multipliers(MathieuModel({0.1, 2, 1, pd.parameter}), N, 4);
+    EXPECT_LE(testing::distance_to_nearest(dense, -1.0), 1e-9) << "N = " << N;
+    by_N.push_back(r.bifurcations);
+  }
+  const auto all = extrapolate_bifurcations(Ns, by_N, 1e-12);
+  ASSERT_EQ(all.size(), 1u);
+  EXPECT_NEAR(all[0].observed_order, 2, 0.1);
 }
 
 TEST(Continuation, StepThatCannotBeReducedEndsTheBranchWithThePointReached) {
