@@ -652,7 +652,7 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
       bif.angle = NAN;
     } else if (std::isfinite(cd::multiplier_test(type, best.multipliers, &critical))) {
       bif.angle = std::abs(std::arg(critical));
-      if (by_tangent && std::abs(critical - 1.0) > 1e-6)
+      if (by_tangent && std::abs(critical - 1.0) > 1e-3)
         bif.note += std::string(bif.note.empty() ? "" : "; ") + "a turning point with no multiplier at +1 (nearest " +
                     format_number(critical.real()) + "): a nonsmooth fold";
     }
