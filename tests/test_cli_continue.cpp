@@ -105,6 +105,13 @@ TEST(ContinueCli, WritesBranchAndBifurcationFilesWithMetadata) {
   EXPECT_EQ(bifs[1].rfind("neimark-sacker,", 0), 0u) << bifs[1];
   EXPECT_TRUE(fs::exists(dir / "continuation.json"));
   EXPECT_TRUE(fs::exists(dir / "complete.json"));
+  // plot draws the branch and |mu_1| from these files
+  CliResult plot = run({"plot", dir.string()});
+  ASSERT_EQ(plot.status, 0) << plot.err;
+  EXPECT_TRUE(fs::exists(dir / "plots" / "branch.png"));
+  EXPECT_TRUE(fs::exists(dir / "plots" / "branch_mu1.svg"));
+  const std::string script = read_all(dir / "plots" / "branch.gp");
+  EXPECT_NE(script.find("'neimark-sacker'"), std::string::npos) << script;  // the bifurcation is marked
   fs::remove_all(dir);
 }
 
