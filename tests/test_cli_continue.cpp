@@ -103,7 +103,7 @@ TEST(ContinueCli, WritesBranchAndBifurcationFilesWithMetadata) {
   const auto bifs = data_lines(dir / "bifurcations.csv");
   ASSERT_EQ(bifs.size(), 2u);
   EXPECT_EQ(bifs[1].rfind("neimark-sacker,", 0), 0u) << bifs[1];
-  EXPECT_TRUE(fs::exists(dir / "continuation.json"));
+  EXPECT_TRUE(fs::exists(dir / "continue.json"));
   EXPECT_TRUE(fs::exists(dir / "complete.json"));
   // plot draws the branch and |mu_1| from these files
   CliResult plot = run({"plot", dir.string()});

@@ -11,7 +11,7 @@
 //   branch.csv         one row per point: parameter, stability, |mu_1|, the measures, the multipliers
 //   bifurcations.csv   one row per bifurcation: type, location at the finest N, extrapolation,
 //                      error estimate, angle, locations by N
-//   continuation.json  the --json result
+//   continue.json  the --json result
 // A branch that ends in a failure (a step that cannot be reduced further) is written as far as it
 // got, the failure named in the files and on stderr, exit 3.
 #include <chrono>
@@ -217,7 +217,7 @@ int command_continue(Config& config, const Invocation& inv) {
     write_file_atomically(dir / "bifurcations.csv", bifs.str());
     json file = j;
     file["metadata"] = metadata_json(metadata);
-    write_file_atomically(dir / "continuation.json", file.dump(2) + "\n");
+    write_file_atomically(dir / "continue.json", file.dump(2) + "\n");
   }
 
   if (!failures.empty()) {

@@ -15,7 +15,7 @@
 //   section.csv (sweep)       -> bifurcation: Poincare-section x against the swept parameter
 //   trajectory.csv, poincare.csv (simulate) -> phase: portrait with Poincare points and x = e
 //   impacts.csv (simulate)    -> impacts: cumulative impact count against time
-//   branch.csv, continuation.json (continue) -> branch, branch_mu1 (plot_continuation.hpp)
+//   branch.csv, continue.json (continue) -> branch, branch_mu1 (plot_continuation.hpp)
 // Keys: plot_gnuplot (the program, default "gnuplot"), plot_width, plot_height (pixels of the PNG).
 //
 // The inputs are read strictly (plot_inputs.hpp): a file of the wrong shape is bad input (exit 2)

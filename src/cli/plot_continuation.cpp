@@ -44,9 +44,9 @@ void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& di
   const std::string key = t.metadata_text("continue_key", "parameter");
   // The bifurcations: parameter, max y1 at the point, |mu| (1 on the circle; grazing: none).
   std::string marks_y, marks_mu, labels_y, labels_mu;
-  if (std::filesystem::exists(dir / "continuation.json")) {
-    const nlohmann::json doc = read_json_file(dir / "continuation.json");
-    const JsonField j(doc, "continuation.json", "");
+  if (std::filesystem::exists(dir / "continue.json")) {
+    const nlohmann::json doc = read_json_file(dir / "continue.json");
+    const JsonField j(doc, "continue.json", "");
     int index = 0;
     for (const JsonField& b : j.at("bifurcations").elements()) {
       const double p = b.at("parameter").number();

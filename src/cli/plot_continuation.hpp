@@ -2,7 +2,7 @@
 // The figures of a `delayspec continue` result directory (command_plot.cpp calls it when DIR has
 // branch.csv):
 //   branch      max of y1 over the orbit against the continued parameter, stable solid, unstable
-//               dashed, the bifurcations of continuation.json marked and named
+//               dashed, the bifurcations of continue.json marked and named
 //   branch_mu1  |mu_1| against the parameter with the unit line and the bifurcations
 // Inputs read strictly (plot_inputs.hpp): bad files are BadInput naming the file and field.
 #include <filesystem>
