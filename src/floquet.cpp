@@ -266,10 +266,32 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
   // One solve, then the residual gate; on failure one retry with ncv doubled (at most n).
   const int first_ncv = settings.ncv;
   double size = -1;  // operator_size(op, start), computed on the first failing pair
+  // The retry: ncv doubled (at most n); Spectra's breakdown thresholds are absolute
+  // (krylov_spectra.cpp), so it also runs on M / s with |M / s| <= 1 / sqrt(n) or so, |M x| / |x|
+  // underestimating |M| by up to sqrt(n).
+  std::string retry_reason;  // why the first attempt was not taken
+  auto prepare_retry = [&] {
+    settings.ncv = static_cast<int>(std::min<long>(n, 2L * settings.ncv));
+    if (options.solver == FloquetSolver::spectra) {
+      if (size < 0) size = operator_size(op, start);
+      if (size > 0 && std::isfinite(size))
+        settings.scale = std::ldexp(1.0, static_cast<int>(std::lround(std::log2(size * std::sqrt(double(n))))));
+    }
+  };
   for (int attempt = 0;; ++attempt) {
-    krylov::RitzPairs pairs = options.solver == FloquetSolver::spectra
-                                  ? krylov::spectra_ritz_pairs(op, settings, start)
-                                  : krylov::arpack_ritz_pairs(op, settings, start);
+    krylov::RitzPairs pairs;
+    try {
+      pairs = options.solver == FloquetSolver::spectra ? krylov::spectra_ritz_pairs(op, settings, start)
+                                                       : krylov::arpack_ritz_pairs(op, settings, start);
+    } catch (const NumericalFailure&) {
+      // The same absolute thresholds can also keep Spectra from converging at all on an operator
+      // of norm >> 1 (measured: x' = 5 x, N = 50, rank one, 0 of 1 converged in 300 restarts after
+      // a change of the step's rounding): the same retry as for a pair failing the gate.
+      if (attempt > 0 || !options.retry_failed_gate || options.solver != FloquetSolver::spectra) throw;
+      retry_reason = " did not converge";
+      prepare_retry();
+      continue;
+    }
     const std::vector<double> residual = ritz_residuals(op, pairs);
     FloquetResult candidate = result;
     std::vector<double> absolute;
@@ -287,17 +309,14 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
     if (failing.empty()) {
       if (attempt > 0)
         candidate.note += std::string(candidate.note.empty() ? "" : "; ") + "ncv = " + std::to_string(first_ncv) +
-                          " gave a pair failing the residual gate, retried with ncv = " + std::to_string(settings.ncv) +
+                          retry_reason + ", retried with ncv = " + std::to_string(settings.ncv) +
                           (settings.scale != 1 ? " on M / " + format_number(settings.scale) : "");
       result = std::move(candidate);
       return;
     }
     if (attempt == 0 && options.retry_failed_gate) {
-      settings.ncv = static_cast<int>(std::min<long>(n, 2L * settings.ncv));
-      // Spectra's breakdown thresholds are absolute (krylov_spectra.cpp): the retry scales the
-      // operator to |M / s| <= 1 / sqrt(n) or so, |M x| / |x| underestimating |M| by up to sqrt(n).
-      if (options.solver == FloquetSolver::spectra && size > 0 && std::isfinite(size))
-        settings.scale = std::ldexp(1.0, static_cast<int>(std::lround(std::log2(size * std::sqrt(double(n))))));
+      retry_reason = " gave a pair failing the residual gate";
+      prepare_retry();
       continue;
     }
     throw NumericalFailure(residual_gate_message(size, candidate, failing, bound, name, first_ncv, settings.ncv));

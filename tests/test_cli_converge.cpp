@@ -261,8 +261,11 @@ TEST(ConvergeCli, TargetStopsAtItsLimitsAndSaysWhich) {
 
 namespace {
 
+// orbit = simulate: these tests are about a level whose simulated orbit fails (the default,
+// orbit = auto, finds the N = 100 orbit by Newton directly: AutoOrbitFindsTheLevelDirectly).
 const std::vector<std::string> kImpactK1{"converge", "--json", "--set", "tau_over_T=1", "--set", "k=1.0", "--set",
-                                         "Ns=100,200,400", "--set", "nev=2", "--set", "events=on"};
+                                         "Ns=100,200,400", "--set", "nev=2", "--set", "events=on",
+                                         "--set", "orbit=simulate"};
 
 std::vector<std::string> with(std::vector<std::string> args, std::initializer_list<std::string> more) {
   args.insert(args.end(), more);
@@ -297,6 +300,23 @@ TEST(ConvergeCli, LevelWhoseSimulatedOrbitFailsIsRetriedWithNewtonFromItsNeighbo
   EXPECT_NEAR(row["multipliers"][0]["abs"].get<double>(), mu, 1e-9);
 }
 
+// The issue-13 study with the default orbit = auto: the N = 100 level's (spuriously unstable)
+// orbit is found directly by Newton, no retry needed, and equals the one the retry finds.
+TEST(ConvergeCli, AutoOrbitFindsTheLevelDirectly) {
+  std::vector<std::string> args = kImpactK1;
+  args.resize(args.size() - 2);  // drop orbit=simulate
+  CliResult automatic = run(args);
+  ASSERT_EQ(automatic.status, 0) << automatic.err;
+  const auto a = nlohmann::json::parse(automatic.out);
+  EXPECT_FALSE(a["rows"][0].contains("note")) << a["rows"][0]["note"];
+  CliResult retried = run(kImpactK1);
+  ASSERT_EQ(retried.status, 0) << retried.err;
+  const auto r = nlohmann::json::parse(retried.out);
+  // two Newton solutions of one discrete problem (tolerance 1e-12): 1e-9 for the multipliers
+  EXPECT_NEAR(a["rows"][0]["multipliers"][0]["abs"].get<double>(), r["rows"][0]["multipliers"][0]["abs"].get<double>(),
+              1e-9);
+}
+
 // A level that fails everywhere (here Newton is allowed one iteration, too few from the
 // prolonged guess) is a row with its reason, `multipliers` [] and `error` null; the study goes on
 // with the other levels and exits 0. With no level left it exits 3 naming each failure.
@@ -317,7 +337,7 @@ TEST(ConvergeCli, LevelThatFailsEverywhereIsReportedAndTheStudyGoesOn) {
   EXPECT_EQ(j["richardson"][0]["entries"].size(), 3u);  // 200, 400, 800
   // text output names the failed level
   r = run({"converge", "--set", "tau_over_T=1", "--set", "k=1.0", "--set", "Ns=100,200,400", "--set", "nev=2", "--set",
-           "events=on", "--set", "orbit_max_iterations=1"});
+           "events=on", "--set", "orbit=simulate", "--set", "orbit_max_iterations=1"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("failed: orbit by simulation"), std::string::npos) << r.out;
   // nothing left: exit 3, each level named

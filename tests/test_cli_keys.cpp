@@ -125,7 +125,7 @@ TEST(Metadata, RecordsEffectiveDefaultsAndTheSourceRevision) {
   ASSERT_TRUE(m.contains("defaults")) << m.dump(1);
   EXPECT_EQ(m["defaults"]["events"], "on");
   EXPECT_EQ(m["defaults"]["jacobian"], "consistent");
-  EXPECT_EQ(m["defaults"]["orbit"], "simulate");
+  EXPECT_EQ(m["defaults"]["orbit"], "auto");
   EXPECT_EQ(m["defaults"]["contact_substeps"], "4");
   EXPECT_FALSE(m["defaults"].contains("N")) << "a given key is not a default";
   EXPECT_EQ(m["source_revision"], DELAYSPEC_REVISION);

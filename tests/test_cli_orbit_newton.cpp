@@ -31,7 +31,7 @@ TEST(OrbitNewtonCli, JsonReportsNewtonAndMatchesSimulation) {
   EXPECT_LT(j["orbit"]["residual"].get<double>(), 1e-12);  // rounding of K = 60 steps
   EXPECT_EQ(j["orbit"]["contacts"], 1);  // the paper's orbit touches the obstacle once per period
 
-  CliResult simulated = run({"floquet", kScene, "--json", "--set", "N=60", "--set", "nev=3"});
+  CliResult simulated = run({"floquet", kScene, "--json", "--set", "N=60", "--set", "nev=3", "--set", "orbit=simulate"});
   ASSERT_EQ(simulated.status, 0) << simulated.err;
   auto s = nlohmann::json::parse(simulated.out);
   EXPECT_EQ(s["orbit"]["method"], "simulate");

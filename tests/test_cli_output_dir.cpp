@@ -376,7 +376,7 @@ TEST(OutputDirectory, ChartAndBasinExitThreeWithFailedPointsRecorded) {
   CliResult chart = run({"chart", "--json", "--quiet", "--out", dir.string(), "--set", "model=impact", "--set", "N=8",
                          "--set", "chart_x=k", "--set", "chart_y=zeta", "--set", "chart_x_range=0,0.2", "--set",
                          "chart_y_range=0,0.1", "--set", "chart_x_points=2", "--set", "chart_y_points=2", "--set",
-                         "orbit_max_periods=2"});
+                         "orbit=simulate", "--set", "orbit_max_periods=2"});
   EXPECT_EQ(chart.status, 3) << chart.err;
   EXPECT_TRUE(contains(chart.err, "numerical failure at 4 of 4 point(s)")) << chart.err;
   auto j = nlohmann::json::parse(chart.out);

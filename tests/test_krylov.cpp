@@ -270,15 +270,19 @@ TEST(KrylovResidualGate, RankOneMonodromyLeadingMultiplierIsExact) {
                 std::string::npos)
           << z.note;
     }
-    // Without the retry, Spectra's first answer is the spurious one, and the gate refuses it.
+    // Without the retry, Spectra's first answer is never returned: depending on the rounding of
+    // the step (it changed with the stepper's small-matrix solves, issue 17) its basis grows from
+    // round-off into a spurious Ritz value that the gate refuses, or it does not converge at all.
     if (solver == FloquetSolver::spectra) {
       FloquetOptions o;
       o.nev = 1;
       o.retry_failed_gate = false;
       const std::string m = numerical_failure_message([&] { floquet_multipliers(op, o); });
-      EXPECT_NE(m.find("Krylov (spectra): multiplier 1 of nev = 1"), std::string::npos) << m;
-      EXPECT_NE(m.find("fails its residual check"), std::string::npos) << m;
-      EXPECT_NE(m.find("> bound 1e-08 (ncv = 11)"), std::string::npos) << m;
+      const bool refused = m.find("Krylov (spectra): multiplier 1 of nev = 1") != std::string::npos &&
+                           m.find("fails its residual check") != std::string::npos &&
+                           m.find("> bound 1e-08 (ncv = 11)") != std::string::npos;
+      const bool not_converged = m.find("Krylov (spectra) did not converge: 0 of nev = 1") != std::string::npos;
+      EXPECT_TRUE(refused || not_converged) << m;
     }
   }
 }

@@ -63,6 +63,7 @@
 
 #include <Eigen/LU>
 
+#include "delayspec/detail/small_solve.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
 #include "delayspec/scalar_search.hpp"
@@ -211,7 +212,7 @@ class EventStepSolver {
       const M Al = model_.A(j, tl, zl, wl), Ar = model_.A(j, tr, zr, wr);
       const M Bl = model_.B(j, tl, zl, wl), Br = model_.B(j, tr, zr, wr);
       const V ftl = model_.f_t(j, tl, zl, wl), ftr = model_.f_t(j, tr, zr, wr);
-      const Eigen::PartialPivLU<M> lu(M(M::Identity() - 0.5 * L * Ar));  // S = I - L/2 A_r
+      const detail::SmallSolve<D> lu(M(M::Identity() - 0.5 * L * Ar));  // S = I - L/2 A_r
       const M Jz = lu.solve(M(M::Identity() + 0.5 * L * Al));             // dz_i/dz_{i-1}
       // dz_i/ds_{i-1} and dz_i/ds_i: the length changes by -1/+1, the node's time and delayed
       // value move with it (d/ds f(t + s, z, w(s)) = f_t + B w').

@@ -17,6 +17,7 @@
 
 #include <Eigen/LU>
 
+#include "delayspec/detail/small_solve.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
 #include "delayspec/step_map.hpp"
@@ -96,7 +97,7 @@ class TrapezoidStepper {
                             int right_region) const {
     const double t1 = t0 + dt;
     SubStepResult<D> r;
-    Eigen::PartialPivLU<M> lu;
+    detail::SmallSolve<D> lu;
     r.z1 = solve_sub_step(t0, dt, z0, w0, w1, left_region, right_region, r.right_region, lu);
     const int jr = r.right_region;
     // For an affine f the last Newton matrix is already S at z1 (A does not depend on z).
@@ -111,7 +112,7 @@ class TrapezoidStepper {
   V sub_step_state(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region,
                    int right_region) const {
     int jr;
-    Eigen::PartialPivLU<M> lu;
+    detail::SmallSolve<D> lu;
     return solve_sub_step(t0, dt, z0, w0, w1, left_region, right_region, jr, lu);
   }
 
@@ -145,7 +146,7 @@ class TrapezoidStepper {
   // Newton on G(z) = z - rhs0 - dt/2 f_jr(t1, z, w1). Returns z1; jr receives the right node's
   // region and lu the factorisation of S = I - dt/2 A_jr(t1, z, w1) at the last iterate.
   V solve_sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region, int right_region,
-                   int& jr, Eigen::PartialPivLU<M>& lu) const {
+                   int& jr, detail::SmallSolve<D>& lu) const {
     const double t1 = t0 + dt;
     const V rhs0 = z0 + 0.5 * dt * model_.f(left_region, t0, z0, w0);  // explicit half
     // For an affine f_jr one Newton step is exact. In the automatic mode (the plain, unsplit
@@ -173,7 +174,8 @@ class TrapezoidStepper {
           continue;
         }
       }
-      if (small || (Model::affine_in_state && (fixed_region || it >= 1))) {
+      // Without switching the region cannot change: one iteration of an affine f is exact.
+      if (small || (Model::affine_in_state && (fixed_region || it >= 1 || !Model::has_switching))) {
         converged = true;
         break;
       }

@@ -60,8 +60,9 @@ int command_chart(Config& config, const Invocation& inv) {
             using Model = std::decay_t<decltype(model)>;
             TrapezoidStepper<Model> stepper(model, step_options(p));
             StroboscopicMap<Model> map(stepper, p.grid);
-            const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
-            const FloquetResult r = floquet_multipliers(map.monodromy(orbit.history), options);
+            OrbitLinearisation<Model::d> at_orbit;
+            find_orbit(model, map, orbit_settings, &at_orbit);
+            const FloquetResult r = floquet_multipliers(Monodromy<Model::d>(p.grid, std::move(at_orbit.maps)), options);
             radius[i] = std::abs(r.multipliers.at(0));
           },
           p.model);

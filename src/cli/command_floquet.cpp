@@ -26,14 +26,18 @@ int command_floquet(Config& config, const Invocation& inv) {
   FloquetResult result;
   PeriodicOrbit orbit;
   ContactSummary contacts;
+  double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
   std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
         TrapezoidStepper<Model> stepper(model, step_options(problem));
         StroboscopicMap<Model> map(stepper, problem.grid);
-        orbit = find_orbit(model, map, orbit_settings);
-        contacts = orbit_contacts(model, map, orbit);
-        auto monodromy = map.monodromy(orbit.history);
+        const auto orbit_start = std::chrono::steady_clock::now();
+        OrbitLinearisation<Model::d> at_orbit;  // the monodromy and states at the orbit
+        orbit = find_orbit(model, map, orbit_settings, &at_orbit);
+        orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
+        contacts = orbit_contacts(model, std::move(at_orbit.states));
+        const Monodromy<Model::d> monodromy(problem.grid, std::move(at_orbit.maps));
         result = floquet_multipliers(monodromy, options);
       },
       problem.model);
@@ -46,6 +50,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["solver"] = result.solver;
     json["multipliers"] = multipliers_json(result.multipliers);
     json["seconds"] = seconds;
+    json["orbit_seconds"] = orbit_seconds;
     json["eigensolver_seconds"] = result.seconds;
     json["operator_applications"] = result.operator_applications;
     json["converged"] = result.converged;

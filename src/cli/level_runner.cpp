@@ -60,23 +60,6 @@ std::vector<std::string> read_word_list(Config& config, const std::string& key, 
   return words;
 }
 
-Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, long K_to) {
-  if (d < 1 || K_to < 1 || x.size() == 0 || x.size() % d != 0)
-    throw BadInput("prolong_periodic_sequence: " + std::to_string(x.size()) + " entries of dimension " +
-                   std::to_string(d) + " to " + std::to_string(K_to) + " states");
-  const long K_from = x.size() / d;
-  Eigen::VectorXd y(static_cast<long>(d) * K_to);
-  for (long l = 0; l < K_to; ++l) {
-    // position of l h_to on the old grid: s = l K_from / K_to (same map period K h)
-    const double s = static_cast<double>(l) * K_from / K_to;
-    const long i = std::min(static_cast<long>(s), K_from - 1);
-    const double w = s - i;  // u(s) = (1 - w) u_i + w u_{i+1}, u_{K_from} = u_0
-    const long i1 = (i + 1) % K_from;
-    y.segment(d * l, d) = (1 - w) * x.segment(d * i, d) + w * x.segment(d * i1, d);
-  }
-  return y;
-}
-
 std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count) {
   if (const auto* linear = std::get_if<LinearModel>(&problem.model)) {
     const LinearParameters& p = linear->parameters();

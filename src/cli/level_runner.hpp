@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "config.hpp"
+#include "delayspec/periodic_orbit.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 #include "orbit_settings.hpp"
 #include "problem.hpp"
@@ -23,13 +24,6 @@ std::vector<std::string> read_word_list(Config& config, const std::string& key, 
 
 // The exact leading multipliers when the model has them (linear: Lambert W), else empty.
 std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count);
-
-// The states of a periodic orbit over one map, x = (u_0, ..., u_{K-1}), u_l = y(l h), d each
-// (PeriodicOrbitProblem's unknowns), carried to another resolution: the K_to states at l h_to
-// over the same map period, by periodic linear interpolation (u_{l+K} = u_l). A Newton guess for
-// the orbit at another N: its distance to that orbit is O(h^2) plus the orbit's own change with N.
-// BadInput: d < 1, K_to < 1, or x.size() not a positive multiple of d.
-Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, long K_to);
 
 // How with_monodromy finds the orbit, beyond the orbit settings.
 struct LevelOrbit {
@@ -56,19 +50,24 @@ void with_monodromy(const Problem& problem, const std::string& events, const Orb
         TrapezoidStepper<Model> stepper(model, step_options(p));
         StroboscopicMap<Model> map(stepper, p.grid);
         PeriodicOrbit orbit;
+        OrbitLinearisation<Model::d> at_orbit;  // step maps and states of one map at the orbit
         if constexpr (!Model::is_linear) {
           if (level_orbit.newton_guess) {
             const Eigen::VectorXd guess = prolong_periodic_sequence(*level_orbit.newton_guess, Model::d, p.grid.K);
             orbit = orbit_by_newton(map, guess, orbit_settings.newton);
+            map.apply(orbit.history, &at_orbit.maps, &at_orbit.states);
           } else {
-            orbit = find_orbit(model, map, orbit_settings);
+            orbit = find_orbit(model, map, orbit_settings, &at_orbit);
           }
-          if (level_orbit.sequence)
-            *level_orbit.sequence = PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
+          if (level_orbit.sequence) {  // the states u_0 .. u_{K-1}
+            Eigen::VectorXd& x = *level_orbit.sequence;
+            x.resize(static_cast<long>(Model::d) * p.grid.K);
+            for (long l = 0; l < p.grid.K; ++l) x.template segment<Model::d>(Model::d * l) = at_orbit.states[l];
+          }
         } else {
-          orbit = find_orbit(model, map, orbit_settings);
+          orbit = find_orbit(model, map, orbit_settings, &at_orbit);
         }
-        auto monodromy = map.monodromy(orbit.history);
+        const Monodromy<Model::d> monodromy(p.grid, std::move(at_orbit.maps));
         const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         fn(monodromy, orbit, setup);
       },

@@ -1,0 +1,120 @@
+#pragma once
+// Restarted GMRES(m) for A x = b with A given only as a product y = A x (matrix-free): the linear
+// solver inside Newton-Krylov shooting (orbit_shooting.hpp), where A = M - I and M is the
+// monodromy at the current iterate.
+//
+// Each cycle builds an orthonormal Krylov basis V_{j+1} of span{r0, A r0, ..., A^j r0} by Arnoldi
+// with classical Gram-Schmidt applied twice (CGS2: orthogonal to working precision, and each pass
+// is two matrix-vector products with the tall basis instead of j dot products), reduces the
+// Hessenberg matrix H_j (A V_j = V_{j+1} H_j) to triangular form by Givens rotations, and stops as
+// soon as the least-squares residual |beta e1 - H_j y| (= |b - A x_j|_2 in exact arithmetic) is at
+// most `tolerance` |b|_2. The true residual is recomputed at every restart and at the end.
+//
+// Why GMRES converges fast here: the spectrum of a DDE's monodromy accumulates at 0, so A = M - I
+// is the identity's negative plus an operator whose eigen/singular values decay (like 1/j for the
+// impact model with feedback); GMRES then converges superlinearly, roughly as the product of the
+// leading singular values of M. Multipliers near +1 (a fold) make A nearly singular and GMRES slow:
+// reported as not converged, never hidden.
+//
+// Cost per iteration: one application of A plus 4 n j flops for CGS2 (memory bound: two passes over
+// the j basis vectors). Memory: (m + 1) n doubles for the basis, owned by the call.
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace delayspec {
+
+struct GmresOptions {
+  double tolerance = 1e-10;  // stop when |b - A x|_2 <= tolerance |b|_2
+  int restart = 40;          // basis vectors per cycle (m); clamped to n
+  int max_iterations = 400;  // applications of A, over all cycles
+};
+
+struct GmresResult {
+  Eigen::VectorXd x;              // the approximate solution (from x = 0)
+  double relative_residual = 1;   // |b - A x|_2 / |b|_2, recomputed from x
+  int iterations = 0;             // applications of A inside Arnoldi
+  bool converged = false;         // relative_residual <= tolerance
+};
+
+// apply(x, y): y = A x, called as apply(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::VectorXd& y)
+// with x and y of length b.size() (x may be a column of the basis). x starts at 0; b = 0 gives x = 0.
+template <class Apply>
+GmresResult gmres(const Apply& apply, const Eigen::VectorXd& b, const GmresOptions& opt) {
+  const Eigen::Index n = b.size();
+  GmresResult res;
+  res.x = Eigen::VectorXd::Zero(n);
+  const double bnorm = b.norm();
+  if (bnorm == 0) {
+    res.relative_residual = 0;
+    res.converged = true;
+    return res;
+  }
+  const int m = static_cast<int>(std::min<Eigen::Index>(opt.restart, n));
+  Eigen::MatrixXd V(n, m + 1);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + 1, m);
+  Eigen::VectorXd cs(m), sn(m), g(m + 1), w(n), r = b, h(m + 1);
+  double rnorm = bnorm;
+  while (res.iterations < opt.max_iterations) {
+    // r = b - A x (true residual at the cycle's start)
+    V.col(0) = r / rnorm;
+    g.setZero();
+    g[0] = rnorm;
+    int j = 0;
+    for (; j < m && res.iterations < opt.max_iterations; ++j) {
+      apply(Eigen::Ref<const Eigen::VectorXd>(V.col(j)), w);  // w = A v_j
+      ++res.iterations;
+      // CGS2: h = V^T w; w -= V h, twice (the second pass removes what rounding left).
+      auto basis = V.leftCols(j + 1);
+      h.head(j + 1) = basis.transpose() * w;
+      w.noalias() -= basis * h.head(j + 1);
+      const Eigen::VectorXd h2 = basis.transpose() * w;
+      w.noalias() -= basis * h2;
+      h.head(j + 1) += h2;
+      h[j + 1] = w.norm();
+      // Apply the earlier rotations to the new column, then make one that zeroes h[j + 1].
+      for (int i = 0; i < j; ++i) {
+        const double t = cs[i] * h[i] + sn[i] * h[i + 1];
+        h[i + 1] = -sn[i] * h[i] + cs[i] * h[i + 1];
+        h[i] = t;
+      }
+      const double rho = std::hypot(h[j], h[j + 1]);
+      const double hnext = h[j + 1];
+      if (rho == 0) {  // A v_j = 0 in the span: singular on the Krylov space
+        cs[j] = 1, sn[j] = 0;
+      } else {
+        cs[j] = h[j] / rho, sn[j] = hnext / rho;
+      }
+      H.col(j).head(j + 1) = h.head(j + 1);
+      H(j, j) = rho;
+      g[j + 1] = -sn[j] * g[j];
+      g[j] = cs[j] * g[j];
+      if (hnext > 0) V.col(j + 1) = w / hnext;
+      // |g[j + 1]| is the least-squares residual of the j + 1 step solution.
+      if (std::abs(g[j + 1]) <= opt.tolerance * bnorm || hnext == 0) {
+        ++j;
+        break;
+      }
+    }
+    // x += V_j y with H_j y = g (upper triangular after the rotations)
+    if (j > 0) {
+      Eigen::VectorXd y = H.topLeftCorner(j, j).triangularView<Eigen::Upper>().solve(g.head(j));
+      if (!y.allFinite()) break;  // a zero pivot: the Krylov space holds no better x
+      res.x.noalias() += V.leftCols(j) * y;
+    }
+    apply(Eigen::Ref<const Eigen::VectorXd>(res.x), w);
+    r = b - w;
+    rnorm = r.norm();
+    res.relative_residual = rnorm / bnorm;
+    if (res.relative_residual <= opt.tolerance) {
+      res.converged = true;
+      return res;
+    }
+    if (!std::isfinite(rnorm)) break;
+  }
+  res.converged = res.relative_residual <= opt.tolerance;
+  return res;
+}
+
+}  // namespace delayspec
