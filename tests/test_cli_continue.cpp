@@ -14,6 +14,7 @@
 
 #include "cli_test_support.hpp"
 #include "delayspec/errors.hpp"
+#include "delayspec_test_paths.hpp"
 
 namespace {
 
@@ -176,4 +177,36 @@ TEST(ContinueCli, StepThatCannotBeReducedExitsThreeWithTheBranchSoFar) {
   const std::string complete = read_all(dir / "complete.json");
   EXPECT_NE(complete.find("\"exit_status\": 3"), std::string::npos) << complete;
   fs::remove_all(dir);
+}
+
+// continue_switch: the period-1 orbit of the PWSDDE-cont system (tau = 3.8, fractional delay)
+// continued in k down from 0.25 loses stability by a period doubling near k = 0.177; the branch
+// switched there must reach, at k = 0.12, the period-2 orbit that `floquet` finds on its own from
+// a simulated guess (data/scenes/pwsdde-period2.toml): same multipliers, to the orbits' tolerance.
+TEST(ContinueCli, SwitchAtPeriodDoublingReachesTheKnownPeriodTwoOrbit) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/pwsdde-period2.toml";
+  CliResult r = run({"continue", scene, "--set", "orbit_period=1", "--set", "k=0.25", "--set", "N=100", "--set",
+                     "orbit_guess_periods=200", "--set", "continue_key=k", "--set", "continue_from=0.25", "--set",
+                     "continue_to=0.12", "--set", "continue_switch=true", "--json", "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_GE(j["bifurcations"].size(), 1u);
+  EXPECT_EQ(j["bifurcations"][0]["type"], "period-doubling");
+  ASSERT_EQ(j["switched"].size(), 1u);
+  const auto& sw = j["switched"][0];
+  EXPECT_EQ(sw["orbit_period"], 2);
+  EXPECT_EQ(sw["from_parameter"], j["bifurcations"][0]["parameter"]);
+  ASSERT_EQ(sw["end"], "to");
+  const auto& last = sw["points"].back();
+  EXPECT_EQ(last["parameter"], 0.12);
+  // the first point is the period doubling itself: multiplier (-1)^2 = +1 of the doubled problem
+  EXPECT_NEAR(sw["points"][0]["multipliers"][0]["abs"].get<double>(), 1, 1e-8);
+  CliResult f = run({"floquet", scene, "--set", "N=100", "--json"});
+  ASSERT_EQ(f.status, 0) << f.err;
+  const auto fj = nlohmann::json::parse(f.out);
+  for (int i = 0; i < 2; ++i) {
+    // both orbits to |F| <= 1e-12 (1 + |x|): the multipliers agree far below 1e-9
+    EXPECT_NEAR(last["multipliers"][i]["re"].get<double>(), fj["multipliers"][i]["re"].get<double>(), 1e-9) << i;
+    EXPECT_NEAR(last["multipliers"][i]["im"].get<double>(), fj["multipliers"][i]["im"].get<double>(), 1e-9) << i;
+  }
 }

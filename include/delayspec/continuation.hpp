@@ -140,6 +140,7 @@ struct Bifurcation {
   double bracket = 0;          // width in p of the final bracket (<= tolerance unless `note` says)
   int evaluations = 0;         // corrected points evaluated to locate it
   std::string note;            // e.g. why the bracket stayed wider than the tolerance
+  Eigen::VectorXd orbit;       // the sequence x at the located point (continue_period_doubled starts there)
 };
 
 struct ContinuationOptions {
@@ -457,9 +458,25 @@ class PeriodicBranch {
   double weight_ = 1, range_ = 1;
 };
 
+namespace continuation_detail {
+// The branch from `guess` at p = options.from (Newton there), or, when start_tangent is given,
+// from the point (guess, start_p) itself along that tangent (no Newton: the point may be singular,
+// e.g. a period doubling seen by the doubled problem), the first segment not searched.
+template <class Model, class ModelAt>
+ContinuationResult trace_branch(const ModelAt& model_at, const Eigen::VectorXd& guess, const ContinuationOptions& options,
+                                const Eigen::VectorXd* start_tangent, double start_p);
+}  // namespace continuation_detail
+
 template <class Model, class ModelAt>
 ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd& guess,
                                   const ContinuationOptions& options) {
+  return continuation_detail::trace_branch<Model>(model_at, guess, options, nullptr, options.from);
+}
+
+template <class Model, class ModelAt>
+ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, const Eigen::VectorXd& guess,
+                                                     const ContinuationOptions& options,
+                                                     const Eigen::VectorXd* start_tangent, double start_p) {
   using Branch = PeriodicBranch<Model, ModelAt>;
   using State = typename Branch::State;
   namespace cd = continuation_detail;
@@ -491,14 +508,27 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
   ContinuationResult result;
   const Eigen::VectorXd zero_row = Eigen::VectorXd::Zero(n);
 
-  // The first point: Newton at p = from; the tangent towards `to`.
+  // The first point: Newton at p = from; the tangent towards `to`. Or the given point and tangent.
   std::string why;
-  std::optional<State> current =
-      branch.correct(guess, o.from, zero_row, 1.0, o.from, o.start_iterations, why, result.newton_seconds);
+  std::optional<State> current;
+  if (start_tangent) {
+    if (start_tangent->size() != n + 1)
+      throw BadInput("continuation: the start tangent has " + std::to_string(start_tangent->size()) + " entries");
+    State given;
+    given.x = guess;
+    given.p = start_p;
+    const double norm = std::sqrt(branch.dot(start_tangent->head(n), (*start_tangent)[n], start_tangent->head(n),
+                                             (*start_tangent)[n]));
+    given.tx = start_tangent->head(n) / norm;
+    given.tp = (*start_tangent)[n] / norm;
+    current = std::move(given);
+  } else {
+    current = branch.correct(guess, o.from, zero_row, 1.0, o.from, o.start_iterations, why, result.newton_seconds);
+  }
   if (!current)
     throw NumericalFailure("continuation start: Newton on the periodic orbit at parameter " + format_number(o.from) +
                            " failed: " + why);
-  if (current->tp * direction < 0) {
+  if (!start_tangent && current->tp * direction < 0) {
     current->tx = -current->tx;
     current->tp = -current->tp;
   }
@@ -521,7 +551,7 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
 
   // Locates a bifurcation of `type` between base (point a) and b at arclength s_b along base's tangent.
   auto locate = [&](BifurcationType type, bool by_tangent, const State& base, const ContinuationPoint& pa,
-                    const ContinuationPoint& pb, double s_b, long after) {
+                    const ContinuationPoint& pb, const Eigen::VectorXd& xb, double s_b, long after) {
     const auto locate_start = std::chrono::steady_clock::now();
     auto test = [&](const ContinuationPoint& pt) {
       if (type == BifurcationType::grazing) return pt.measures.max_H;
@@ -535,8 +565,9 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
     struct Sample {
       double s, g, p;
       ContinuationPoint point;
+      Eigen::VectorXd x;  // the orbit (a switch at a period doubling starts from it)
     };
-    Sample neg{0, test(pa), pa.parameter, pa}, pos{s_b, test(pb), pb.parameter, pb};
+    Sample neg{0, test(pa), pa.parameter, pa, base.x}, pos{s_b, test(pb), pb.parameter, pb, xb};
     // A long segment may hold more than the one crossing (a pair colliding on the real axis, the
     // multiplier nearest +-1 not being the one that crosses): bisect on the detection counts,
     // which are exact, until the test function changes sign over the sub-segment.
@@ -560,7 +591,7 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
       } catch (const NumericalFailure&) {
         break;
       }
-      const Sample m{s, test(mid), mid.parameter, mid};
+      const Sample m{s, test(mid), mid.parameter, mid, st->x};
       if (changes_here(neg.point, mid)) pos = m;  // (neg, pos) keep the order of s until the sign change
       else neg = m;
     }
@@ -621,18 +652,18 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
         continue;
       }
       if (g == 0) {
-        neg = {s, g, pt->parameter, *pt};
+        neg = {s, g, pt->parameter, *pt, st->x};
         pos = neg;
         break;
       }
       if (g < 0) {
         prev_neg = neg;
-        neg = {s, g, pt->parameter, *pt};
+        neg = {s, g, pt->parameter, *pt, st->x};
         g_neg = g;
         if (side == -1) g_pos *= 0.5;
         side = -1;
       } else {
-        pos = {s, g, pt->parameter, *pt};
+        pos = {s, g, pt->parameter, *pt, st->x};
         g_pos = g;
         if (side == 1) g_neg *= 0.5;
         side = 1;
@@ -647,6 +678,7 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
     bif.parameter = std::isfinite(located) ? located : best.parameter;
     bif.multipliers = best.multipliers;
     bif.measures = best.measures;
+    bif.orbit = nearer.x;
     std::complex<double> critical;
     if (type == BifurcationType::grazing) {
       bif.angle = NAN;
@@ -734,7 +766,7 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
     }
     point.step = ds;
     const ContinuationPoint& previous = result.points.back();
-    if (o.locate) {
+    if (o.locate && !(start_tangent && result.points.size() == 1)) {
       std::vector<BifurcationType> found =
           cd::detected_changes(cd::unstable_counts(previous.multipliers), cd::unstable_counts(point.multipliers));
       // A turning point of the parameter is a fold, located where dp/ds = 0 (for the discrete
@@ -747,7 +779,7 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
         if ((previous.measures.max_H > 0) != (point.measures.max_H > 0)) found.push_back(BifurcationType::grazing);
       const ContinuationPoint a = previous;
       for (BifurcationType type : found)
-        locate(type, turning && type == BifurcationType::fold, *current, a, point, s_b,
+        locate(type, turning && type == BifurcationType::fold, *current, a, point, next->x, s_b,
                static_cast<long>(result.points.size()) - 1);
     }
     const int iterations = next->iterations;
@@ -760,6 +792,62 @@ ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   return result;
+}
+
+// The period-2 branch born at a period doubling `at` of the branch continue_orbit traced with
+// `options` (its orbit: at.orbit). The doubled problem (periods_per_map twice the options') has
+// the period-1 orbit repeated twice as a solution, singular at the period doubling (multiplier
+// (-1)^2 = 1); its null vector w is the critical Floquet mode carried over two periods, which
+// flips sign after one (w_{l+K} = -w_l). The branch leaves along t = (w, 0): the hyperplane
+// <t, X - X_0 - s t>_w = 0 meets the period-2 branch and not the repeated period-1 orbits (they
+// are orthogonal to an antiperiodic w). w is formed by a difference quotient of two runs of the
+// doubled map from U* and U* + eps v (v the real eigenvector of -1, eps = 1e-7 |U*|): a direction
+// only, its O(eps) error moves no result. The segment leaving the period doubling is not searched
+// for bifurcations (its multiplier +1 is the bifurcation itself). Then as continue_orbit, within
+// [from, to] (either end).
+// BadInput: `at` is not a located period doubling (no orbit, or the wrong size).
+template <class Model, class ModelAt>
+ContinuationResult continue_period_doubled(const ModelAt& model_at, const Bifurcation& at,
+                                           const ContinuationOptions& options) {
+  using Map = StroboscopicMap<Model>;
+  if (at.type != BifurcationType::period_doubling || at.orbit.size() == 0)
+    throw BadInput("continue_period_doubled: needs a located period doubling with its orbit");
+  const Model model = model_at(at.parameter);
+  const StepOptions& so = options.step_options;
+  const Map map1(TrapezoidStepper<Model>(model, so), make_grid(model.tau(), model.period(), options.N, options.periods_per_map));
+  const Map map2(TrapezoidStepper<Model>(model, so),
+                 make_grid(model.tau(), model.period(), options.N, 2 * options.periods_per_map));
+  const PeriodicOrbitProblem<Map> problem1(map1);
+  if (at.orbit.size() != problem1.unknowns())
+    throw BadInput("continue_period_doubled: the orbit has " + std::to_string(at.orbit.size()) + " entries, expected " +
+                   std::to_string(problem1.unknowns()));
+  const Eigen::VectorXd U = problem1.history(at.orbit);
+  // The real eigenvector of the multiplier nearest -1.
+  FloquetOptions fo = options.floquet;
+  fo.keep_vectors = true;
+  if (fo.solver == FloquetSolver::dense_eigen || fo.solver == FloquetSolver::dense_lapack) fo.solver = FloquetSolver::spectra;
+  const FloquetResult r = floquet_multipliers(map1.monodromy(U), fo);
+  size_t k = 0;
+  for (size_t i = 1; i < r.multipliers.size(); ++i)
+    if (std::abs(r.multipliers[i] + 1.0) < std::abs(r.multipliers[k] + 1.0)) k = i;
+  if (r.subspace.cols() <= static_cast<long>(k))
+    throw NumericalFailure("continue_period_doubled: no eigenvector for the multiplier " +
+                           format_number(r.multipliers[k].real()));
+  const Eigen::VectorXd v = r.subspace.col(static_cast<long>(k)).normalized();
+  const double eps = 1e-7 * std::max(1.0, U.lpNorm<Eigen::Infinity>());
+  std::vector<Vec<Model::d>> base, moved;
+  map2.apply(U, nullptr, &base);
+  map2.apply(U + eps * v, nullptr, &moved);
+  const long K2 = map2.grid().K;
+  Eigen::VectorXd x0(static_cast<long>(Model::d) * K2), tangent(static_cast<long>(Model::d) * K2 + 1);
+  for (long l = 0; l < K2; ++l) {
+    x0.segment<Model::d>(Model::d * l) = base[static_cast<size_t>(l)];
+    tangent.segment<Model::d>(Model::d * l) = (moved[static_cast<size_t>(l)] - base[static_cast<size_t>(l)]) / eps;
+  }
+  tangent[tangent.size() - 1] = 0;
+  ContinuationOptions o2 = options;
+  o2.periods_per_map = 2 * options.periods_per_map;
+  return continuation_detail::trace_branch<Model>(model_at, x0, o2, &tangent, at.parameter);
 }
 
 }  // namespace delayspec

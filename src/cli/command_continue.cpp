@@ -74,6 +74,25 @@ ContinuationResult branch_at(const Config& config, const ContinueSettings& setti
       problem.model);
 }
 
+// The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
+ContinuationResult switched_at(const Config& config, const ContinueSettings& settings, ContinuationOptions options,
+                               int N, const Bifurcation& pd, Progress& progress) {
+  Config level = config;
+  level.set("N", std::to_string(N), "continue_Ns");
+  level.set(settings.key, format_number(pd.parameter), "continue_switch");
+  const Problem problem = read_problem(level, 100);
+  options.N = N;
+  options.periods_per_map = problem.orbit_period;
+  options.step_options = step_options(problem);
+  options.on_point = [&](const ContinuationPoint&) { progress.add(); };
+  return std::visit(
+      [&](const auto& model) {
+        using Model = std::decay_t<decltype(model)>;
+        return continue_period_doubled<Model>(ModelWithKey<Model>{level, settings.key}, pd, options);
+      },
+      problem.model);
+}
+
 json measures_json(const OrbitMeasures& m) {
   json j;
   j["max"] = m.max;
@@ -84,6 +103,22 @@ json measures_json(const OrbitMeasures& m) {
 }
 
 std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : "nan"; }
+
+json points_json(const std::vector<ContinuationPoint>& points) {
+  json list = json::array();
+  for (const auto& p : points) {
+    json pj;
+    pj["parameter"] = p.parameter;
+    pj["multipliers"] = multipliers_json(p.multipliers);
+    pj["unstable"] = p.unstable;
+    pj["stable"] = p.stable();
+    pj["measures"] = measures_json(p.measures);
+    pj["newton_iterations"] = p.newton_iterations;
+    pj["step"] = p.step;
+    list.push_back(pj);
+  }
+  return list;
+}
 
 }  // namespace
 
@@ -106,7 +141,6 @@ int command_continue(Config& config, const Invocation& inv) {
   Progress progress(inv.err, "continue", 0, inv.quiet);
   std::vector<ContinuationResult> levels;
   for (int N : Ns) levels.push_back(branch_at(config, settings, orbit_settings, options, N, progress));
-  progress.finish();
   const ContinuationResult& branch = levels.back();
   std::vector<std::vector<Bifurcation>> by_N;
   for (const auto& r : levels) by_N.push_back(r.bifurcations);
@@ -114,7 +148,21 @@ int command_continue(Config& config, const Invocation& inv) {
   RichardsonOptions richardson;
   if (switching && problem.events == "off") richardson.order = richardson.order_step = 1;  // design.md 1.5
   const std::vector<BifurcationEstimate> estimates = extrapolate_bifurcations(Ns, by_N, tolerance, richardson);
+  // continue_switch: the period-2 branch of every period doubling on the finest branch.
+  std::vector<ContinuationResult> switched;
+  std::vector<double> switched_from;
+  if (settings.switch_period_doubling)
+    for (const Bifurcation& b : branch.bifurcations)
+      if (b.type == BifurcationType::period_doubling) {
+        switched.push_back(switched_at(config, settings, options, Ns.back(), b, progress));
+        switched_from.push_back(b.parameter);
+      }
+  progress.finish();
   std::string failures;
+  for (size_t i = 0; i < switched.size(); ++i)
+    if (!switched[i].failure.empty())
+      failures += (failures.empty() ? "" : "; ") + std::string("period-2 branch from ") +
+                  format_number(switched_from[i]) + ": " + switched[i].failure;
   for (size_t i = 0; i < levels.size(); ++i)
     if (!levels[i].failure.empty())
       failures += (failures.empty() ? "" : "; ") + std::string("N = ") + std::to_string(Ns[i]) + ": " + levels[i].failure;
@@ -129,18 +177,7 @@ int command_continue(Config& config, const Invocation& inv) {
   j["jacobian"] = problem.jacobian;
   j["end"] = branch.end;
   if (!failures.empty()) j["failure"] = failures;
-  j["points"] = json::array();
-  for (const auto& p : branch.points) {
-    json pj;
-    pj["parameter"] = p.parameter;
-    pj["multipliers"] = multipliers_json(p.multipliers);
-    pj["unstable"] = p.unstable;
-    pj["stable"] = p.stable();
-    pj["measures"] = measures_json(p.measures);
-    pj["newton_iterations"] = p.newton_iterations;
-    pj["step"] = p.step;
-    j["points"].push_back(pj);
-  }
+  j["points"] = points_json(branch.points);
   j["bifurcations"] = json::array();
   for (size_t b = 0; b < estimates.size(); ++b) {
     const BifurcationEstimate& e = estimates[b];
@@ -159,6 +196,25 @@ int command_continue(Config& config, const Invocation& inv) {
     bj["bracket"] = finest.bracket;
     if (!e.note.empty() || !finest.note.empty()) bj["note"] = finest.note + (finest.note.empty() ? "" : "; ") + e.note;
     j["bifurcations"].push_back(bj);
+  }
+  if (settings.switch_period_doubling) {
+    j["switched"] = json::array();
+    for (size_t i = 0; i < switched.size(); ++i) {
+      json sj;
+      sj["from_parameter"] = switched_from[i];
+      sj["orbit_period"] = 2 * problem.orbit_period;
+      sj["N"] = Ns.back();
+      sj["end"] = switched[i].end;
+      sj["points"] = points_json(switched[i].points);
+      sj["bifurcations"] = json::array();
+      for (const Bifurcation& b : switched[i].bifurcations)
+        sj["bifurcations"].push_back({{"type", to_string(b.type)},
+                                      {"parameter", b.parameter},
+                                      {"angle", b.angle},
+                                      {"multipliers", multipliers_json(b.multipliers)},
+                                      {"note", b.note}});
+      j["switched"].push_back(sj);
+    }
   }
   json cost;
   cost["points"] = branch.points.size();

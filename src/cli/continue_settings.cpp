@@ -42,6 +42,7 @@ ContinueSettings read_continue_settings(Config& config) {
       s.Ns.push_back(static_cast<int>(N));
     }
   }
+  s.switch_period_doubling = config.get_choice("continue_switch", "false", {"false", "true"}) == "true";
   return s;
 }
 
