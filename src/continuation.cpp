@@ -8,10 +8,14 @@ namespace delayspec {
 
 std::string to_string(BifurcationType type) {
   switch (type) {
-    case BifurcationType::fold: return "fold";
-    case BifurcationType::period_doubling: return "period-doubling";
-    case BifurcationType::neimark_sacker: return "neimark-sacker";
-    case BifurcationType::grazing: return "grazing";
+    case BifurcationType::fold:
+      return "fold";
+    case BifurcationType::period_doubling:
+      return "period-doubling";
+    case BifurcationType::neimark_sacker:
+      return "neimark-sacker";
+    case BifurcationType::grazing:
+      return "grazing";
   }
   return "?";
 }
@@ -24,9 +28,12 @@ UnstableCounts unstable_counts(const std::vector<std::complex<double>>& multipli
   UnstableCounts c;
   for (const auto& mu : multipliers) {
     if (!(std::abs(mu) > 1)) continue;
-    if (!is_real(mu)) ++c.complex;
-    else if (mu.real() > 0) ++c.real_plus;
-    else ++c.real_minus;
+    if (!is_real(mu))
+      ++c.complex;
+    else if (mu.real() > 0)
+      ++c.real_plus;
+    else
+      ++c.real_minus;
   }
   return c;
 }
@@ -98,13 +105,16 @@ double hermite_maximum(double g0, double g1, double s0, double s1, double h) {
 
 std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>& Ns,
                                                           const std::vector<std::vector<Bifurcation>>& by_N,
-                                                          double location_accuracy, const RichardsonOptions& richardson) {
+                                                          double location_accuracy,
+                                                          const RichardsonOptions& richardson) {
   if (Ns.size() != by_N.size())
     throw BadInput("extrapolate_bifurcations: " + std::to_string(Ns.size()) + " levels but " +
                    std::to_string(by_N.size()) + " lists of bifurcations");
   if (Ns.empty()) return {};
   for (size_t i = 1; i < Ns.size(); ++i)
-    if (Ns[i] <= Ns[i - 1]) throw BadInput("`continue_Ns`: must be increasing (" + std::to_string(Ns[i - 1]) + ", " + std::to_string(Ns[i]) + ")");
+    if (Ns[i] <= Ns[i - 1])
+      throw BadInput("`continue_Ns`: must be increasing (" + std::to_string(Ns[i - 1]) + ", " + std::to_string(Ns[i]) +
+                     ")");
   std::vector<BifurcationEstimate> estimates;
   const size_t finest = Ns.size() - 1;
   std::vector<std::set<size_t>> used(Ns.size());

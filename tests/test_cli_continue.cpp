@@ -28,15 +28,26 @@ using std::numbers::pi;
 const double kTau = 2 * pi / (3 * std::sqrt(3.0));
 
 std::vector<std::string> linear_args(std::vector<std::string> extra) {
-  std::vector<std::string> args = {"continue", "--set", "model=linear", "--set", "a=-1",
-                                   "--set", "tau=" + delayspec::format_number(kTau), "--set", "continue_key=b",
-                                   "--set", "continue_from=-1.5", "--set", "continue_to=-2.5"};
+  std::vector<std::string> args = {"continue",
+                                   "--set",
+                                   "model=linear",
+                                   "--set",
+                                   "a=-1",
+                                   "--set",
+                                   "tau=" + delayspec::format_number(kTau),
+                                   "--set",
+                                   "continue_key=b",
+                                   "--set",
+                                   "continue_from=-1.5",
+                                   "--set",
+                                   "continue_to=-2.5"};
   for (auto& e : extra) args.push_back(std::move(e));
   return args;
 }
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_continue_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("delayspec_test_continue_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir;
 }
@@ -59,7 +70,8 @@ std::string read_all(const fs::path& file) {
 }  // namespace
 
 TEST(ContinueCli, NeimarkSackerOfLinearDdeWithErrorBars) {
-  CliResult r = run(linear_args({"--set", "continue_Ns=100,200,400,800", "--set", "continue_tolerance=1e-13", "--json"}));
+  CliResult r =
+      run(linear_args({"--set", "continue_Ns=100,200,400,800", "--set", "continue_tolerance=1e-13", "--json"}));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["continue_key"], "b");
@@ -134,22 +146,25 @@ TEST_P(ContinueBadInput, ExitsTwoNamingTheKey) {
 
 INSTANTIATE_TEST_SUITE_P(
     Keys, ContinueBadInput,
-    ::testing::Values(BadContinue{{"continue_from=0", "continue_to=1"}, "continue_key"},
-                      BadContinue{{"continue_key=bb", "continue_from=0", "continue_to=1"}, "`bb`"},
-                      BadContinue{{"continue_key=b", "continue_from=0.3", "continue_to=0.3"}, "empty range"},
-                      BadContinue{{"continue_key=b", "continue_to=0.3"}, "continue_from"},
-                      BadContinue{{"continue_key=N", "continue_from=10", "continue_to=20"}, "`continue_key = N`"},
-                      BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_Ns=400,200"},
-                                  "continue_Ns"},
-                      BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_step=-1"},
-                                  "`continue_step = -1`"},
-                      BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_max_points=1"},
-                                  "`continue_max_points = 1`"}));
+    ::testing::Values(
+        BadContinue{{"continue_from=0", "continue_to=1"}, "continue_key"},
+        BadContinue{{"continue_key=bb", "continue_from=0", "continue_to=1"}, "`bb`"},
+        BadContinue{{"continue_key=b", "continue_from=0.3", "continue_to=0.3"}, "empty range"},
+        BadContinue{{"continue_key=b", "continue_to=0.3"}, "continue_from"},
+        BadContinue{{"continue_key=N", "continue_from=10", "continue_to=20"}, "`continue_key = N`"},
+        BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_Ns=400,200"}, "continue_Ns"},
+        BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_step=-1"}, "`continue_step = -1`"},
+        BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_max_points=1"},
+                    "`continue_max_points = 1`"},
+        // a key that changes the grid (the period of the map: K steps per map)
+        BadContinue{{"continue_key=period", "continue_from=1", "continue_to=2", "N=20"},
+                    "must not change the size of the discrete problem"}));
 
 TEST(ContinueCli, StartWhereNewtonFailsExitsThreeNamingTheResidual) {
   // Newton from the first period after rest (orbit_guess_periods = 0) with one iteration allowed
-  CliResult r = run({"continue", "--set", "orbit=newton", "--set", "orbit_max_iterations=1", "--set", "orbit_guess_periods=0", "--set", "continue_key=k",
-                     "--set", "continue_from=0.2", "--set", "continue_to=0.3", "--set", "N=50"});
+  CliResult r =
+      run({"continue", "--set", "orbit=newton", "--set", "orbit_max_iterations=1", "--set", "orbit_guess_periods=0",
+           "--set", "continue_key=k", "--set", "continue_from=0.2", "--set", "continue_to=0.3", "--set", "N=50"});
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("|F|_inf"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
@@ -185,9 +200,16 @@ TEST(ContinueCli, StepThatCannotBeReducedExitsThreeWithTheBranchSoFar) {
 // a simulated guess (data/scenes/pwsdde-period2.toml): same multipliers, to the orbits' tolerance.
 TEST(ContinueCli, SwitchAtPeriodDoublingReachesTheKnownPeriodTwoOrbit) {
   const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/pwsdde-period2.toml";
-  CliResult r = run({"continue", scene, "--set", "orbit_period=1", "--set", "k=0.25", "--set", "N=100", "--set",
-                     "orbit_guess_periods=200", "--set", "continue_key=k", "--set", "continue_from=0.25", "--set",
-                     "continue_to=0.12", "--set", "continue_switch=true", "--json", "--quiet"});
+  CliResult r = run({"continue", scene,
+                     "--set",    "orbit_period=1",
+                     "--set",    "k=0.25",
+                     "--set",    "N=100",
+                     "--set",    "orbit_guess_periods=200",
+                     "--set",    "continue_key=k",
+                     "--set",    "continue_from=0.25",
+                     "--set",    "continue_to=0.12",
+                     "--set",    "continue_switch=true",
+                     "--json",   "--quiet"});
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_GE(j["bifurcations"].size(), 1u);

@@ -69,7 +69,8 @@ TEST(Continuation, DetectionCountsSeparateCrossingsFromCollisions) {
   using C = std::complex<double>;
   auto counts = [](std::vector<C> m) { return cd::unstable_counts(m); };
   // a real multiplier through +1: fold
-  EXPECT_EQ(cd::detected_changes(counts({C(0.9)}), counts({C(1.1)})), std::vector<BifurcationType>{BifurcationType::fold});
+  EXPECT_EQ(cd::detected_changes(counts({C(0.9)}), counts({C(1.1)})),
+            std::vector<BifurcationType>{BifurcationType::fold});
   // through -1: period doubling
   EXPECT_EQ(cd::detected_changes(counts({C(-0.9)}), counts({C(-1.1)})),
             std::vector<BifurcationType>{BifurcationType::period_doubling});

@@ -34,8 +34,9 @@
 // in newton.max_iterations, the residual growing, a singular matrix, a step the stepper cannot
 // take), whose tangent turns by more than ~37 degrees (cos < 0.8: a jump to another branch is
 // the usual cause), or whose secant turns back against the previous one (a corner of a piecewise-
-// smooth branch, where the branch would retrace itself) is retried with half the step. A step below step_min ends the branch with
-// `failure` set: the point reached and the reason (the points so far are kept).
+// smooth branch, where the branch would retrace itself) is retried with half the step. A step
+// below step_min ends the branch with `failure` set: the point reached and the reason (the
+// points so far are kept).
 //
 // End of the branch: the first point past `to`, or back past `from` after a fold, is replaced
 // by the point at exactly that end (Newton with p fixed); or max_points points. A predictor past
@@ -134,29 +135,29 @@ struct Bifurcation {
   BifurcationType type = BifurcationType::fold;
   double parameter = 0;
   std::vector<std::complex<double>> multipliers;  // at the located point
-  double angle = 0;            // arg of the critical multiplier, in [0, pi] (grazing: NaN)
+  double angle = 0;                               // arg of the critical multiplier, in [0, pi] (grazing: NaN)
   OrbitMeasures measures;
-  long after_point = 0;        // index of the branch point before it
-  double bracket = 0;          // width in p of the final bracket (<= tolerance unless `note` says)
-  int evaluations = 0;         // corrected points evaluated to locate it
-  std::string note;            // e.g. why the bracket stayed wider than the tolerance
-  Eigen::VectorXd orbit;       // the sequence x at the located point (continue_period_doubled starts there)
+  long after_point = 0;   // index of the branch point before it
+  double bracket = 0;     // width in p of the final bracket (<= tolerance unless `note` says)
+  int evaluations = 0;    // corrected points evaluated to locate it
+  std::string note;       // e.g. why the bracket stayed wider than the tolerance
+  Eigen::VectorXd orbit;  // the sequence x at the located point (continue_period_doubled starts there)
 };
 
 struct ContinuationOptions {
-  double from = 0, to = 1;   // the parameter range; the branch starts at `from`
-  double step = 0;           // initial arclength step; 0 = |to - from| / 50
-  double step_min = 0;       // 0 = 1e-6 |to - from|
-  double step_max = 0;       // 0 = |to - from| / 10
-  int max_points = 1000;     // branch points at most (the start included), >= 2
-  double tolerance = 0;      // location tolerance in p; 0 = 1e-10 |to - from|
+  double from = 0, to = 1;                 // the parameter range; the branch starts at `from`
+  double step = 0;                         // initial arclength step; 0 = |to - from| / 50
+  double step_min = 0;                     // 0 = 1e-6 |to - from|
+  double step_max = 0;                     // 0 = |to - from| / 10
+  int max_points = 1000;                   // branch points at most (the start included), >= 2
+  double tolerance = 0;                    // location tolerance in p; 0 = 1e-10 |to - from|
   OrbitByNewtonOptions newton{1e-12, 10};  // corrector: relative residual, iterations per point
   int start_iterations = 30;               // Newton iterations allowed for the first point
   FloquetOptions floquet;
-  bool locate = true;        // locate the bifurcations detected (false: points only)
+  bool locate = true;  // locate the bifurcations detected (false: points only)
   // The discretisation.
   int N = 100;
-  int periods_per_map = 1;   // period-p orbits
+  int periods_per_map = 1;  // period-p orbits
   StepOptions step_options;
   // Called after every accepted point (e.g. progress); may be empty.
   std::function<void(const ContinuationPoint&)> on_point;
@@ -165,8 +166,8 @@ struct ContinuationOptions {
 struct ContinuationResult {
   std::vector<ContinuationPoint> points;
   std::vector<Bifurcation> bifurcations;  // in the order met along the branch
-  std::string end;      // "to", "from" (turned back past the start), "max_points", or "failure"
-  std::string failure;  // when end == "failure": the point reached and the reason
+  std::string end;                        // "to", "from" (turned back past the start), "max_points", or "failure"
+  std::string failure;                    // when end == "failure": the point reached and the reason
   // Cost: corrector iterations (each one linearisation + one sparse LU) and Krylov solves.
   long newton_iterations = 0;
   long krylov_solves = 0;
@@ -176,13 +177,13 @@ struct ContinuationResult {
 // The bifurcations of one type near one location, across N, and their extrapolation.
 struct BifurcationEstimate {
   BifurcationType type = BifurcationType::fold;
-  std::vector<int> Ns;              // the levels where it was found (increasing)
-  std::vector<double> parameters;   // its location at each of them
-  double parameter = 0;             // at the finest N
-  double extrapolated = 0;          // Richardson (richardson.hpp), = parameter with one level
-  double error_estimate = INFINITY; // of `extrapolated`; infinity with one level
-  double observed_order = NAN;      // log(d1 / d2) / log(r) of the last three levels
-  double angle = 0;                 // at the finest N
+  std::vector<int> Ns;               // the levels where it was found (increasing)
+  std::vector<double> parameters;    // its location at each of them
+  double parameter = 0;              // at the finest N
+  double extrapolated = 0;           // Richardson (richardson.hpp), = parameter with one level
+  double error_estimate = INFINITY;  // of `extrapolated`; infinity with one level
+  double observed_order = NAN;       // log(d1 / d2) / log(r) of the last three levels
+  double angle = 0;                  // at the finest N
   std::string note;
 };
 
@@ -197,6 +198,13 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
                                                           const RichardsonOptions& richardson = {});
 
 namespace continuation_detail {
+
+// The continued key changed the size of the discrete problem (e.g. a period that changes K): bad
+// input, not a point outside the model's domain (which ends the branch).
+class ProblemSizeChanged : public BadInput {
+ public:
+  using BadInput::BadInput;
+};
 
 // Multipliers outside the unit circle, by kind (the detection counts of the header).
 struct UnstableCounts {
@@ -278,6 +286,8 @@ class PeriodicBranch {
       } catch (const NumericalFailure& e) {
         why = std::string("residual not computable at ") + format_number(p) + " (" + e.what() + ")";
         return std::nullopt;
+      } catch (const continuation_detail::ProblemSizeChanged&) {
+        throw;
       } catch (const BadInput& e) {  // p (or p +- delta) outside the model's domain
         why = std::string("the model rejects parameter ") + format_number(p) + " (" + e.what() + ")";
         return std::nullopt;
@@ -290,8 +300,8 @@ class PeriodicBranch {
       }
       // g is linear: after one Newton step it is at its rounding level, eps times the size of its terms
       const double g_scale = row_x.cwiseAbs().dot(x.cwiseAbs()) + std::abs(row_p * p) + std::abs(target);
-      const bool converged = r <= o_.newton.tolerance * (1 + x.lpNorm<Eigen::Infinity>()) &&
-                             std::abs(g) <= 1e-12 * (1 + g_scale);
+      const bool converged =
+          r <= o_.newton.tolerance * (1 + x.lpNorm<Eigen::Infinity>()) && std::abs(g) <= 1e-12 * (1 + g_scale);
       // Diverging: the residual 1e3 times above the one after the first step (not any growth: near
       // grazing the discrete problem is only piecewise smooth and an iterate may raise |F| before
       // converging; the start may have |F| = 0 with the constraint violated).
@@ -355,8 +365,8 @@ class PeriodicBranch {
     const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max({std::abs(p), range_, 1e-300});
     const double up = p + delta, down = p - delta;
     const Map map_up = map_at(up), map_down = map_at(down);
-    Fp = (PeriodicOrbitProblem<Map>(map_up).residual(x) - PeriodicOrbitProblem<Map>(map_down).residual(x)) /
-         (up - down);
+    Fp =
+        (PeriodicOrbitProblem<Map>(map_up).residual(x) - PeriodicOrbitProblem<Map>(map_down).residual(x)) / (up - down);
   }
 
   // Weighted inner product of the state parts plus the parameters' product.
@@ -420,9 +430,9 @@ class PeriodicBranch {
         const int ja = region_of(model, a), jb = region_of(model, b);
         const V grad = model.grad_H(a);  // H affine (model.hpp)
         // max H on [t, t + h]: Hermite cubic through H and dH/dt = grad H . f at both nodes
-        m.max_H = std::max(m.max_H, continuation_detail::hermite_maximum(
-                                        model.H(a), model.H(b), grad.dot(model.f(ja, t, a, w0)),
-                                        grad.dot(model.f(jb, t + h, b, w1)), h));
+        m.max_H = std::max(m.max_H,
+                           continuation_detail::hermite_maximum(model.H(a), model.H(b), grad.dot(model.f(ja, t, a, w0)),
+                                                                grad.dot(model.f(jb, t + h, b, w1)), h));
         // time in region 1 within the step, from its events (none with events off: the node's region)
         StepEvents events;
         map.stepper().step(t, h, a, w0, w1, scratch, &events);
@@ -446,9 +456,10 @@ class PeriodicBranch {
   HistoryGrid grid_at_model(const Model& model, double p) const {
     const HistoryGrid g = make_grid(model.tau(), model.period(), o_.N, o_.periods_per_map);
     if (K_ != 0 && (g.K != K_ || g.M != M_))
-      throw BadInput("continuation: at parameter " + format_number(p) + " the grid has K = " + std::to_string(g.K) +
-                     ", M = " + std::to_string(g.M) + " (at the start K = " + std::to_string(K_) + ", M = " +
-                     std::to_string(M_) + "): the continued key must not change the size of the discrete problem");
+      throw continuation_detail::ProblemSizeChanged(
+          "continuation: at parameter " + format_number(p) + " the grid has K = " + std::to_string(g.K) +
+          ", M = " + std::to_string(g.M) + " (at the start K = " + std::to_string(K_) + ", M = " + std::to_string(M_) +
+          "): the continued key must not change the size of the discrete problem");
     return g;
   }
 
@@ -463,8 +474,9 @@ namespace continuation_detail {
 // from the point (guess, start_p) itself along that tangent (no Newton: the point may be singular,
 // e.g. a period doubling seen by the doubled problem), the first segment not searched.
 template <class Model, class ModelAt>
-ContinuationResult trace_branch(const ModelAt& model_at, const Eigen::VectorXd& guess, const ContinuationOptions& options,
-                                const Eigen::VectorXd* start_tangent, double start_p);
+ContinuationResult trace_branch(const ModelAt& model_at, const Eigen::VectorXd& guess,
+                                const ContinuationOptions& options, const Eigen::VectorXd* start_tangent,
+                                double start_p);
 }  // namespace continuation_detail
 
 template <class Model, class ModelAt>
@@ -495,8 +507,8 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
   require_positive("continue_step_max", o.step_max);
   require_positive("continue_tolerance", o.tolerance);
   if (o.step_min > o.step_max)
-    throw BadInput("`continue_step_min = " + format_number(o.step_min) + "` exceeds `continue_step_max = " +
-                   format_number(o.step_max) + "`");
+    throw BadInput("`continue_step_min = " + format_number(o.step_min) +
+                   "` exceeds `continue_step_max = " + format_number(o.step_max) + "`");
   o.step = std::clamp(o.step, o.step_min, o.step_max);
   if (o.max_points < 2) throw BadInput("`continue_max_points = " + std::to_string(o.max_points) + "`: must be >= 2");
 
@@ -517,8 +529,8 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
     State given;
     given.x = guess;
     given.p = start_p;
-    const double norm = std::sqrt(branch.dot(start_tangent->head(n), (*start_tangent)[n], start_tangent->head(n),
-                                             (*start_tangent)[n]));
+    const double norm =
+        std::sqrt(branch.dot(start_tangent->head(n), (*start_tangent)[n], start_tangent->head(n), (*start_tangent)[n]));
     given.tx = start_tangent->head(n) / norm;
     given.tp = (*start_tangent)[n] / norm;
     current = std::move(given);
@@ -592,15 +604,17 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
         break;
       }
       const Sample m{s, test(mid), mid.parameter, mid, st->x};
-      if (changes_here(neg.point, mid)) pos = m;  // (neg, pos) keep the order of s until the sign change
-      else neg = m;
+      if (changes_here(neg.point, mid))
+        pos = m;  // (neg, pos) keep the order of s until the sign change
+      else
+        neg = m;
     }
     if (neg.g > 0) std::swap(neg, pos);
-    std::optional<Sample> prev_neg;  // the negative sample before `neg`
+    std::optional<Sample> prev_neg;       // the negative sample before `neg`
     double g_neg = neg.g, g_pos = pos.g;  // Illinois: possibly halved copies
-    int side = 0;                          // which side moved last (Illinois)
-    bool one_sided = false;  // a corrector failed on the positive side: secant from the negative side
-    double located = NAN;    // the root from the secant through prev_neg and neg
+    int side = 0;                         // which side moved last (Illinois)
+    bool one_sided = false;               // a corrector failed on the positive side: secant from the negative side
+    double located = NAN;                 // the root from the secant through prev_neg and neg
     if (!(neg.g < 0 && pos.g > 0)) {
       bif.note = "the test function does not change sign over the segment (" + format_number(neg.g) + ", " +
                  format_number(pos.g) + "): location by the nearer end";
@@ -647,8 +661,8 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
         one_sided = true;
         pos.s = s;
         side = 1;
-        bif.note = "located from one side: " + (pt ? std::string("no candidate multiplier") : reason) + " at s = " +
-                   format_number(s);
+        bif.note = "located from one side: " + (pt ? std::string("no candidate multiplier") : reason) +
+                   " at s = " + format_number(s);
         continue;
       }
       if (g == 0) {
@@ -706,9 +720,10 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
       next->tp = -next->tp;
     }
     if (next && branch.dot(next->tx, next->tp, current->tx, current->tp) < 0.8) {
-      reason = "the tangent turned by " +
-               format_number(std::acos(std::clamp(branch.dot(next->tx, next->tp, current->tx, current->tp), -1.0, 1.0))) +
-               " rad";
+      reason =
+          "the tangent turned by " +
+          format_number(std::acos(std::clamp(branch.dot(next->tx, next->tp, current->tx, current->tp), -1.0, 1.0))) +
+          " rad";
       next.reset();
     }
     if (next && previous_state) {
@@ -718,8 +733,8 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
       // the corner lands on the same branch behind it and the branch would retrace itself.
       const Eigen::VectorXd d1x = current->x - previous_state->x, d2x = next->x - current->x;
       const double d1p = current->p - previous_state->p, d2p = next->p - current->p;
-      const double cosine = branch.dot(d1x, d1p, d2x, d2p) /
-                            std::sqrt(branch.dot(d1x, d1p, d1x, d1p) * branch.dot(d2x, d2p, d2x, d2p));
+      const double cosine =
+          branch.dot(d1x, d1p, d2x, d2p) / std::sqrt(branch.dot(d1x, d1p, d1x, d1p) * branch.dot(d2x, d2p, d2x, d2p));
       if (cosine < 0) {
         reason = "the branch turns back on itself (consecutive secants at " +
                  format_number(std::acos(std::clamp(cosine, -1.0, 1.0))) + " rad: a corner, not a smooth fold)";
@@ -745,8 +760,8 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
     const double past_to = (next->p - o.to) * direction, before_from = (o.from - next->p) * direction;
     if (past_to >= 0 || before_from > 0) {
       const double end_p = past_to >= 0 ? o.to : o.from;
-      std::optional<State> end = branch.correct(next->x, next->p, zero_row, 1.0, end_p, o.newton.max_iterations,
-                                                reason, result.newton_seconds);
+      std::optional<State> end = branch.correct(next->x, next->p, zero_row, 1.0, end_p, o.newton.max_iterations, reason,
+                                                result.newton_seconds);
       if (end) {
         if (branch.dot(end->tx, end->tp, next->tx, next->tp) < 0) end->tx = -end->tx, end->tp = -end->tp;
         s_b = branch.dot(current->tx, current->tp, end->x - current->x, end->p - current->p);
@@ -787,8 +802,10 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
     current = std::move(next);
     add_point(std::move(point));
     if (last) break;
-    if (iterations <= 3) ds = std::min(1.5 * ds, o.step_max);
-    else if (iterations >= 6) ds = std::max(0.7 * ds, o.step_min);
+    if (iterations <= 3)
+      ds = std::min(1.5 * ds, o.step_max);
+    else if (iterations >= 6)
+      ds = std::max(0.7 * ds, o.step_min);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   return result;
@@ -814,7 +831,8 @@ ContinuationResult continue_period_doubled(const ModelAt& model_at, const Bifurc
     throw BadInput("continue_period_doubled: needs a located period doubling with its orbit");
   const Model model = model_at(at.parameter);
   const StepOptions& so = options.step_options;
-  const Map map1(TrapezoidStepper<Model>(model, so), make_grid(model.tau(), model.period(), options.N, options.periods_per_map));
+  const Map map1(TrapezoidStepper<Model>(model, so),
+                 make_grid(model.tau(), model.period(), options.N, options.periods_per_map));
   const Map map2(TrapezoidStepper<Model>(model, so),
                  make_grid(model.tau(), model.period(), options.N, 2 * options.periods_per_map));
   const PeriodicOrbitProblem<Map> problem1(map1);
@@ -825,7 +843,8 @@ ContinuationResult continue_period_doubled(const ModelAt& model_at, const Bifurc
   // The real eigenvector of the multiplier nearest -1.
   FloquetOptions fo = options.floquet;
   fo.keep_vectors = true;
-  if (fo.solver == FloquetSolver::dense_eigen || fo.solver == FloquetSolver::dense_lapack) fo.solver = FloquetSolver::spectra;
+  if (fo.solver == FloquetSolver::dense_eigen || fo.solver == FloquetSolver::dense_lapack)
+    fo.solver = FloquetSolver::spectra;
   const FloquetResult r = floquet_multipliers(map1.monodromy(U), fo);
   size_t k = 0;
   for (size_t i = 1; i < r.multipliers.size(); ++i)

@@ -51,46 +51,53 @@ struct ModelWithKey {
   }
 };
 
-// The branch at one N: the start orbit at `from`, then continue_orbit.
-ContinuationResult branch_at(const Config& config, const ContinueSettings& settings, const OrbitSettings& orbit_settings,
-                             ContinuationOptions options, int N, Progress& progress) {
-  Config level = config;
-  level.set("N", std::to_string(N), "continue_Ns");
-  level.set(settings.key, format_number(options.from), "continue_from");
-  const Problem problem = read_problem(level, 100);
+// One level N with the continued key at p: the scene the model factory reads (ModelWithKey keeps
+// a reference to `config`), its problem, and the options' discretisation taken from it.
+struct Level {
+  Config config;
+  Problem problem;
+};
+Level level_at(const Config& config, const std::string& key, double p, int N, ContinuationOptions& options,
+               Progress& progress) {
+  Level level{config, {}};
+  level.config.set("N", std::to_string(N), "continue_Ns");
+  level.config.set(key, format_number(p), "continue");
+  level.problem = read_problem(level.config, 100);
   options.N = N;
-  options.periods_per_map = problem.orbit_period;
-  options.step_options = step_options(problem);
-  options.on_point = [&](const ContinuationPoint&) { progress.add(); };
+  options.periods_per_map = level.problem.orbit_period;
+  options.step_options = step_options(level.problem);
+  options.on_point = [&progress](const ContinuationPoint&) { progress.add(); };
+  return level;
+}
+
+// The branch at one N: the start orbit at `from`, then continue_orbit.
+ContinuationResult branch_at(const Config& config, const ContinueSettings& settings,
+                             const OrbitSettings& orbit_settings, ContinuationOptions options, int N,
+                             Progress& progress) {
+  const Level level = level_at(config, settings.key, options.from, N, options, progress);
   return std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
         TrapezoidStepper<Model> stepper(model, options.step_options);
-        StroboscopicMap<Model> map(stepper, problem.grid);
+        StroboscopicMap<Model> map(stepper, level.problem.grid);
         const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
-        const Eigen::VectorXd guess = PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
-        return continue_orbit<Model>(ModelWithKey<Model>{level, settings.key}, guess, options);
+        const Eigen::VectorXd guess =
+            PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
+        return continue_orbit<Model>(ModelWithKey<Model>{level.config, settings.key}, guess, options);
       },
-      problem.model);
+      level.problem.model);
 }
 
 // The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
 ContinuationResult switched_at(const Config& config, const ContinueSettings& settings, ContinuationOptions options,
                                int N, const Bifurcation& pd, Progress& progress) {
-  Config level = config;
-  level.set("N", std::to_string(N), "continue_Ns");
-  level.set(settings.key, format_number(pd.parameter), "continue_switch");
-  const Problem problem = read_problem(level, 100);
-  options.N = N;
-  options.periods_per_map = problem.orbit_period;
-  options.step_options = step_options(problem);
-  options.on_point = [&](const ContinuationPoint&) { progress.add(); };
+  const Level level = level_at(config, settings.key, pd.parameter, N, options, progress);
   return std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
-        return continue_period_doubled<Model>(ModelWithKey<Model>{level, settings.key}, pd, options);
+        return continue_period_doubled<Model>(ModelWithKey<Model>{level.config, settings.key}, pd, options);
       },
-      problem.model);
+      level.problem.model);
 }
 
 json measures_json(const OrbitMeasures& m) {
@@ -128,7 +135,7 @@ int command_continue(Config& config, const Invocation& inv) {
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   ContinuationOptions options = settings.options;
   options.floquet = read_floquet_options(config);
-  options.newton.tolerance = orbit_settings.newton.tolerance;        // the corrector's relative residual
+  options.newton.tolerance = orbit_settings.newton.tolerance;       // the corrector's relative residual
   options.start_iterations = orbit_settings.newton.max_iterations;  // the first point's Newton
   // The continued key takes the start value; reading the problem with it validates it and marks
   // it as used (a key no model reads is then reported as unknown).
@@ -136,7 +143,8 @@ int command_continue(Config& config, const Invocation& inv) {
   const Problem problem = read_problem(config, 100);
   config.check_all_used();
   const std::vector<int> Ns = settings.Ns.empty() ? std::vector<int>{problem.N} : settings.Ns;
-  const bool switching = std::visit([](const auto& m) { return std::decay_t<decltype(m)>::has_switching; }, problem.model);
+  const bool switching =
+      std::visit([](const auto& m) { return std::decay_t<decltype(m)>::has_switching; }, problem.model);
 
   Progress progress(inv.err, "continue", 0, inv.quiet);
   std::vector<ContinuationResult> levels;
@@ -165,7 +173,8 @@ int command_continue(Config& config, const Invocation& inv) {
                   format_number(switched_from[i]) + ": " + switched[i].failure;
   for (size_t i = 0; i < levels.size(); ++i)
     if (!levels[i].failure.empty())
-      failures += (failures.empty() ? "" : "; ") + std::string("N = ") + std::to_string(Ns[i]) + ": " + levels[i].failure;
+      failures +=
+          (failures.empty() ? "" : "; ") + std::string("N = ") + std::to_string(Ns[i]) + ": " + levels[i].failure;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   json j;
@@ -260,13 +269,14 @@ int command_continue(Config& config, const Invocation& inv) {
     for (size_t b = 0; b < estimates.size(); ++b) {
       const BifurcationEstimate& e = estimates[b];
       std::complex<double> critical;
-      const double g = e.type == BifurcationType::grazing
-                           ? NAN
-                           : continuation_detail::multiplier_test(e.type, branch.bifurcations[b].multipliers, &critical);
+      const double g = e.type == BifurcationType::grazing ? NAN
+                                                          : continuation_detail::multiplier_test(
+                                                                e.type, branch.bifurcations[b].multipliers, &critical);
       bifs << to_string(e.type) << "," << csv_number(e.parameter) << "," << csv_number(e.extrapolated) << ","
            << csv_number(e.error_estimate) << "," << csv_number(e.observed_order) << "," << csv_number(e.angle) << ","
            << csv_number(std::isfinite(g) ? std::abs(critical) : NAN) << ",";
-      for (size_t i = 0; i < e.Ns.size(); ++i) bifs << (i ? ";" : "") << e.Ns[i] << ":" << format_number(e.parameters[i]);
+      for (size_t i = 0; i < e.Ns.size(); ++i)
+        bifs << (i ? ";" : "") << e.Ns[i] << ":" << format_number(e.parameters[i]);
       bifs << "\n";
     }
     write_file_atomically(dir / "branch.csv", rows.str());
@@ -302,7 +312,8 @@ int command_continue(Config& config, const Invocation& inv) {
   for (size_t b = 0; b < estimates.size(); ++b) {
     const BifurcationEstimate& e = estimates[b];
     inv.out << "  " << to_string(e.type) << " at " << settings.key << " = " << format_number(e.parameter);
-    if (e.type != BifurcationType::grazing) inv.out << ", angle " << e.angle << " (" << e.angle / std::numbers::pi << " pi)";
+    if (e.type != BifurcationType::grazing)
+      inv.out << ", angle " << e.angle << " (" << e.angle / std::numbers::pi << " pi)";
     if (e.Ns.size() > 1)
       inv.out << "; extrapolated " << format_number(e.extrapolated) << " +- " << e.error_estimate << " (order "
               << e.observed_order << ")";

@@ -10,9 +10,9 @@
 namespace delayspec::cli {
 
 struct ContinueSettings {
-  std::string key;                 // continue_key: a numeric model key
-  ContinuationOptions options;     // from, to, step, step_min, step_max, max_points, tolerance
-  std::vector<int> Ns;             // continue_Ns (increasing); empty: the one level N
+  std::string key;                      // continue_key: a numeric model key
+  ContinuationOptions options;          // from, to, step, step_min, step_max, max_points, tolerance
+  std::vector<int> Ns;                  // continue_Ns (increasing); empty: the one level N
   bool switch_period_doubling = false;  // continue_switch: the period-2 branch at each period doubling
 };
 

@@ -72,11 +72,13 @@ void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& di
     gp << gnuplot_datablock("stable", solid.empty() ? "nan nan\n" : solid)
        << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
        << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
-    gp << "set title " << gnuplot_string("Branch of " + t.metadata_text("model", "?") + " against " + key +
-                                         " (stable solid, unstable dashed)")
+    gp << "set title "
+       << gnuplot_string("Branch of " + t.metadata_text("model", "?") + " against " + key +
+                         " (stable solid, unstable dashed)")
        << "\n";
     gp << "set xlabel " << gnuplot_string(key) << "\nset ylabel " << gnuplot_string(ylabel)
-       << "\nset grid\nset key top left\n" << labels;
+       << "\nset grid\nset key top left\n"
+       << labels;
     gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
        << "     $unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable', \\\n"
        << "     $marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'"
