@@ -31,8 +31,8 @@
 //
 // Step control (Newton's convergence): a corrector that converges in <= 3 iterations grows the
 // next step by 1.5 (at most step_max); 6 or more shrink it by 0.7; one that fails (not converged
-// in newton.max_iterations, the residual growing, a singular matrix, a step the stepper cannot
-// take), whose tangent turns by more than ~37 degrees (cos < 0.8: a jump to another branch is
+// in newton.max_iterations, the residual 1e3 times above the one after the first iteration, a
+// singular matrix, a step the stepper cannot take), whose tangent turns by more than ~37 degrees (cos < 0.8: a jump to another branch is
 // the usual cause), or whose secant turns back against the previous one (a corner of a piecewise-
 // smooth branch, where the branch would retrace itself) is retried with half the step. A step
 // below step_min ends the branch with `failure` set: the point reached and the reason (the
@@ -62,11 +62,15 @@
 //   grazing          switching models: the sign of max H over the orbit changes.
 // Location: on the segment's own curve s -> X(s) (the corrector from X_a + s t_a on the
 // hyperplane <t_a, X - X_a - s t_a>_w = 0, s in [0, s_b]), the zero of the test function
-//   fold: mu - 1 for the real positive multiplier nearest 1; period doubling: |mu| - 1 for the
-//   real negative one nearest -1; Neimark-Sacker: |mu| - 1 for the non-real one nearest the
-//   circle; grazing: max H,
-// by the Illinois variant of regula falsi until the bracket's two ends differ by <= tolerance in
-// p (a test function crossing transversally: superlinear). A multiplier is real when |Im mu| <=
+//   fold: dp/ds at a turning point, else mu - 1 for the real positive multiplier nearest 1;
+//   period doubling: |mu| - 1 for the real negative one nearest -1; Neimark-Sacker: |mu| - 1 for
+//   the non-real one nearest the circle; grazing: max H,
+// first by bisection on the detection counts until the test function changes sign (a long
+// segment may also hold a collision), then by the Illinois variant of regula falsi until the
+// bracket's two ends differ by <= tolerance in p (a test function crossing transversally:
+// superlinear). Where the corrector fails on one side (near grazing the discrete problem is only
+// piecewise smooth and Newton may stall in contact), the root is the secant through the last two
+// points of the other side, accepted when it moves by <= tolerance (`note` says so). A multiplier is real when |Im mu| <=
 // 1e-10 |mu|. Only the nev leading multipliers are watched: more than nev outside the circle
 // make the counts wrong.
 //
