@@ -7,7 +7,7 @@
 #include <limits>
 #include <string>
 
-#include "delayspec/dense_spectrum.hpp"
+#include "delayspec/multipliers.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {

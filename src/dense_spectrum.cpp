@@ -13,15 +13,6 @@ extern "C" void dgeev_(const char* jobvl, const char* jobvr, const int* n, doubl
 
 namespace delayspec {
 
-void sort_by_modulus(std::vector<std::complex<double>>& values) {
-  std::stable_sort(values.begin(), values.end(), [](const auto& a, const auto& b) {
-    const double ma = std::abs(a), mb = std::abs(b);
-    if (ma != mb) return ma > mb;
-    if (a.real() != b.real()) return a.real() > b.real();
-    return a.imag() > b.imag();
-  });
-}
-
 namespace {
 
 std::vector<std::complex<double>> eigen_backend(const Eigen::MatrixXd& A) {

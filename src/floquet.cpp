@@ -15,21 +15,46 @@
 namespace delayspec {
 
 FloquetSolver parse_floquet_solver(const std::string& name) {
+  if (name == "auto") return FloquetSolver::automatic;
   if (name == "spectra") return FloquetSolver::spectra;
   if (name == "arpack") return FloquetSolver::arpack;
   if (name == "dense" || name == "dense-lapack") return FloquetSolver::dense_lapack;
   if (name == "dense-eigen") return FloquetSolver::dense_eigen;
-  throw BadInput("`solver = " + name + "`: must be one of spectra, arpack, dense, dense-eigen, dense-lapack");
+  throw BadInput("`solver = " + name + "`: must be one of auto, spectra, arpack, dense, dense-eigen, dense-lapack");
+}
+
+FloquetSolver choose_floquet_solver(long n) {
+  if (n <= 100) return FloquetSolver::dense_lapack;
+  return n < 2000 ? FloquetSolver::spectra : FloquetSolver::arpack;
 }
 
 std::string to_string(FloquetSolver solver) {
   switch (solver) {
+    case FloquetSolver::automatic: return "auto";
     case FloquetSolver::spectra: return "spectra";
     case FloquetSolver::arpack: return "arpack";
     case FloquetSolver::dense_eigen: return "dense-eigen";
     case FloquetSolver::dense_lapack: return "dense-lapack";
   }
   return "?";
+}
+
+void validate_floquet_options(const FloquetOptions& options, long n) {
+  if (options.nev < 1 || options.nev > n)
+    throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " +
+                   std::to_string(n));
+  // The Krylov options are checked whenever a Krylov backend may run (auto included, whatever
+  // it picks): a bad ncv is an error of the request, not of the size that hides it.
+  if (options.solver == FloquetSolver::dense_eigen || options.solver == FloquetSolver::dense_lapack) return;
+  if (options.ncv != 0 && options.ncv < options.nev + 2)
+    throw BadInput("`ncv = " + std::to_string(options.ncv) + "`: must be 0 (automatic) or >= nev + 2 = " +
+                   std::to_string(options.nev + 2));
+  if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
+    throw BadInput("`tol = " + format_number(options.tolerance) + "`: must be > 0 and finite");
+  if (options.max_iterations < 1)
+    throw BadInput("`max_iterations = " + std::to_string(options.max_iterations) + "`: must be >= 1");
+  if (!(options.residual_bound > 0) || !std::isfinite(options.residual_bound))
+    throw BadInput("`residual_bound = " + format_number(options.residual_bound) + "`: must be > 0 and finite");
 }
 
 int default_ncv(int nev, long n) {
@@ -326,23 +351,12 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
 }  // namespace
 
 template <int D>
-FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& options) {
+FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& requested) {
   const long n = op.rows();
-  if (options.nev < 1 || options.nev > n)
-    throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " +
-                   std::to_string(n));
+  validate_floquet_options(requested, n);
+  FloquetOptions options = requested;
+  if (options.solver == FloquetSolver::automatic) options.solver = choose_floquet_solver(n);
   const bool krylov = options.solver == FloquetSolver::spectra || options.solver == FloquetSolver::arpack;
-  if (krylov) {
-    if (options.ncv != 0 && options.ncv < options.nev + 2)
-      throw BadInput("`ncv = " + std::to_string(options.ncv) + "`: must be 0 (automatic) or >= nev + 2 = " +
-                     std::to_string(options.nev + 2));
-    if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
-      throw BadInput("`tol = " + format_number(options.tolerance) + "`: must be > 0 and finite");
-    if (options.max_iterations < 1)
-      throw BadInput("`max_iterations = " + std::to_string(options.max_iterations) + "`: must be >= 1");
-    if (!(options.residual_bound > 0) || !std::isfinite(options.residual_bound))
-      throw BadInput("`residual_bound = " + format_number(options.residual_bound) + "`: must be > 0 and finite");
-  }
   const auto start = std::chrono::steady_clock::now();
   FloquetResult result;
   const long applications_before = op.applications();
@@ -353,6 +367,7 @@ FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& 
     solver = FloquetSolver::dense_lapack;
   }
   switch (solver) {
+    case FloquetSolver::automatic:  // resolved above
     case FloquetSolver::spectra:
     case FloquetSolver::arpack:
       krylov_solve(op, options, result);

@@ -6,6 +6,7 @@
 #pragma GCC diagnostic ignored "-Wuse-after-free"
 #endif
 #include <Spectra/GenEigsSolver.h>
+#include <Spectra/Util/Version.h>
 
 #include <cmath>
 #include <limits>
@@ -50,6 +51,12 @@ class ScaledMonodromy {
 
 // GenEigsSolver plus read access to what Spectra keeps protected: the Arnoldi basis V, the
 // Ritz coefficient vectors y (Ritz vector = V y) and the residual estimates |f| |e_m^T y|.
+// Protected members are not Spectra's interface: this class is pinned to the version it was
+// written and tested against (Debian's libspectra-dev 1.0.1; the Krylov tests check the pairs it
+// returns against their true residuals and the dense spectrum). Another version stops the build
+// here: re-read GenEigsSolver / EigsBase for m_fac, m_ritz_val, m_ritz_vec, m_ritz_est, m_nev.
+static_assert(SPECTRA_MAJOR_VERSION == 1 && SPECTRA_MINOR_VERSION == 0 && SPECTRA_PATCH_VERSION == 1,
+              "krylov_spectra.cpp reads Spectra 1.0.1's protected members: check them for this version");
 template <int D>
 class SpectraSolver : public Spectra::GenEigsSolver<const ScaledMonodromy<D>> {
   using Base = Spectra::GenEigsSolver<const ScaledMonodromy<D>>;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "delayspec/dense_spectrum.hpp"
+#include "delayspec/multipliers.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {

@@ -28,7 +28,7 @@ double dependence_threshold(long n) { return static_cast<double>(n) * 2.22044604
 template <int KC>
 void apply_reflector(const double* a, long n, int k_runtime, int j, double tau, double* x, int c0) {
   const int k = KC > 0 ? KC : k_runtime;
-  double w0[KC > 0 ? KC : 64], w1[KC > 0 ? KC : 64];
+  double w0[KC > 0 ? KC : kMaxTangentVectors], w1[KC > 0 ? KC : kMaxTangentVectors];
   for (int c = c0; c < k; ++c) {
     w0[c] = x[j * k + c];
     w1[c] = 0;
@@ -102,7 +102,7 @@ void qr_rows(double* a, long n, int k, double* tau, double* r, double* column_no
   form_q_rows<KC>(a, n, k, tau, q);
 }
 
-// Compile-time k for the common small blocks, runtime k (<= 64 per reflector pass) otherwise.
+// Compile-time k for the common small blocks, runtime k (<= kMaxTangentVectors per reflector pass) otherwise.
 void qr_rows_dispatch(double* a, long n, int k, double* tau, double* r, double* norm, double* q) {
   switch (k) {
     case 1: return qr_rows<1>(a, n, k, tau, r, norm, q);
@@ -121,7 +121,9 @@ void qr_rows_dispatch(double* a, long n, int k, double* tau, double* r, double* 
 
 TangentQR::TangentQR(double* block, long n, int k)
     : block_(block), n_(n), k_(k), tau_(k), r_(k), norm_(k) {
-  if (k > 64) throw BadInput("`exponents = " + std::to_string(k) + "`: at most 64 tangent vectors");
+  if (k > kMaxTangentVectors)
+    throw BadInput("`exponents = " + std::to_string(k) + "`: at most " + std::to_string(kMaxTangentVectors) +
+                   " tangent vectors");
 }
 
 void TangentQR::factorise(double* q_out, double* log_r) {
@@ -209,8 +211,9 @@ LyapunovStatistics lyapunov_statistics(const std::vector<double>& interval_logs,
 }
 
 void validate_lyapunov_options(const LyapunovOptions& o, long n) {
-  if (o.exponents < 1 || o.exponents > n || o.exponents > 64)
-    throw BadInput("`exponents = " + std::to_string(o.exponents) + "`: must be between 1 and min(64, n = " +
+  if (o.exponents < 1 || o.exponents > n || o.exponents > kMaxTangentVectors)
+    throw BadInput("`exponents = " + std::to_string(o.exponents) + "`: must be between 1 and min(" +
+                   std::to_string(kMaxTangentVectors) + ", n = " +
                    std::to_string(n) + ") (only leading exponents are meant)");
   if (o.qr_every < 1) throw BadInput("`qr_every = " + std::to_string(o.qr_every) + "`: must be an integer >= 1");
   if (o.periods < 2 * static_cast<long>(o.qr_every) || o.periods % o.qr_every != 0)

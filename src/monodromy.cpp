@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "delayspec/block_kernel.hpp"
+#include "delayspec/detail/block_kernel.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {
@@ -21,7 +21,7 @@ template <int D>
 void Monodromy<D>::perform_op(const double* x, double* y) const {
   using V = Vec<D>;
   const int M = grid_.M, m = grid_.m, K = grid_.K;
-  const double theta = grid_.theta, c0 = 1 - theta;
+  const double theta = grid_.theta;
   double* b = work_.data();
   std::copy(x, x + n_, b);
   auto block = [b](long j) { return Eigen::Map<V>(b + j * D); };
@@ -32,13 +32,11 @@ void Monodromy<D>::perform_op(const double* x, double* y) const {
       block(M + l + 1).noalias() = s.P * block(M + l) + s.Q * block(M + l - m) + s.R * block(M + l - m + 1);
     }
   } else {
-    // y_tau(t) = c0 b[M+l-m] + theta b[M+l-m-1],  y_tau(t+h) = c0 b[M+l-m+1] + theta b[M+l-m]
+    // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the delayed values from grid.delay_tap
     for (long l = 0; l < K; ++l) {
       const StepMap<D>& s = maps_[l];
-      const long j = M + l - m;
-      V w0 = c0 * block(j) + theta * block(j - 1);
-      V w1 = c0 * block(j + 1) + theta * block(j);
-      block(M + l + 1).noalias() = s.P * block(M + l) + s.Q * w0 + s.R * w1;
+      const DelayTap<V> tap = grid_.delay_tap<V>(l, block);
+      block(M + l + 1).noalias() = s.P * block(M + l) + s.Q * tap.w0 + s.R * tap.w1;
     }
   }
   std::copy(b + static_cast<long>(K) * D, b + static_cast<long>(K) * D + n_, y);
@@ -56,7 +54,7 @@ void Monodromy<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
 
 template <int D>
 void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const {
-  const long M = grid_.M, m = grid_.m, K = grid_.K;
+  const long M = grid_.M, K = grid_.K;
   const double theta = grid_.theta;
   const size_t need = static_cast<size_t>(M + 1 + K) * D * k;
   if (block_work_.size() < need) block_work_.resize(need);
@@ -65,9 +63,10 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
   for (long v = 0; v < k; ++v)
     for (long i = 0; i < n_; ++i) b[i * k + v] = X[v * ldx + i];
   const long stride = static_cast<long>(D) * k;  // one history slot
-  // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), delayed slot M+l-m (block_kernel.hpp)
+  // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the tap of grid.delay_tap on k vectors (block_kernel.hpp)
   for (long l = 0; l < K; ++l)
-    step_block<D>(maps_[l], b + (M + l) * stride, b + (M + l - m) * stride, k, theta, b + (M + l + 1) * stride);
+    step_block<D>(maps_[l], b + (M + l) * stride, b + grid_.delayed_slot(l) * stride, k, theta,
+                  b + (M + l + 1) * stride);
   const double* res = b + K * stride;
   for (long v = 0; v < k; ++v)
     for (long i = 0; i < n_; ++i) Y[v * ldy + i] = res[i * k + v];

@@ -1,4 +1,4 @@
-#include "delayspec/sparse_lu.hpp"
+#include "delayspec/detail/sparse_lu.hpp"
 
 #include <cmath>
 #include <string>

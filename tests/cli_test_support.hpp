@@ -1,9 +1,12 @@
 #pragma once
 // The delayspec command line run in-process (run_cli, as main() does), for the CLI tests:
 // exit status and everything written to stdout and stderr.
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include "commands.hpp"
 
@@ -13,6 +16,15 @@ struct CliResult {
   int status;
   std::string out, err;
 };
+
+// A scratch path for one test, removed first and not created: the temporary directory's
+// delayspec_test_NAME_PID (per process: ctest -j runs the cases of a parameterised test at once).
+inline std::filesystem::path fresh_dir(const std::string& name) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("delayspec_test_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
+}
 
 // `args` without the program name, e.g. {"floquet", scene, "--json", "--set", "N=40"}.
 inline CliResult run(std::vector<std::string> args) {

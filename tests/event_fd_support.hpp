@@ -6,7 +6,7 @@
 
 #include "delayspec/model_impact.hpp"
 #include "delayspec/orbit_simulation.hpp"
-#include "delayspec/scalar_search.hpp"
+#include "delayspec/detail/scalar_search.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec::testing {

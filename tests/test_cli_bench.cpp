@@ -64,8 +64,7 @@ TEST(BenchCli, DenseStopsAtTheMemoryLimitWithAMessage) {
 }
 
 TEST(BenchCli, TextTableAndCsv) {
-  const auto dir = std::filesystem::temp_directory_path() / "delayspec_test_bench_out";
-  std::filesystem::remove_all(dir);
+  const auto dir = delayspec::testing::fresh_dir("bench_out");
   CliResult r = run({"bench", "--out", dir.string(), "--set", "model=mathieu", "--set", "Ns=50,100,200", "--set",
                      "nev=3", "--set", "solvers=spectra,dense"});
   ASSERT_EQ(r.status, 0) << r.err;

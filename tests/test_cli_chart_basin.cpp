@@ -62,8 +62,7 @@ TEST(ChartCli, UnforcedUndelayedMathieuMatchesCayleyTransformExactly) {
 }
 
 TEST(ChartCli, ParallelEqualsSerialAndCsvHasGridBlocks) {
-  const fs::path dir = fs::temp_directory_path() / "delayspec_test_chart_csv";
-  fs::remove_all(dir);
+  const fs::path dir = delayspec::testing::fresh_dir("chart_csv");
   std::vector<std::string> sets = {"model=mathieu", "kappa=0.1", "eps=1", "N=20", "solver=dense",
                                    "chart_x_points=4", "chart_y_points=3"};
   auto serial = with_sets({"chart", "--json"}, sets);

@@ -349,8 +349,7 @@ TEST(ConvergeCli, LevelThatFailsEverywhereIsReportedAndTheStudyGoesOn) {
 }
 
 TEST(ConvergeCli, ImpactShowsEventsOnAndOffSideBySideAndWritesCsv) {
-  const auto dir = std::filesystem::temp_directory_path() / "delayspec_test_converge_out";
-  std::filesystem::remove_all(dir);
+  const auto dir = delayspec::testing::fresh_dir("converge_out");
   CliResult r = run({"converge", std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/default.toml", "--json", "--out",
                      dir.string(), "--set", "Ns=100,200,400", "--set", "nev=2"});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -414,6 +413,8 @@ INSTANTIATE_TEST_SUITE_P(Keys, ConvergeBadInput, ::testing::Values(
     BadValue{"reference", "best"}, BadValue{"reference", "exact"}, BadValue{"events", "on,maybe"},
     BadValue{"events", "on,on"}, BadValue{"solver", "magic"}, BadValue{"extrapolation_order", "-1"},
     BadValue{"extrapolation_order_step", "nan"}, BadValue{"extrapolation_levels", "0"},
+    // 2^32 + 1 and 2^32 + 400: each would wrap to a valid int (1, 400) if cast before the range check
+    BadValue{"extrapolation_levels", "4294967297"}, BadValue{"N_max", "4294967696"},
     BadValue{"converge_target", "-1e-8"}, BadValue{"converge_target", "2"}, BadValue{"converge_target", "0"},
     BadValue{"converge_max_N", "5000"} /* no target */, BadValue{"converge_max_seconds", "30"} /* no target */));
 // clang-format on

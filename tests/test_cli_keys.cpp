@@ -20,16 +20,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using delayspec::testing::fresh_dir;
 using delayspec::testing::CliResult;
 using delayspec::testing::run;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_keys_" + name);
-  fs::remove_all(dir);
-  return dir;
-}
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path);
@@ -53,7 +48,7 @@ TEST(CommandHelp, ListsTheKeysTheCommandReadsWithDefaults) {
 TEST(CommandHelp, ModelKeysAreListedPerModel) {
   CliResult r = run({"floquet", "--help"});
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* line : {"nev = 6", "solver = spectra", "tol = 1e-12", " with model = impact:", "zeta = 0.01",
+  for (const char* line : {"nev = 6", "solver = auto", "tol = 1e-12", " with model = impact:", "zeta = 0.01",
                            " with model = linear:", "a = -1", " with model = mathieu:", "kappa = 0.1",
                            " with model = mackey-glass:", "gamma = 0.1"})
     EXPECT_TRUE(contains(r.out, line)) << line << "\n" << r.out;
@@ -107,7 +102,7 @@ TEST(UnreadKey, MisspeltKeyStillGetsADidYouMean) {
 }
 
 TEST(UnreadKey, RunNamesTheAnalysesOfTheScene) {
-  const fs::path dir = fresh_dir("run_unread");
+  const fs::path dir = fresh_dir("keys_run_unread");
   CliResult r = run({"run", DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml", "--out", dir.string(), "--set",
                      "exponents=3"});
   EXPECT_EQ(r.status, 2);
@@ -116,7 +111,7 @@ TEST(UnreadKey, RunNamesTheAnalysesOfTheScene) {
 }
 
 TEST(Metadata, RecordsEffectiveDefaultsAndTheSourceRevision) {
-  const fs::path dir = fresh_dir("metadata");
+  const fs::path dir = fresh_dir("keys_metadata");
   CliResult r = run({"run", DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml", "--out", dir.string(), "--set", "N=40",
                      "--set", "solver=dense", "--quiet"});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -136,7 +131,7 @@ TEST(Metadata, RecordsEffectiveDefaultsAndTheSourceRevision) {
 }
 
 TEST(Metadata, EveryCsvStartsWithTheMetadataLines) {
-  const fs::path dir = fresh_dir("csv");
+  const fs::path dir = fresh_dir("keys_csv");
   const std::string out = dir.string();
   const std::vector<std::vector<std::string>> commands = {
       {"simulate", "--set", "model=linear", "--set", "N=10", "--set", "t_end=4"},
@@ -194,7 +189,7 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
 
 TEST(Scenes, Fig63RunsWithRunAtReducedSize) {
   // The reproducer: exit 2 (`control_on_at` unknown to floquet) before the fix.
-  const fs::path dir = fresh_dir("fig6_3");
+  const fs::path dir = fresh_dir("keys_fig6_3");
   CliResult r = run({"run", DELAYSPEC_SOURCE_DIR "/data/scenes/fig6_3.toml", "--out", dir.string(), "--set", "N=20",
                      "--set", "control_on_at=20", "--set", "t_start=20", "--set", "t_end=40", "--quiet"});
   ASSERT_EQ(r.status, 0) << r.err;

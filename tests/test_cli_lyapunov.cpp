@@ -16,6 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using delayspec::testing::fresh_dir;
 using delayspec::testing::CliResult;
 using delayspec::testing::run;
 
@@ -33,12 +34,6 @@ std::string without_metadata(const std::string& csv) {
   for (std::string line; std::getline(ss, line);)
     if (line.rfind("#", 0) != 0) out += line + "\n";
   return out;
-}
-
-fs::path fresh_dir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("delayspec_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
 }
 
 struct BadValue {
@@ -142,7 +137,7 @@ TEST(SweepCli, SweptKeyMustBeAParameterOfTheModel) {
 
 // A linear sweep over b: at each point the exponents must equal a lyapunov run at that point.
 TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
-  const fs::path dir = fresh_dir("sweep");
+  const fs::path dir = fresh_dir("lyapunov_sweep");
   std::vector<std::string> args = {"sweep", "--json", "--out", dir.string(), "--set", "sweep_key=b", "--set",
                                    "sweep_from=-2", "--set", "sweep_to=-1", "--set", "sweep_points=3", "--set",
                                    "section_points=4", "--set", "threads=2"};
@@ -180,7 +175,7 @@ TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
 // An interrupted sweep: two point files and no final files. --resume computes only the missing
 // points and produces the same tables as an uninterrupted sweep; other settings are refused.
 TEST(SweepCli, ResumeCompletesAnInterruptedSweep) {
-  const fs::path dir = fresh_dir("resume");
+  const fs::path dir = fresh_dir("lyapunov_resume");
   std::vector<std::string> args = {"sweep", "--json", "--quiet", "--out", dir.string(), "--set", "sweep_key=a",
                                    "--set", "sweep_from=-2", "--set", "sweep_to=0", "--set", "sweep_points=5"};
   args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
@@ -218,7 +213,7 @@ TEST(SweepCli, ResumeNeedsAnOutDirectoryWithASweep) {
                                    "sweep_to=0"};
   args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
   EXPECT_EQ(run(args).status, 2);
-  const fs::path dir = fresh_dir("noresume");
+  const fs::path dir = fresh_dir("lyapunov_noresume");
   args.insert(args.end(), {"--out", dir.string()});
   CliResult r = run(args);
   EXPECT_EQ(r.status, 2);

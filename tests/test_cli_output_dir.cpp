@@ -31,14 +31,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using delayspec::testing::fresh_dir;
 using delayspec::testing::CliResult;
 using delayspec::testing::run;
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_outdir_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
-}
 
 std::string read(const fs::path& path) {
   std::ifstream in(path);
@@ -101,7 +96,7 @@ const std::vector<std::string> kSweep = {"--quiet", "--set", "model=linear", "--
 // A second run into a directory whose lock another run holds stops at once: exit 2 naming DIR,
 // nothing written. Once the lock is free, the same command runs.
 TEST(OutputDirectory, SecondRunWhileTheLockIsHeldExitsTwo) {
-  const fs::path dir = fresh_dir("held");
+  const fs::path dir = fresh_dir("outdir_held");
   const std::vector<std::vector<std::string>> commands = {
       with({"sweep", "--out", dir.string()}, kSweep),
       {"chart", "--quiet", "--out", dir.string(), "--set", "model=mathieu", "--set", "N=8", "--set", "chart_x_points=2",
@@ -131,7 +126,7 @@ TEST(OutputDirectory, SecondRunWhileTheLockIsHeldExitsTwo) {
 // stopped by bad input creates nothing. If another run created it meanwhile (holding its lock,
 // or already finished), this run writes nothing there.
 TEST(OutputDirectory, DirectoryCreatedLaterBelongsToTheRunThatCreatedIt) {
-  const fs::path dir = fresh_dir("later");
+  const fs::path dir = fresh_dir("outdir_later");
   auto write_fails = [&](const fs::path& target) {
     try {
       delayspec::cli::write_file_atomically(target, "x\n");
@@ -169,7 +164,7 @@ TEST(OutputDirectory, DirectoryCreatedLaterBelongsToTheRunThatCreatedIt) {
 // complete.json appears last, for a finished run, and lists its files; a run interrupted
 // between two files of its set leaves no complete.json (the earlier run's is gone too).
 TEST(OutputDirectory, InterruptedMultiFileOutputHasNoCompleteMarker) {
-  const fs::path dir = fresh_dir("simulate");
+  const fs::path dir = fresh_dir("outdir_simulate");
   const std::vector<std::string> args = {"simulate", "--out", dir.string(), "--set", "N=8", "--set", "t_end=2"};
   CliResult r = run(args);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -192,7 +187,7 @@ TEST(OutputDirectory, InterruptedMultiFileOutputHasNoCompleteMarker) {
 // `run` removes run.json before its first analysis: after a failure the directory has neither
 // run.json nor complete.json, although the previous run had both.
 TEST(OutputDirectory, RunJsonAbsentAfterAFailedRun) {
-  const fs::path dir = fresh_dir("runjson");
+  const fs::path dir = fresh_dir("outdir_runjson");
   const std::string scene = DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml";
   CliResult r = run({"run", scene, "--out", dir.string(), "--set", "N=40", "--quiet"});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -213,8 +208,8 @@ TEST(OutputDirectory, RunJsonAbsentAfterAFailedRun) {
 // then completes the sweep with tables identical to an uninterrupted sweep (bit for bit, all
 // columns but the wall-clock seconds).
 TEST(OutputDirectory, KilledRunIsIncompleteAndResumesToTheSameTables) {
-  const fs::path dir = fresh_dir("killed");
-  const fs::path reference = fresh_dir("killed_reference");
+  const fs::path dir = fresh_dir("outdir_killed");
+  const fs::path reference = fresh_dir("outdir_killed_reference");
   const fs::path scene = fs::temp_directory_path() / ("delayspec_test_outdir_killed_" + std::to_string(::getpid()) + ".toml");
   // ~200 points of several milliseconds each: the sweep runs long enough to be caught mid-way.
   std::ofstream(scene) << "analyses = [\"floquet\", \"sweep\"]\nmodel = \"linear\"\nb = -0.5\nN = 10\nsolver = "
@@ -285,8 +280,8 @@ TEST(OutputDirectory, KilledRunIsIncompleteAndResumesToTheSameTables) {
 // A point file of another sweep (other settings) in the directory: --resume refuses it, naming
 // the file, instead of merging it into the tables.
 TEST(OutputDirectory, ResumeRefusesAPointFileOfOtherSettings) {
-  const fs::path dir = fresh_dir("foreign");
-  const fs::path other = fresh_dir("foreign_other");
+  const fs::path dir = fresh_dir("outdir_foreign");
+  const fs::path other = fresh_dir("outdir_foreign_other");
   ASSERT_EQ(run(with({"sweep", "--out", dir.string()}, kSweep)).status, 0);
   ASSERT_EQ(run(with({"sweep", "--out", other.string(), "--set", "seed=9"}, kSweep)).status, 0);
   for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "complete.json", "points/point_00001.json"})
@@ -305,7 +300,7 @@ TEST(OutputDirectory, ResumeRefusesAPointFileOfOtherSettings) {
 // The settings --resume compares are the effective ones: a scene or --set stating keys at their
 // default values (in any spelling of the number) resumes a sweep made without them.
 TEST(OutputDirectory, ResumeAcceptsExplicitDefaults) {
-  const fs::path dir = fresh_dir("defaults");
+  const fs::path dir = fresh_dir("outdir_defaults");
   CliResult full = run(with({"sweep", "--out", dir.string()}, kSweep));
   ASSERT_EQ(full.status, 0) << full.err;
   const std::string complete_csv = read(dir / "exponents.csv");
@@ -371,7 +366,7 @@ INSTANTIATE_TEST_SUITE_P(Flags, OutputFlags, ::testing::Values(
 // chart and basin: a failing point is recorded in the output (null / nan, its reason), the other
 // points still run, and the command exits 3 after writing everything, as sweep does.
 TEST(OutputDirectory, ChartAndBasinExitThreeWithFailedPointsRecorded) {
-  const fs::path dir = fresh_dir("failing");
+  const fs::path dir = fresh_dir("outdir_failing");
   // impact model, an orbit by simulation allowed 2 periods: it cannot settle at any point
   CliResult chart = run({"chart", "--json", "--quiet", "--out", dir.string(), "--set", "model=impact", "--set", "N=8",
                          "--set", "chart_x=k", "--set", "chart_y=zeta", "--set", "chart_x_range=0,0.2", "--set",
@@ -402,7 +397,7 @@ TEST(OutputDirectory, ChartAndBasinExitThreeWithFailedPointsRecorded) {
 // `run`: an analysis exiting 3 keeps its file, the next analysis still runs, and run exits 3
 // with a manifest naming each analysis's exit status.
 TEST(OutputDirectory, RunKeepsGoingAfterAnAnalysisExitsThree) {
-  const fs::path dir = fresh_dir("run3");
+  const fs::path dir = fresh_dir("outdir_run3");
   CliResult r = run({"run", "--out", dir.string(), "--quiet", "--set", "analyses=basin,floquet", "--set", "model=linear", "--set", "N=8", "--set", "basin_x=a",
                      "--set", "basin_y=b", "--set", "basin_x_range=-1,10", "--set", "basin_y_range=0,1", "--set",
                      "basin_x_points=2", "--set", "basin_y_points=2", "--set", "solver=dense", "--set", "nev=2"});

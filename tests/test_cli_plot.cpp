@@ -16,6 +16,15 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using delayspec::testing::fresh_dir;
+
+// A fresh, created scratch directory (plot reads the directory it is given).
+fs::path fresh_plot_dir(const std::string& name) {
+  const fs::path dir = fresh_dir(std::string("plot_") + name);
+  fs::create_directories(dir);
+  return dir;
+}
+
 using delayspec::testing::CliResult;
 using delayspec::testing::run;
 
@@ -27,18 +36,10 @@ std::string head(const fs::path& p, size_t n) {
   return s;
 }
 
-fs::path fresh_dir(const std::string& name) {
-  // per process: ctest -j runs the cases of a parameterised test at the same time
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_plot_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
 }  // namespace
 
 TEST(PlotCli, RendersMultipliersAndChartAsPngAndSvg) {
-  const fs::path dir = fresh_dir("render");
+  const fs::path dir = fresh_plot_dir("render");
   // Inputs written by the commands themselves.
   CliResult f = run({"floquet", "--json", "--set", "model=linear", "--set", "N=20", "--set", "solver=dense",
                      "--set", "nev=4"});
@@ -70,7 +71,7 @@ TEST(PlotCli, BadInputPaths) {
   EXPECT_EQ(none.status, 2);
   EXPECT_NE(none.err.find("needs a results directory"), std::string::npos) << none.err;
 
-  const fs::path empty = fresh_dir("empty");
+  const fs::path empty = fresh_plot_dir("empty");
   CliResult nothing = run({"plot", empty.string()});
   EXPECT_EQ(nothing.status, 2);
   EXPECT_NE(nothing.err.find("nothing to plot"), std::string::npos) << nothing.err;
@@ -78,8 +79,13 @@ TEST(PlotCli, BadInputPaths) {
   CliResult width = run({"plot", empty.string(), "--set", "plot_width=5"});
   EXPECT_EQ(width.status, 2);
   EXPECT_NE(width.err.find("`plot_width = 5`"), std::string::npos) << width.err;
+  // 2^32 + 300 wraps to 300 in a cast to int: the range is checked on the value as given.
+  CliResult wrapped = run({"plot", empty.string(), "--set", "plot_height=4294967596"});
+  EXPECT_EQ(wrapped.status, 2);
+  EXPECT_NE(wrapped.err.find("`plot_height = 4294967596`: must be between 100 and 10000"), std::string::npos)
+      << wrapped.err;
 
-  const fs::path dir = fresh_dir("nognuplot");
+  const fs::path dir = fresh_plot_dir("nognuplot");
   std::ofstream(dir / "floquet.json") << R"({"model": "linear", "N": 4, "solver": "dense",
       "multipliers": [{"re": 0.5, "im": 0, "abs": 0.5}]})";
   CliResult no_gnuplot = run({"plot", dir.string(), "--set", "plot_gnuplot=/nonexistent/gnuplot"});
@@ -96,7 +102,7 @@ TEST(PlotCli, BadInputPaths) {
 TEST(PlotCli, RendersSweepSimulateConvergeAndBenchFiles) {
   // Synthetic inputs in the formats the sweep, simulate, converge and bench commands write
   // (docs/formats.md): every figure is produced as a PNG and an SVG.
-  const fs::path dir = fresh_dir("formats");
+  const fs::path dir = fresh_plot_dir("formats");
   std::ofstream(dir / "exponents.csv") << "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds\n"
                                           "0,0.1,-0.2,0.01,0.01,0.0127,-0.025,1\n0.5,-0.1,-0.3,0.01,0.02,-0.0127,-0.038,1\n";
   std::ofstream(dir / "section.csv") << "parameter,x\n0,0.1\n0,0.2\n0.5,-0.05\n";
@@ -136,7 +142,7 @@ const char* const kTrajectory = "t,x,v\n0,0,1\n0.1,0.1,0.99\n0.2,0.2,0.96\n";
 // Issue 13 item 2: text of a results file reaches gnuplot only as a number we print or an inert
 // string. On main, `# e = 1; system "touch MARKER"` ran the shell command.
 TEST(PlotCli, MetadataTextIsNeverExecuted) {
-  const fs::path dir = fresh_dir("inject");
+  const fs::path dir = fresh_plot_dir("inject");
   const fs::path marker = dir / "pwned";
   const std::string touch = "system \"touch " + marker.string() + "\"";
   // A value that must be a number (the impact boundary e): exit 2 naming the value.
@@ -187,7 +193,7 @@ TEST(PlotCli, MetadataTextIsNeverExecuted) {
 // A hex-float value (as a run given `--set e=0x1...` records it, at full precision) plots, as
 // the decimal number it is: 0x1.428f5c28f5c29p+0 is the double nearest 1.26.
 TEST(PlotCli, HexFloatMetadataPlots) {
-  const fs::path dir = fresh_dir("hexfloat");
+  const fs::path dir = fresh_plot_dir("hexfloat");
   CliResult b = run({"basin", "--out", dir.string(), "--quiet", "--set", "e=0x1.428f5c28f5c29p+0", "--set", "N=10",
                      "--set", "basin_x_points=2", "--set", "basin_y_points=2", "--set", "basin_transient=5"});
   ASSERT_EQ(b.status, 0) << b.err;
@@ -218,7 +224,7 @@ class PlotBadFile : public ::testing::TestWithParam<BadFile> {};
 
 TEST_P(PlotBadFile, IsBadInputNamingTheFieldOrLine) {
   const BadFile& b = GetParam();
-  const fs::path dir = fresh_dir("badfile");
+  const fs::path dir = fresh_plot_dir("badfile");
   write(dir / b.name, b.contents);
   const std::string name = b.name;
   if (name == "simulate.json" || name == "poincare.csv") write(dir / "trajectory.csv", kTrajectory);
@@ -290,7 +296,7 @@ INSTANTIATE_TEST_SUITE_P(Csv, PlotBadFile, ::testing::Values(
 // A nan spectral radius (a failed chart point) is documented and drawn as a gap; a chart where
 // every point failed has nothing to draw: exit 3 (the chart's numerical failure), saying so.
 TEST(PlotCli, FailedChartPoints) {
-  const fs::path dir = fresh_dir("failedpoints");
+  const fs::path dir = fresh_plot_dir("failedpoints");
   write(dir / "chart.csv", "x,y,spectral_radius\n0,0,0.5\n1,0,nan\n\n0,1,1.5\n1,1,0.9\n");
   CliResult some = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
   EXPECT_EQ(some.status, 0) << some.err;
@@ -305,7 +311,7 @@ TEST(PlotCli, FailedChartPoints) {
 // is the user's input (exit 2); gnuplot not installed (the default name not found) is exit 3.
 // On main the first two cases exited 1 ("internal error").
 TEST(PlotCli, GnuplotFailureIsExit3) {
-  const fs::path dir = fresh_dir("gnuplotfails");
+  const fs::path dir = fresh_plot_dir("gnuplotfails");
   write(dir / "floquet.json", R"({"multipliers": [{"re": 0.5, "im": 0}]})");
   CliResult fails = run({"plot", dir.string(), "--set", "plot_gnuplot=/bin/false"});
   EXPECT_EQ(fails.status, 3) << fails.err;
@@ -343,7 +349,7 @@ TEST(PlotCli, GnuplotFailureIsExit3) {
 // converge and bench report), not the error of |mu_1|; sweep figures name the swept key, read
 // from the metadata header sweep writes; old files without it fall back to "parameter".
 TEST(PlotCli, FiguresLabelWhatIsPlotted) {
-  const fs::path dir = fresh_dir("labels");
+  const fs::path dir = fresh_plot_dir("labels");
   CliResult s = run({"sweep", "--out", dir.string(), "--quiet", "--set", "model=linear", "--set", "sweep_key=b",
                      "--set", "sweep_from=-2", "--set", "sweep_to=-1", "--set", "sweep_points=2", "--set", "N=10",
                      "--set", "periods=20", "--set", "transient=0", "--set", "section_points=2"});
@@ -359,7 +365,7 @@ TEST(PlotCli, FiguresLabelWhatIsPlotted) {
   EXPECT_NE(speed.find("set xlabel 'relative error of complex {/Symbol m}_1'"), std::string::npos) << speed;
   EXPECT_EQ(speed.find("|{/Symbol m}_1|"), std::string::npos) << speed;
 
-  const fs::path old = fresh_dir("labels_old");
+  const fs::path old = fresh_plot_dir("labels_old");
   write(old / "section.csv", "parameter,x\n0,0.1\n0.5,0.2\n");
   ASSERT_EQ(run({"plot", old.string(), "--set", "plot_width=200", "--set", "plot_height=150"}).status, 0);
   EXPECT_NE(read(old / "plots" / "bifurcation.gp").find("set xlabel 'parameter'\n"), std::string::npos);
@@ -367,7 +373,7 @@ TEST(PlotCli, FiguresLabelWhatIsPlotted) {
 
 // A FIFO (or any non-regular file) where a result file is expected would block the read forever.
 TEST(PlotCli, NonRegularInputIsBadInput) {
-  const fs::path dir = fresh_dir("fifo");
+  const fs::path dir = fresh_plot_dir("fifo");
   ASSERT_EQ(::mkfifo((dir / "chart.csv").c_str(), 0600), 0);
   CliResult r = run({"plot", dir.string()});
   EXPECT_EQ(r.status, 2) << r.err;

@@ -14,7 +14,7 @@ using namespace delayspec::testing;
 namespace {
 
 // FD step and tolerance for the step checks. The step is smooth in its inputs away from the
-// degenerate points (event.hpp header); central differences err by delta^2/6 |y'''|. Near an
+// degenerate points (event_step.hpp header); central differences err by delta^2/6 |y'''|. Near an
 // impact the third derivative is dominated by the event time s(u) ~ H/v with impact speed
 // v ~ 0.05 on this orbit: |s'''| ~ 1/v^3 ~ 1e4, times |f| ~ 1: delta = 1e-6 gives ~2e-9, plus
 // rounding eps |y| / delta ~ 1e-10. 1e-6 relative (the bound) leaves a wide margin

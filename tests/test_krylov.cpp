@@ -177,6 +177,63 @@ TEST(Krylov, NevAboveDimensionMinusTwoRoutesToDense) {
   EXPECT_EQ(solve(op, FloquetSolver::arpack, 4).solver, "arpack");
 }
 
+// The message validate_floquet_options throws for `o` at dimension n ("" when it accepts them).
+std::string rule_broken(const FloquetOptions& o, long n) {
+  try {
+    validate_floquet_options(o, n);
+  } catch (const BadInput& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(FloquetOptionsRules, EachBoundAtItsEdgeWithOneMessage) {
+  const long n = 21;
+  FloquetOptions o;  // defaults: nev 6, auto, ncv 0, tol 1e-12, 300 iterations, bound 1e-8
+  EXPECT_EQ(rule_broken(o, n), "");
+  o.nev = 0;
+  EXPECT_EQ(rule_broken(o, n), "`nev = 0`: must be between 1 and the dimension n = 21");
+  o.nev = 22;
+  EXPECT_EQ(rule_broken(o, n), "`nev = 22`: must be between 1 and the dimension n = 21");
+  o.nev = 21;  // nev = n is allowed (Krylov then runs dense, floquet.hpp), for every solver
+  EXPECT_EQ(rule_broken(o, n), "");
+  o.solver = FloquetSolver::dense_lapack;
+  EXPECT_EQ(rule_broken(o, n), "");
+
+  FloquetOptions k;  // the Krylov rules, for auto (which may pick Krylov) too, and dense ignoring them
+  ASSERT_EQ(k.solver, FloquetSolver::automatic);
+  k.ncv = k.nev + 1;
+  EXPECT_EQ(rule_broken(k, n), "`ncv = 7`: must be 0 (automatic) or >= nev + 2 = 8");
+  k.ncv = k.nev + 2;
+  EXPECT_EQ(rule_broken(k, n), "");
+  k.solver = FloquetSolver::spectra;
+  k.tolerance = 0;
+  EXPECT_EQ(rule_broken(k, n), "`tol = 0`: must be > 0 and finite");
+  k.tolerance = INFINITY;
+  EXPECT_NE(rule_broken(k, n).find("`tol = "), std::string::npos);
+  k.solver = FloquetSolver::dense_eigen;
+  EXPECT_EQ(rule_broken(k, n), "");
+  FloquetOptions a;
+  a.solver = FloquetSolver::arpack;
+  a.max_iterations = 0;
+  EXPECT_EQ(rule_broken(a, n), "`max_iterations = 0`: must be >= 1");
+  a.max_iterations = 1;
+  a.residual_bound = NAN;
+  EXPECT_NE(rule_broken(a, n).find("`residual_bound = "), std::string::npos);
+
+  // floquet_multipliers applies the same rules with n = the operator's rows.
+  auto op = zero_orbit_monodromy(LinearModel(), 20);
+  ASSERT_EQ(op.rows(), n);
+  FloquetOptions big;
+  big.nev = 22;
+  try {
+    floquet_multipliers(op, big);
+    ADD_FAILURE() << "nev = 22 > n accepted";
+  } catch (const BadInput& e) {
+    EXPECT_EQ(std::string(e.what()), rule_broken(big, n));
+  }
+}
+
 TEST(Krylov, BadOptionsAreBadInput) {
   auto op = zero_orbit_monodromy(MathieuModel(), 40);
   EXPECT_THROW(solve(op, FloquetSolver::spectra, 6, 7), BadInput);  // ncv < nev + 2
@@ -276,6 +333,7 @@ TEST(KrylovResidualGate, RankOneMonodromyLeadingMultiplierIsExact) {
     if (solver == FloquetSolver::spectra) {
       FloquetOptions o;
       o.nev = 1;
+      o.solver = FloquetSolver::spectra;
       o.retry_failed_gate = false;
       const std::string m = numerical_failure_message([&] { floquet_multipliers(op, o); });
       const bool refused = m.find("Krylov (spectra): multiplier 1 of nev = 1") != std::string::npos &&

@@ -145,14 +145,14 @@ TEST(Lyapunov, LinearDdeExponentsAreRealPartsOfExactRoots) {
     EXPECT_NEAR(same_N, exact, 40 * 1e-4) << i;
     for (const LyapunovResult* r : {&short_run, &long_run}) {
       // statistical agreement with the same-N value: 3 standard errors
-      EXPECT_NEAR(r->per_time[i], same_N, 3 * r->standard_error_per_time[i]) << i << " periods " << r->periods;
+      EXPECT_NEAR(r->per_time[i], same_N, 3 * r->error_per_time[i]) << i << " periods " << r->periods;
       // against the exact root: statistics plus the discretisation error just bounded
-      EXPECT_NEAR(r->per_time[i], exact, 3 * r->standard_error_per_time[i] + std::abs(same_N - exact)) << i;
+      EXPECT_NEAR(r->per_time[i], exact, 3 * r->error_per_time[i] + std::abs(same_N - exact)) << i;
     }
     // 16x the run: the quasi-periodic fluctuation of a complex pair averages out like 1/periods,
     // noise like 1/sqrt(periods); either way the error estimate shrinks by more than 3x
-    EXPECT_LT(long_run.standard_error_per_time[i], short_run.standard_error_per_time[i] / 3) << i;
-    EXPECT_GT(long_run.standard_error_per_time[i], 0) << i;
+    EXPECT_LT(long_run.error_per_time[i], short_run.error_per_time[i] / 3) << i;
+    EXPECT_GT(long_run.error_per_time[i], 0) << i;
   }
   EXPECT_EQ(long_run.periods, 16000);
   EXPECT_DOUBLE_EQ(long_run.map_time, 1.0);
@@ -189,8 +189,8 @@ TEST(Lyapunov, StableMathieuPointGivesLogOfFloquetMultipliers) {
     // rounding, so the reported error stays at rounding level too (the fluctuation bound adds
     // nothing here: D(i) is a sum of roundings, ~ i eps per period at most).
     std::printf("mathieu aligned: lambda_%d err %.3e (batch SE %.3e, fluctuation bound %.3e)\n", i + 1,
-                r.standard_error_per_period[i], r.batch_standard_error_per_period[i], r.fluctuation_bound_per_period[i]);
-    EXPECT_LT(r.standard_error_per_period[i], 1e-12) << i;
+                r.error_per_period[i], r.batch_standard_error_per_period[i], r.fluctuation_bound_per_period[i]);
+    EXPECT_LT(r.error_per_period[i], 1e-12) << i;
   }
 }
 
@@ -219,10 +219,10 @@ TEST(Lyapunov, RealMultipliersWithoutTransientErrorCoversTheAlignmentBiasTightly
   for (int i = 0; i < 2; ++i) {
     const double deviation = std::abs(r.per_period[i] - std::log(std::abs(mu[i])));
     std::printf("mathieu no transient: lambda_%d deviation %.3e err %.3e (batch SE %.3e, fluctuation bound %.3e)\n",
-                i + 1, deviation, r.standard_error_per_period[i], r.batch_standard_error_per_period[i],
+                i + 1, deviation, r.error_per_period[i], r.batch_standard_error_per_period[i],
                 r.fluctuation_bound_per_period[i]);
-    EXPECT_LE(deviation, r.standard_error_per_period[i]) << i;
-    EXPECT_LE(r.standard_error_per_period[i], 3 * deviation) << i;
+    EXPECT_LE(deviation, r.error_per_period[i]) << i;
+    EXPECT_LE(r.error_per_period[i], 3 * deviation) << i;
   }
 }
 
@@ -283,13 +283,13 @@ TEST(Lyapunov, ImpactPeriodOneOrbitGivesLogOfFloquetMultipliers) {
   // the exponents are off by ~1.1e-4 (a named regression of the old error bar: 60 SE).
   for (int i = 0; i < 2; ++i) {
     std::printf("impact pair: lambda_%d %.9f err %.3e (batch SE %.3e, fluctuation bound %.3e), |lambda - log|mu|| %.3e, phase bound %.3e\n",
-                i + 1, r.per_period[i], r.standard_error_per_period[i], r.batch_standard_error_per_period[i],
+                i + 1, r.per_period[i], r.error_per_period[i], r.batch_standard_error_per_period[i],
                 r.fluctuation_bound_per_period[i], std::abs(r.per_period[i] - log_mu), phase_bound);
-    EXPECT_LE(std::abs(r.per_period[i] - log_mu), r.standard_error_per_period[i]) << i;
+    EXPECT_LE(std::abs(r.per_period[i] - log_mu), r.error_per_period[i]) << i;
     EXPECT_GT(std::abs(r.per_period[i] - log_mu), 10 * r.batch_standard_error_per_period[i]) << i;
     // and it is no looser than the a-priori bound: g in [-log cond S, log cond S] with g(0) = 0
     // (the block starts in the plane) gives range D <= range g + |g(I)| <= 3 log cond S
-    EXPECT_LE(r.standard_error_per_period[i], 3 * phase_bound) << i;
+    EXPECT_LE(r.error_per_period[i], 3 * phase_bound) << i;
   }
   // the run stays on the orbit: final history equals the orbit to the simulation tolerance
   EXPECT_LT((r.final_history - orbit.history).lpNorm<Eigen::Infinity>(), 1e-9);
@@ -319,12 +319,12 @@ TEST(Lyapunov, SeedAndQrIntervalChangeResultsOnlyWithinTheError) {
       // the same trajectory in every run, so the difference is the tangent block's start and
       // the QR schedule: bounded by 4 combined standard errors (independent-error bound is 3;
       // the runs share the trajectory, which only makes them closer)
-      const double se = std::hypot(runs[0].standard_error_per_period[i], runs[a].standard_error_per_period[i]);
+      const double se = std::hypot(runs[0].error_per_period[i], runs[a].error_per_period[i]);
       EXPECT_NEAR(runs[a].per_period[i], runs[0].per_period[i], 4 * se) << "run " << a << " exponent " << i;
     }
   EXPECT_GT(runs[0].per_period[0], 0) << "tau = 17 is chaotic: lambda_1 > 0";
   // lambda_2 is the flow direction (zero) up to the error
-  EXPECT_NEAR(runs[0].per_period[1], 0, 4 * runs[0].standard_error_per_period[1] + 0.01);
+  EXPECT_NEAR(runs[0].per_period[1], 0, 4 * runs[0].error_per_period[1] + 0.01);
 }
 
 // Chaos: the reported error must be of the order of the actual scatter of the exponent, measured
@@ -356,7 +356,7 @@ TEST(Lyapunov, ChaoticErrorMatchesTheSpreadOfIndependentWindows) {
     const LyapunovResult r = ds::lyapunov_exponents(map, U, o);
     for (int i = 0; i < 2; ++i) {
       value[i].push_back(r.per_period[i]);
-      error[i].push_back(r.standard_error_per_period[i]);
+      error[i].push_back(r.error_per_period[i]);
       batch[i].push_back(r.batch_standard_error_per_period[i]);
     }
     U = r.final_history;
@@ -456,10 +456,10 @@ TEST(Lyapunov, StaysFiniteOverManyPeriodsOfStrongContraction) {
   const auto mu = ds::testing::dense_multipliers(model, N, 2);
   for (int i = 0; i < 2; ++i) {
     ASSERT_TRUE(std::isfinite(r.per_period[i])) << i;
-    ASSERT_TRUE(std::isfinite(r.standard_error_per_period[i])) << i;
+    ASSERT_TRUE(std::isfinite(r.error_per_period[i])) << i;
     EXPECT_LT(r.per_period[i], -3.5) << i;  // contracting as computed above
     // the same-N value to the error, plus the log of a relative rounding of R_ii per period
-    EXPECT_NEAR(r.per_period[i], std::log(std::abs(mu[i])), 3 * r.standard_error_per_period[i] + 1e-9) << i;
+    EXPECT_NEAR(r.per_period[i], std::log(std::abs(mu[i])), 3 * r.error_per_period[i] + 1e-9) << i;
   }
 }
 

@@ -16,7 +16,7 @@
 #include "delayspec/model_mathieu.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/orbit_simulation.hpp"
-#include "delayspec/sparse_lu.hpp"
+#include "delayspec/detail/sparse_lu.hpp"
 
 namespace {
 

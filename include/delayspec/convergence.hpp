@@ -60,11 +60,10 @@
 #include <string>
 #include <vector>
 
+#include "delayspec/multipliers.hpp"
 #include "delayspec/richardson.hpp"
 
 namespace delayspec {
-
-using Multipliers = std::vector<std::complex<double>>;
 
 // assignment[i] = index in `candidates` matched to targets[i], minimising sum_i |t_i - c_a(i)|.
 // BadInput when there are fewer candidates than targets or a value is not finite.

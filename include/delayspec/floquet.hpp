@@ -46,18 +46,25 @@
 #include <Eigen/Core>
 
 #include "delayspec/monodromy.hpp"
+#include "delayspec/multipliers.hpp"
 
 namespace delayspec {
 
-enum class FloquetSolver { spectra, arpack, dense_eigen, dense_lapack };
+enum class FloquetSolver { automatic, spectra, arpack, dense_eigen, dense_lapack };
 
-// "spectra", "arpack", "dense" (= dense_lapack), "dense-eigen", "dense-lapack"; BadInput otherwise.
+// "auto", "spectra", "arpack", "dense" (= dense_lapack), "dense-eigen", "dense-lapack"; BadInput otherwise.
 FloquetSolver parse_floquet_solver(const std::string& name);
 std::string to_string(FloquetSolver solver);
 
+// solver = auto: the backend measured fastest for the operator's size (docs/benchmarks.md,
+// "Choosing the eigensolver"): dense LAPACK for n <= 100 (all eigenvalues, no Krylov constraint,
+// as fast as Krylov there), Spectra for n < 2000, ARPACK from n = 2000 on (its BLAS dgemv
+// orthogonalisation: 1.2x Spectra at n = 8000, 3x at n = 128000, 2.9x at n = 2e6, nev = 20).
+FloquetSolver choose_floquet_solver(long n);
+
 struct FloquetOptions {
   int nev = 6;                              // multipliers wanted
-  FloquetSolver solver = FloquetSolver::spectra;
+  FloquetSolver solver = FloquetSolver::automatic;  // choose_floquet_solver(n)
   // Krylov only:
   int ncv = 0;                  // Krylov subspace dimension; 0 = default_ncv(nev, n); clamped to n
   double tolerance = 1e-12;     // relative Ritz residual at which a pair counts as converged
@@ -86,6 +93,13 @@ struct FloquetResult {
   // column k = Re v_k when Im mu_k >= 0, Im v_k otherwise (a conjugate pair spans {Re v, Im v}).
   Eigen::MatrixXd subspace;
 };
+
+// The options' rules for an n x n monodromy, each in one place, named by the CLI keys:
+// 1 <= nev <= n; for Krylov and auto also ncv = 0 or ncv >= nev + 2, tolerance > 0 and finite,
+// max_iterations >= 1, residual_bound > 0 and finite. BadInput "`key = v`: must be ..." otherwise.
+// floquet_multipliers() calls it first; a command calls it before its heavy work (the orbit) to
+// fail fast. (Krylov's nev <= n - 2 is not a rule: a larger nev runs the dense path.)
+void validate_floquet_options(const FloquetOptions& options, long n);
 
 // The nev leading multipliers. See the header comment for errors.
 template <int D>

@@ -13,10 +13,19 @@
 //    step is the linear interpolant (1 - theta) u_m + theta u_{m+1}.
 //
 // In both cases the delayed value at the start of a step is (1 - theta) u_m + theta u_{m+1}
-// and at its end (1 - theta) u_{m-1} + theta u_m (the terms with theta = 0 are absent).
+// and at its end (1 - theta) u_{m-1} + theta u_m (the terms with theta = 0 are absent):
+// HistoryGrid::delay_tap, the one statement of this rule.
 #include <string>
 
 namespace delayspec {
+
+// What step l of a map reads from the history (HistoryGrid::delay_tap).
+template <class V>
+struct DelayTap {
+  V w0;      // y(t - tau): the delayed state at the step's start
+  V w1;      // y(t + h - tau): the delayed state at the step's end
+  double t;  // the step's start time within the forcing period, (l mod K_1) h
+};
 
 struct HistoryGrid {
   int N = 0;             // requested steps per delay
@@ -31,6 +40,27 @@ struct HistoryGrid {
   int M = 0;             // last history slot: the history has M + 1 blocks
 
   bool aligned() const { return theta == 0; }
+
+  // The slot of the working history holding u_m for step l: b(delayed_slot(l)) = y(t - tau)
+  // when aligned (numbering of delay_tap). The block kernels (block_kernel.hpp) take it as d0.
+  long delayed_slot(long l) const { return M + l - m; }
+
+  // The delay tap of step l (l >= 0, counted from the start of a map or of a run). `b(i)` is
+  // slot i of the working history: b(0..M) = u_M .. u_0 at the start, b(M + l) = the state at
+  // the start of step l (any callable returning a state or an Eigen expression of one). With
+  // j = M + l - m:
+  //   w0 = (1 - theta) b(j) + theta b(j - 1),  w1 = (1 - theta) b(j + 1) + theta b(j)
+  // (aligned, theta = 0: w0 = b(j), w1 = b(j + 1), no arithmetic). Inline and allocation-free:
+  // it sits in every stepper loop. block_kernel.hpp's step_block applies the same formula to k
+  // vectors at once.
+  template <class V, class Slot>
+  DelayTap<V> delay_tap(long l, const Slot& b) const {
+    const long j = delayed_slot(l);
+    const double t = static_cast<double>(l % steps_per_period) * h;
+    if (theta == 0) return {V(b(j)), V(b(j + 1)), t};
+    const double c0 = 1 - theta;
+    return {V(c0 * b(j) + theta * b(j - 1)), V(c0 * b(j + 1) + theta * b(j)), t};
+  }
   // Dimension of the history vector for state dimension d.
   long dimension(int d) const { return static_cast<long>(d) * (M + 1); }
   std::string describe() const;

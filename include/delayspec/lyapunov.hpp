@@ -31,7 +31,8 @@
 //   bounds |lambda - lambda_true| up to the fraction P / I (small when the run covers many
 //   rotations or the excess dies out early). For a random walk D is a Brownian bridge whose
 //   range has mean sqrt(pi / 2) sigma sqrt(n) (Kuiper), so F ~ 1.25 SE. Reported error
-//   (standard_error_per_period, its historical name and the CLI key):
+//   (LyapunovResult::error_per_period; the JSON key keeps its historical name
+//   standard_error_per_period):
 //       error = sqrt(SE^2 + F^2).
 //   On a bounded fluctuation it is >= F, and where F falls short by the fraction P / I (an
 //   excess concentrated in the first P intervals, i.e. in the first batch) SE = |bias| exactly
@@ -50,10 +51,10 @@
 // in place; Q is written back to slots 0..M and the trajectory slots are moved down. All
 // buffers are allocated once per call.
 //
-// QR interval. With qr_every = m > 1 the block is not re-orthonormalised for m periods, so its
-// columns separate by the ratio of the Floquet/Lyapunov growth factors over m periods; the
+// QR interval. With qr_every = q > 1 the block is not re-orthonormalised for q periods, so its
+// columns separate by the ratio of the Floquet/Lyapunov growth factors over q periods; the
 // k-th column then keeps only about 16 - log10(R_11 / R_kk) digits, and a large enough growth
-// overflows. The run therefore checks every QR of an interval m > 1: if max_i |log R_ii| > 300
+// overflows. The run therefore checks every QR of an interval q > 1: if max_i |log R_ii| > 300
 // (entries near 1e130, halfway to overflow) or R_11 / R_kk > 1e8 (fewer than 8 digits left in
 // the k-th direction) it stops with NumericalFailure asking for a smaller qr_every. With
 // qr_every = 1 (the default) no such check applies: any loss is then a property of one period
@@ -66,7 +67,7 @@
 // Example:
 //   StroboscopicMap<LinearModel> map(TrapezoidStepper<LinearModel>(model), grid);
 //   LyapunovResult r = lyapunov_exponents(map, map.constant_history(Vec<1>(1)), LyapunovOptions{});
-//   r.per_time[0] +- r.standard_error_per_time[0]   // the error of the header comment
+//   r.per_time[0] +- r.error_per_time[0]   // the error of the header comment
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -76,14 +77,19 @@
 
 #include <Eigen/Core>
 
-#include "delayspec/block_kernel.hpp"
+#include "delayspec/detail/block_kernel.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/stroboscopic_map.hpp"
+#include "delayspec/detail/tangent_qr.hpp"
 
 namespace delayspec {
 
+// The most tangent vectors a run carries: the QR kernel keeps one row of the block in stack
+// buffers of this size (lyapunov.cpp); only leading exponents are meant.
+inline constexpr int kMaxTangentVectors = 64;
+
 struct LyapunovOptions {
-  int exponents = 2;         // k: tangent vectors (exponents wanted), 1 <= k <= min(n, 64)
+  int exponents = 2;         // k: tangent vectors (exponents wanted), 1 <= k <= min(n, kMaxTangentVectors)
   long periods = 1000;       // stroboscopic periods averaged (a multiple of qr_every)
   long transient = 100;      // periods discarded first (>= 0)
   std::uint64_t seed = 1;    // initial tangent block: a fixed pseudo-random n x k block, orthonormalised
@@ -97,8 +103,8 @@ struct LyapunovOptions {
 struct LyapunovResult {
   std::vector<double> per_period;                  // sum log |R_ii| / periods, largest first as computed
   std::vector<double> per_time;                    // per_period / (K h)
-  std::vector<double> standard_error_per_period;   // the error: sqrt(batch SE^2 + fluctuation bound^2) (header comment)
-  std::vector<double> standard_error_per_time;     // standard_error_per_period / (K h)
+  std::vector<double> error_per_period;   // the error: sqrt(batch SE^2 + fluctuation bound^2) (header comment)
+  std::vector<double> error_per_time;     // error_per_period / (K h)
   std::vector<double> batch_standard_error_per_period;  // batch means: sd(batch means) / sqrt(batches)
   std::vector<double> fluctuation_bound_per_period;     // range of the detrended cumulative sum / periods
   long periods = 0, transient = 0;
@@ -109,29 +115,6 @@ struct LyapunovResult {
   double qr_seconds = 0;          // of which: QR factorisations and forming Q
   Eigen::VectorXd final_history;  // the trajectory's history at the end
   Eigen::MatrixXd section;        // section_points x d: y(t0 + j T), one row per forcing period
-};
-
-// The QR step on an n x k block stored row-major (the interleaved layout: row i = entry i of
-// the k vectors), factorised in place by Householder reflections (the LAPACK/Eigen algorithm,
-// written for this layout: Eigen's HouseholderQR on a row-major Ref measured 4x slower;
-// tests compare the two). Binds to the block's memory once; no allocation after construction.
-// A block whose largest entry is beyond 2^+-300 is first scaled by an exact power of two, so
-// squares neither overflow nor underflow.
-class TangentQR {
- public:
-  TangentQR(double* block, long n, int k);
-
-  // Factorises the bound block = Q R in place, writes Q (n x k row-major, columns signed so
-  // that R_ii > 0) to q_out (must not overlap the block) and stores log |R_ii| in log_r[0..k).
-  // NumericalFailure when an entry of the block or of R is not finite, or when |R_ii| is below
-  // n eps times the norm of column i (that vector is lost in rounding: dependent on the others).
-  void factorise(double* q_out, double* log_r);
-
- private:
-  double* block_;
-  long n_;
-  int k_;
-  std::vector<double> tau_, r_, norm_;
 };
 
 // Fills the n x k row-major block with a reproducible pseudo-random matrix (entries uniform
@@ -167,8 +150,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   if (!U0.allFinite()) throw BadInput("lyapunov_exponents: the initial history is not finite");
 
   const auto start = std::chrono::steady_clock::now();
-  const long M = grid.M, m = grid.m, K = grid.K, spp = grid.steps_per_period;
-  const double theta = grid.theta, c0 = 1 - theta, h = grid.h;
+  const long M = grid.M, K = grid.K, spp = grid.steps_per_period;
   const int k = options.exponents;
   const long stride = static_cast<long>(D) * k;  // one slot of the block
   const Stepper& stepper = map.stepper();
@@ -201,15 +183,13 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   // One stroboscopic period, trajectory and block fused; afterwards the trajectory history is
   // back in slots 0..M and the (unnormalised) block in slots K..K+M.
   auto advance = [&](bool record) {
+    auto slot = [&traj](long i) -> const V& { return traj[i]; };
     for (long l = 0; l < K; ++l) {
-      const long j = M + l - m;  // delayed slot at the step's start
-      const V w0 = theta == 0 ? traj[j] : V(c0 * traj[j] + theta * traj[j - 1]);
-      const V w1 = theta == 0 ? traj[j + 1] : V(c0 * traj[j + 1] + theta * traj[j]);
-      const double t = static_cast<double>(l % spp) * h;
-      traj[M + l + 1] = stepper.step(t, h, traj[M + l], w0, w1, step_map);
-      // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors
-      step_block<D>(step_map, block.data() + (M + l) * stride, block.data() + j * stride, k, theta,
-                    block.data() + (M + l + 1) * stride);
+      const DelayTap<V> tap = grid.delay_tap<V>(l, slot);
+      traj[M + l + 1] = stepper.step(tap.t, grid.h, traj[M + l], tap.w0, tap.w1, step_map);
+      // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same tap)
+      step_block<D>(step_map, block.data() + (M + l) * stride, block.data() + grid.delayed_slot(l) * stride, k,
+                    grid.theta, block.data() + (M + l + 1) * stride);
       if (record && (l + 1) % spp == 0 && section_count < options.section_points)
         result.section.row(section_count++) = traj[M + l + 1].transpose();
     }
@@ -256,14 +236,14 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
 
   LyapunovStatistics stats = lyapunov_statistics(interval_logs, k, options.qr_every, options.batches);
   result.per_period = std::move(stats.mean_per_period);
-  result.standard_error_per_period = std::move(stats.error);
+  result.error_per_period = std::move(stats.error);
   result.batch_standard_error_per_period = std::move(stats.batch_standard_error);
   result.fluctuation_bound_per_period = std::move(stats.fluctuation_bound);
   result.batches = stats.batches;
-  result.map_time = static_cast<double>(K) * h;
+  result.map_time = static_cast<double>(K) * grid.h;
   for (int i = 0; i < k; ++i) {
     result.per_time.push_back(result.per_period[i] / result.map_time);
-    result.standard_error_per_time.push_back(result.standard_error_per_period[i] / result.map_time);
+    result.error_per_time.push_back(result.error_per_period[i] / result.map_time);
   }
   result.periods = options.periods;
   result.transient = options.transient;

@@ -27,14 +27,9 @@
 // Jacobian also assumes A and B constant within a region (true for the impact model).
 //
 // Regions: j = 1 is the strict side H > 0 (design.md 1.5 conventions).
-#include <Eigen/Core>
+#include "delayspec/types.hpp"
 
 namespace delayspec {
-
-template <int D>
-using Vec = Eigen::Matrix<double, D, 1>;
-template <int D>
-using Mat = Eigen::Matrix<double, D, D>;
 
 // Region of a state: 1 on the strict side H > 0, else 2. Models without switching: 1.
 template <class Model>

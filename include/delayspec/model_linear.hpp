@@ -1,6 +1,6 @@
 #pragma once
 // Scalar linear DDE  x' = a x + b x(t - tau), with a stroboscopic period T chosen by the user.
-// Its characteristic roots are known exactly (Lambert W, see linear_exact.hpp), which makes
+// Its characteristic roots are known exactly (Lambert W, see lambert_w.hpp), which makes
 // it the reference for the discretisation's convergence order.
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"

@@ -37,7 +37,7 @@
 
 #include "delayspec/errors.hpp"
 #include "delayspec/periodic_orbit.hpp"
-#include "delayspec/sparse_lu.hpp"
+#include "delayspec/detail/sparse_lu.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec {
@@ -62,18 +62,17 @@ class PeriodicOrbitProblem {
   // F(x); when jacobian is non-null it receives dF/dx (unknowns() x unknowns(), compressed).
   Eigen::VectorXd residual(const Eigen::VectorXd& x, Eigen::SparseMatrix<double>* jacobian = nullptr) const {
     check_size(x);
-    const long K = grid_.K, m = grid_.m;
-    const double theta = grid_.theta, c0 = 1 - theta, h = grid_.h;
+    const long K = grid_.K, m = grid_.m, M = grid_.M;
+    const double theta = grid_.theta, c0 = 1 - theta;
     auto u = [&](long l) { return x.segment<D>(D * wrap(l)); };
+    auto slot = [&](long i) { return u(i - M); };  // delay_tap's numbering: slot M + l = u_l
     Eigen::VectorXd F(unknowns());
     std::vector<Eigen::Triplet<double>> triplets;
     if (jacobian) triplets.reserve(static_cast<size_t>(K) * D * D * (theta == 0 ? 4 : 6) + K * D);
     StepMap<D> map;
     for (long l = 0; l < K; ++l) {
-      const V w0 = theta == 0 ? V(u(l - m)) : V(c0 * u(l - m) + theta * u(l - m - 1));
-      const V w1 = theta == 0 ? V(u(l - m + 1)) : V(c0 * u(l - m + 1) + theta * u(l - m));
-      const double t = static_cast<double>(l % grid_.steps_per_period) * h;
-      const V next = map_.stepper().step(t, h, V(u(l)), w0, w1, map);
+      const DelayTap<V> tap = grid_.delay_tap<V>(l, slot);
+      const V next = map_.stepper().step(tap.t, grid_.h, V(u(l)), tap.w0, tap.w1, map);
       F.segment<D>(D * l) = u(l + 1) - next;  // F_l = u_{l+1} - S_l(u_l, w0_l, w1_l)
       if (jacobian) {
         add_block(triplets, l, l + 1, Mat<D>::Identity());

@@ -68,8 +68,8 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
     throw BadInput("`t_end = " + format_number(options.t_end) + "`, `t_start = " + format_number(options.t_start) +
                    "`, `sample_every = " + std::to_string(options.sample_every) +
                    "`: more than 1e8 trajectory samples; raise sample_every or shorten the window");
-  const long M = grid.M, m = grid.m, ring = M + 3;
-  const double theta = grid.theta, c0 = 1 - theta, h = grid.h;
+  const long M = grid.M, ring = M + 3;
+  const double h = grid.h;
   std::vector<V> b(static_cast<size_t>(ring));
   auto slot = [&](long i) -> V& { return b[static_cast<size_t>(i % ring)]; };  // linear index -> ring
   for (long j = 0; j <= M; ++j) slot(j) = U0.template segment<D>(j * D);  // u_M .. u_0 at t = 0
@@ -92,14 +92,11 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
   StepMap<D> scratch;
   StepEvents events;
   for (long l = 0; l < steps; ++l) {
-    const long j = M + l - m;  // linear index of u_m
-    const V w0 = theta == 0 ? V(slot(j)) : V(c0 * slot(j) + theta * slot(j - 1));
-    const V w1 = theta == 0 ? V(slot(j + 1)) : V(c0 * slot(j + 1) + theta * slot(j));
+    const DelayTap<V> tap = grid.delay_tap<V>(l, slot);  // tap.t: the time in the period, as StroboscopicMap
     const double t_abs = static_cast<double>(l) * h;
-    const double t_phase = static_cast<double>(l % grid.steps_per_period) * h;  // as StroboscopicMap
     const TrapezoidStepper<Model>& stepper = t_abs >= options.switch_time ? after : before;
     const V u = slot(M + l);
-    const V next = stepper.step(t_phase, h, u, w0, w1, scratch, &events);
+    const V next = stepper.step(tap.t, h, u, tap.w0, tap.w1, scratch, &events);
     if (!next.allFinite())
       throw NumericalFailure("simulate: the trajectory diverged at t = " + format_number(t_abs));
     slot(M + l + 1) = next;

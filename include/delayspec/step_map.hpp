@@ -8,7 +8,7 @@
 // theta u_m are the delayed values at the step's two ends (grid.hpp). For an aligned delay
 // (theta = 0) this is the design's P du_0 + Q du_N + R du_{N-1}. Steps containing events have
 // the same form with other blocks.
-#include "delayspec/model.hpp"
+#include "delayspec/types.hpp"
 
 namespace delayspec {
 

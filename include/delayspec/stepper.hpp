@@ -8,7 +8,7 @@
 //   z1 = z0 + dt/2 [ f_jl(t0, z0, w0) + f_jr(t0 + dt, z1, w1) ]          (*)
 //
 // so that an event (a crossing of H = 0) can split it into pieces with explicit regions
-// (event handling: see the events extension). The derivative of (*) is
+// (event handling: event_step.hpp). The derivative of (*) is
 //
 //   dz1 = S^{-1} [ (I + dt/2 A_l) dz0 + dt/2 B_l dw0 + dt/2 B_r dw1 ],   S = I - dt/2 A_r.
 #include <array>
@@ -17,65 +17,14 @@
 
 #include <Eigen/LU>
 
+#include "delayspec/detail/event_step.hpp"  // event_step(), called by step()
 #include "delayspec/detail/small_solve.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
 #include "delayspec/step_map.hpp"
+#include "delayspec/step_options.hpp"
 
 namespace delayspec {
-
-// How a step treats a crossing of the switching surface H = 0 (design.md 1.5).
-enum class EventMode { on, linear, off };
-// Which derivative of a step with events: the exact derivative of the discrete map
-// (event-time sensitivity included) or the paper's, with the split points frozen.
-enum class JacobianMode { consistent, frozen };
-
-struct StepOptions {
-  EventMode events = EventMode::on;
-  JacobianMode jacobian = JacobianMode::consistent;
-  // Trapezoid sub-steps per piece of a step on the H > 0 side (contact), events on/linear only:
-  // resolves a contact shorter than h (design.md 1.5). >= 1; 1 = one trapezoid per piece.
-  // Default 4: a split step's trapezoid error depends on where the event falls in the step,
-  // which adds an O(h^2) term to the multipliers whose constant jumps with N; m sub-steps shrink
-  // it by m^2. On the paper's orbit m = 1 converges erratically (observed order -0.1 between
-  // N = 1600 and 3200), m = 4 with order 1.95 (docs/events.md), at no measurable cost there.
-  int contact_substeps = 4;
-};
-
-// What happened inside one step (filled by step() when asked; events off: always empty).
-struct StepEvents {
-  static constexpr int kMaxEvents = 16;  // more crossings than this in one step: NumericalFailure
-  int count = 0;
-  std::array<double, kMaxEvents> offset{};  // event time minus step start, in [0, h]
-  std::array<int, kMaxEvents> new_region{};  // region entered at the event (1: H > 0, contact)
-  // Number of entries into region 1 (impacts, for the impact model).
-  int entries_into_region1() const {
-    int n = 0;
-    for (int i = 0; i < count; ++i) n += new_region[i] == 1;
-    return n;
-  }
-};
-
-template <class Model>
-class TrapezoidStepper;
-// One full step with event location (event_step.hpp); called by TrapezoidStepper::step().
-template <class Model>
-Vec<Model::d> event_step(const TrapezoidStepper<Model>& stepper, double t, double h, const Vec<Model::d>& u0,
-                         const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepMap<Model::d>& map,
-                         StepEvents* events);
-
-// Region choice for the right node of a sub-step: a fixed region, or "the region of z1"
-// (found together with z1: the plain, unsplit trapezoid rule).
-inline constexpr int kRegionOfEndpoint = 0;
-
-template <int D>
-struct SubStepResult {
-  Vec<D> z1;
-  Mat<D> dz0;  // dz1 / dz0
-  Mat<D> dw0;  // dz1 / dw0 (delayed value at the left node)
-  Mat<D> dw1;  // dz1 / dw1 (delayed value at the right node)
-  int right_region = 1;
-};
 
 template <class Model>
 class TrapezoidStepper {
@@ -192,5 +141,3 @@ class TrapezoidStepper {
 };
 
 }  // namespace delayspec
-
-#include "delayspec/event_step.hpp"  // IWYU pragma: export (event_step() used by step())

@@ -43,8 +43,7 @@ class StroboscopicMap {
     if (U.size() != dimension())
       throw BadInput("StroboscopicMap: history has " + std::to_string(U.size()) + " entries, expected " +
                      std::to_string(dimension()));
-    const long M = grid_.M, m = grid_.m, K = grid_.K;
-    const double theta = grid_.theta, c0 = 1 - theta, h = grid_.h;
+    const long M = grid_.M, K = grid_.K;
     std::vector<V> b(static_cast<size_t>(M + 1 + K));
     for (long j = 0; j <= M; ++j) b[j] = U.segment<D>(j * D);
     if (maps) maps->resize(K);
@@ -54,12 +53,10 @@ class StroboscopicMap {
       trajectory->push_back(b[M]);
     }
     StepMap<D> scratch;
+    auto slot = [&b](long i) -> const V& { return b[i]; };
     for (long l = 0; l < K; ++l) {
-      const long j = M + l - m;
-      V w0 = theta == 0 ? b[j] : V(c0 * b[j] + theta * b[j - 1]);
-      V w1 = theta == 0 ? b[j + 1] : V(c0 * b[j + 1] + theta * b[j]);
-      double t = static_cast<double>(l % grid_.steps_per_period) * h;
-      b[M + l + 1] = stepper_.step(t, h, b[M + l], w0, w1, maps ? (*maps)[l] : scratch);
+      const DelayTap<V> tap = grid_.delay_tap<V>(l, slot);
+      b[M + l + 1] = stepper_.step(tap.t, grid_.h, b[M + l], tap.w0, tap.w1, maps ? (*maps)[l] : scratch);
       if (trajectory) trajectory->push_back(b[M + l + 1]);
     }
     Eigen::VectorXd out(dimension());

@@ -67,30 +67,26 @@ int command_basin(Config& config, const Invocation& inv) {
     point.set(y.name, format_number(y.value(i / x.points)), "basin");
     const Problem p = read_problem(point, 50);
     try {
-      std::visit(
-        [&](const auto& model) {
-          using Model = std::decay_t<decltype(model)>;
-          TrapezoidStepper<Model> stepper(model, step_options(p));
-          StroboscopicMap<Model> map(stepper, p.grid);
-          Eigen::VectorXd U = map.constant_history(model.initial_state());
-          for (long j = 0; j < transient; ++j) U = map.apply(U);
-          // Section sequence U_0 .. U_{2 P}: enough to test every p <= P on P + 1 pairs.
-          std::vector<Eigen::VectorXd> section(static_cast<size_t>(2 * max_period + 1));
-          section[0] = U;
-          for (long j = 1; j <= 2 * max_period; ++j) section[j] = map.apply(section[j - 1]);
-          Classification c;
-          c.max_section_x = -INFINITY;
-          for (const auto& S : section) {
-            if (!S.allFinite()) {
-              failure[i] = "trajectory not finite";
-              return;
-            }
-            c.max_section_x = std::max(c.max_section_x, S[S.size() - Model::d]);  // u_0's first component
+      with_map(p, [&](const auto& model, const auto& map) {
+        using Model = std::decay_t<decltype(model)>;
+        Eigen::VectorXd U = map.constant_history(model.initial_state());
+        for (long j = 0; j < transient; ++j) U = map.apply(U);
+        // Section sequence U_0 .. U_{2 P}: enough to test every p <= P on P + 1 pairs.
+        std::vector<Eigen::VectorXd> section(static_cast<size_t>(2 * max_period + 1));
+        section[0] = U;
+        for (long j = 1; j <= 2 * max_period; ++j) section[j] = map.apply(section[j - 1]);
+        Classification c;
+        c.max_section_x = -INFINITY;
+        for (const auto& S : section) {
+          if (!S.allFinite()) {
+            failure[i] = "trajectory not finite";
+            return;
           }
-          c.period = section_period(section, max_period, tolerance);
-          result[i] = c;
-        },
-        p.model);
+          c.max_section_x = std::max(c.max_section_x, S[S.size() - Model::d]);  // u_0's first component
+        }
+        c.period = section_period(section, max_period, tolerance);
+        result[i] = c;
+      });
     } catch (const NumericalFailure& e) {
       failure[i] = e.what();  // reported with the point, not fatal to the basin
     }
@@ -117,8 +113,8 @@ int command_basin(Config& config, const Invocation& inv) {
   }
   nlohmann::json count_json = nlohmann::json::object();
   for (const auto& [period, n] : counts) count_json[std::to_string(period)] = n;
-  nlohmann::json json = {{"model", problem.model_name}, {"N", problem.N}, {"events", problem.events},
-                         {"jacobian", problem.jacobian}, {"x", x.name}, {"y", y.name},
+  nlohmann::json json = {{"model", problem.model_name}, {"N", problem.N}, {"events", to_string(problem.events)},
+                         {"jacobian", to_string(problem.jacobian)}, {"x", x.name}, {"y", y.name},
                          {"x_range", {x.min, x.max}}, {"y_range", {y.min, y.max}}, {"x_points", x.points},
                          {"y_points", y.points}, {"transient", transient}, {"max_period", max_period},
                          {"tolerance", tolerance}, {"counts", count_json}, {"failed_points", failed},

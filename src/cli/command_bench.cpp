@@ -27,7 +27,6 @@
 #include "delayspec/floquet.hpp"
 #include "floquet_settings.hpp"
 #include "level_runner.hpp"
-#include "lyapunov_settings.hpp"  // state_dimension
 #include "memory_probe.hpp"
 #include "metadata.hpp"
 #include "output.hpp"
@@ -57,44 +56,65 @@ bool is_dense(FloquetSolver s) { return s == FloquetSolver::dense_lapack || s ==
 // Eigen's Schur form), and the QR workspace / Householder blocks: about 3 n^2 doubles.
 double dense_bytes_estimate(long n) { return 3.0 * 8.0 * static_cast<double>(n) * static_cast<double>(n); }
 
-nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+// What bench reads and checks before any work.
+struct BenchSettings {
+  Problem problem;
+  OrbitSettings orbit;
+  std::vector<int> Ns;
+  std::vector<std::string> solver_names;  // as given (`dense` stays `dense`)
+  std::vector<FloquetSolver> solvers;
+  FloquetOptions base;  // nev, ncv, tol, ... (the solver is set per row)
+  ReferenceKind reference_kind = ReferenceKind::automatic;
+  long repeats = 1;
+  double limit_mb = 2048;
+  Multipliers exact;  // the exact multipliers when the model has them
+};
 
-}  // namespace
-
-int command_bench(Config& config, const Invocation& inv) {
-  const auto command_start = std::chrono::steady_clock::now();
+BenchSettings read_bench_settings(Config& config) {
+  BenchSettings s;
   // bench compares several solvers: `solver` on the command line is a mistake; in a scene shared
   // with floquet it is floquet's key (ignored here).
   if (config.has("solver") && config.origin("solver") == "--set")
     throw BadInput("`solver = " + config.get_string("solver", "") + "`: bench compares several: use `solvers` (a comma list)");
-  Problem problem = read_problem(config, 100);
-  const OrbitSettings orbit_settings = read_orbit_settings(config);
-  const std::vector<int> Ns = read_N_list(config, problem, 100, 400);
-  const std::vector<std::string> solver_names = read_word_list(
-      config, "solvers", "spectra,arpack,dense-lapack", {"spectra", "arpack", "dense", "dense-lapack", "dense-eigen"});
-  FloquetOptions base = read_floquet_options(config, 10);
-  const ReferenceKind reference_kind =
+  s.problem = read_problem(config, 100);
+  s.orbit = read_orbit_settings(config);
+  s.Ns = read_N_list(config, s.problem, 100, 400);
+  s.solver_names = read_word_list(config, "solvers", "spectra,arpack,dense-lapack",
+                                  {"spectra", "arpack", "dense", "dense-lapack", "dense-eigen"});
+  s.base = read_floquet_options(config, 10);
+  s.reference_kind =
       parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
-  const long repeats = config.get_int_in_range("repeats", 1, 1, 1000);
-  const double limit_mb = config.get_double("dense_memory_limit_mb", 2048);
-  require_positive("dense_memory_limit_mb", limit_mb);
+  s.repeats = config.get_int_in_range("repeats", 1, 1, 1000);
+  s.limit_mb = config.get_double("dense_memory_limit_mb", 2048);
+  require_positive("dense_memory_limit_mb", s.limit_mb);
   config.check_all_used();
 
-  std::vector<FloquetSolver> solvers;
-  for (const auto& s : solver_names) solvers.push_back(parse_floquet_solver(s));
-  const int d = state_dimension(problem);
-  const long n_min = static_cast<long>(d) * (Ns.front() + 1);  // at least d (N + 1)
-  if (base.nev > n_min - 2)
-    throw BadInput("`nev = " + std::to_string(base.nev) + "`: the Krylov solvers need nev <= n - 2, and n is about " +
-                   std::to_string(n_min) + " at the coarsest N = " + std::to_string(Ns.front()));
-  const Multipliers exact = exact_multipliers(problem, base.nev);
-  if (reference_kind == ReferenceKind::exact && exact.empty())
-    throw BadInput("`reference = exact`: model `" + problem.model_name + "` has no exact multipliers");
+  for (const auto& name : s.solver_names) s.solvers.push_back(parse_floquet_solver(name));
+  Problem coarsest = s.problem;
+  coarsest.N = s.Ns.front();
+  const long n_min = coarsest.dimension();  // the dimension at the coarsest N, the smallest
+  validate_floquet_options(s.base, n_min);
+  // A Krylov row with nev > n - 2 would run the dense path (floquet.hpp): not a comparison.
+  const bool krylov_listed = std::any_of(s.solvers.begin(), s.solvers.end(), [](FloquetSolver f) { return !is_dense(f); });
+  if (krylov_listed && s.base.nev > n_min - 2)
+    throw BadInput("`nev = " + std::to_string(s.base.nev) + "`: the Krylov solvers need nev <= n - 2 = " +
+                   std::to_string(n_min - 2) + " at the coarsest N = " + std::to_string(s.Ns.front()));
+  s.exact = exact_multipliers(s.problem, s.base.nev);
+  if (s.reference_kind == ReferenceKind::exact && s.exact.empty())
+    throw BadInput("`reference = exact`: model `" + s.problem.model_name + "` has no exact multipliers");
+  return s;
+}
 
+// Every solver at every N: one row each (ok, skipped for memory, or failed numerically).
+std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
+  const std::vector<FloquetSolver>& solvers = s.solvers;
+  const FloquetOptions& base = s.base;
+  const long repeats = s.repeats;
+  const double limit_mb = s.limit_mb;
   std::vector<BenchRow> rows;
-  Progress progress(inv.err, "bench", static_cast<long>(Ns.size() * solvers.size()), inv.quiet);
-  for (int N : Ns) {
-    with_monodromy(problem, problem.events, orbit_settings, N, [&](const auto& op, const PeriodicOrbit&, double setup) {
+  Progress progress(inv.err, "bench", static_cast<long>(s.Ns.size() * solvers.size()), inv.quiet);
+  for (int N : s.Ns) {
+    with_monodromy(s.problem, s.problem.events, s.orbit, N, [&](const auto& op, const PeriodicOrbit&, double setup) {
       for (FloquetSolver solver : solvers) {
         BenchRow row;
         row.N = N;
@@ -136,19 +156,28 @@ int command_bench(Config& config, const Invocation& inv) {
     });
   }
   progress.finish();
+  return rows;
+}
 
-  // The reference: exact, or from the solver with the most completed levels (first listed on ties).
-  Multipliers ref;
-  std::vector<double> ref_precision;
-  std::string reference_used = "none", reference_note;
-  if (!exact.empty() && (reference_kind == ReferenceKind::exact || reference_kind == ReferenceKind::automatic)) {
-    ref = exact;
-    ref_precision.assign(ref.size(), 1e-14);
-    reference_used = "exact";
+// The reference values the rows are scored against.
+struct BenchReference {
+  Multipliers values;
+  std::vector<double> precision;
+  std::string used = "none", note;
+};
+
+// Exact when available (and not refused), else from the solver with the most completed levels
+// (first listed on ties): Richardson extrapolation or its finest level.
+BenchReference bench_reference(const BenchSettings& s, const std::vector<BenchRow>& rows) {
+  BenchReference reference;
+  if (!s.exact.empty() && (s.reference_kind == ReferenceKind::exact || s.reference_kind == ReferenceKind::automatic)) {
+    reference.values = s.exact;
+    reference.precision.assign(reference.values.size(), 1e-14);
+    reference.used = "exact";
   } else {
     std::string best;
     size_t best_count = 0;
-    for (const auto& name : solver_names) {
+    for (const auto& name : s.solver_names) {
       const std::string canonical = to_string(parse_floquet_solver(name));
       size_t count = 0;
       for (const auto& r : rows) count += r.solver == canonical && r.status == "ok";
@@ -156,9 +185,9 @@ int command_bench(Config& config, const Invocation& inv) {
     }
     if (best_count >= 2) {
       ConvergenceOptions co;
-      co.nev = base.nev;
+      co.nev = s.base.nev;
       co.extra = 0;
-      co.reference = reference_kind == ReferenceKind::finest ? ReferenceKind::finest : ReferenceKind::extrapolated;
+      co.reference = s.reference_kind == ReferenceKind::finest ? ReferenceKind::finest : ReferenceKind::extrapolated;
       std::vector<LevelResult> levels;
       for (const auto& r : rows)
         if (r.solver == best && r.status == "ok") {
@@ -169,19 +198,24 @@ int command_bench(Config& config, const Invocation& inv) {
           level.operator_applications = r.operator_applications;
           levels.push_back(std::move(level));
         }
-      const ConvergenceStudy s = analyse_convergence(levels, co);
-      ref = s.reference_values;
-      ref_precision = s.reference_precision;
-      reference_used = to_string(s.reference);
-      reference_note = "from the " + best + " rows";
+      const ConvergenceStudy study = analyse_convergence(levels, co);
+      reference.values = study.reference_values;
+      reference.precision = study.reference_precision;
+      reference.used = to_string(study.reference);
+      reference.note = "from the " + best + " rows";
     } else {
-      reference_note = "no exact values and fewer than two completed levels: errors not computed";
+      reference.note = "no exact values and fewer than two completed levels: errors not computed";
     }
   }
+  return reference;
+}
+
+// error, max_error, correct_digits against the reference; deviation_from_dense at the same N.
+void score_rows(std::vector<BenchRow>& rows, const BenchReference& reference) {
   for (auto& r : rows) {
     if (r.status != "ok") continue;
-    if (!ref.empty()) {
-      const MatchedErrors m = errors_against(r.multipliers, ref, ref_precision);
+    if (!reference.values.empty()) {
+      const MatchedErrors m = errors_against(r.multipliers, reference.values, reference.precision);
       r.error = m.errors[0];
       r.max_error = *std::max_element(m.errors.begin(), m.errors.end());
       r.correct_digits = m.correct_digits[0];
@@ -195,71 +229,74 @@ int command_bench(Config& config, const Invocation& inv) {
         break;
       }
   }
+}
 
-  if (inv.out_dir) {
-    AtomicFile csv(std::filesystem::path(*inv.out_dir) / "bench.csv");
-    csv.stream() << metadata_comment_lines(make_metadata("bench", inv.scene, config, nlohmann::json::object(),
-                                                           std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
-    csv.stream() << "# delayspec bench: model " << problem.model_name << ", nev " << base.nev << ", reference "
-                 << reference_used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
-                 << "error,max_error,correct_digits,deviation_from_dense,abs_mu1\n";
-    csv.stream().precision(10);
-    for (const auto& r : rows)
-      csv.stream() << r.N << "," << r.n << "," << r.solver << "," << r.status << "," << r.seconds << ","
-                   << r.setup_seconds << "," << r.peak_bytes << "," << r.operator_applications << "," << r.error
-                   << "," << r.max_error << "," << r.correct_digits << "," << r.deviation_from_dense << ","
-                   << (r.multipliers.empty() ? NAN : std::abs(r.multipliers[0])) << "\n";
-    csv.commit();
-  }
+void write_bench_csv(const std::filesystem::path& path, const std::string& metadata_header, const BenchSettings& s,
+                     const std::vector<BenchRow>& rows, const BenchReference& reference) {
+  AtomicFile csv(path);
+  csv.stream() << metadata_header;
+  csv.stream() << "# delayspec bench: model " << s.problem.model_name << ", nev " << s.base.nev << ", reference "
+               << reference.used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
+               << "error,max_error,correct_digits,deviation_from_dense,abs_mu1\n";
+  csv.stream().precision(10);
+  for (const auto& r : rows)
+    csv.stream() << r.N << "," << r.n << "," << r.solver << "," << r.status << "," << r.seconds << ","
+                 << r.setup_seconds << "," << r.peak_bytes << "," << r.operator_applications << "," << r.error
+                 << "," << r.max_error << "," << r.correct_digits << "," << r.deviation_from_dense << ","
+                 << (r.multipliers.empty() ? NAN : std::abs(r.multipliers[0])) << "\n";
+  csv.commit();
+}
 
-  if (inv.json) {
-    nlohmann::json j;
-    j["model"] = problem.model_name;
-    j["events"] = problem.events;
-    j["nev"] = base.nev;
-    j["reference"] = reference_used;
-    if (!reference_note.empty()) j["reference_note"] = reference_note;
-    j["dense_memory_limit_mb"] = limit_mb;
-    j["peak_bytes_method"] = "VmHWM - VmRSS after malloc_trim and a reset of the peak mark (per row)";
-    j["rows"] = nlohmann::json::array();
-    for (const auto& r : rows) {
-      nlohmann::json row = {{"N", r.N},
-                            {"dimension", r.n},
-                            {"solver", r.solver},
-                            {"status", r.status},
-                            {"seconds", num(r.seconds)},
-                            {"setup_seconds", num(r.setup_seconds)},
-                            {"peak_bytes", r.peak_bytes >= 0 ? nlohmann::json(r.peak_bytes) : nlohmann::json(nullptr)},
-                            {"error", num(r.error)},
-                            {"max_error", num(r.max_error)},
-                            {"correct_digits", num(r.correct_digits)},
-                            {"deviation_from_dense", num(r.deviation_from_dense)},
-                            {"operator_applications", r.operator_applications},
-                            {"repeats", r.repeats},
-                            {"multipliers", multipliers_json(r.multipliers)}};
-      if (!r.message.empty()) row["message"] = r.message;
-      j["rows"].push_back(row);
-    }
-    inv.out << j.dump(2) << "\n";
-    return 0;
+nlohmann::json bench_json(const BenchSettings& s, const std::vector<BenchRow>& rows, const BenchReference& reference) {
+  nlohmann::json j;
+  j["model"] = s.problem.model_name;
+  j["events"] = to_string(s.problem.events);
+  j["nev"] = s.base.nev;
+  j["reference"] = reference.used;
+  if (!reference.note.empty()) j["reference_note"] = reference.note;
+  j["dense_memory_limit_mb"] = s.limit_mb;
+  j["peak_bytes_method"] = "VmHWM - VmRSS after malloc_trim and a reset of the peak mark (per row)";
+  j["rows"] = nlohmann::json::array();
+  for (const auto& r : rows) {
+    nlohmann::json row = {{"N", r.N},
+                          {"dimension", r.n},
+                          {"solver", r.solver},
+                          {"status", r.status},
+                          {"seconds", number_or_null(r.seconds)},
+                          {"setup_seconds", number_or_null(r.setup_seconds)},
+                          {"peak_bytes", r.peak_bytes >= 0 ? nlohmann::json(r.peak_bytes) : nlohmann::json(nullptr)},
+                          {"error", number_or_null(r.error)},
+                          {"max_error", number_or_null(r.max_error)},
+                          {"correct_digits", number_or_null(r.correct_digits)},
+                          {"deviation_from_dense", number_or_null(r.deviation_from_dense)},
+                          {"operator_applications", r.operator_applications},
+                          {"repeats", r.repeats},
+                          {"multipliers", multipliers_json(r.multipliers)}};
+    if (!r.message.empty()) row["message"] = r.message;
+    j["rows"].push_back(row);
   }
+  return j;
+}
+
+void print_bench(std::ostream& out, const BenchSettings& s, const std::vector<BenchRow>& rows,
+                 const BenchReference& reference) {
   char line[300];
-  inv.out << "delayspec bench: model " << problem.model_name << ", nev " << base.nev << ", reference " << reference_used
-          << (reference_note.empty() ? "" : " (" + reference_note + ")") << "\n";
+  out << "delayspec bench: model " << s.problem.model_name << ", nev " << s.base.nev << ", reference " << reference.used
+      << (reference.note.empty() ? "" : " (" + reference.note + ")") << "\n";
   std::snprintf(line, sizeof line, "  %6s  %7s  %-12s  %10s  %10s  %9s  %10s  %10s  %6s  %10s\n", "N", "n", "solver",
                 "seconds", "peak MB", "op.appl", "error", "max error", "digits", "vs dense");
-  inv.out << line;
+  out << line;
   for (const auto& r : rows) {
     if (r.status != "ok") {
       std::snprintf(line, sizeof line, "  %6d  %7ld  %-12s  %s: %s\n", r.N, r.n, r.solver.c_str(), r.status.c_str(),
                     r.message.c_str());
-      inv.out << line;
+      out << line;
       continue;
     }
     std::snprintf(line, sizeof line, "  %6d  %7ld  %-12s  %10.4g  %10.3g  %9ld  %10.3e  %10.3e  %6.2f  %10.2e\n", r.N,
                   r.n, r.solver.c_str(), r.seconds, r.peak_bytes / (1024.0 * 1024.0), r.operator_applications, r.error,
                   r.max_error, r.correct_digits, r.deviation_from_dense);
-    inv.out << line;
+    out << line;
   }
   // Speed-up of each Krylov solver over dense LAPACK at the same N.
   for (const auto& dense : rows) {
@@ -268,10 +305,30 @@ int command_bench(Config& config, const Invocation& inv) {
       if (r.N == dense.N && r.status == "ok" && !is_dense(parse_floquet_solver(r.solver))) {
         std::snprintf(line, sizeof line, "  N = %d: %s is %.0fx faster than dense-lapack\n", r.N, r.solver.c_str(),
                       dense.seconds / r.seconds);
-        inv.out << line;
+        out << line;
       }
   }
-  inv.out << "peak MB: resident memory the solve added at its peak (VmHWM after a reset, per row)\n";
+  out << "peak MB: resident memory the solve added at its peak (VmHWM after a reset, per row)\n";
+}
+
+}  // namespace
+
+int command_bench(Config& config, const Invocation& inv) {
+  const auto command_start = std::chrono::steady_clock::now();
+  const BenchSettings settings = read_bench_settings(config);  // read and check
+  std::vector<BenchRow> rows = run_bench(settings, inv);        // compute
+  const BenchReference reference = bench_reference(settings, rows);
+  score_rows(rows, reference);
+  if (inv.out_dir) {  // report
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count();
+    write_bench_csv(std::filesystem::path(*inv.out_dir) / "bench.csv",
+                    metadata_comment_lines(make_metadata("bench", inv.scene, config, nlohmann::json::object(), seconds)),
+                    settings, rows, reference);
+  }
+  if (inv.json)
+    inv.out << bench_json(settings, rows, reference).dump(2) << "\n";
+  else
+    print_bench(inv.out, settings, rows, reference);
   return 0;
 }
 

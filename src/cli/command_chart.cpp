@@ -55,17 +55,13 @@ int command_chart(Config& config, const Invocation& inv) {
     const Problem p = read_problem(point, 40);
     const FloquetOptions options = read_floquet_options(point, 1);
     try {
-      std::visit(
-          [&](const auto& model) {
-            using Model = std::decay_t<decltype(model)>;
-            TrapezoidStepper<Model> stepper(model, step_options(p));
-            StroboscopicMap<Model> map(stepper, p.grid);
-            OrbitLinearisation<Model::d> at_orbit;
-            find_orbit(model, map, orbit_settings, &at_orbit);
-            const FloquetResult r = floquet_multipliers(Monodromy<Model::d>(p.grid, std::move(at_orbit.maps)), options);
-            radius[i] = std::abs(r.multipliers.at(0));
-          },
-          p.model);
+      with_map(p, [&](const auto& model, const auto& map) {
+        using Model = std::decay_t<decltype(model)>;
+        OrbitLinearisation<Model::d> at_orbit;
+        find_orbit(model, map, orbit_settings, &at_orbit);
+        const FloquetResult r = floquet_multipliers(Monodromy<Model::d>(map.grid(), std::move(at_orbit.maps)), options);
+        radius[i] = std::abs(r.multipliers.at(0));
+      });
     } catch (const NumericalFailure& e) {
       failure[i] = e.what();  // e.g. no periodic orbit at this point: reported, not fatal
     }
@@ -88,8 +84,8 @@ int command_chart(Config& config, const Invocation& inv) {
     }
     rows.push_back(row);
   }
-  nlohmann::json json = {{"model", problem.model_name}, {"N", problem.N}, {"events", problem.events},
-                         {"jacobian", problem.jacobian}, {"x", x.name}, {"y", y.name},
+  nlohmann::json json = {{"model", problem.model_name}, {"N", problem.N}, {"events", to_string(problem.events)},
+                         {"jacobian", to_string(problem.jacobian)}, {"x", x.name}, {"y", y.name},
                          {"x_range", {x.min, x.max}}, {"y_range", {y.min, y.max}}, {"x_points", x.points},
                          {"y_points", y.points}, {"points", count}, {"stable_points", stable},
                          {"failed_points", failed}, {"threads", threads}, {"seconds", seconds}, {"rows", rows}};

@@ -1,7 +1,7 @@
 // delayspec converge: h-convergence study of the leading Floquet multipliers (CLI contract,
 // design.md 1.8). Library part: include/delayspec/convergence.hpp.
 //
-// Keys: Ns (comma list) or N_min/N_max (doubling); nev, solver (default spectra), ncv, tol,
+// Keys: Ns (comma list) or N_min/N_max (doubling); nev, solver (default auto), ncv, tol,
 // max_restarts, seed (floquet_settings.hpp); reference = exact | extrapolated |
 // finest | auto; solver; extrapolation_order, extrapolation_order_step, extrapolation_levels;
 // converge_target (a relative error: keep doubling N until every tracked multiplier's estimate
@@ -28,7 +28,6 @@
 #include "floquet_settings.hpp"
 #include "level_runner.hpp"
 #include "metadata.hpp"
-#include "lyapunov_settings.hpp"  // state_dimension
 #include "output.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
@@ -37,7 +36,6 @@ namespace delayspec::cli {
 
 namespace {
 
-nlohmann::json number_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
 // A failure message on one line (for a CSV comment).
 std::string one_line(std::string text) {
@@ -221,9 +219,9 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
 // level whose orbit failed can be retried with Newton from its nearest neighbour's.
 class ConvergeLevels {
  public:
-  ConvergeLevels(const Problem& problem, std::string events, const OrbitSettings& orbit,
-                 const FloquetOptions& solver, Progress& progress)
-      : problem_(problem), events_(std::move(events)), orbit_(orbit), solver_(solver), progress_(progress) {}
+  ConvergeLevels(const Problem& problem, EventMode events, const OrbitSettings& orbit, const FloquetOptions& solver,
+                 Progress& progress)
+      : problem_(problem), events_(events), orbit_(orbit), solver_(solver), progress_(progress) {}
 
   LevelResult level(int N, int count) { return run(N, count, nullptr); }
 
@@ -269,7 +267,7 @@ class ConvergeLevels {
   }
 
   const Problem& problem_;
-  std::string events_;
+  EventMode events_;
   const OrbitSettings& orbit_;
   const FloquetOptions& solver_;
   Progress& progress_;
@@ -285,11 +283,11 @@ int command_converge(Config& config, const Invocation& inv) {
   // events may be a list here (side by side); the problem reads the first of them.
   const bool switching_default = config.get_string("model", "impact") == "impact";
   const std::vector<std::string> events =
-      read_word_list(config, "events", switching_default ? "on,off" : "on", {"on", "linear", "off"});
+      read_word_list(config, "events", switching_default ? "on,off" : "on", event_mode_names());
   config.set("events", events.front(), "converge");
   Problem problem = read_problem(config, 100);
   const bool switching =
-      std::visit([](const auto& m) { return std::decay_t<decltype(m)>::has_switching; }, problem.model);
+      std::visit([](const auto& model) { return std::decay_t<decltype(model)>::has_switching; }, problem.model);
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   ConvergenceOptions base;
   base.Ns = read_N_list(config, problem, 25, 400);
@@ -303,11 +301,10 @@ int command_converge(Config& config, const Invocation& inv) {
   const double x_step = config.get_double("extrapolation_order_step", 2);
   require_positive("extrapolation_order", x_order);
   require_positive("extrapolation_order_step", x_step);
-  base.richardson.max_columns = static_cast<int>(config.get_int("extrapolation_levels", 4));
-  if (base.richardson.max_columns < 1)
-    throw BadInput("`extrapolation_levels = " + std::to_string(base.richardson.max_columns) + "`: must be >= 1");
+  // More columns than levels is harmless (the table stops at the levels); the bound keeps the cast exact.
+  base.richardson.max_columns = static_cast<int>(config.get_int_in_range("extrapolation_levels", 4, 1, 1000));
   base.target = config.get_double("converge_target", 0);
-  const long max_N = config.get_int("converge_max_N", base.max_N);
+  base.max_N = static_cast<int>(config.get_int_in_range("converge_max_N", base.max_N, 1, 10'000'000));
   base.max_seconds = config.get_double("converge_max_seconds", base.max_seconds);
   if (!config.has("converge_target"))
     for (const char* key : {"converge_max_N", "converge_max_seconds"})
@@ -316,21 +313,15 @@ int command_converge(Config& config, const Invocation& inv) {
                        "`: a limit of `converge_target`, which is not given");
   if (config.has("converge_target") && !(base.target > 0))
     throw BadInput("`converge_target = " + config.get_string("converge_target", "") + "`: must be > 0");
-  if (max_N < 1 || max_N > 10000000)
-    throw BadInput("`converge_max_N = " + std::to_string(max_N) + "`: must be between 1 and 1e7");
-  base.max_N = static_cast<int>(max_N);
   if (!(base.max_seconds > 0) || !std::isfinite(base.max_seconds) || base.max_seconds > 1e7)
     throw BadInput("`converge_max_seconds = " + config.get_string("converge_max_seconds", "") +
                    "`: must be > 0 and at most 1e7");
   config.check_all_used();
 
-  const int d = state_dimension(problem);
-  long n_min = 0;
-  std::visit([&](const auto& m) { n_min = make_grid(m.tau(), m.period(), base.Ns.front(), problem.orbit_period).dimension(d); },
-             problem.model);
-  if (base.nev > n_min)
-    throw BadInput("`nev = " + std::to_string(base.nev) + "`: more than the dimension n = " + std::to_string(n_min) +
-                   " at the coarsest N = " + std::to_string(base.Ns.front()));
+  Problem coarsest = problem;
+  coarsest.N = base.Ns.front();
+  const long n_min = coarsest.dimension();
+  validate_floquet_options(solver_options, n_min);  // at the coarsest N, the smallest n
   base.exact = exact_multipliers(problem, base.nev + base.extra);
   if (base.reference == ReferenceKind::exact && base.exact.empty())
     throw BadInput("`reference = exact`: model `" + problem.model_name +
@@ -346,7 +337,7 @@ int command_converge(Config& config, const Invocation& inv) {
     const bool first_order = switching && ev == "off";
     options.richardson.order = order_given ? x_order : first_order ? 1 : 2;
     options.richardson.order_step = step_given ? x_step : first_order ? 1 : 2;
-    ConvergeLevels levels(problem, ev, orbit_settings, solver_options, progress);
+    ConvergeLevels levels(problem, parse_event_mode(ev), orbit_settings, solver_options, progress);
     studies.push_back(run_convergence_study(
         [&](int N, int count) { return levels.level(N, count); }, options,
         [&](int N, int count, int from_N) { return levels.retry(N, count, from_N); }));

@@ -18,29 +18,24 @@ int command_floquet(Config& config, const Invocation& inv) {
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   const FloquetOptions options = read_floquet_options(config);
   config.check_all_used();
-  const long n = std::visit([&](const auto& m) { return problem.grid.dimension(std::decay_t<decltype(m)>::d); }, problem.model);
-  if (options.nev < 1 || options.nev > n)
-    throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " + std::to_string(n));
+  const long n = problem.dimension();
+  validate_floquet_options(options, n);  // before the orbit: fail fast
 
   nlohmann::json json;
   FloquetResult result;
   PeriodicOrbit orbit;
   ContactSummary contacts;
   double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
-  std::visit(
-      [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        TrapezoidStepper<Model> stepper(model, step_options(problem));
-        StroboscopicMap<Model> map(stepper, problem.grid);
-        const auto orbit_start = std::chrono::steady_clock::now();
-        OrbitLinearisation<Model::d> at_orbit;  // the monodromy and states at the orbit
-        orbit = find_orbit(model, map, orbit_settings, &at_orbit);
-        orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
-        contacts = orbit_contacts(model, std::move(at_orbit.states));
-        const Monodromy<Model::d> monodromy(problem.grid, std::move(at_orbit.maps));
-        result = floquet_multipliers(monodromy, options);
-      },
-      problem.model);
+  with_map(problem, [&](const auto& model, const auto& map) {
+    using Model = std::decay_t<decltype(model)>;
+    const auto orbit_start = std::chrono::steady_clock::now();
+    OrbitLinearisation<Model::d> at_orbit;  // the monodromy and states at the orbit
+    orbit = find_orbit(model, map, orbit_settings, &at_orbit);
+    orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
+    contacts = orbit_contacts(model, std::move(at_orbit.states));
+    const Monodromy<Model::d> monodromy(map.grid(), std::move(at_orbit.maps));
+    result = floquet_multipliers(monodromy, options);
+  });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (inv.json) {
@@ -62,17 +57,17 @@ int command_floquet(Config& config, const Invocation& inv) {
       json["iterations"] = result.iterations;
       json["seed"] = options.seed;
     }
-    json["h"] = problem.grid.h;
-    json["steps_per_map"] = problem.grid.K;
-    json["events"] = problem.events;
-    json["jacobian"] = problem.jacobian;
+    json["h"] = problem.grid().h;
+    json["steps_per_map"] = problem.grid().K;
+    json["events"] = to_string(problem.events);
+    json["jacobian"] = to_string(problem.jacobian);
     json["orbit_residual"] = orbit.residual;
     json["orbit_periods"] = orbit.maps;
     json["orbit"] = orbit_json(orbit, contacts);
     if (!result.note.empty()) json["note"] = result.note;
     inv.out << json.dump(2) << "\n";
   } else {
-    inv.out << "delayspec floquet: model " << problem.model_name << ", " << problem.grid.describe() << ", n = " << n
+    inv.out << "delayspec floquet: model " << problem.model_name << ", " << problem.grid().describe() << ", n = " << n
             << "\n";
     print_orbit(inv.out, orbit, contacts);
     inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << result.solver << ", "

@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "lyapunov_settings.hpp"
+#include "output.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
 
@@ -17,7 +18,7 @@ int command_lyapunov(Config& config, const Invocation& inv) {
   Problem problem = read_problem(config, 100);
   LyapunovOptions options = read_lyapunov_options(config, 2);
   config.check_all_used();
-  const long n = problem.grid.dimension(state_dimension(problem));
+  const long n = problem.dimension();
   validate_lyapunov_options(options, n);
 
   Progress progress(inv.err, "lyapunov", options.transient + options.periods, inv.quiet);
@@ -27,31 +28,24 @@ int command_lyapunov(Config& config, const Invocation& inv) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (inv.json) {
-    nlohmann::json j;
+    nlohmann::json j = lyapunov_json(r);
     j["model"] = problem.model_name;
     j["N"] = problem.N;
     j["dimension"] = n;
-    j["exponents_per_period"] = r.per_period;
-    j["exponents_per_time"] = r.per_time;
-    j["standard_error_per_period"] = r.standard_error_per_period;
-    j["standard_error_per_time"] = r.standard_error_per_time;
-    j["batch_standard_error_per_period"] = r.batch_standard_error_per_period;
-    j["fluctuation_bound_per_period"] = r.fluctuation_bound_per_period;
     j["periods"] = r.periods;
     j["transient"] = r.transient;
     j["seconds"] = seconds;
     j["qr_seconds"] = r.qr_seconds;
-    j["period_time"] = r.map_time;
     j["qr_every"] = r.qr_every;
     j["batches"] = r.batches;
     j["seed"] = options.seed;
     j["steps"] = r.steps;
-    j["h"] = problem.grid.h;
-    j["events"] = problem.events;
-    j["jacobian"] = problem.jacobian;
+    j["h"] = problem.grid().h;
+    j["events"] = to_string(problem.events);
+    j["jacobian"] = to_string(problem.jacobian);
     inv.out << j.dump(2) << "\n";
   } else {
-    inv.out << "delayspec lyapunov: model " << problem.model_name << ", " << problem.grid.describe() << ", n = " << n
+    inv.out << "delayspec lyapunov: model " << problem.model_name << ", " << problem.grid().describe() << ", n = " << n
             << "\n";
     inv.out << r.per_period.size() << " leading Lyapunov exponents after a transient of " << r.transient
             << " periods, averaged over " << r.periods << " periods (period = " << r.map_time << " time units, QR every "
@@ -62,7 +56,7 @@ int command_lyapunov(Config& config, const Invocation& inv) {
     inv.out << line;
     for (size_t i = 0; i < r.per_period.size(); ++i) {
       std::snprintf(line, sizeof line, "  %3zu  %+.6e +- %.1e  %+.6e +- %.1e\n", i + 1, r.per_period[i],
-                    r.standard_error_per_period[i], r.per_time[i], r.standard_error_per_time[i]);
+                    r.error_per_period[i], r.per_time[i], r.error_per_time[i]);
       inv.out << line;
     }
     inv.out << "time: " << seconds << " s (QR " << r.qr_seconds << " s)\n";

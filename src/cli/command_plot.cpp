@@ -420,12 +420,8 @@ int command_plot(Config& config, const Invocation& inv) {
   GnuplotSettings settings;
   settings.program_given = config.has("plot_gnuplot");
   settings.program = config.get_string("plot_gnuplot", settings.program);
-  settings.width = config.get_int("plot_width", settings.width);
-  settings.height = config.get_int("plot_height", settings.height);
-  if (settings.width < 100 || settings.width > 10000)
-    throw BadInput("`plot_width = " + std::to_string(settings.width) + "`: must be between 100 and 10000");
-  if (settings.height < 100 || settings.height > 10000)
-    throw BadInput("`plot_height = " + std::to_string(settings.height) + "`: must be between 100 and 10000");
+  settings.width = static_cast<int>(config.get_int_in_range("plot_width", settings.width, 100, 10000));
+  settings.height = static_cast<int>(config.get_int_in_range("plot_height", settings.height, 100, 10000));
   if (settings.program.empty()) throw BadInput("`plot_gnuplot = `: empty (the gnuplot program to run)");
   config.check_all_used();
   // The directory: `delayspec plot DIR` (the positional argument) or --out DIR.

@@ -30,12 +30,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Analyses that are planned commands of delayspec but may be missing from this build.
-const std::set<std::string>& planned_analyses() {
-  static const std::set<std::string> names = {"simulate", "lyapunov", "sweep", "converge", "bench", "chart", "basin"};
-  return names;
-}
-
 std::vector<std::string> split_list(const std::string& text) {
   std::vector<std::string> out;
   std::stringstream ss(text);
@@ -57,7 +51,7 @@ std::string inferred_analysis(const Config& config) {
   for (const char* name : {"floquet", "lyapunov", "converge", "simulate", "sweep", "chart", "basin", "bench"}) {
     if (!command_table().count(name)) continue;
     std::set<std::string> read = {"analyses", "title"};
-    for (const auto& r : probe_reads(name, config)) read.insert(r.key);
+    for (const auto& r : probe_command(name, config).reads) read.insert(r.key);
     if (std::all_of(config.values().begin(), config.values().end(), [&](const auto& kv) { return read.count(kv.first) > 0; }))
       return name;
   }
@@ -81,30 +75,12 @@ std::vector<std::string> read_analyses(Config& config) {
     if (name == "run" || name == "plot")
       throw BadInput("`analyses = " + text + "`: `" + name + "` is a command, not an analysis");
     if (command_table().count(name)) continue;
-    if (planned_analyses().count(name))
-      throw BadInput("`analyses = " + text + "`: analysis `" + name + "` is not available in this build (available: " +
-                     available_list + ")");
     const std::string suggestion = closest_key(name, available);
     throw BadInput("`analyses = " + text + "`: unknown analysis `" + name + "`" +
                    (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?") + " (available: " +
                    available_list + ")");
   }
   return names;
-}
-
-// Runs `name` in key-collection mode and returns the keys it reads (or marks as its own).
-std::set<std::string> keys_read_by(const std::string& name, const Config& config) {
-  Config probe = config;
-  probe.collect_keys_only(true);
-  std::ostringstream sink_out, sink_err;
-  Invocation dry{.command = name, .scene = std::nullopt, .json = true, .out_dir = std::nullopt, .quiet = true,
-                 .resume = false, .out = sink_out, .err = sink_err};
-  try {
-    command_table().at(name)(probe, dry);
-  } catch (const KeysCollected& collected) {
-    return collected.keys;
-  }
-  return probe.used_keys();  // a command that never checked its keys (it should): what it read
 }
 
 }  // namespace
@@ -114,7 +90,7 @@ RunPlan plan_run(Config& config) {
   plan.analyses = read_analyses(config);
   plan.known_keys = {"analyses", "title"};
   for (const auto& name : plan.analyses) {
-    const std::set<std::string> keys = keys_read_by(name, config);
+    const std::set<std::string> keys = probe_command(name, config, OnBadInput::rethrow).keys;
     plan.known_keys.insert(keys.begin(), keys.end());
   }
   for (const auto& [key, value] : config.values()) {

@@ -58,7 +58,8 @@ nlohmann::json points_json(const std::vector<double>& t, const std::vector<Vec<D
 int command_simulate(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
   Problem problem = read_problem(config, 100);
-  const double period = problem.grid.period;
+  const HistoryGrid grid = problem.grid();
+  const double period = grid.period;
   SimulationOptions options;
   options.t_end = config.get_double("t_end", 10 * period);
   options.t_start = config.get_double("t_start", 0);
@@ -69,9 +70,10 @@ int command_simulate(Config& config, const Invocation& inv) {
   if (control_on_at > 0 && problem.model_name != "impact")
     throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: only for model = impact (it switches k)");
   Problem before_problem = problem;
-  before_problem.events = config.get_choice("events_before_control", problem.events, {"on", "linear", "off"});
+  before_problem.events = parse_event_mode(
+      config.get_choice("events_before_control", to_string(problem.events), event_mode_names()), "events_before_control");
   if (before_problem.events != problem.events && !(control_on_at > 0))
-    throw BadInput("`events_before_control = " + before_problem.events + "`: needs control_on_at > 0");
+    throw BadInput("`events_before_control = " + to_string(before_problem.events) + "`: needs control_on_at > 0");
   // A scene shared with the analysis commands (e.g. the default scene) may carry their keys.
   for (const char* key : {"nev", "solver", "ncv", "tol", "max_restarts", "seed", "residual_bound", "orbit", "orbit_tolerance",
                           "orbit_max_periods", "orbit_max_iterations", "orbit_guess_periods", "exponents", "periods", "transient", "Ns"})
@@ -95,9 +97,9 @@ int command_simulate(Config& config, const Invocation& inv) {
           }
         }
         const TrapezoidStepper<Model> before(before_model, step_options(before_problem)), after(model, step);
-        Eigen::VectorXd U(problem.grid.dimension(D));
-        for (int j = 0; j <= problem.grid.M; ++j) U.template segment<D>(static_cast<long>(j) * D) = model.initial_state();
-        const SimulationRecord<D> rec = simulate(before, after, problem.grid, U, options);
+        Eigen::VectorXd U(grid.dimension(D));
+        for (int j = 0; j <= grid.M; ++j) U.template segment<D>(static_cast<long>(j) * D) = model.initial_state();
+        const SimulationRecord<D> rec = simulate(before, after, grid, U, options);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
         std::vector<std::string> files;
@@ -105,7 +107,7 @@ int command_simulate(Config& config, const Invocation& inv) {
           const std::filesystem::path dir(*inv.out_dir);
           const std::string header = metadata_comment_lines(make_metadata(
               "simulate", inv.scene, config,
-              {{"N", problem.N}, {"events", problem.events}, {"jacobian", problem.jacobian}}, seconds));
+              {{"N", problem.N}, {"events", to_string(problem.events)}, {"jacobian", to_string(problem.jacobian)}}, seconds));
           AtomicFile traj(dir / "trajectory.csv");
           traj.stream() << header;
           write_points<D>(traj.stream(), rec.t, rec.y);
@@ -123,14 +125,14 @@ int command_simulate(Config& config, const Invocation& inv) {
         if (inv.json) {
           json["model"] = problem.model_name;
           json["N"] = problem.N;
-          json["h"] = problem.grid.h;
-          json["events"] = problem.events;
+          json["h"] = grid.h;
+          json["events"] = to_string(problem.events);
           json["contact_substeps"] = problem.contact_substeps;
           json["t_start"] = options.t_start;
           json["t_end"] = options.t_end;
           json["steps"] = rec.steps;
           json["control_on_at"] = control_on_at;
-          json["events_before_control"] = before_problem.events;
+          json["events_before_control"] = to_string(before_problem.events);
           json["impacts"] = rec.impact_times.size();
           json["impact_times"] = rec.impact_times;
           json["poincare"] = points_json<D>(rec.poincare_t, rec.poincare_y);
@@ -140,11 +142,11 @@ int command_simulate(Config& config, const Invocation& inv) {
           json["seconds"] = seconds;
           json["files"] = files;
         } else {
-          text << "delayspec simulate: model " << problem.model_name << ", " << problem.grid.describe() << ", events "
-               << problem.events << "\n";
+          text << "delayspec simulate: model " << problem.model_name << ", " << grid.describe() << ", events "
+               << to_string(problem.events) << "\n";
           text << "window [" << options.t_start << ", " << options.t_end << "], " << rec.steps << " steps";
           if (control_on_at > 0)
-            text << ", control (k) on from t = " << control_on_at << " (events " << before_problem.events << " before)";
+            text << ", control (k) on from t = " << control_on_at << " (events " << to_string(before_problem.events) << " before)";
           text << "\n";
           if constexpr (Model::has_switching)
             text << "impacts (entries into H > 0): " << rec.impact_times.size() << "; max H at grid points: " << rec.max_H

@@ -15,7 +15,7 @@
 // Exponents are per stroboscopic period (the paper's unit); *_per_time divide by period_time.
 // A point whose run fails numerically is recorded with its reason (exponents null/nan), the
 // other points still run, and the command exits 3 after writing everything.
-#include <atomic>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -23,8 +23,8 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
-#include <thread>
+#include <optional>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -32,6 +32,9 @@
 #include "commands.hpp"
 #include "lyapunov_settings.hpp"
 #include "metadata.hpp"
+#include "output.hpp"
+#include "parallel_points.hpp"
+#include "parameter_grid.hpp"  // read_threads
 #include "problem.hpp"
 #include "progress.hpp"
 
@@ -68,16 +71,9 @@ std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : 
 double number_or_nan(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
 
 json point_record(const SweepPoint& p, const LyapunovResult& r, int d) {
-  json j;
+  json j = lyapunov_json(r);
   j["index"] = p.index;
   j["parameter"] = p.parameter;
-  j["exponents_per_period"] = r.per_period;
-  j["standard_error_per_period"] = r.standard_error_per_period;
-  j["exponents_per_time"] = r.per_time;
-  j["standard_error_per_time"] = r.standard_error_per_time;
-  j["batch_standard_error_per_period"] = r.batch_standard_error_per_period;
-  j["fluctuation_bound_per_period"] = r.fluctuation_bound_per_period;
-  j["period_time"] = r.map_time;
   std::vector<double> x(r.section.rows());
   for (long i = 0; i < r.section.rows(); ++i) x[i] = r.section(i, 0);
   j["section_x"] = x;
@@ -96,155 +92,127 @@ fs::path point_path(const fs::path& dir, long index) {
   return dir / "points" / name;
 }
 
-}  // namespace
+// What the command reads and checks before any work.
+struct SweepSettings {
+  std::string key;  // the swept parameter
+  double from = 0, to = 0;
+  long count = 0;
+  int threads = 1;  // read_threads: 0 in the key = all cores
+  long section_points = 0;
+  LyapunovOptions options;
+  Problem first;                   // the problem at sweep_from
+  std::vector<SweepPoint> points;  // every point's problem, validated
+};
 
-int command_sweep(Config& config, const Invocation& inv) {
-  const auto start = std::chrono::steady_clock::now();
+SweepSettings read_sweep_settings(Config& config) {
+  SweepSettings s;
   if (!config.has("sweep_key")) throw BadInput("missing key `sweep_key` (the parameter to sweep, e.g. k)");
-  const std::string key = config.get_string("sweep_key", "");
+  s.key = config.get_string("sweep_key", "");
   for (const char* reserved : {"sweep_key", "sweep_from", "sweep_to", "sweep_points", "threads", "section_points",
                                "exponents", "periods", "transient", "seed", "qr_every", "batches", "model"})
-    if (key == reserved) throw BadInput("`sweep_key = " + key + "`: not a parameter that can be swept");
-  const double from = config.require_double("sweep_from");
-  const double to = config.require_double("sweep_to");
-  const long count = config.get_int_in_range("sweep_points", 11, 1, 1'000'000);
-  const long threads_key = config.get_int_in_range("threads", 0, 0, 4096);  // 0 = all cores
+    if (s.key == reserved) throw BadInput("`sweep_key = " + s.key + "`: not a parameter that can be swept");
+  s.from = config.require_double("sweep_from");
+  s.to = config.require_double("sweep_to");
+  s.count = config.get_int_in_range("sweep_points", 11, 1, 1'000'000);
+  s.threads = read_threads(config);
   // section points are kept in memory (d doubles each) for every point of the sweep
-  const long section_points = config.get_int_in_range("section_points", 100, 0, 10'000'000);
-  LyapunovOptions options = read_lyapunov_options(config, 2);
-  options.section_points = section_points;
+  s.section_points = config.get_int_in_range("section_points", 100, 0, 10'000'000);
+  s.options = read_lyapunov_options(config, 2);
+  s.options.section_points = s.section_points;
   // The swept key takes each point's value; reading the problem once with the first value
   // validates it and marks the key as used (a key no model reads is then reported as unknown).
-  config.set(key, format_number(from), "sweep_from");
-  Problem first = read_problem(config, 100);
+  config.set(s.key, format_number(s.from), "sweep_from");
+  s.first = read_problem(config, 100);
   config.check_all_used();
 
-  std::vector<SweepPoint> points(static_cast<size_t>(count));
-  for (long i = 0; i < count; ++i) {
-    SweepPoint& p = points[i];
+  s.points.resize(static_cast<size_t>(s.count));
+  for (long i = 0; i < s.count; ++i) {
+    SweepPoint& p = s.points[i];
     p.index = i;
-    p.parameter = count == 1 ? from : from + (to - from) * static_cast<double>(i) / static_cast<double>(count - 1);
+    p.parameter =
+        s.count == 1 ? s.from : s.from + (s.to - s.from) * static_cast<double>(i) / static_cast<double>(s.count - 1);
     Config point_config = config;
-    point_config.set(key, format_number(p.parameter), "sweep point " + std::to_string(i));
+    point_config.set(s.key, format_number(p.parameter), "sweep point " + std::to_string(i));
     p.problem = read_problem(point_config, 100);  // BadInput here names the key and the value
-    validate_lyapunov_options(options, p.problem.grid.dimension(state_dimension(p.problem)));
+    validate_lyapunov_options(s.options, p.problem.dimension());
   }
-  const int d = state_dimension(first);
+  return s;
+}
 
-  // Settings of the sweep for --resume: the effective values (a key stated at its default equals
-  // the key left out), except the thread count (results do not depend on it) and the scene-level
-  // keys of `run` (analyses, title).
+// Settings of the sweep for --resume: the effective values (a key stated at its default equals
+// the key left out), except the thread count (results do not depend on it) and the scene-level
+// keys of `run` (analyses, title).
+json resume_settings(const Config& config, const std::string& key) {
   json settings = json::object();
   for (const auto& [k, v] : config.effective_values())
     if (k != "threads" && k != "analyses" && k != "title") settings[k] = v;
   settings[key] = nullptr;  // the swept key's value is per point
-  const std::string hash = settings_hash(settings);
-  std::optional<fs::path> dir;
-  if (inv.out_dir) {
-    dir = fs::path(*inv.out_dir);
-    const fs::path settings_path = *dir / "sweep_settings.json";
-    if (inv.resume) {
-      std::ifstream in(settings_path);
-      if (!in) throw BadInput("`--resume`: `" + settings_path.string() + "` not found (no sweep to resume there)");
-      json stored;
-      try {
-        stored = json::parse(in);
-      } catch (const std::exception&) {
-        throw BadInput("`--resume`: `" + settings_path.string() + "` is not valid JSON");
+  return settings;
+}
+
+// --resume: the stored settings must equal these (BadInput naming each differing key with both
+// values); the finished point files of this sweep are taken, a point of another sweep refused.
+void resume_points(const fs::path& dir, const json& settings, const std::string& hash, std::vector<SweepPoint>& points) {
+  const fs::path settings_path = dir / "sweep_settings.json";
+  std::ifstream in(settings_path);
+  if (!in) throw BadInput("`--resume`: `" + settings_path.string() + "` not found (no sweep to resume there)");
+  json stored;
+  try {
+    stored = json::parse(in);
+  } catch (const std::exception&) {
+    throw BadInput("`--resume`: `" + settings_path.string() + "` is not valid JSON");
+  }
+  if (stored != settings) {
+    // Name each differing key with both values (a missing key shows as null).
+    std::string diff;
+    auto add = [&](const std::string& k) {
+      diff += (diff.empty() ? "`" : ", `") + k + "` (now " + settings.value(k, json()).dump() + ", the sweep's " +
+              (stored.is_object() ? stored.value(k, json()) : json()).dump() + ")";
+    };
+    for (const auto& [k, v] : settings.items())
+      if (!stored.is_object() || !stored.contains(k) || stored[k] != v) add(k);
+    if (stored.is_object())
+      for (const auto& [k, v] : stored.items())
+        if (!settings.contains(k)) add(k);
+    throw BadInput("`--resume`: the settings differ from the interrupted sweep in " + diff);
+  }
+  for (SweepPoint& p : points) {
+    const fs::path path = point_path(dir, p.index);
+    std::ifstream pin(path);
+    if (!pin) continue;
+    json record;
+    try {
+      record = json::parse(pin);
+    } catch (const std::exception&) {
+      continue;  // unreadable point file: recompute the point
+    }
+    // A point of another sweep (other settings) is never merged into this one.
+    const json stored_hash = record.is_object() ? record.value("settings_hash", json()) : json();
+    if (stored_hash != hash)
+      throw BadInput("`--resume`: `" + path.string() + "` belongs to a sweep with other settings (settings_hash " +
+                     (stored_hash.is_string() ? stored_hash.get<std::string>() : std::string("missing")) +
+                     ", this sweep " + hash + ", settings in " + settings_path.string() +
+                     "): remove the file, or resume with the settings it was computed with");
+    try {
+      if (record.at("index").get<long>() == p.index && record.at("parameter").get<double>() == p.parameter) {
+        p.result = record;
+        p.done = true;
       }
-      if (stored != settings) {
-        // Name each differing key with both values (a missing key shows as null).
-        std::string diff;
-        auto add = [&](const std::string& k) {
-          diff += (diff.empty() ? "`" : ", `") + k + "` (now " + settings.value(k, json()).dump() + ", the sweep's " +
-                  (stored.is_object() ? stored.value(k, json()) : json()).dump() + ")";
-        };
-        for (const auto& [k, v] : settings.items())
-          if (!stored.is_object() || !stored.contains(k) || stored[k] != v) add(k);
-        if (stored.is_object())
-          for (const auto& [k, v] : stored.items())
-            if (!settings.contains(k)) add(k);
-        throw BadInput("`--resume`: the settings differ from the interrupted sweep in " + diff);
-      }
-      for (SweepPoint& p : points) {
-        const fs::path path = point_path(*dir, p.index);
-        std::ifstream pin(path);
-        if (!pin) continue;
-        json record;
-        try {
-          record = json::parse(pin);
-        } catch (const std::exception&) {
-          continue;  // unreadable point file: recompute the point
-        }
-        // A point of another sweep (other settings) is never merged into this one.
-        const json stored_hash = record.is_object() ? record.value("settings_hash", json()) : json();
-        if (stored_hash != hash)
-          throw BadInput("`--resume`: `" + path.string() + "` belongs to a sweep with other settings (settings_hash " +
-                         (stored_hash.is_string() ? stored_hash.get<std::string>() : std::string("missing")) +
-                         ", this sweep " + hash + ", settings in " + settings_path.string() +
-                         "): remove the file, or resume with the settings it was computed with");
-        try {
-          if (record.at("index").get<long>() == p.index && record.at("parameter").get<double>() == p.parameter) {
-            p.result = record;
-            p.done = true;
-          }
-        } catch (const std::exception&) {
-          // a point record without index/parameter: recompute the point
-        }
-      }
-    } else {
-      if (fs::exists(settings_path) || fs::exists(*dir / "points"))
-        throw BadInput("`--out " + dir->string() +
-                       "` already holds a sweep: add --resume to complete it, or choose another directory");
-      write_file_atomically(settings_path, settings.dump(2) + "\n");
+    } catch (const std::exception&) {
+      // a point record without index/parameter: recompute the point
     }
   }
+}
 
-  std::vector<SweepPoint*> todo;
-  for (SweepPoint& p : points)
-    if (!p.done) todo.push_back(&p);
-  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-  const long thread_count =
-      std::max<long>(1, std::min<long>(threads_key == 0 ? hardware : threads_key, static_cast<long>(todo.size())));
-  if (!inv.quiet && inv.resume)
-    inv.err << "sweep: resuming, " << (count - static_cast<long>(todo.size())) << " of " << count
-            << " points already done\n";
+// The tables of a finished sweep: exponents.csv and section.csv (without the metadata header),
+// and the points' records with the failed ones listed.
+struct SweepTables {
+  std::string exponents_csv, section_csv;
+  json points = json::array(), failed = json::array();
+};
 
-  Progress progress(inv.err, "sweep", static_cast<long>(todo.size()), inv.quiet);
-  std::atomic<size_t> next{0};
-  std::atomic<bool> stop{false};
-  std::exception_ptr fatal;
-  std::mutex fatal_mutex;
-  auto worker = [&] {
-    while (!stop) {
-      const size_t i = next++;
-      if (i >= todo.size()) return;
-      SweepPoint& p = *todo[i];
-      try {
-        try {
-          p.result = point_record(p, run_lyapunov(p.problem, options), d);
-        } catch (const NumericalFailure& e) {
-          p.result = {{"index", p.index}, {"parameter", p.parameter}, {"error", e.what()}};
-        }
-        p.result["settings_hash"] = hash;
-        if (dir) write_file_atomically(point_path(*dir, p.index), p.result.dump() + "\n");
-        p.done = true;
-        progress.add();
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(fatal_mutex);
-        if (!fatal) fatal = std::current_exception();
-        stop = true;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (long t = 0; t < thread_count; ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
-  progress.finish();
-  if (fatal) std::rethrow_exception(fatal);
-
-  // Everything is done: the tables and the summary.
-  const int k = options.exponents;
+SweepTables sweep_tables(const std::vector<SweepPoint>& points, int k) {
+  SweepTables t;
   std::ostringstream exponents_csv, section_csv;
   exponents_csv << "parameter";
   for (int i = 1; i <= k; ++i) exponents_csv << ",lambda" << i;
@@ -252,64 +220,118 @@ int command_sweep(Config& config, const Invocation& inv) {
   for (int i = 1; i <= k; ++i) exponents_csv << ",lambda" << i << "_per_time";
   exponents_csv << ",seconds\n";
   section_csv << "parameter,x\n";
-  json summary;
-  json failed = json::array();
   for (const SweepPoint& p : points) {
     const json& r = p.result;
     const bool ok = !r.contains("error");
-    if (!ok) failed.push_back({{"parameter", p.parameter}, {"error", r["error"]}});
+    if (!ok) t.failed.push_back({{"parameter", p.parameter}, {"error", r["error"]}});
     exponents_csv << csv_number(p.parameter);
     for (const char* field : {"exponents_per_period", "standard_error_per_period", "exponents_per_time"})
       for (int i = 0; i < k; ++i) exponents_csv << "," << csv_number(ok ? number_or_nan(r[field][i]) : NAN);
     exponents_csv << "," << csv_number(ok ? number_or_nan(r["seconds"]) : NAN) << "\n";
     if (ok)
       for (const auto& x : r["section_x"]) section_csv << csv_number(p.parameter) << "," << csv_number(number_or_nan(x)) << "\n";
-    summary["points"].push_back(r);
+    t.points.push_back(r);
   }
+  t.exponents_csv = exponents_csv.str();
+  t.section_csv = section_csv.str();
+  return t;
+}
+
+}  // namespace
+
+int command_sweep(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  // Read and check.
+  SweepSettings s = read_sweep_settings(config);
+  const LyapunovOptions& options = s.options;
+  const int d = s.first.state_dimension();
+  const json settings = resume_settings(config, s.key);
+  const std::string hash = settings_hash(settings);
+  std::optional<fs::path> dir;
+  if (inv.out_dir) {
+    dir = fs::path(*inv.out_dir);
+    if (inv.resume) {
+      resume_points(*dir, settings, hash, s.points);
+    } else {
+      if (fs::exists(*dir / "sweep_settings.json") || fs::exists(*dir / "points"))
+        throw BadInput("`--out " + dir->string() +
+                       "` already holds a sweep: add --resume to complete it, or choose another directory");
+      write_file_atomically(*dir / "sweep_settings.json", settings.dump(2) + "\n");
+    }
+  }
+
+  // Compute the points not done yet, in parallel; a point's file is written as it finishes.
+  std::vector<SweepPoint*> todo;
+  for (SweepPoint& p : s.points)
+    if (!p.done) todo.push_back(&p);
+  const long todo_count = static_cast<long>(todo.size());
+  const long thread_count = std::clamp<long>(s.threads, 1, std::max<long>(todo_count, 1));  // as parallel_points
+  if (!inv.quiet && inv.resume)
+    inv.err << "sweep: resuming, " << (s.count - todo_count) << " of " << s.count << " points already done\n";
+  Progress progress(inv.err, "sweep", todo_count, inv.quiet);
+  parallel_points(todo_count, s.threads, [&](long i) {
+    SweepPoint& p = *todo[i];
+    try {
+      p.result = point_record(p, run_lyapunov(p.problem, options), d);
+    } catch (const NumericalFailure& e) {
+      p.result = {{"index", p.index}, {"parameter", p.parameter}, {"error", e.what()}};
+    }
+    p.result["settings_hash"] = hash;
+    if (dir) write_file_atomically(point_path(*dir, p.index), p.result.dump() + "\n");
+    p.done = true;
+    progress.add();
+  });
+  progress.finish();
+
+  // Report: the tables and the summary.
+  const SweepTables tables = sweep_tables(s.points, options.exponents);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  summary["model"] = first.model_name;
-  summary["sweep_key"] = key;
-  summary["sweep_from"] = from;
-  summary["sweep_to"] = to;
-  summary["sweep_points"] = count;
-  summary["N"] = first.N;
-  summary["exponents"] = k;
+  json summary;
+  summary["points"] = tables.points;
+  summary["model"] = s.first.model_name;
+  summary["sweep_key"] = s.key;
+  summary["sweep_from"] = s.from;
+  summary["sweep_to"] = s.to;
+  summary["sweep_points"] = s.count;
+  summary["N"] = s.first.N;
+  summary["exponents"] = options.exponents;
   summary["periods"] = options.periods;
   summary["transient"] = options.transient;
   summary["qr_every"] = options.qr_every;
   summary["seed"] = options.seed;
-  summary["section_points"] = section_points;
-  summary["events"] = first.events;
-  summary["jacobian"] = first.jacobian;
+  summary["section_points"] = s.section_points;
+  summary["events"] = to_string(s.first.events);
+  summary["jacobian"] = to_string(s.first.jacobian);
   summary["threads"] = thread_count;
   summary["points_computed_now"] = todo.size();
-  summary["failed"] = failed;
+  summary["failed"] = tables.failed;
   summary["seconds"] = seconds;
   if (dir) {
     // The files carry the metadata header (it names the swept key: `plot` labels the x axis
     // with it); the swept key's own value is per row, so it is not a metadata line.
     OutputMetadata metadata = make_metadata("sweep", inv.scene, config, summary, seconds);
-    metadata.parameters.erase(key);
+    metadata.parameters.erase(s.key);
     const std::string header = metadata_comment_lines(metadata);
-    write_file_atomically(*dir / "exponents.csv", header + exponents_csv.str());
-    write_file_atomically(*dir / "section.csv", header + section_csv.str());
+    write_file_atomically(*dir / "exponents.csv", header + tables.exponents_csv);
+    write_file_atomically(*dir / "section.csv", header + tables.section_csv);
     write_file_atomically(*dir / "sweep.json", summary.dump(1) + "\n");
   }
 
   if (inv.json) {
     inv.out << summary.dump(1) << "\n";
   } else {
-    inv.out << "delayspec sweep: model " << first.model_name << ", " << key << " from " << from << " to " << to << " ("
-            << count << " points, " << thread_count << " threads), N = " << first.N << ", transient "
+    inv.out << "delayspec sweep: model " << s.first.model_name << ", " << s.key << " from " << s.from << " to " << s.to
+            << " (" << s.count << " points, " << thread_count << " threads), N = " << s.first.N << ", transient "
             << options.transient << ", periods " << options.periods << "\n";
-    inv.out << exponents_csv.str();
+    inv.out << tables.exponents_csv;
     if (dir) inv.out << "files: " << (*dir / "exponents.csv").string() << ", " << (*dir / "section.csv").string() << ", "
                      << (*dir / "sweep.json").string() << "\n";
     inv.out << "time: " << seconds << " s\n";
   }
-  if (!failed.empty()) {
-    inv.err << "delayspec sweep: numerical failure at " << failed.size() << " point(s), first: parameter "
-            << failed[0]["parameter"].get<double>() << ": " << failed[0]["error"].get<std::string>() << "\n";
+  if (!tables.failed.empty()) {
+    inv.err << "delayspec sweep: numerical failure at " << tables.failed.size() << " point(s), first: parameter "
+            << tables.failed[0]["parameter"].get<double>() << ": " << tables.failed[0]["error"].get<std::string>()
+            << "\n";
     return 3;
   }
   return 0;

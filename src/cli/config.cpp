@@ -213,10 +213,22 @@ bool Config::has(const std::string& key) const {
   return values_.count(key) > 0;
 }
 
-void Config::note_read(const std::string& key, const std::optional<std::string>& fallback) const {
+Config::Read& Config::note_read(const std::string& key, const std::optional<std::string>& fallback) const {
   auto it = std::find_if(reads_.begin(), reads_.end(), [&](const Read& r) { return r.key == key; });
-  if (it == reads_.end()) it = reads_.insert(reads_.end(), Read{key, std::nullopt});
+  if (it == reads_.end()) it = reads_.insert(reads_.end(), Read{key, std::nullopt, std::nullopt});
   if (fallback && !values_.count(key)) it->fallback = fallback;  // the latest reader's default counts
+  return *it;
+}
+
+void Config::note_value(const std::string& key, const std::string& value) {
+  note_read(key, std::nullopt).value = value;  // the latest typed read counts
+}
+
+std::map<std::string, std::string> Config::effective_values() const {
+  std::map<std::string, std::string> out;
+  for (const auto& r : reads_)
+    if (r.value) out[r.key] = *r.value;
+  return out;
 }
 
 std::map<std::string, std::string> Config::effective_defaults() const {
@@ -239,7 +251,7 @@ void Config::mark_used(const std::string& key) { used_.insert(key); }
 double Config::get_double(const std::string& key, double fallback) {
   auto text = lookup(key);
   if (!text) {
-    effective_[key] = format_number(fallback);
+    note_value(key, format_number(fallback));
     note_read(key, format_number(fallback));
     return fallback;
   }
@@ -251,7 +263,7 @@ double Config::get_double(const std::string& key, double fallback) {
   if (s.empty() || end != s.c_str() + s.size() || (errno == ERANGE && std::abs(value) == HUGE_VAL))
     throw BadInput("`" + key + " = " + s + "`: not a number");
   if (!std::isfinite(value)) throw BadInput("`" + key + " = " + s + "`: must be a finite number");
-  effective_[key] = format_number(value);
+  note_value(key, format_number(value));
   return value;
 }
 
@@ -263,7 +275,7 @@ double Config::require_double(const std::string& key) {
 long Config::get_int(const std::string& key, long fallback) {
   auto text = lookup(key);
   if (!text) {
-    effective_[key] = std::to_string(fallback);
+    note_value(key, std::to_string(fallback));
     note_read(key, std::to_string(fallback));
     return fallback;
   }
@@ -273,7 +285,7 @@ long Config::get_int(const std::string& key, long fallback) {
   const long value = std::strtol(s.c_str(), &end, 10);
   if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE)
     throw BadInput("`" + key + " = " + s + "`: not an integer");
-  effective_[key] = std::to_string(value);
+  note_value(key, std::to_string(value));
   return value;
 }
 
@@ -289,7 +301,7 @@ std::string Config::get_string(const std::string& key, const std::string& fallba
   auto text = lookup(key);
   const std::string value = text ? *text : fallback;
   if (!text) note_read(key, fallback);
-  effective_[key] = value;
+  note_value(key, value);
   return value;
 }
 
@@ -311,7 +323,7 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
   };
   auto text = lookup(key);
   if (!text) {
-    effective_[key] = join(fallback);
+    note_value(key, join(fallback));
     note_read(key, join(fallback));
     return fallback;
   }
@@ -328,7 +340,7 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
     out.push_back(value);
   }
   if (out.empty()) throw BadInput("`" + key + " = " + *text + "`: empty list");
-  effective_[key] = join(out);
+  note_value(key, join(out));
   return out;
 }
 

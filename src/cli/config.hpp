@@ -60,9 +60,13 @@ class Config {
   // One key a getter or has() asked for, in the order of the first request: `fallback` is the
   // default the getter fell back to (as text), or none when the key was given or only asked
   // about with has() / require_double().
+  // `value`: the value a typed getter used, in the canonical spelling of effective_values()
+  // (none after has() / mark-only reads). One record serves the key registry, the effective
+  // defaults and the effective settings.
   struct Read {
     std::string key;
     std::optional<std::string> fallback;
+    std::optional<std::string> value;
   };
   const std::vector<Read>& reads() const { return reads_; }
   // Keys read but not given, with the default used: the effective defaults of a run.
@@ -85,14 +89,15 @@ class Config {
   // joined by ","), the fallback included when the key was not given. `b = -2.0` and `b = -2`,
   // or a key stated at its default and the same key left out, give the same map: what --resume
   // compares.
-  const std::map<std::string, std::string>& effective_values() const { return effective_; }
+  std::map<std::string, std::string> effective_values() const;
 
  private:
   std::optional<std::string> lookup(const std::string& key);
   // Records a read of `key`; `fallback` when the key is absent and the getter has a default.
-  void note_read(const std::string& key, const std::optional<std::string>& fallback) const;
+  Read& note_read(const std::string& key, const std::optional<std::string>& fallback) const;
+  // Records the value a typed getter used for `key` (canonical spelling).
+  void note_value(const std::string& key, const std::string& value);
   std::map<std::string, std::string> values_;
-  std::map<std::string, std::string> effective_;
   std::map<std::string, std::string> origin_;
   std::set<std::string> scene_keys_;  // keys whose value comes from the scene file (not overridden)
   mutable std::set<std::string> used_;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "delayspec/errors.hpp"
+#include "delayspec/lyapunov.hpp"  // kMaxTangentVectors
 #include "problem.hpp"
 
 namespace delayspec::cli {
@@ -35,7 +36,7 @@ const Probes& all_probes() {
   static const Probes probes = [] {
     Probes p;
     for (const auto& [command, fn] : command_table())
-      for (const auto& model : model_names()) p[command][model] = probe_reads(command, probe_config(command, model));
+      for (const auto& model : model_names()) p[command][model] = probe_command(command, probe_config(command, model)).reads;
     return p;
   }();
   return probes;
@@ -55,7 +56,7 @@ std::string default_text(const std::string& command, const Config::Read& r) {
 
 }  // namespace
 
-std::vector<Config::Read> probe_reads(const std::string& command, Config config) {
+Probe probe_command(const std::string& command, Config config, OnBadInput on_bad_input) {
   config.collect_keys_only(true);
   std::ostringstream sink_out, sink_err;
   Invocation dry{.command = command, .scene = std::nullopt, .json = true, .out_dir = std::nullopt, .quiet = true,
@@ -63,9 +64,12 @@ std::vector<Config::Read> probe_reads(const std::string& command, Config config)
   try {
     command_table().at(command)(config, dry);
   } catch (const KeysCollected&) {
+    // the keys it carries are config.used_keys()
   } catch (const BadInput&) {
+    if (on_bad_input == OnBadInput::rethrow) throw;
   }
-  return config.reads();
+  // (a command that never checked its keys, as every command should: what it read)
+  return {config.reads(), config.used_keys()};
 }
 
 const KeyReaders& key_readers() {
@@ -113,14 +117,14 @@ const std::map<std::string, std::string>& key_meanings() {
       {"orbit_guess_periods", "newton, auto, shooting: periods simulated from the initial history before the guess"},
       {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this; one level below 8x it"},
       {"nev", "multipliers wanted, >= 1"},
-      {"solver", "eigensolver: spectra, arpack (Krylov), dense (= dense-lapack), dense-eigen"},
+      {"solver", "eigensolver: auto (dense n <= 100, spectra n < 2000, else arpack), spectra, arpack, dense, dense-eigen"},
       {"ncv", "Krylov subspace dimension; 0 = max(2 nev + 1, nev + 10), at most n"},
       {"tol", "Krylov: converged when residual estimate <= tol max(|mu|, eps^(2/3))"},
       {"residual_bound", "Krylov: a returned pair needs a true residual |M v - mu v| / (|mu| |v|) <= max(residual_bound, 100 tol) (else retried, then exit 3)"},
       {"max_restarts", "Krylov: implicit restarts allowed (more: exit 3), 0..1000000"},
       {"seed", "seed of the random start vector (Krylov) or initial tangent block (Lyapunov)"},
       // lyapunov (lyapunov_settings.cpp), sweep
-      {"exponents", "Lyapunov exponents wanted, 1..64"},
+      {"exponents", "Lyapunov exponents wanted, 1.." + std::to_string(kMaxTangentVectors)},
       {"periods", "Lyapunov: periods averaged (a multiple of qr_every), >= 2"},
       {"transient", "Lyapunov: periods discarded first, >= 0"},
       {"qr_every", "Lyapunov: periods between QR factorisations"},

@@ -18,10 +18,17 @@
 
 namespace delayspec::cli {
 
-// The keys `command` reads given `config` (its scene and --set values), stopping right before
-// the command's work. A BadInput the command raises while validating (e.g. chart's default axes
-// with a model that lacks them) ends the probe: the keys read up to there are returned.
-std::vector<Config::Read> probe_reads(const std::string& command, Config config);
+// What `command` reads given `config` (its scene and --set values), found by running it in
+// key-collection mode: it stops right before its work (Config::check_all_used).
+struct Probe {
+  std::vector<Config::Read> reads;  // the keys read, with their defaults (Config::reads())
+  std::set<std::string> keys;       // the keys read or marked as its own (Config::used_keys())
+};
+// A BadInput the command raises while validating (e.g. chart's default axes with a model that
+// lacks them) either ends the probe, with what was read up to there (the key registry), or is
+// rethrown (`run`, which validates a scene before any analysis computes).
+enum class OnBadInput { stop, rethrow };
+Probe probe_command(const std::string& command, Config config, OnBadInput on_bad_input = OnBadInput::stop);
 
 // For every key some command reads: command -> the models with which it reads the key.
 using KeyReaders = std::map<std::string, std::map<std::string, std::set<std::string>>>;

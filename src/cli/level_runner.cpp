@@ -21,18 +21,19 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
       Ns.push_back(static_cast<int>(N));
     }
   } else {
-    const long lo = config.get_int("N_min", default_min), hi = config.get_int("N_max", default_max);
-    if (lo < 1 || lo > INT_MAX) throw BadInput("`N_min = " + std::to_string(lo) + "`: must be an integer >= 1");
-    if (hi < lo || hi > INT_MAX)
-      throw BadInput("`N_max = " + std::to_string(hi) + "`: must be >= N_min = " + std::to_string(lo));
+    const long lo = config.get_int_in_range("N_min", default_min, 1, INT_MAX);
+    const long hi = config.get_int_in_range("N_max", default_max, lo, INT_MAX);  // lo = N_min
     for (long N = lo; N <= hi; N *= 2) Ns.push_back(static_cast<int>(N));
   }
   for (size_t i = 1; i < Ns.size(); ++i)
     if (Ns[i] <= Ns[i - 1])
       throw BadInput(what + ": must be strictly increasing (" + std::to_string(Ns[i - 1]) + " then " +
                      std::to_string(Ns[i]) + ")");
-  for (int N : Ns)  // fail fast on an N the grid cannot take
-    std::visit([&](const auto& m) { make_grid(m.tau(), m.period(), N, problem.orbit_period); }, problem.model);
+  for (int N : Ns) {  // fail fast on an N the grid cannot take
+    Problem at_N = problem;
+    at_N.N = N;
+    at_N.grid();
+  }
   return Ns;
 }
 

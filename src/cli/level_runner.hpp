@@ -37,41 +37,37 @@ struct LevelOrbit {
 // Builds the problem at resolution N with the given events mode, finds its periodic orbit and
 // calls fn(monodromy, orbit, setup_seconds). fn is generic in the Monodromy<D> type.
 template <class Fn>
-void with_monodromy(const Problem& problem, const std::string& events, const OrbitSettings& orbit_settings, int N,
-                    Fn&& fn, const LevelOrbit& level_orbit = {}) {
-  std::visit(
-      [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        const auto start = std::chrono::steady_clock::now();
-        Problem p = problem;
-        p.events = events;
-        p.N = N;
-        p.grid = make_grid(model.tau(), model.period(), N, problem.orbit_period);
-        TrapezoidStepper<Model> stepper(model, step_options(p));
-        StroboscopicMap<Model> map(stepper, p.grid);
-        PeriodicOrbit orbit;
-        OrbitLinearisation<Model::d> at_orbit;  // step maps and states of one map at the orbit
-        if constexpr (!Model::is_linear) {
-          if (level_orbit.newton_guess) {
-            const Eigen::VectorXd guess = prolong_periodic_sequence(*level_orbit.newton_guess, Model::d, p.grid.K);
-            orbit = orbit_by_newton(map, guess, orbit_settings.newton);
-            map.apply(orbit.history, &at_orbit.maps, &at_orbit.states);
-          } else {
-            orbit = find_orbit(model, map, orbit_settings, &at_orbit);
-          }
-          if (level_orbit.sequence) {  // the states u_0 .. u_{K-1}
-            Eigen::VectorXd& x = *level_orbit.sequence;
-            x.resize(static_cast<long>(Model::d) * p.grid.K);
-            for (long l = 0; l < p.grid.K; ++l) x.template segment<Model::d>(Model::d * l) = at_orbit.states[l];
-          }
-        } else {
-          orbit = find_orbit(model, map, orbit_settings, &at_orbit);
-        }
-        const Monodromy<Model::d> monodromy(p.grid, std::move(at_orbit.maps));
-        const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        fn(monodromy, orbit, setup);
-      },
-      problem.model);
+void with_monodromy(const Problem& problem, EventMode events, const OrbitSettings& orbit_settings, int N, Fn&& fn,
+                    const LevelOrbit& level_orbit = {}) {
+  const auto start = std::chrono::steady_clock::now();
+  Problem p = problem;
+  p.events = events;
+  p.N = N;
+  with_map(p, [&](const auto& model, const auto& map) {
+    using Model = std::decay_t<decltype(model)>;
+    const long K = map.grid().K;
+    PeriodicOrbit orbit;
+    OrbitLinearisation<Model::d> at_orbit;  // step maps and states of one map at the orbit
+    if constexpr (!Model::is_linear) {
+      if (level_orbit.newton_guess) {
+        const Eigen::VectorXd guess = prolong_periodic_sequence(*level_orbit.newton_guess, Model::d, K);
+        orbit = orbit_by_newton(map, guess, orbit_settings.newton);
+        map.apply(orbit.history, &at_orbit.maps, &at_orbit.states);
+      } else {
+        orbit = find_orbit(model, map, orbit_settings, &at_orbit);
+      }
+      if (level_orbit.sequence) {  // the states u_0 .. u_{K-1}
+        Eigen::VectorXd& x = *level_orbit.sequence;
+        x.resize(static_cast<long>(Model::d) * K);
+        for (long l = 0; l < K; ++l) x.template segment<Model::d>(Model::d * l) = at_orbit.states[l];
+      }
+    } else {
+      orbit = find_orbit(model, map, orbit_settings, &at_orbit);
+    }
+    const Monodromy<Model::d> monodromy(map.grid(), std::move(at_orbit.maps));
+    const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fn(monodromy, orbit, setup);
+  });
 }
 
 }  // namespace delayspec::cli

@@ -6,11 +6,11 @@ namespace delayspec::cli {
 
 LyapunovOptions read_lyapunov_options(Config& config, int default_exponents) {
   LyapunovOptions o;
-  // Bounds: at most 64 exponents (only the leading ones are meant); periods and transient at most
+  // Bounds: at most kMaxTangentVectors exponents (lyapunov.hpp); periods and transient at most
   // 1e9 each, so transient + periods cannot overflow; the per-interval logs (periods / qr_every
   // times exponents doubles) at most kMaxLogs = 1e8 (800 MB), checked before anything is allocated.
   constexpr long kMaxPeriods = 1'000'000'000, kMaxLogs = 100'000'000;
-  o.exponents = static_cast<int>(config.get_int_in_range("exponents", default_exponents, 1, 64));
+  o.exponents = static_cast<int>(config.get_int_in_range("exponents", default_exponents, 1, kMaxTangentVectors));
   o.periods = config.get_int_in_range("periods", o.periods, 2, kMaxPeriods);
   o.transient = config.get_int_in_range("transient", o.transient, 0, kMaxPeriods);
   o.seed = static_cast<std::uint64_t>(config.get_int_in_range("seed", 1, 0, LONG_MAX));
@@ -27,17 +27,9 @@ LyapunovOptions read_lyapunov_options(Config& config, int default_exponents) {
 }
 
 LyapunovResult run_lyapunov(const Problem& problem, const LyapunovOptions& options) {
-  return std::visit(
-      [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        StroboscopicMap<Model> map(TrapezoidStepper<Model>(model, step_options(problem)), problem.grid);
-        return lyapunov_exponents(map, map.constant_history(model.initial_state()), options);
-      },
-      problem.model);
-}
-
-int state_dimension(const Problem& problem) {
-  return std::visit([](const auto& m) { return std::decay_t<decltype(m)>::d; }, problem.model);
+  return with_map(problem, [&](const auto& model, const auto& map) {
+    return lyapunov_exponents(map, map.constant_history(model.initial_state()), options);
+  });
 }
 
 }  // namespace delayspec::cli

@@ -16,7 +16,4 @@ LyapunovOptions read_lyapunov_options(Config& config, int default_exponents = 2)
 // model's keys (x0, v0). Thread-safe: builds its own stepper and buffers.
 LyapunovResult run_lyapunov(const Problem& problem, const LyapunovOptions& options);
 
-// The problem's state dimension d.
-int state_dimension(const Problem& problem);
-
 }  // namespace delayspec::cli

@@ -1,8 +1,23 @@
 #include "output.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 namespace delayspec::cli {
+
+nlohmann::json number_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+nlohmann::json lyapunov_json(const LyapunovResult& r) {
+  nlohmann::json j;
+  j["exponents_per_period"] = r.per_period;
+  j["standard_error_per_period"] = r.error_per_period;
+  j["exponents_per_time"] = r.per_time;
+  j["standard_error_per_time"] = r.error_per_time;
+  j["batch_standard_error_per_period"] = r.batch_standard_error_per_period;
+  j["fluctuation_bound_per_period"] = r.fluctuation_bound_per_period;
+  j["period_time"] = r.map_time;
+  return j;
+}
 
 nlohmann::json multipliers_json(const std::vector<std::complex<double>>& values) {
   nlohmann::json list = nlohmann::json::array();

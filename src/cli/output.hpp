@@ -1,15 +1,26 @@
 #pragma once
-// Shared output pieces of the commands: multipliers as JSON and as text.
+// Shared output pieces of the commands: numbers, multipliers and Lyapunov exponents as JSON,
+// multipliers as text.
 #include <complex>
 #include <ostream>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "delayspec/lyapunov.hpp"
 #include "delayspec/orbit_contacts.hpp"
 #include "delayspec/periodic_orbit.hpp"
 
 namespace delayspec::cli {
+
+// A number, or null when it is not finite (JSON has no nan or inf).
+nlohmann::json number_or_null(double x);
+
+// The exponents and their errors, the fields `lyapunov --json` and each `sweep` point share:
+// exponents_per_period, standard_error_per_period (= error_per_period, the historical key),
+// exponents_per_time, standard_error_per_time,
+// batch_standard_error_per_period, fluctuation_bound_per_period, period_time.
+nlohmann::json lyapunov_json(const LyapunovResult& r);
 
 // [{"re": .., "im": .., "abs": ..}, ...]
 nlohmann::json multipliers_json(const std::vector<std::complex<double>>& values);

@@ -63,10 +63,40 @@ MackeyGlassModel read_mackey_glass(Config& c) {
 
 StepOptions step_options(const Problem& problem) {
   StepOptions options;
-  options.events = problem.events == "off" ? EventMode::off : problem.events == "linear" ? EventMode::linear : EventMode::on;
-  options.jacobian = problem.jacobian == "frozen" ? JacobianMode::frozen : JacobianMode::consistent;
+  options.events = problem.events;
+  options.jacobian = problem.jacobian;
   options.contact_substeps = problem.contact_substeps;
   return options;
+}
+
+HistoryGrid Problem::grid() const {
+  return std::visit([&](const auto& mod) { return make_grid(mod.tau(), mod.period(), N, orbit_period); }, model);
+}
+
+int Problem::state_dimension() const {
+  return std::visit([](const auto& mod) { return std::decay_t<decltype(mod)>::d; }, model);
+}
+
+std::string to_string(EventMode mode) {
+  switch (mode) {
+    case EventMode::on: return "on";
+    case EventMode::linear: return "linear";
+    case EventMode::off: return "off";
+  }
+  return "?";
+}
+
+std::string to_string(JacobianMode mode) { return mode == JacobianMode::frozen ? "frozen" : "consistent"; }
+
+const std::vector<std::string>& event_mode_names() {
+  static const std::vector<std::string> names = {"on", "linear", "off"};
+  return names;
+}
+
+EventMode parse_event_mode(const std::string& text, const std::string& key) {
+  for (EventMode mode : {EventMode::on, EventMode::linear, EventMode::off})
+    if (to_string(mode) == text) return mode;
+  throw BadInput("`" + key + " = " + text + "`: must be one of on, linear, off");
 }
 
 const std::vector<std::string>& model_names() {
@@ -88,12 +118,12 @@ Problem read_problem(Config& config, int default_N) {
   if (problem.orbit_period != 1 && (problem.model_name == "linear" || problem.model_name == "mackey-glass"))
     throw BadInput("`orbit_period = " + std::to_string(problem.orbit_period) +
                    "`: only for forced models (impact, mathieu); for linear and mackey-glass set `period`");
-  problem.events = config.get_choice("events", "on", {"on", "linear", "off"});
-  problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"});
+  problem.events = parse_event_mode(config.get_choice("events", "on", event_mode_names()));
+  problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"}) == "frozen"
+                         ? JacobianMode::frozen
+                         : JacobianMode::consistent;
   problem.contact_substeps = static_cast<int>(config.get_int_in_range("contact_substeps", problem.contact_substeps, 1, 1000));
-  problem.grid = std::visit(
-      [&](const auto& model) { return make_grid(model.tau(), model.period(), problem.N, problem.orbit_period); },
-      problem.model);
+  problem.grid();  // BadInput now when N does not fit the delay/period ratio
   return problem;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Problem: what every command needs to know about the system being studied: the model (one of
-// the built-in ones, as a variant), the grid, and the discretisation options. Read from a
-// Config; every key it reads is documented in the CLI contract.
+// the built-in ones, as a variant), the resolution N and the discretisation options; the grid
+// and the dimensions follow from them. Read from a Config; every key it reads is documented in
+// the CLI contract. with_map() is the one hand-off from a problem to its stroboscopic map.
 #include <string>
 #include <variant>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "delayspec/model_mackey_glass.hpp"
 #include "delayspec/model_mathieu.hpp"
 #include "delayspec/stepper.hpp"
+#include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec::cli {
 
@@ -23,20 +25,45 @@ struct Problem {
   AnyModel model;
   int N = 100;
   int orbit_period = 1;
-  std::string events = "on";           // on | linear | off
-  std::string jacobian = "consistent"; // consistent | frozen
+  EventMode events = EventMode::on;
+  JacobianMode jacobian = JacobianMode::consistent;
   int contact_substeps = StepOptions{}.contact_substeps;  // trapezoid sub-steps per contact piece
-  HistoryGrid grid;
+
+  // The grid of this problem: a function of (model, N, orbit_period), never a stored copy.
+  HistoryGrid grid() const;
+  // d: the model's state dimension.
+  int state_dimension() const;
+  // n = d (M + 1): the dimension of the map's history vector (and of the monodromy).
+  long dimension() const { return grid().dimension(state_dimension()); }
 };
 
-// The stepper options (events, jacobian, ...) the problem asks for.
+// The stepper options (events, jacobian, contact sub-steps) the problem asks for.
 StepOptions step_options(const Problem& problem);
+
+// The problem as a map, in one place: builds the problem's stepper and stroboscopic map and
+// returns fn(model, map) (fn is generic in the model; every alternative must return one type).
+template <class Fn>
+decltype(auto) with_map(const Problem& problem, Fn&& fn) {
+  return std::visit(
+      [&](const auto& model) -> decltype(auto) {
+        using Model = std::decay_t<decltype(model)>;
+        const StroboscopicMap<Model> map(TrapezoidStepper<Model>(model, step_options(problem)), problem.grid());
+        return fn(model, map);
+      },
+      problem.model);
+}
 
 // The built-in models, the default first (the values of the key `model`).
 const std::vector<std::string>& model_names();
 
-// Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps;
-// builds the grid.
+// The key values of `events` and `jacobian` (the JSON and text edge): "on", "linear", "off";
+// "consistent", "frozen". parse_* throw BadInput naming `key` for any other text.
+std::string to_string(EventMode mode);
+std::string to_string(JacobianMode mode);
+EventMode parse_event_mode(const std::string& text, const std::string& key = "events");
+const std::vector<std::string>& event_mode_names();
+
+// Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps.
 // default_N is used when the key N is absent.
 Problem read_problem(Config& config, int default_N = 100);
 

@@ -5,7 +5,8 @@
 //
 // Layout: a history slot holds D components of k vectors, component-major with the k values
 // of a component contiguous ("interleaved"): slot[r * k + v] = component r of vector v. A slot
-// is D k doubles. With the delayed slot j = (current slot) - m, the step computes
+// is D k doubles. With the delayed slot j = (current slot) - m (HistoryGrid::delayed_slot), the
+// step computes HistoryGrid::delay_tap's formula (grid.hpp) on k vectors at once:
 //
 //   out = P u0 + Q w0 + R w1,   w0 = (1 - theta) b[j] + theta b[j - 1],
 //                               w1 = (1 - theta) b[j + 1] + theta b[j]

@@ -66,11 +66,14 @@
 #include "delayspec/detail/small_solve.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
-#include "delayspec/scalar_search.hpp"
+#include "delayspec/detail/scalar_search.hpp"
 #include "delayspec/step_map.hpp"
-#include "delayspec/stepper.hpp"
+#include "delayspec/step_options.hpp"
 
 namespace delayspec {
+
+template <class Model>
+class TrapezoidStepper;  // stepper.hpp: its sub_step() and options() are what a split step uses
 
 namespace detail {
 
