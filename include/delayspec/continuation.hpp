@@ -102,7 +102,7 @@
 #include "delayspec/grid.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/richardson.hpp"
-#include "delayspec/sparse_lu.hpp"
+#include "delayspec/detail/sparse_lu.hpp"
 #include "delayspec/stepper.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 

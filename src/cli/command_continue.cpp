@@ -75,17 +75,13 @@ ContinuationResult branch_at(const Config& config, const ContinueSettings& setti
                              const OrbitSettings& orbit_settings, ContinuationOptions options, int N,
                              Progress& progress) {
   const Level level = level_at(config, settings.key, options.from, N, options, progress);
-  return std::visit(
-      [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        TrapezoidStepper<Model> stepper(model, options.step_options);
-        StroboscopicMap<Model> map(stepper, level.problem.grid);
-        const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
-        const Eigen::VectorXd guess =
-            PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
-        return continue_orbit<Model>(ModelWithKey<Model>{level.config, settings.key}, guess, options);
-      },
-      level.problem.model);
+  return with_map(level.problem, [&](const auto& model, const auto& map) {
+    using Model = std::decay_t<decltype(model)>;
+    const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
+    const Eigen::VectorXd guess =
+        PeriodicOrbitProblem<std::decay_t<decltype(map)>>(map).sequence_from_history(orbit.history);
+    return continue_orbit<Model>(ModelWithKey<Model>{level.config, settings.key}, guess, options);
+  });
 }
 
 // The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
@@ -154,7 +150,7 @@ int command_continue(Config& config, const Invocation& inv) {
   for (const auto& r : levels) by_N.push_back(r.bifurcations);
   const double tolerance = options.tolerance > 0 ? options.tolerance : 1e-10 * std::abs(options.to - options.from);
   RichardsonOptions richardson;
-  if (switching && problem.events == "off") richardson.order = richardson.order_step = 1;  // design.md 1.5
+  if (switching && problem.events == EventMode::off) richardson.order = richardson.order_step = 1;  // design.md 1.5
   const std::vector<BifurcationEstimate> estimates = extrapolate_bifurcations(Ns, by_N, tolerance, richardson);
   // continue_switch: the period-2 branch of every period doubling on the finest branch.
   std::vector<ContinuationResult> switched;
@@ -182,8 +178,8 @@ int command_continue(Config& config, const Invocation& inv) {
   j["continue_key"] = settings.key;
   j["N"] = Ns.back();
   j["Ns"] = Ns;
-  j["events"] = problem.events;
-  j["jacobian"] = problem.jacobian;
+  j["events"] = to_string(problem.events);
+  j["jacobian"] = to_string(problem.jacobian);
   j["end"] = branch.end;
   if (!failures.empty()) j["failure"] = failures;
   j["points"] = points_json(branch.points);
