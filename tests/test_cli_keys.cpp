@@ -172,7 +172,9 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
       {"convergence", "converge"}, {"default", "floquet"},   {"fig6_1", "basin"},
       {"fig6_2", "sweep"},         {"fig6_2_zoom", "sweep"}, {"fig6_3", "simulate"},
       {"fig6_4", "sweep"},         {"mathieu_chart", "chart"}, {"paper-period1", "floquet"},
-      {"pwsdde-period2", "floquet"}};
+      {"pwsdde-period2", "floquet"}, {"continue_grazing_e", "continue"}, {"continue_tau_half_k", "continue"},
+      {"continue_mathieu_delta2", "continue"}, {"continue_mathieu_delta3", "continue"},
+      {"continue_pwsdde_k", "continue"}};
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
     if (entry.path().extension() != ".toml") continue;

@@ -847,8 +847,7 @@ ContinuationResult continue_period_doubled(const ModelAt& model_at, const Bifurc
   // The real eigenvector of the multiplier nearest -1.
   FloquetOptions fo = options.floquet;
   fo.keep_vectors = true;
-  if (fo.solver == FloquetSolver::dense_eigen || fo.solver == FloquetSolver::dense_lapack)
-    fo.solver = FloquetSolver::spectra;
+  if (fo.solver != FloquetSolver::arpack) fo.solver = FloquetSolver::spectra;  // eigenvectors: Krylov only
   const FloquetResult r = floquet_multipliers(map1.monodromy(U), fo);
   size_t k = 0;
   for (size_t i = 1; i < r.multipliers.size(); ++i)
