@@ -169,7 +169,7 @@ struct ContinuationOptions {
 
 struct ContinuationResult {
   std::vector<ContinuationPoint> points;
-  std::vector<Bifurcation> bifurcations;  // in the order met along the branch
+  std::vector<Bifurcation> bifurcations;  // by segment along the branch (within one: multiplier types first)
   std::string end;                        // "to", "from" (turned back past the start), "max_points", or "failure"
   std::string failure;                    // when end == "failure": the point reached and the reason
   // Cost: corrector iterations (each one linearisation + one sparse LU) and Krylov solves.
