@@ -78,7 +78,7 @@ TEST(KeyRegistry, EveryKeyReadHasAMeaningAndEveryMeaningIsRead) {
 TEST(UnreadKey, KeyOfAnotherCommandSaysItIsNotRead) {
   CliResult r = run({"lyapunov", "--set", "nev=4", "--set", "model=linear"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_TRUE(contains(r.err, "`nev` (= 4, from --set) is not read by lyapunov (it is a key of bench, chart, "
+  EXPECT_TRUE(contains(r.err, "`nev` (= 4, from --set) is not read by lyapunov (it is a key of bench, chart, continue, "
                               "converge, floquet")) << r.err;
   EXPECT_TRUE(contains(r.err, "`delayspec lyapunov --help` lists the keys it reads")) << r.err;
   EXPECT_FALSE(contains(r.err, "did you mean")) << r.err;
@@ -172,7 +172,9 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
       {"convergence", "converge"}, {"default", "floquet"},   {"fig6_1", "basin"},
       {"fig6_2", "sweep"},         {"fig6_2_zoom", "sweep"}, {"fig6_3", "simulate"},
       {"fig6_4", "sweep"},         {"mathieu_chart", "chart"}, {"paper-period1", "floquet"},
-      {"pwsdde-period2", "floquet"}};
+      {"pwsdde-period2", "floquet"}, {"continue_grazing_e", "continue"}, {"continue_tau_half_k", "continue"},
+      {"continue_mathieu_delta2", "continue"}, {"continue_mathieu_delta3", "continue"},
+      {"continue_pwsdde_k", "continue"}};
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
     if (entry.path().extension() != ".toml") continue;

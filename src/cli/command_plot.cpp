@@ -15,6 +15,7 @@
 //   section.csv (sweep)       -> bifurcation: Poincare-section x against the swept parameter
 //   trajectory.csv, poincare.csv (simulate) -> phase: portrait with Poincare points and x = e
 //   impacts.csv (simulate)    -> impacts: cumulative impact count against time
+//   branch.csv, continue.json (continue) -> branch, branch_mu1 (plot_continuation.hpp)
 // Keys: plot_gnuplot (the program, default "gnuplot"), plot_width, plot_height (pixels of the PNG).
 //
 // The inputs are read strictly (plot_inputs.hpp): a file of the wrong shape is bad input (exit 2)
@@ -29,6 +30,7 @@
 #include "commands.hpp"
 #include "delayspec/errors.hpp"
 #include "gnuplot_script.hpp"
+#include "plot_continuation.hpp"
 #include "plot_inputs.hpp"
 
 #include <nlohmann/json.hpp>
@@ -443,6 +445,7 @@ int command_plot(Config& config, const Invocation& inv) {
   if (present(dir, "section.csv")) plot_bifurcation(renderer, dir);
   if (present(dir, "trajectory.csv")) plot_phase(renderer, dir);
   if (present(dir, "impacts.csv")) plot_impacts(renderer, dir);
+  if (present(dir, "branch.csv")) plot_continuation(renderer, dir);
   if (present(dir, "converge.json")) {
     converge = read_json_file(dir / "converge.json");
     const JsonField j(converge, "converge.json", "");
@@ -458,7 +461,7 @@ int command_plot(Config& config, const Invocation& inv) {
   if (renderer.written().empty())
     throw BadInput("`" + dir.string() +
                    "`: nothing to plot (looked for floquet.json, chart.csv, basin.csv, converge.json, bench.json, "
-                   "exponents.csv, section.csv, trajectory.csv, impacts.csv; see docs/formats.md)");
+                   "exponents.csv, section.csv, trajectory.csv, impacts.csv, branch.csv; see docs/formats.md)");
   if (inv.json) inv.out << Json{{"directory", dir.string()}, {"files", renderer.written()}}.dump(2) << "\n";
   return 0;
 }

@@ -17,7 +17,8 @@ namespace {
 // reaches its other reads. The swept key's placeholder is a name no model reads.
 const std::map<std::string, std::map<std::string, std::string>>& required_placeholders() {
   static const std::map<std::string, std::map<std::string, std::string>> keys = {
-      {"sweep", {{"sweep_key", "(swept)"}, {"sweep_from", "0"}, {"sweep_to", "1"}}}};
+      {"sweep", {{"sweep_key", "(swept)"}, {"sweep_from", "0"}, {"sweep_to", "1"}}},
+      {"continue", {{"continue_key", "(continued)"}, {"continue_from", "0"}, {"continue_to", "1"}}}};
   return keys;
 }
 
@@ -170,6 +171,17 @@ const std::map<std::string, std::string>& key_meanings() {
       {"basin_transient", "basin: maps discarded before classifying"},
       {"basin_max_period", "basin: longest period detected (0 in the result: none up to it)"},
       {"basin_tolerance", "basin: relative sup-norm tolerance of a repeat"},
+      // continue (continue_settings.cpp, command_continue.cpp)
+      {"continue_key", "continue: the model parameter continued (any numeric model key)"},
+      {"continue_from", "continue: start of the branch (the orbit there is found as `floquet` finds it)"},
+      {"continue_to", "continue: end of the range (the branch may turn back at folds; it ends at either end)"},
+      {"continue_step", "continue: first arclength step (parameter units); 0 = |to - from| / 50"},
+      {"continue_step_min", "continue: smallest step; below it the branch ends (exit 3); 0 = 1e-6 |to - from|"},
+      {"continue_step_max", "continue: largest step; 0 = |to - from| / 10"},
+      {"continue_max_points", "continue: branch points at most, 2..1e7"},
+      {"continue_tolerance", "continue: bifurcations located to this in the parameter; 0 = 1e-10 |to - from|"},
+      {"continue_Ns", "continue: N list (increasing) for error bars on the bifurcations (none: N only)"},
+      {"continue_switch", "continue: true = also the period-2 branch from each period doubling (finest N)"},
       // plot, run
       {"plot_gnuplot", "plot: the gnuplot program"},
       {"plot_width", "plot: PNG width in pixels, 100..10000"},

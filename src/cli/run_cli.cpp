@@ -26,6 +26,7 @@ const std::map<std::string, CommandFunction>& command_table() {
       {"basin", command_basin},
       {"plot", command_plot},
       {"simulate", command_simulate},
+      {"continue", command_continue},
   };
   return table;
 }
@@ -39,6 +40,7 @@ OutputUse output_use(const std::string& command) {
       {"chart", {OutDirUse::written, false}},
       {"basin", {OutDirUse::written, false}},
       {"simulate", {OutDirUse::written, false}},
+      {"continue", {OutDirUse::written, false}},
       {"plot", {OutDirUse::read, false}},  // `plot --out DIR` = `plot DIR`
   };
   auto it = table.find(command);

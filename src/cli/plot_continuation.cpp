@@ -1,0 +1,92 @@
+#include "plot_continuation.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "delayspec/errors.hpp"
+#include "plot_inputs.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+// Two datablocks of (x, y) over the branch: one with the stable stretches, one with the unstable
+// ones, each stretch a separate line (a blank line between stretches) and each ending on the
+// first point of the next stretch so that the curve has no gap where stability changes.
+void stable_and_unstable(const ResultTable& t, int x, int y, int stable, std::string& solid, std::string& dashed) {
+  std::vector<const std::vector<double>*> rows;
+  for (const auto& row : t.rows)
+    if (!row.empty()) rows.push_back(&row);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const bool s = (*rows[i])[stable] != 0;
+    const std::string line = gnuplot_number((*rows[i])[x]) + " " + gnuplot_number((*rows[i])[y]) + "\n";
+    (s ? solid : dashed) += line;
+    if (i + 1 < rows.size() && ((*rows[i + 1])[stable] != 0) != s) {
+      (s ? solid : dashed) += gnuplot_number((*rows[i + 1])[x]) + " " + gnuplot_number((*rows[i + 1])[y]) + "\n\n";
+      (s ? dashed : solid) += "\n";
+    }
+  }
+}
+
+}  // namespace
+
+void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& dir) {
+  // max_H and contact_time are nan for models without switching; the multiplier columns for points
+  // with fewer multipliers than nev.
+  const ResultTable t = read_result_table(dir / "branch.csv", [](const std::string& c) {
+    return c == "max_H" || c == "contact_time" || c.rfind("mu", 0) == 0 || c == "abs_mu1";
+  });
+  t.require_header({"parameter", "stable", "unstable", "abs_mu1", "max_y1"});
+  t.require_rows();
+  const int stable = t.column("stable"), mu1 = t.column("abs_mu1"), max_y1 = t.column("max_y1");
+  const std::string key = t.metadata_text("continue_key", "parameter");
+  // The bifurcations: parameter, max y1 at the point, |mu| (1 on the circle; grazing: none).
+  std::string marks_y, marks_mu, labels_y, labels_mu;
+  if (std::filesystem::exists(dir / "continue.json")) {
+    const nlohmann::json doc = read_json_file(dir / "continue.json");
+    const JsonField j(doc, "continue.json", "");
+    int index = 0;
+    for (const JsonField& b : j.at("bifurcations").elements()) {
+      const double p = b.at("parameter").number();
+      const double y = b.at("measures").at("max").elements().at(0).number();
+      const std::string type = b.at("type").text();
+      if (type != "fold" && type != "period-doubling" && type != "neimark-sacker" && type != "grazing")
+        b.at("type").fail("unknown bifurcation type");
+      marks_y += gnuplot_number(p) + " " + gnuplot_number(y) + "\n";
+      labels_y += "set label " + std::to_string(++index) + " " + gnuplot_string(type) + " at " + gnuplot_number(p) +
+                  "," + gnuplot_number(y) + " offset 0.5,0.8 font ',9'\n";
+      if (type != "grazing") {
+        marks_mu += gnuplot_number(p) + " 1\n";
+        labels_mu += "set label " + std::to_string(index) + " " + gnuplot_string(type) + " at " + gnuplot_number(p) +
+                     ",1 offset 0.5,0.8 font ',9'\n";
+      }
+    }
+  }
+  auto figure = [&](const std::string& name, int y, const std::string& ylabel, const std::string& marks,
+                    const std::string& labels, bool unit_line) {
+    std::string solid, dashed;
+    stable_and_unstable(t, 0, y, stable, solid, dashed);
+    std::ostringstream gp;
+    gp << gnuplot_datablock("stable", solid.empty() ? "nan nan\n" : solid)
+       << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
+       << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
+    gp << "set title "
+       << gnuplot_string("Branch of " + t.metadata_text("model", "?") + " against " + key +
+                         " (stable solid, unstable dashed)")
+       << "\n";
+    gp << "set xlabel " << gnuplot_string(key) << "\nset ylabel " << gnuplot_string(ylabel)
+       << "\nset grid\nset key top left\n"
+       << labels;
+    gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
+       << "     $unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable', \\\n"
+       << "     $marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'"
+       << (unit_line ? ", \\\n     1 with lines lc rgb '#2ca02c' title '|{/Symbol m}| = 1'" : "") << "\n";
+    renderer.figure(name, gp.str());
+  };
+  figure("branch", max_y1, "max y_1 over the orbit", marks_y, labels_y, false);
+  if (mu1 >= 0) figure("branch_mu1", mu1, "|{/Symbol m}_1|", marks_mu, labels_mu, true);
+}
+
+}  // namespace delayspec::cli

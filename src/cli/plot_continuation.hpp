@@ -1,0 +1,16 @@
+#pragma once
+// The figures of a `delayspec continue` result directory (command_plot.cpp calls it when DIR has
+// branch.csv):
+//   branch      max of y1 over the orbit against the continued parameter, stable solid, unstable
+//               dashed, the bifurcations of continue.json marked and named
+//   branch_mu1  |mu_1| against the parameter with the unit line and the bifurcations
+// Inputs read strictly (plot_inputs.hpp): bad files are BadInput naming the file and field.
+#include <filesystem>
+
+#include "gnuplot_script.hpp"
+
+namespace delayspec::cli {
+
+void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& dir);
+
+}  // namespace delayspec::cli

@@ -1,0 +1,173 @@
+// The non-template parts of continuation.hpp: detection counts, test functions, the Hermite
+// maximum, and the extrapolation of bifurcation points across N.
+#include "delayspec/continuation.hpp"
+
+#include <set>
+
+namespace delayspec {
+
+std::string to_string(BifurcationType type) {
+  switch (type) {
+    case BifurcationType::fold:
+      return "fold";
+    case BifurcationType::period_doubling:
+      return "period-doubling";
+    case BifurcationType::neimark_sacker:
+      return "neimark-sacker";
+    case BifurcationType::grazing:
+      return "grazing";
+  }
+  return "?";
+}
+
+namespace continuation_detail {
+
+bool is_real(std::complex<double> mu) { return std::abs(mu.imag()) <= 1e-10 * std::abs(mu); }
+
+UnstableCounts unstable_counts(const std::vector<std::complex<double>>& multipliers) {
+  UnstableCounts c;
+  for (const auto& mu : multipliers) {
+    if (!(std::abs(mu) > 1)) continue;
+    if (!is_real(mu))
+      ++c.complex;
+    else if (mu.real() > 0)
+      ++c.real_plus;
+    else
+      ++c.real_minus;
+  }
+  return c;
+}
+
+std::vector<BifurcationType> detected_changes(const UnstableCounts& a, const UnstableCounts& b) {
+  std::vector<BifurcationType> found;
+  const bool fold = (a.real_plus - b.real_plus) % 2 != 0;
+  const bool period_doubling = (a.real_minus - b.real_minus) % 2 != 0;
+  if (fold) found.push_back(BifurcationType::fold);
+  if (period_doubling) found.push_back(BifurcationType::period_doubling);
+  // Non-real multipliers leaving / entering the circle, unless the change is a real pair turning
+  // complex (or back) outside it: then the total of unstable multipliers is what the real
+  // crossings alone explain.
+  const int real_change = (b.real_plus - a.real_plus) * fold + (b.real_minus - a.real_minus) * period_doubling;
+  if (a.complex != b.complex && b.total() - a.total() != real_change) found.push_back(BifurcationType::neimark_sacker);
+  return found;
+}
+
+double multiplier_test(BifurcationType type, const std::vector<std::complex<double>>& multipliers,
+                       std::complex<double>* critical) {
+  double best_distance = INFINITY, value = NAN;
+  for (const auto& mu : multipliers) {
+    double distance = INFINITY, g = NAN;
+    if (type == BifurcationType::fold && is_real(mu) && mu.real() > 0) {
+      distance = std::abs(mu.real() - 1);
+      g = mu.real() - 1;
+    } else if (type == BifurcationType::period_doubling && is_real(mu) && mu.real() < 0) {
+      distance = std::abs(mu.real() + 1);
+      g = -mu.real() - 1;
+    } else if (type == BifurcationType::neimark_sacker && !is_real(mu)) {
+      distance = std::abs(std::abs(mu) - 1);
+      g = std::abs(mu) - 1;
+    }
+    if (distance < best_distance) {
+      best_distance = distance;
+      value = g;
+      if (critical) *critical = mu;
+    }
+  }
+  return value;
+}
+
+double hermite_maximum(double g0, double g1, double s0, double s1, double h) {
+  // g(u) = a + b u + c u^2 + d u^3 on u in [0, 1], slopes in u: h s0, h s1
+  const double a = g0, b = h * s0, c = 3 * (g1 - g0) - h * (2 * s0 + s1), d = 2 * (g0 - g1) + h * (s0 + s1);
+  double best = std::max(g0, g1);
+  auto consider = [&](double u) {
+    if (u > 0 && u < 1) best = std::max(best, a + u * (b + u * (c + u * d)));
+  };
+  // g'(u) = b + 2 c u + 3 d u^2 = 0
+  if (d == 0) {
+    if (c != 0) consider(-b / (2 * c));
+  } else {
+    const double disc = c * c - 3 * b * d;
+    if (disc >= 0) {
+      const double q = -(c + std::copysign(std::sqrt(disc), c));  // stable roots: q / (3 d), b / q
+      if (q != 0) {
+        consider(q / (3 * d));
+        consider(b / q);
+      } else {
+        consider(0);
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace continuation_detail
+
+std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>& Ns,
+                                                          const std::vector<std::vector<Bifurcation>>& by_N,
+                                                          double location_accuracy,
+                                                          const RichardsonOptions& richardson) {
+  if (Ns.size() != by_N.size())
+    throw BadInput("extrapolate_bifurcations: " + std::to_string(Ns.size()) + " levels but " +
+                   std::to_string(by_N.size()) + " lists of bifurcations");
+  if (Ns.empty()) return {};
+  for (size_t i = 1; i < Ns.size(); ++i)
+    if (Ns[i] <= Ns[i - 1])
+      throw BadInput("`continue_Ns`: must be increasing (" + std::to_string(Ns[i - 1]) + ", " + std::to_string(Ns[i]) +
+                     ")");
+  std::vector<BifurcationEstimate> estimates;
+  const size_t finest = Ns.size() - 1;
+  std::vector<std::set<size_t>> used(Ns.size());
+  for (const Bifurcation& b : by_N[finest]) {
+    BifurcationEstimate e;
+    e.type = b.type;
+    e.parameter = b.parameter;
+    e.angle = b.angle;
+    std::vector<double> h, values;
+    for (size_t level = 0; level < Ns.size(); ++level) {
+      const Bifurcation* match = nullptr;
+      size_t match_index = 0;
+      if (level == finest) {
+        match = &b;
+      } else {
+        for (size_t j = 0; j < by_N[level].size(); ++j) {
+          const Bifurcation& c = by_N[level][j];
+          if (c.type != b.type || used[level].count(j)) continue;
+          if (!match || std::abs(c.parameter - b.parameter) < std::abs(match->parameter - b.parameter)) {
+            match = &c;
+            match_index = j;
+          }
+        }
+        if (match) used[level].insert(match_index);
+      }
+      if (!match) continue;
+      e.Ns.push_back(Ns[level]);
+      e.parameters.push_back(match->parameter);
+      h.push_back(1.0 / Ns[level]);
+      values.push_back(match->parameter);
+    }
+    if (values.size() < Ns.size())
+      e.note = "found at " + std::to_string(values.size()) + " of " + std::to_string(Ns.size()) + " levels; ";
+    if (values.size() >= 3) {
+      const size_t L = values.size();
+      const double d1 = std::abs(values[L - 2] - values[L - 3]), d2 = std::abs(values[L - 1] - values[L - 2]);
+      const double r = std::sqrt(h[L - 3] / h[L - 1]);
+      if (d1 > 0 && d2 > 0) e.observed_order = std::log(d1 / d2) / std::log(r);
+    }
+    if (values.size() >= 2) {
+      std::vector<std::complex<double>> x(values.begin(), values.end());
+      const Extrapolation ex =
+          richardson_extrapolate(h, x, richardson, std::vector<double>(values.size(), location_accuracy));
+      e.extrapolated = ex.value.real();
+      e.error_estimate = ex.error_estimate;
+      e.note += ex.note;
+    } else {
+      e.extrapolated = b.parameter;
+      e.note += "one level: no error estimate";
+    }
+    estimates.push_back(std::move(e));
+  }
+  return estimates;
+}
+
+}  // namespace delayspec

@@ -1,0 +1,234 @@
+// `delayspec continue`: the JSON result and files against the exact stability boundary of a
+// linear DDE, and every bad-input and failure path of the issue (exit 2 naming the key and value,
+// exit 3 naming the residual or the point reached, with the branch so far written).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_test_support.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec_test_paths.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using delayspec::testing::CliResult;
+using delayspec::testing::run;
+using std::numbers::pi;
+
+// x' = -x + b x(t - tau), tau = 2 pi / (3 sqrt 3): a pair of roots +-i sqrt 3 crosses at b = -2,
+// angle sqrt 3 tau = 2 pi / 3 per period T = tau (test_continuation.cpp).
+const double kTau = 2 * pi / (3 * std::sqrt(3.0));
+
+std::vector<std::string> linear_args(std::vector<std::string> extra) {
+  std::vector<std::string> args = {"continue",
+                                   "--set",
+                                   "model=linear",
+                                   "--set",
+                                   "a=-1",
+                                   "--set",
+                                   "tau=" + delayspec::format_number(kTau),
+                                   "--set",
+                                   "continue_key=b",
+                                   "--set",
+                                   "continue_from=-1.5",
+                                   "--set",
+                                   "continue_to=-2.5"};
+  for (auto& e : extra) args.push_back(std::move(e));
+  return args;
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("delayspec_test_continue_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+std::vector<std::string> data_lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#') lines.push_back(line);
+  return lines;
+}
+
+std::string read_all(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST(ContinueCli, NeimarkSackerOfLinearDdeWithErrorBars) {
+  CliResult r =
+      run(linear_args({"--set", "continue_Ns=100,200,400,800", "--set", "continue_tolerance=1e-13", "--json"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["continue_key"], "b");
+  EXPECT_EQ(j["N"], 800);
+  EXPECT_EQ(j["end"], "to");
+  ASSERT_GE(j["points"].size(), 3u);
+  EXPECT_EQ(j["points"].front()["parameter"], -1.5);
+  EXPECT_EQ(j["points"].back()["parameter"], -2.5);
+  for (const auto& p : j["points"]) {
+    // stable exactly while b > -2 (up to the discrete boundary's O(h^2) shift, far below the steps)
+    EXPECT_EQ(p["stable"].get<bool>(), p["parameter"].get<double>() > -2) << p["parameter"];
+    EXPECT_EQ(p["multipliers"].size(), 6u);
+    EXPECT_TRUE(p["multipliers"][0].contains("abs"));
+  }
+  ASSERT_EQ(j["bifurcations"].size(), 1u);
+  const auto& b = j["bifurcations"][0];
+  EXPECT_EQ(b["type"], "neimark-sacker");
+  ASSERT_EQ(b["by_N"].size(), 4u);
+  EXPECT_EQ(b["by_N"][3]["N"], 800);
+  EXPECT_EQ(b["by_N"][3]["parameter"], b["parameter"]);
+  const double h = kTau / 800;
+  EXPECT_NEAR(b["angle"].get<double>(), 2 * pi / 3, 5 * h * h);  // the angle's O(h^2) error
+  EXPECT_NEAR(b["observed_order"].get<double>(), 2, 0.05);
+  // honest: the extrapolated boundary within its estimate of -2, the estimate <= 1e-8
+  EXPECT_LE(std::abs(b["extrapolated"].get<double>() + 2), b["error_estimate"].get<double>());
+  EXPECT_LE(b["error_estimate"].get<double>(), 1e-8);
+  // |mu| = 1 at the located point, to the location tolerance times d|mu|/db = O(1)
+  EXPECT_NEAR(b["multipliers"][0]["abs"].get<double>(), 1, 1e-11);
+}
+
+TEST(ContinueCli, WritesBranchAndBifurcationFilesWithMetadata) {
+  const fs::path dir = scratch("files");
+  CliResult r = run(linear_args({"--set", "N=200", "--out", dir.string(), "--json"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const std::string branch = read_all(dir / "branch.csv");
+  EXPECT_NE(branch.find("# command: continue"), std::string::npos) << branch;
+  EXPECT_NE(branch.find("# continue_key = b"), std::string::npos) << branch;
+  const auto rows = data_lines(dir / "branch.csv");
+  ASSERT_EQ(rows.size(), j["points"].size() + 1);  // header + one row per point
+  EXPECT_EQ(rows[0].rfind("parameter,stable,unstable,abs_mu1,max_y1,min_y1,max_H,contact_time", 0), 0u) << rows[0];
+  const auto bifs = data_lines(dir / "bifurcations.csv");
+  ASSERT_EQ(bifs.size(), 2u);
+  EXPECT_EQ(bifs[1].rfind("neimark-sacker,", 0), 0u) << bifs[1];
+  EXPECT_TRUE(fs::exists(dir / "continue.json"));
+  EXPECT_TRUE(fs::exists(dir / "complete.json"));
+  // plot draws the branch and |mu_1| from these files
+  CliResult plot = run({"plot", dir.string()});
+  ASSERT_EQ(plot.status, 0) << plot.err;
+  EXPECT_TRUE(fs::exists(dir / "plots" / "branch.png"));
+  EXPECT_TRUE(fs::exists(dir / "plots" / "branch_mu1.svg"));
+  const std::string script = read_all(dir / "plots" / "branch.gp");
+  EXPECT_NE(script.find("'neimark-sacker'"), std::string::npos) << script;  // the bifurcation is marked
+  fs::remove_all(dir);
+}
+
+struct BadContinue {
+  std::vector<std::string> sets;
+  const char* named;  // the message names this
+};
+
+class ContinueBadInput : public ::testing::TestWithParam<BadContinue> {};
+
+TEST_P(ContinueBadInput, ExitsTwoNamingTheKey) {
+  std::vector<std::string> args = {"continue", "--set", "model=linear"};
+  for (const auto& s : GetParam().sets) args.insert(args.end(), {"--set", s});
+  CliResult r = run(args);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(GetParam().named), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Keys, ContinueBadInput,
+    ::testing::Values(
+        BadContinue{{"continue_from=0", "continue_to=1"}, "continue_key"},
+        BadContinue{{"continue_key=bb", "continue_from=0", "continue_to=1"}, "`bb`"},
+        BadContinue{{"continue_key=b", "continue_from=0.3", "continue_to=0.3"}, "empty range"},
+        BadContinue{{"continue_key=b", "continue_to=0.3"}, "continue_from"},
+        BadContinue{{"continue_key=N", "continue_from=10", "continue_to=20"}, "`continue_key = N`"},
+        BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_Ns=400,200"}, "continue_Ns"},
+        BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_step=-1"}, "`continue_step = -1`"},
+        BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_max_points=1"},
+                    "`continue_max_points = 1`"},
+        // a key that changes the grid (the period of the map: K steps per map)
+        BadContinue{{"continue_key=period", "continue_from=1", "continue_to=2", "N=20"},
+                    "must not change the size of the discrete problem"}));
+
+TEST(ContinueCli, StartWhereNewtonFailsExitsThreeNamingTheResidual) {
+  // Newton from the first period after rest (orbit_guess_periods = 0) with one iteration allowed
+  CliResult r =
+      run({"continue", "--set", "orbit=newton", "--set", "orbit_max_iterations=1", "--set", "orbit_guess_periods=0",
+           "--set", "continue_key=k", "--set", "continue_from=0.2", "--set", "continue_to=0.3", "--set", "N=50"});
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("|F|_inf"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST(ContinueCli, StepThatCannotBeReducedExitsThreeWithTheBranchSoFar) {
+  // The damping continued from 0.02 towards -0.02: the model exists only for zeta >= 0, so the
+  // branch shrinks its step at zeta = 0 until it is below continue_step_min.
+  const fs::path dir = scratch("failure");
+  CliResult r = run({"continue", "--set", "orbit=newton", "--set", "e=1.3", "--set", "continue_key=zeta", "--set",
+                     "continue_from=0.02", "--set", "continue_to=-0.02", "--set", "N=50", "--set", "nev=2", "--out",
+                     dir.string()});
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("step below continue_step_min"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("`zeta = -"), std::string::npos) << r.err;  // the model's own message
+  const std::string branch = read_all(dir / "branch.csv");
+  EXPECT_NE(branch.find("# INCOMPLETE"), std::string::npos) << branch;
+  const auto rows = data_lines(dir / "branch.csv");
+  ASSERT_GE(rows.size(), 3u);
+  // the last point reached lies just above zeta = 0, and is the one the message names
+  const std::string last = rows.back().substr(0, rows.back().find(','));
+  EXPECT_GE(std::stod(last), 0);
+  EXPECT_LT(std::stod(last), 1e-3);
+  EXPECT_NE(r.err.find("at parameter " + last), std::string::npos) << r.err;
+  const std::string complete = read_all(dir / "complete.json");
+  EXPECT_NE(complete.find("\"exit_status\": 3"), std::string::npos) << complete;
+  fs::remove_all(dir);
+}
+
+// continue_switch: the period-1 orbit of the PWSDDE-cont system (tau = 3.8, fractional delay)
+// continued in k down from 0.25 loses stability by a period doubling near k = 0.177; the branch
+// switched there must reach, at k = 0.12, the period-2 orbit that `floquet` finds on its own from
+// a simulated guess (data/scenes/pwsdde-period2.toml): same multipliers, to the orbits' tolerance.
+TEST(ContinueCli, SwitchAtPeriodDoublingReachesTheKnownPeriodTwoOrbit) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/pwsdde-period2.toml";
+  CliResult r = run({"continue", scene,
+                     "--set",    "orbit_period=1",
+                     "--set",    "k=0.25",
+                     "--set",    "N=100",
+                     "--set",    "orbit_guess_periods=200",
+                     "--set",    "continue_key=k",
+                     "--set",    "continue_from=0.25",
+                     "--set",    "continue_to=0.12",
+                     "--set",    "continue_switch=true",
+                     "--json",   "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_GE(j["bifurcations"].size(), 1u);
+  EXPECT_EQ(j["bifurcations"][0]["type"], "period-doubling");
+  ASSERT_EQ(j["switched"].size(), 1u);
+  const auto& sw = j["switched"][0];
+  EXPECT_EQ(sw["orbit_period"], 2);
+  EXPECT_EQ(sw["from_parameter"], j["bifurcations"][0]["parameter"]);
+  ASSERT_EQ(sw["end"], "to");
+  const auto& last = sw["points"].back();
+  EXPECT_EQ(last["parameter"], 0.12);
+  // the first point is the period doubling itself: multiplier (-1)^2 = +1 of the doubled problem
+  EXPECT_NEAR(sw["points"][0]["multipliers"][0]["abs"].get<double>(), 1, 1e-8);
+  CliResult f = run({"floquet", scene, "--set", "N=100", "--json"});
+  ASSERT_EQ(f.status, 0) << f.err;
+  const auto fj = nlohmann::json::parse(f.out);
+  for (int i = 0; i < 2; ++i) {
+    // both orbits to |F| <= 1e-12 (1 + |x|): the multipliers agree far below 1e-9
+    EXPECT_NEAR(last["multipliers"][i]["re"].get<double>(), fj["multipliers"][i]["re"].get<double>(), 1e-9) << i;
+    EXPECT_NEAR(last["multipliers"][i]["im"].get<double>(), fj["multipliers"][i]["im"].get<double>(), 1e-9) << i;
+  }
+}
