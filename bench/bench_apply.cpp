@@ -52,9 +52,7 @@ void BM_ApplyBlock(benchmark::State& state) {
   state.counters["GFlops"] = benchmark::Counter(iters * flops * 1e-9, benchmark::Counter::kIsRate);
   state.counters["working_set_KiB"] = (8.0 * ((N + 1 + K) * d * k + 9.0 * d * d * K / 3.0)) / 1024.0;
 }
-BENCHMARK(BM_ApplyBlock)
-    ->ArgsProduct({{1000, 4000}, {1, 4, 8, 16, 32}})
-    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 4, 8, 16, 32}})->Unit(benchmark::kMicrosecond);
 
 void BM_Triad(benchmark::State& state) {
   const long n = state.range(0);
@@ -65,8 +63,8 @@ void BM_Triad(benchmark::State& state) {
     benchmark::DoNotOptimize(a.data());
     benchmark::ClobberMemory();
   }
-  state.counters["GBps"] = benchmark::Counter(static_cast<double>(state.iterations()) * 24.0 * n * 1e-9,
-                                              benchmark::Counter::kIsRate);
+  state.counters["GBps"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * 24.0 * n * 1e-9, benchmark::Counter::kIsRate);
   state.counters["KiB_total"] = 24.0 * n / 1024.0;
 }
 // 3 arrays of: 16 KiB (L1), 256 KiB (L2), 4 MiB (L3), 64 MiB (memory).

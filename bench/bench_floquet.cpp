@@ -33,8 +33,15 @@ const Monodromy<2>& impact_monodromy(int N) {
   static std::map<int, std::unique_ptr<Monodromy<2>>> cache;
   auto& slot = cache[N];
   if (!slot) {
-    ImpactModel model({.zeta = 0.01, .e = 1.26, .a = 0.7, .beta = 28, .omega = 0.802, .k = 0.2, .tau_over_T = 1,
-                       .x0 = -0.0566, .v0 = 1.0101});
+    ImpactModel model({.zeta = 0.01,
+                       .e = 1.26,
+                       .a = 0.7,
+                       .beta = 28,
+                       .omega = 0.802,
+                       .k = 0.2,
+                       .tau_over_T = 1,
+                       .x0 = -0.0566,
+                       .v0 = 1.0101});
     HistoryGrid grid = make_grid(model.tau(), model.period(), N);
     StroboscopicMap<ImpactModel> map(TrapezoidStepper<ImpactModel>(model), grid);
     PeriodicOrbit orbit = orbit_by_simulation(map, map.constant_history(model.initial_state()));
@@ -133,8 +140,13 @@ BENCHMARK(BM_KrylovTop20)
     ->MeasureProcessCPUTime();  // CPU time of all threads (OpenBLAS may use two inside ARPACK)
 // dense-eigen (EigenSolver, single-threaded, ~3x dgeev) only at N = 1000
 BENCHMARK(BM_DenseVsKrylov)
-    ->Args({0, 1000})->Args({1, 1000})->Args({2, 1000})->Args({3, 1000})
-    ->Args({0, 2000})->Args({1, 2000})->Args({2, 2000})
+    ->Args({0, 1000})
+    ->Args({1, 1000})
+    ->Args({2, 1000})
+    ->Args({3, 1000})
+    ->Args({0, 2000})
+    ->Args({1, 2000})
+    ->Args({2, 2000})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->MeasureProcessCPUTime();

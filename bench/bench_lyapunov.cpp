@@ -46,9 +46,8 @@ static void BM_LyapunovImpact(benchmark::State& state) {
   }
   state.counters["qr_fraction"] = qr_fraction;
   state.counters["lambda1"] = lambda1;
-  state.counters["ns_per_step"] =
-      benchmark::Counter(static_cast<double>(periods) * N, benchmark::Counter::kIsIterationInvariantRate |
-                                                              benchmark::Counter::kInvert);
+  state.counters["ns_per_step"] = benchmark::Counter(
+      static_cast<double>(periods) * N, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_LyapunovImpact)->Args({1000, 10000})->Args({1000, 1000})->Iterations(1)->Unit(benchmark::kSecond);
 

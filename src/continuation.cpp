@@ -8,14 +8,10 @@ namespace delayspec {
 
 std::string to_string(BifurcationType type) {
   switch (type) {
-    case BifurcationType::fold:
-      return "fold";
-    case BifurcationType::period_doubling:
-      return "period-doubling";
-    case BifurcationType::neimark_sacker:
-      return "neimark-sacker";
-    case BifurcationType::grazing:
-      return "grazing";
+    case BifurcationType::fold: return "fold";
+    case BifurcationType::period_doubling: return "period-doubling";
+    case BifurcationType::neimark_sacker: return "neimark-sacker";
+    case BifurcationType::grazing: return "grazing";
   }
   return "?";
 }
@@ -28,12 +24,9 @@ UnstableCounts unstable_counts(const std::vector<std::complex<double>>& multipli
   UnstableCounts c;
   for (const auto& mu : multipliers) {
     if (!(std::abs(mu) > 1)) continue;
-    if (!is_real(mu))
-      ++c.complex;
-    else if (mu.real() > 0)
-      ++c.real_plus;
-    else
-      ++c.real_minus;
+    if (!is_real(mu)) ++c.complex;
+    else if (mu.real() > 0) ++c.real_plus;
+    else ++c.real_minus;
   }
   return c;
 }

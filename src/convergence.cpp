@@ -41,8 +41,8 @@ void validate(const ConvergenceOptions& o) {
   for (size_t i = 0; i < o.Ns.size(); ++i) {
     if (o.Ns[i] < 1) throw BadInput("convergence study: `N = " + std::to_string(o.Ns[i]) + "`: must be >= 1");
     if (i > 0 && o.Ns[i] <= o.Ns[i - 1])
-      throw BadInput("convergence study: `Ns`: must be strictly increasing (" + std::to_string(o.Ns[i - 1]) +
-                     " then " + std::to_string(o.Ns[i]) + ")");
+      throw BadInput("convergence study: `Ns`: must be strictly increasing (" + std::to_string(o.Ns[i - 1]) + " then " +
+                     std::to_string(o.Ns[i]) + ")");
   }
   if (o.nev < 1) throw BadInput("convergence study: `nev = " + std::to_string(o.nev) + "`: must be >= 1");
   if (o.extra < 0) throw BadInput("convergence study: `extra = " + std::to_string(o.extra) + "`: must be >= 0");
@@ -53,8 +53,8 @@ void validate(const ConvergenceOptions& o) {
                    " exact multipliers, this model provides " + std::to_string(o.exact.size()) +
                    " (use reference = extrapolated or finest)");
   if ((o.reference == ReferenceKind::extrapolated || o.reference == ReferenceKind::finest) && o.Ns.size() < 2)
-    throw BadInput("convergence study: `reference = " + to_string(o.reference) + "` needs at least two N, got `Ns` of " +
-                   std::to_string(o.Ns.size()));
+    throw BadInput("convergence study: `reference = " + to_string(o.reference) +
+                   "` needs at least two N, got `Ns` of " + std::to_string(o.Ns.size()));
   if (o.reference == ReferenceKind::automatic && o.exact.empty() && o.Ns.size() < 2)
     throw BadInput("convergence study: no exact multipliers and one N only: give at least two N");
   if (!(o.target >= 0 && o.target < 1))
@@ -107,8 +107,10 @@ void judge(OrderReport& r, const std::vector<double>& log_x, const std::vector<d
     r.observed = -slope(xs, ys);
   } else {
     char buf[200];
-    std::snprintf(buf, sizeof buf, "orders not settled: the last %zu pair orders range over [%.3g, %.3g] (spread %.2g > %.2g): pre-asymptotic, refine N",
-                  m, lo, hi, hi - lo, spread_limit);
+    std::snprintf(
+        buf, sizeof buf,
+        "orders not settled: the last %zu pair orders range over [%.3g, %.3g] (spread %.2g > %.2g): pre-asymptotic, refine N",
+        m, lo, hi, hi - lo, spread_limit);
     r.note = buf;
   }
 }
@@ -273,7 +275,8 @@ ConvergenceStudy analyse_levels(const std::vector<LevelResult>& levels, const Co
   ConvergenceStudy study;
   study.reference = options.reference;
   if (study.reference == ReferenceKind::automatic)
-    study.reference = static_cast<int>(options.exact.size()) >= nev ? ReferenceKind::exact : ReferenceKind::extrapolated;
+    study.reference =
+        static_cast<int>(options.exact.size()) >= nev ? ReferenceKind::exact : ReferenceKind::extrapolated;
   const bool exact = study.reference == ReferenceKind::exact;
 
   // Anchors of the tracks: the exact values, or the finest level's leading nev.
@@ -332,7 +335,8 @@ ConvergenceStudy analyse_levels(const std::vector<LevelResult>& levels, const Co
     } else if (study.reference == ReferenceKind::extrapolated) {
       ref = study.extrapolated[k].value;
       // relative; at most 1 (an infinite estimate certifies no digit)
-      precision = std::clamp(study.extrapolated[k].error_estimate / std::max(std::abs(ref), scale_floor), kMinPrecision, 1.0);
+      precision =
+          std::clamp(study.extrapolated[k].error_estimate / std::max(std::abs(ref), scale_floor), kMinPrecision, 1.0);
     } else {  // finest: its own error estimated from the last two levels, e ~ |x_f - x_{f-1}| / (r^p - 1)
       ref = matched[L - 1][k];
       const double r = double(options.Ns[L - 1]) / options.Ns[L - 2];
@@ -415,14 +419,15 @@ ConvergenceStudy analyse_convergence(const std::vector<LevelResult>& levels, con
   sub.Ns.clear();
   for (size_t i = 0; i < levels.size(); ++i)
     if (levels[i].failure.empty()) ok.push_back(levels[i]), sub.Ns.push_back(options.Ns[i]);
-  const bool exact = options.reference == ReferenceKind::exact ||
-                     (options.reference == ReferenceKind::automatic && static_cast<int>(options.exact.size()) >= options.nev);
+  const bool exact =
+      options.reference == ReferenceKind::exact ||
+      (options.reference == ReferenceKind::automatic && static_cast<int>(options.exact.size()) >= options.nev);
   const size_t needed = exact ? 1 : 2;
   if (ok.size() < needed)
     throw NumericalFailure("convergence study: " + std::to_string(ok.size()) + " of " + std::to_string(levels.size()) +
                            " levels succeeded, " + std::to_string(needed) + " needed" +
-                           (exact ? "" : " without an exact reference") + "; the failures:" +
-                           failures_text(options.Ns, levels));
+                           (exact ? "" : " without an exact reference") +
+                           "; the failures:" + failures_text(options.Ns, levels));
   ConvergenceStudy study = analyse_levels(ok, sub);
   std::vector<ConvergenceRow> rows;
   size_t next = 0;
@@ -557,14 +562,14 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
     if (worst <= o.target) {
       study.target_met = true;
       study.stopped_by = "target";
-      study.stop_note = fmt("target %.3g met at N = %.0f: largest relative error estimate %.3g", o.target,
-                            o.Ns.back(), worst);
+      study.stop_note =
+          fmt("target %.3g met at N = %.0f: largest relative error estimate %.3g", o.target, o.Ns.back(), worst);
       return study;
     }
     study.target_met = false;
-    const std::string unmet = (std::isfinite(worst) ? fmt("largest relative error estimate %.3g", worst)
-                                                    : std::string("no error estimate")) +
-                              fmt(" > target %.3g", o.target);
+    const std::string unmet =
+        (std::isfinite(worst) ? fmt("largest relative error estimate %.3g", worst) : std::string("no error estimate")) +
+        fmt(" > target %.3g", o.target);
     const int last = o.Ns.back();
     if (last > o.max_N / 2) {
       study.stopped_by = "converge_max_N";
@@ -578,10 +583,11 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
     const double predicted = t_last * growth, spent = total_seconds();
     if (spent + predicted > o.max_seconds) {
       study.stopped_by = "converge_max_seconds";
-      study.stop_note = fmt("converge_max_seconds = %.3g: the next level (N = %.0f) would take about %.3g s after %.3g s "
-                            "spent: ",
-                            o.max_seconds, 2.0 * last, predicted, spent) +
-                        unmet;
+      study.stop_note =
+          fmt("converge_max_seconds = %.3g: the next level (N = %.0f) would take about %.3g s after %.3g s "
+              "spent: ",
+              o.max_seconds, 2.0 * last, predicted, spent) +
+          unmet;
       return study;
     }
     const int N = 2 * last;

@@ -18,8 +18,8 @@ namespace {
 std::vector<std::complex<double>> eigen_backend(const Eigen::MatrixXd& A) {
   Eigen::EigenSolver<Eigen::MatrixXd> solver(A, /*computeEigenvectors=*/false);
   if (solver.info() != Eigen::Success)
-    throw NumericalFailure("dense eigenvalues (Eigen): the QR algorithm did not converge (n = " +
-                           std::to_string(A.rows()) + ")");
+    throw NumericalFailure(
+        "dense eigenvalues (Eigen): the QR algorithm did not converge (n = " + std::to_string(A.rows()) + ")");
   const auto& ev = solver.eigenvalues();
   return {ev.data(), ev.data() + ev.size()};
 }

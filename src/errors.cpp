@@ -27,14 +27,12 @@ void require_finite(const char* name, double value) {
 
 void require_positive(const char* name, double value) {
   require_finite(name, value);
-  if (!(value > 0))
-    throw BadInput(std::string("`") + name + " = " + format_number(value) + "`: must be > 0");
+  if (!(value > 0)) throw BadInput(std::string("`") + name + " = " + format_number(value) + "`: must be > 0");
 }
 
 void require_nonnegative(const char* name, double value) {
   require_finite(name, value);
-  if (!(value >= 0))
-    throw BadInput(std::string("`") + name + " = " + format_number(value) + "`: must be >= 0");
+  if (!(value >= 0)) throw BadInput(std::string("`") + name + " = " + format_number(value) + "`: must be >= 0");
 }
 
 }  // namespace delayspec

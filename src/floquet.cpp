@@ -41,14 +41,14 @@ std::string to_string(FloquetSolver solver) {
 
 void validate_floquet_options(const FloquetOptions& options, long n) {
   if (options.nev < 1 || options.nev > n)
-    throw BadInput("`nev = " + std::to_string(options.nev) + "`: must be between 1 and the dimension n = " +
-                   std::to_string(n));
+    throw BadInput("`nev = " + std::to_string(options.nev) +
+                   "`: must be between 1 and the dimension n = " + std::to_string(n));
   // The Krylov options are checked whenever a Krylov backend may run (auto included, whatever
   // it picks): a bad ncv is an error of the request, not of the size that hides it.
   if (options.solver == FloquetSolver::dense_eigen || options.solver == FloquetSolver::dense_lapack) return;
   if (options.ncv != 0 && options.ncv < options.nev + 2)
-    throw BadInput("`ncv = " + std::to_string(options.ncv) + "`: must be 0 (automatic) or >= nev + 2 = " +
-                   std::to_string(options.nev + 2));
+    throw BadInput("`ncv = " + std::to_string(options.ncv) +
+                   "`: must be 0 (automatic) or >= nev + 2 = " + std::to_string(options.nev + 2));
   if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
     throw BadInput("`tol = " + format_number(options.tolerance) + "`: must be > 0 and finite");
   if (options.max_iterations < 1)
@@ -83,7 +83,8 @@ double largest_relative_estimate(const std::vector<std::complex<double>>& theta,
   const double eps23 = std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);
   std::vector<size_t> order(theta.size());
   std::iota(order.begin(), order.end(), size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return std::abs(theta[a]) > std::abs(theta[b]); });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return std::abs(theta[a]) > std::abs(theta[b]); });
   double worst = 0;
   for (size_t k = 0; k < order.size() && k < static_cast<size_t>(nev); ++k) {
     const size_t i = order[k];
@@ -165,13 +166,14 @@ void take_leading_pairs(const krylov::RitzPairs& pairs, const std::vector<double
   std::vector<Entry> entries;
   for (size_t i = 0; i < pairs.values.size(); ++i) {
     const auto mu = pairs.values[i];
-    if (!std::isfinite(mu.real()) || !std::isfinite(mu.imag())) throw NumericalFailure(name + ": non-finite Ritz value");
+    if (!std::isfinite(mu.real()) || !std::isfinite(mu.imag()))
+      throw NumericalFailure(name + ": non-finite Ritz value");
     entries.push_back({mu, i, false});
     if (mu.imag() != 0) entries.push_back({std::conj(mu), i, true});
   }
   if (static_cast<int>(entries.size()) < options.nev)
-    throw NumericalFailure(name + ": only " + std::to_string(entries.size()) + " Ritz values returned for nev = " +
-                           std::to_string(options.nev));
+    throw NumericalFailure(name + ": only " + std::to_string(entries.size()) +
+                           " Ritz values returned for nev = " + std::to_string(options.nev));
   std::vector<std::complex<double>> sorted;
   for (const auto& e : entries) sorted.push_back(e.value);
   sort_by_modulus(sorted);
@@ -179,12 +181,12 @@ void take_leading_pairs(const krylov::RitzPairs& pairs, const std::vector<double
   const long n = pairs.vectors.rows();
   if (options.keep_vectors) result.subspace.resize(n, options.nev);
   for (int k = 0; k < options.nev; ++k) {
-    const auto it =
-        std::find_if(entries.begin(), entries.end(), [&](const Entry& e) { return e.value == sorted[k]; });
+    const auto it = std::find_if(entries.begin(), entries.end(), [&](const Entry& e) { return e.value == sorted[k]; });
     result.multipliers.push_back(it->value);
     absolute.push_back(residual[it->pair]);
     result.residuals.push_back(residual[it->pair] / std::abs(it->value));
-    if (options.keep_vectors) result.subspace.col(k) = pairs.vectors.col(pairs.column[it->pair] + (it->conjugate ? 1 : 0));
+    if (options.keep_vectors)
+      result.subspace.col(k) = pairs.vectors.col(pairs.column[it->pair] + (it->conjugate ? 1 : 0));
   }
 }
 
@@ -219,8 +221,8 @@ size_t zero_round_off_pairs(FloquetResult& r, const std::vector<double>& absolut
   failing.swap(still_failing);
   if (!zeroed.empty())
     r.note += std::string(r.note.empty() ? "" : "; ") + "multipliers " + std::to_string(zeroed.front() + 1) + ".." +
-              std::to_string(zeroed.back() + 1) + " are at the operator's round-off level (|mu| <= " +
-              format_number(level) + "): reported as 0";
+              std::to_string(zeroed.back() + 1) +
+              " are at the operator's round-off level (|mu| <= " + format_number(level) + "): reported as 0";
   return zeroed.size();
 }
 
@@ -237,14 +239,14 @@ double operator_size(const Monodromy<D>& op, const Eigen::VectorXd& x) {
 // of one application alone makes its relative residual O(1)), say so: no method resolves it next
 // to larger ones, and the multipliers before it are what can be asked for.
 // `size` = operator_size(op, start).
-std::string residual_gate_message(double size, const FloquetResult& r, const std::vector<size_t>& failing,
-                                  double bound, const std::string& name, int first_ncv, int last_ncv) {
+std::string residual_gate_message(double size, const FloquetResult& r, const std::vector<size_t>& failing, double bound,
+                                  const std::string& name, int first_ncv, int last_ncv) {
   const size_t k = failing.front();
   const std::complex<double> mu = r.multipliers[k];
   const std::string others =
       failing.size() > 1 ? " (and " + std::to_string(failing.size() - 1) + " more after it)" : "";
-  std::string message = name + ": multiplier " + std::to_string(k + 1) + others + " of nev = " +
-                        std::to_string(r.multipliers.size()) + ", mu = " + format_number(mu.real()) +
+  std::string message = name + ": multiplier " + std::to_string(k + 1) + others +
+                        " of nev = " + std::to_string(r.multipliers.size()) + ", mu = " + format_number(mu.real()) +
                         (mu.imag() < 0 ? " - " : " + ") + format_number(std::abs(mu.imag())) +
                         "i, fails its residual check: |M v - mu v| / (|mu| |v|) = " + format_number(r.residuals[k]) +
                         " > bound " + krylov::short_number(bound) + " (ncv = " + std::to_string(first_ncv) +
@@ -252,10 +254,9 @@ std::string residual_gate_message(double size, const FloquetResult& r, const std
   const double round_off = std::numeric_limits<double>::epsilon() * size;
   if (std::abs(mu) <= 1e3 * round_off)
     message += "; |mu| is at the round-off level of this operator (eps |M x| / |x| = " + format_number(round_off) +
-               " next to |mu_1| = " + format_number(std::abs(r.multipliers[0])) +
-               "): no eigensolver resolves it" + (k > 0 ? ", ask for fewer multipliers (nev = " + std::to_string(k) + ")" : "");
-  else
-    message += "; try a larger ncv or another solver";
+               " next to |mu_1| = " + format_number(std::abs(r.multipliers[0])) + "): no eigensolver resolves it" +
+               (k > 0 ? ", ask for fewer multipliers (nev = " + std::to_string(k) + ")" : "");
+  else message += "; try a larger ncv or another solver";
   return message;
 }
 
@@ -268,8 +269,8 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
   settings.tolerance = options.tolerance;
   settings.max_iterations = options.max_iterations;
   if (settings.ncv < options.nev + 2)
-    throw BadInput("`ncv = " + std::to_string(settings.ncv) + "`: must be >= nev + 2 = " +
-                   std::to_string(options.nev + 2));
+    throw BadInput("`ncv = " + std::to_string(settings.ncv) +
+                   "`: must be >= nev + 2 = " + std::to_string(options.nev + 2));
   if (settings.ncv > n) {
     result.note = "ncv = " + std::to_string(settings.ncv) + " reduced to the dimension n = " + std::to_string(n);
     settings.ncv = static_cast<int>(n);
@@ -362,20 +363,17 @@ FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& 
   const long applications_before = op.applications();
   FloquetSolver solver = options.solver;
   if (krylov && options.nev > n - 2) {
-    result.note = "nev = " + std::to_string(options.nev) + " > n - 2 = " + std::to_string(n - 2) +
-                  ": Krylov (" + to_string(options.solver) + ") needs nev <= n - 2, used the dense LAPACK solver";
+    result.note = "nev = " + std::to_string(options.nev) + " > n - 2 = " + std::to_string(n - 2) + ": Krylov (" +
+                  to_string(options.solver) + ") needs nev <= n - 2, used the dense LAPACK solver";
     solver = FloquetSolver::dense_lapack;
   }
   switch (solver) {
     case FloquetSolver::automatic:  // resolved above
     case FloquetSolver::spectra:
-    case FloquetSolver::arpack:
-      krylov_solve(op, options, result);
-      break;
+    case FloquetSolver::arpack: krylov_solve(op, options, result); break;
     case FloquetSolver::dense_eigen:
     case FloquetSolver::dense_lapack: {
-      const DenseBackend backend =
-          solver == FloquetSolver::dense_eigen ? DenseBackend::eigen : DenseBackend::lapack;
+      const DenseBackend backend = solver == FloquetSolver::dense_eigen ? DenseBackend::eigen : DenseBackend::lapack;
       auto values = dense_eigenvalues(op.to_dense(), backend);
       values.resize(options.nev);
       result.multipliers = std::move(values);

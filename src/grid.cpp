@@ -26,8 +26,8 @@ constexpr long kMaxSteps = 2'000'000'000L / 8;  // keeps every block index far i
 }  // namespace
 
 std::string HistoryGrid::describe() const {
-  return "N=" + std::to_string(N) + " h=" + format_number(h) + " K=" + std::to_string(K) +
-         " M=" + std::to_string(M) + (aligned() ? " (aligned delay)" : " (fractional delay, theta=" + format_number(theta) + ")");
+  return "N=" + std::to_string(N) + " h=" + format_number(h) + " K=" + std::to_string(K) + " M=" + std::to_string(M) +
+         (aligned() ? " (aligned delay)" : " (fractional delay, theta=" + format_number(theta) + ")");
 }
 
 HistoryGrid make_grid(double tau, double period, int N, int periods_per_map) {
@@ -47,9 +47,8 @@ HistoryGrid make_grid(double tau, double period, int N, int periods_per_map) {
   if (r.q > 0) {
     // Aligned: h = tau / N, steps per period N T / tau = N q / p must be an integer.
     if ((static_cast<long>(N) * r.q) % r.p != 0)
-      throw BadInput("`N = " + std::to_string(N) + "`: tau/T = " + std::to_string(r.p) + "/" +
-                     std::to_string(r.q) + " needs N divisible by " + std::to_string(r.p) +
-                     " so that a period is a whole number of steps");
+      throw BadInput("`N = " + std::to_string(N) + "`: tau/T = " + std::to_string(r.p) + "/" + std::to_string(r.q) +
+                     " needs N divisible by " + std::to_string(r.p) + " so that a period is a whole number of steps");
     long k1 = static_cast<long>(N) * r.q / r.p;
     if (k1 * periods_per_map > kMaxSteps || N > kMaxSteps)
       throw BadInput("`N = " + std::to_string(N) + "`: too many steps per map");

@@ -29,9 +29,9 @@ struct Settings {
 struct RitzPairs {
   std::vector<std::complex<double>> values;
   std::vector<long> column;
-  Eigen::MatrixXd vectors;   // n x (columns used); may hold unused columns (ARPACK: its basis)
-  int converged = 0;         // as reported by the backend (ARPACK: iparam(5))
-  int iterations = 0;        // Arnoldi iterations (1 + restarts)
+  Eigen::MatrixXd vectors;  // n x (columns used); may hold unused columns (ARPACK: its basis)
+  int converged = 0;        // as reported by the backend (ARPACK: iparam(5))
+  int iterations = 0;       // Arnoldi iterations (1 + restarts)
 };
 
 // Both throw NumericalFailure when the backend does not converge within max_iterations or

@@ -17,13 +17,13 @@
 // The ISO_C_BINDING entry points of ARPACK-ng (arpack/arpack.h declares them too, together with
 // C99 `_Complex` prototypes that are not C++).
 extern "C" {
-void dnaupd_c(a_int* ido, char const* bmat, a_int n, char const* which, a_int nev, double tol, double* resid,
-              a_int ncv, double* v, a_int ldv, a_int* iparam, a_int* ipntr, double* workd, double* workl,
-              a_int lworkl, a_int* info);
+void dnaupd_c(a_int* ido, char const* bmat, a_int n, char const* which, a_int nev, double tol, double* resid, a_int ncv,
+              double* v, a_int ldv, a_int* iparam, a_int* ipntr, double* workd, double* workl, a_int lworkl,
+              a_int* info);
 void dneupd_c(a_int rvec, char const* howmny, a_int const* select, double* dr, double* di, double* z, a_int ldz,
               double sigmar, double sigmai, double* workev, char const* bmat, a_int n, char const* which, a_int nev,
-              double tol, double* resid, a_int ncv, double* v, a_int ldv, a_int* iparam, a_int* ipntr,
-              double* workd, double* workl, a_int lworkl, a_int* info);
+              double tol, double* resid, a_int ncv, double* v, a_int ldv, a_int* iparam, a_int* ipntr, double* workd,
+              double* workl, a_int lworkl, a_int* info);
 }
 
 namespace delayspec::krylov {
@@ -35,8 +35,9 @@ std::mutex arpack_mutex;
 std::string dnaupd_error(a_int info) {
   switch (info) {
     case 1: return "maximum number of iterations reached";
-    case 3: return "no shifts could be applied during a cycle of the implicitly restarted Arnoldi iteration "
-                   "(increase ncv)";
+    case 3:
+      return "no shifts could be applied during a cycle of the implicitly restarted Arnoldi iteration "
+             "(increase ncv)";
     case -1: return "n must be positive";
     case -2: return "nev must be positive";
     case -3: return "ncv must satisfy nev + 2 <= ncv <= n";
@@ -110,18 +111,17 @@ RitzPairs arpack_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eig
       theta.emplace_back(workl[ipntr[5] - 1 + i], workl[ipntr[6] - 1 + i]);
       est.push_back(std::abs(workl[ipntr[7] - 1 + i]));
     }
-    throw NumericalFailure("Krylov (arpack) did not converge: " + std::to_string(pairs.converged) +
-                           " of nev = " + std::to_string(nev) + " Ritz values converged after " +
-                           std::to_string(pairs.iterations) + " Arnoldi iterations (max_iterations = " +
-                           std::to_string(s.max_iterations) + " = 1 + max_restarts, ncv = " + std::to_string(ncv) +
-                           "), largest relative residual estimate " +
-                           format_number(largest_relative_estimate(theta, est, nev)) + " > tol " +
-                           short_number(s.tolerance) + " (dnaupd info = " + std::to_string(info) + ")");
+    throw NumericalFailure(
+        "Krylov (arpack) did not converge: " + std::to_string(pairs.converged) + " of nev = " + std::to_string(nev) +
+        " Ritz values converged after " + std::to_string(pairs.iterations) + " Arnoldi iterations (max_iterations = " +
+        std::to_string(s.max_iterations) + " = 1 + max_restarts, ncv = " + std::to_string(ncv) +
+        "), largest relative residual estimate " + format_number(largest_relative_estimate(theta, est, nev)) +
+        " > tol " + short_number(s.tolerance) + " (dnaupd info = " + std::to_string(info) + ")");
   }
   if (info != 0)
     throw NumericalFailure("Krylov (arpack): dnaupd info = " + std::to_string(info) + ": " + dnaupd_error(info) +
-                           " (after " + std::to_string(pairs.iterations) + " iterations, ncv = " +
-                           std::to_string(ncv) + ")");
+                           " (after " + std::to_string(pairs.iterations) + " iterations, ncv = " + std::to_string(ncv) +
+                           ")");
 
   // Ritz vectors into the first columns of V (allowed by dneupd: Z may be V). dr/di get ncv
   // entries, not the documented nev + 1: iparam(5) can exceed nev + 1 (arpack-ng issue #465).
@@ -134,8 +134,8 @@ RitzPairs arpack_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eig
     throw NumericalFailure("Krylov (arpack): dneupd info = " + std::to_string(einfo) + ": " + dneupd_error(einfo));
   const a_int nconv = std::min<a_int>(iparam[4], ncv);  // dneupd's count of converged Ritz values
   if (nconv < nev)
-    throw NumericalFailure("Krylov (arpack): dneupd returned " + std::to_string(nconv) + " Ritz values, nev = " +
-                           std::to_string(nev));
+    throw NumericalFailure("Krylov (arpack): dneupd returned " + std::to_string(nconv) +
+                           " Ritz values, nev = " + std::to_string(nev));
   for (a_int j = 0; j < nconv; ++j) {
     if (di[j] == 0) {
       pairs.values.emplace_back(dr[j], 0.0);

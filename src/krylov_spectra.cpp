@@ -91,18 +91,18 @@ RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Ei
   const ScaledMonodromy<D> scaled(op, scale);
   SpectraSolver<D> solver(scaled, s.nev, s.ncv);
   solver.init(start.data());  // Spectra starts from M * start (forces the vector into M's range)
-  const Eigen::Index nconv = solver.compute(Spectra::SortRule::LargestMagn, s.max_iterations, s.tolerance,
-                                            Spectra::SortRule::LargestMagn);
+  const Eigen::Index nconv =
+      solver.compute(Spectra::SortRule::LargestMagn, s.max_iterations, s.tolerance, Spectra::SortRule::LargestMagn);
   RitzPairs pairs;
   pairs.converged = static_cast<int>(nconv);
   pairs.iterations = static_cast<int>(solver.num_iterations());
   if (solver.info() != Spectra::CompInfo::Successful || nconv < s.nev)
-    throw NumericalFailure("Krylov (spectra) did not converge: " + std::to_string(nconv) + " of nev = " +
-                           std::to_string(s.nev) + " Ritz values converged after " +
-                           std::to_string(pairs.iterations) + " Arnoldi iterations (max_iterations = " +
-                           std::to_string(s.max_iterations) + " = 1 + max_restarts, ncv = " + std::to_string(s.ncv) +
-                           "), largest relative residual estimate " + format_number(solver.largest_estimate()) +
-                           " > tol " + short_number(s.tolerance));
+    throw NumericalFailure(
+        "Krylov (spectra) did not converge: " + std::to_string(nconv) + " of nev = " + std::to_string(s.nev) +
+        " Ritz values converged after " + std::to_string(pairs.iterations) +
+        " Arnoldi iterations (max_iterations = " + std::to_string(s.max_iterations) +
+        " = 1 + max_restarts, ncv = " + std::to_string(s.ncv) + "), largest relative residual estimate " +
+        format_number(solver.largest_estimate()) + " > tol " + short_number(s.tolerance));
 
   // Representatives: real values, and each complex pair once with imag > 0 (a pair split by nev
   // is completed from its conjugate).

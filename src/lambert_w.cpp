@@ -31,8 +31,7 @@ cd initial_guess(cd z, int k) {
 }  // namespace
 
 cd lambert_w(cd z, int k) {
-  if (!std::isfinite(z.real()) || !std::isfinite(z.imag()))
-    throw BadInput("lambert_w: argument must be finite");
+  if (!std::isfinite(z.real()) || !std::isfinite(z.imag())) throw BadInput("lambert_w: argument must be finite");
   if (z == cd(0)) {
     if (k == 0) return 0.0;
     throw BadInput("lambert_w: W_k(0) is -infinity for branch k = " + std::to_string(k));

@@ -5,7 +5,6 @@
 #include <random>
 #include <string>
 
-
 namespace delayspec {
 
 namespace {
@@ -119,8 +118,7 @@ void qr_rows_dispatch(double* a, long n, int k, double* tau, double* r, double* 
 
 }  // namespace
 
-TangentQR::TangentQR(double* block, long n, int k)
-    : block_(block), n_(n), k_(k), tau_(k), r_(k), norm_(k) {
+TangentQR::TangentQR(double* block, long n, int k) : block_(block), n_(n), k_(k), tau_(k), r_(k), norm_(k) {
   if (k > kMaxTangentVectors)
     throw BadInput("`exponents = " + std::to_string(k) + "`: at most " + std::to_string(kMaxTangentVectors) +
                    " tangent vectors");
@@ -142,8 +140,8 @@ void TangentQR::factorise(double* q_out, double* log_r) {
   for (int i = 0; i < k_; ++i) {
     const double r = r_[i];
     if (!std::isfinite(r))
-      throw NumericalFailure("Lyapunov QR: R(" + std::to_string(i) + "," + std::to_string(i) + ") = " +
-                             format_number(r) + " (the tangent block is not finite)");
+      throw NumericalFailure("Lyapunov QR: R(" + std::to_string(i) + "," + std::to_string(i) +
+                             ") = " + format_number(r) + " (the tangent block is not finite)");
     if (!(std::abs(r) > dependence_threshold(n_) * norm_[i]))
       throw NumericalFailure("Lyapunov QR: tangent vector " + std::to_string(i + 1) +
                              " became linearly dependent on the previous ones (|R_ii| = " + format_number(std::abs(r)) +
@@ -213,16 +211,15 @@ LyapunovStatistics lyapunov_statistics(const std::vector<double>& interval_logs,
 void validate_lyapunov_options(const LyapunovOptions& o, long n) {
   if (o.exponents < 1 || o.exponents > n || o.exponents > kMaxTangentVectors)
     throw BadInput("`exponents = " + std::to_string(o.exponents) + "`: must be between 1 and min(" +
-                   std::to_string(kMaxTangentVectors) + ", n = " +
-                   std::to_string(n) + ") (only leading exponents are meant)");
+                   std::to_string(kMaxTangentVectors) + ", n = " + std::to_string(n) +
+                   ") (only leading exponents are meant)");
   if (o.qr_every < 1) throw BadInput("`qr_every = " + std::to_string(o.qr_every) + "`: must be an integer >= 1");
   if (o.periods < 2 * static_cast<long>(o.qr_every) || o.periods % o.qr_every != 0)
     throw BadInput("`periods = " + std::to_string(o.periods) + "` must be a multiple of `qr_every = " +
                    std::to_string(o.qr_every) + "` with at least two QR intervals (for the error estimate)");
   if (o.transient < 0) throw BadInput("`transient = " + std::to_string(o.transient) + "`: must be >= 0");
   if (o.batches < 2) throw BadInput("`batches = " + std::to_string(o.batches) + "`: must be an integer >= 2");
-  if (o.section_points < 0)
-    throw BadInput("`section_points = " + std::to_string(o.section_points) + "`: must be >= 0");
+  if (o.section_points < 0) throw BadInput("`section_points = " + std::to_string(o.section_points) + "`: must be >= 0");
 }
 
 }  // namespace delayspec

@@ -12,8 +12,8 @@ template <int D>
 Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
     : grid_(grid), maps_(std::move(maps)), n_(grid.dimension(D)) {
   if (static_cast<long>(maps_.size()) != grid_.K)
-    throw BadInput("Monodromy: " + std::to_string(maps_.size()) + " step maps given, the grid has K = " +
-                   std::to_string(grid_.K) + " steps per map");
+    throw BadInput("Monodromy: " + std::to_string(maps_.size()) +
+                   " step maps given, the grid has K = " + std::to_string(grid_.K) + " steps per map");
   work_.assign(static_cast<size_t>(grid_.M + 1 + grid_.K) * D, 0.0);
 }
 

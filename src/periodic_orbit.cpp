@@ -24,8 +24,8 @@ Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, long 
       continue;
     }
     // 4-point Lagrange cubic through u_{i-1}, u_i, u_{i+1}, u_{i+2} (weights at offset w in [0, 1))
-    const double cm = -w * (w - 1) * (w - 2) / 6, c0 = (w + 1) * (w - 1) * (w - 2) / 2,
-                 c1 = -(w + 1) * w * (w - 2) / 2, c2 = (w + 1) * w * (w - 1) / 6;
+    const double cm = -w * (w - 1) * (w - 2) / 6, c0 = (w + 1) * (w - 1) * (w - 2) / 2, c1 = -(w + 1) * w * (w - 2) / 2,
+                 c2 = (w + 1) * w * (w - 1) / 6;
     y.segment(d * l, d) = cm * u(i - 1) + c0 * u(i) + c1 * u(i + 1) + c2 * u(i + 2);
   }
   return y;

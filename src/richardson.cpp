@@ -167,27 +167,30 @@ Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::ve
     } else {
       e.error_estimate = std::max({d_last, d_prev * std::pow(r, -q), roundoff});
     }
-    e.note = fmt(J == 0 ? "column %.0f (%.0f level, no extrapolation) shows order %.3g over its last entries, expected %.3g: "
-                        : "column %.0f (%.0f levels) shows order %.3g over its last entries, expected %.3g: ",
-                 J + 1.0, J + 1.0, e.column_orders[J], tab.remaining_order(J)) +
-             (J + 1 <= top ? "higher columns not used; " : "") +
-             (std::isfinite(e.error_estimate) ? "error from that column's last differences"
-                                              : "its differences grow: no error estimate");
+    e.note =
+        fmt(J == 0
+                ? "column %.0f (%.0f level, no extrapolation) shows order %.3g over its last entries, expected %.3g: "
+                : "column %.0f (%.0f levels) shows order %.3g over its last entries, expected %.3g: ",
+            J + 1.0, J + 1.0, e.column_orders[J], tab.remaining_order(J)) +
+        (J + 1 <= top ? "higher columns not used; " : "") +
+        (std::isfinite(e.error_estimate) ? "error from that column's last differences"
+                                         : "its differences grow: no error estimate");
     return e;
   }
   if (J == 0) {  // column 0 unchecked (fewer than three levels) or the only one
     e.error_estimate = std::numeric_limits<double>::infinity();
     e.note = L < 3 ? fmt("%.0f level(s): the order cannot be checked (three levels needed): no extrapolation, no error "
-                         "estimate", L)
+                         "estimate",
+                         L)
                    : "one column only: no extrapolation, no error estimate";
     return e;
   }
   e.error_estimate = std::max(std::abs(entry(L - 1, J) - entry(L - 1, J - 1)), roundoff);
   e.note = !options.check_orders ? fmt("%.0f levels (orders not checked)", J + 1.0)
-           : J < top              ? fmt("%.0f levels: every column below shows its expected order; column %.0f has too "
-                                        "few entries to check, so it is not built upon (more N would allow more levels)",
-                                        J + 1.0, J + 1.0)
-                                  : fmt("%.0f levels: every column below shows its expected order", J + 1.0);
+           : J < top             ? fmt("%.0f levels: every column below shows its expected order; column %.0f has too "
+                                                   "few entries to check, so it is not built upon (more N would allow more levels)",
+                                       J + 1.0, J + 1.0)
+                                 : fmt("%.0f levels: every column below shows its expected order", J + 1.0);
   return e;
 }
 

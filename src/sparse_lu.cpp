@@ -68,15 +68,15 @@ SparseLU::SparseLU(const Eigen::SparseMatrix<double>& A) {
   // Jacobian (N = 10^4, 82668 unknowns) the same fill (5.4e6) in 2.1 s instead of 3.6 s.
   control[UMFPACK_ORDERING] = UMFPACK_ORDERING_AMD;
   const int n = static_cast<int>(n_);
-  int status = umfpack_di_symbolic(n, n, column_starts_.data(), row_indices_.data(), values_.data(), &symbolic_,
-                                   control, info);
+  int status =
+      umfpack_di_symbolic(n, n, column_starts_.data(), row_indices_.data(), values_.data(), &symbolic_, control, info);
   if (status != UMFPACK_OK) {
     release();
     check_status(status, "symbolic", n_, 0);
     throw NumericalFailure("sparse LU (UMFPACK symbolic) failed: " + umfpack_status_name(status));
   }
-  status = umfpack_di_numeric(column_starts_.data(), row_indices_.data(), values_.data(), symbolic_, &numeric_,
-                              control, info);
+  status = umfpack_di_numeric(column_starts_.data(), row_indices_.data(), values_.data(), symbolic_, &numeric_, control,
+                              info);
   rcond_ = info[UMFPACK_RCOND];
   factor_nonzeros_ = static_cast<long>(info[UMFPACK_LNZ] + info[UMFPACK_UNZ]);
   if (status != UMFPACK_OK) {

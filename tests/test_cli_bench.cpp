@@ -18,9 +18,9 @@ using delayspec::testing::run;
 }  // namespace
 
 TEST(BenchCli, KrylovAndDenseAgreeAndMatchLambertW) {
-  CliResult r = run({"bench", "--json", "--set", "model=linear", "--set", "a=-1", "--set", "b=-2", "--set",
-                     "Ns=100,400", "--set", "nev=4", "--set", "solvers=spectra,arpack,dense-lapack", "--set",
-                     "repeats=2"});
+  CliResult r =
+      run({"bench", "--json", "--set", "model=linear", "--set", "a=-1", "--set", "b=-2", "--set", "Ns=100,400", "--set",
+           "nev=4", "--set", "solvers=spectra,arpack,dense-lapack", "--set", "repeats=2"});
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["reference"], "exact");
@@ -42,7 +42,8 @@ TEST(BenchCli, KrylovAndDenseAgreeAndMatchLambertW) {
       // Dense forms the matrix: n = N + 1 applications, and holds at least one n x n matrix.
       const long n = row["dimension"].get<long>();
       EXPECT_EQ(row["operator_applications"].get<long>(), n);
-      EXPECT_GE(row["peak_bytes"].get<long>(), static_cast<long>(0.5 * 8.0 * n * n)) << "at least the matrix (half, for slack)";
+      EXPECT_GE(row["peak_bytes"].get<long>(), static_cast<long>(0.5 * 8.0 * n * n))
+          << "at least the matrix (half, for slack)";
     }
   }
 }
@@ -75,7 +76,7 @@ TEST(BenchCli, TextTableAndCsv) {
   int lines = 0;
   while (std::getline(csv, line))
     if (line.rfind("#", 0) != 0) ++lines;  // the metadata comment lines first (docs/formats.md)
-  EXPECT_EQ(lines, 1 + 3 * 2);  // header, 3 N x 2 solvers
+  EXPECT_EQ(lines, 1 + 3 * 2);             // header, 3 N x 2 solvers
   std::filesystem::remove_all(dir);
 }
 
@@ -92,7 +93,8 @@ class BenchBadInput : public ::testing::TestWithParam<BadValue> {};
 
 TEST_P(BenchBadInput, ExitsTwoNamingKeyAndValue) {
   const BadValue b = GetParam();
-  CliResult r = run({"bench", "--set", "model=linear", "--set", "Ns=20,40", "--set", std::string(b.key) + "=" + b.value});
+  CliResult r =
+      run({"bench", "--set", "model=linear", "--set", "Ns=20,40", "--set", std::string(b.key) + "=" + b.value});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find(std::string("`") + b.key), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(b.value), std::string::npos) << r.err;

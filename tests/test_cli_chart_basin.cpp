@@ -63,8 +63,8 @@ TEST(ChartCli, UnforcedUndelayedMathieuMatchesCayleyTransformExactly) {
 
 TEST(ChartCli, ParallelEqualsSerialAndCsvHasGridBlocks) {
   const fs::path dir = delayspec::testing::fresh_dir("chart_csv");
-  std::vector<std::string> sets = {"model=mathieu", "kappa=0.1", "eps=1", "N=20", "solver=dense",
-                                   "chart_x_points=4", "chart_y_points=3"};
+  std::vector<std::string> sets = {"model=mathieu", "kappa=0.1",        "eps=1",           "N=20",
+                                   "solver=dense",  "chart_x_points=4", "chart_y_points=3"};
   auto serial = with_sets({"chart", "--json"}, sets);
   serial.insert(serial.end(), {"--set", "threads=1"});
   auto parallel = with_sets({"chart", "--json", "--out", dir.string()}, sets);
@@ -112,9 +112,9 @@ TEST(SectionPeriod, FindsSmallestPeriodOrNone) {
 TEST(BasinCli, NeighbourhoodOfStablePeriodOneOrbitIsPeriodOne) {
   // The default scene's orbit (k = 0.2, tau = T) is stable (|mu_1| < 1, FloquetCli.DefaultSceneRuns);
   // histories within 0.01 of it converge to it.
-  CliResult r = run(with_sets({"basin", "--json"}, {"k=0.2", "N=40", "basin_x_range=-0.0666,-0.0466",
-                                                    "basin_y_range=1.0001,1.0201", "basin_x_points=2",
-                                                    "basin_y_points=2", "basin_transient=300", "basin_max_period=5"}));
+  CliResult r = run(with_sets({"basin", "--json"},
+                              {"k=0.2", "N=40", "basin_x_range=-0.0666,-0.0466", "basin_y_range=1.0001,1.0201",
+                               "basin_x_points=2", "basin_y_points=2", "basin_transient=300", "basin_max_period=5"}));
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   for (const auto& row : j["rows"]) EXPECT_EQ(row["period"], 1) << row.dump();
@@ -134,7 +134,8 @@ class GridBadInput : public ::testing::TestWithParam<BadKey> {};
 
 TEST_P(GridBadInput, ExitsTwoNamingKeyAndValue) {
   const BadKey b = GetParam();
-  CliResult r = run(with_sets({b.command}, {"model=mathieu", "N=8", "solver=dense", std::string(b.key) + "=" + b.value}));
+  CliResult r =
+      run(with_sets({b.command}, {"model=mathieu", "N=8", "solver=dense", std::string(b.key) + "=" + b.value}));
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_TRUE(contains(r.err, b.expected)) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;

@@ -48,7 +48,8 @@ TEST(ConvergeCli, LinearAgainstLambertWIsSecondOrder) {
     const auto& e = j["extrapolated"][k];
     const auto& x = j["reference_values"][k];
     EXPECT_EQ(e["levels"], 3) << k << ": " << e["note"];
-    const double actual = std::hypot(e["re"].get<double>() - x["re"].get<double>(), e["im"].get<double>() - x["im"].get<double>());
+    const double actual =
+        std::hypot(e["re"].get<double>() - x["re"].get<double>(), e["im"].get<double>() - x["im"].get<double>());
     EXPECT_LE(actual, e["error_estimate"].get<double>()) << k;
   }
 }
@@ -89,9 +90,7 @@ std::vector<std::complex<double>> upper_track(const nlohmann::json& j) {
   return z;
 }
 
-std::complex<double> upper(const nlohmann::json& e) {
-  return {e["re"].get<double>(), std::abs(e["im"].get<double>())};
-}
+std::complex<double> upper(const nlohmann::json& e) { return {e["re"].get<double>(), std::abs(e["im"].get<double>())}; }
 
 }  // namespace
 
@@ -121,8 +120,7 @@ TEST(ConvergeCli, ImpactWithEventsClaimsAnErrorThatBoundsTheIndependentReference
   // actual error: what this test guards against.
   std::vector<double> h;
   for (const auto& row : j["rows"]) h.push_back(1.0 / row["N"].get<int>());
-  const delayspec::Extrapolation old =
-      delayspec::richardson_extrapolate(h, upper_track(j), {.check_orders = false});
+  const delayspec::Extrapolation old = delayspec::richardson_extrapolate(h, upper_track(j), {.check_orders = false});
   EXPECT_EQ(old.levels, 4);
   EXPECT_GT(std::abs(old.value - reference), 5 * old.error_estimate);
 }
@@ -146,8 +144,7 @@ TEST(ConvergeCli, ImpactDefaultSceneClaimsAnErrorThatBoundsTheFineReference) {
   EXPECT_LE(std::abs(upper(e) - reference) + reference_error, e["error_estimate"].get<double>()) << e["note"];
   std::vector<double> h;
   for (const auto& row : j["rows"]) h.push_back(1.0 / row["N"].get<int>());
-  const delayspec::Extrapolation old =
-      delayspec::richardson_extrapolate(h, upper_track(j), {.check_orders = false});
+  const delayspec::Extrapolation old = delayspec::richardson_extrapolate(h, upper_track(j), {.check_orders = false});
   EXPECT_GT(std::abs(old.value - reference) - reference_error, old.error_estimate);
 }
 
@@ -164,8 +161,10 @@ TEST(ConvergeCli, LinearStudiesClaimAFiniteErrorThatBoundsLambertW) {
                                                     {"a=-1", "b=0.5", "tau=1", "period=1"},
                                                     {"a=0.2", "b=-1", "tau=1", "period=3"}};
   for (const auto& params : cases)
-    for (const std::string ns : {"25,50,100", "100,200,400", "25,50,100,200", "50,100,200,400,800", "200,400,800,1600"}) {
-      std::vector<std::string> args{"converge", "--json", "--set", "model=linear", "--set", "Ns=" + ns, "--set", "nev=6"};
+    for (const std::string ns :
+         {"25,50,100", "100,200,400", "25,50,100,200", "50,100,200,400,800", "200,400,800,1600"}) {
+      std::vector<std::string> args{"converge", "--json",   "--set", "model=linear",
+                                    "--set",    "Ns=" + ns, "--set", "nev=6"};
       for (const auto& p : params) args.insert(args.end(), {"--set", p});
       CliResult r = run(args);
       ASSERT_EQ(r.status, 0) << r.err;
@@ -174,9 +173,11 @@ TEST(ConvergeCli, LinearStudiesClaimAFiniteErrorThatBoundsLambertW) {
       for (size_t k = 0; k < 6; ++k) {
         const auto& e = j["extrapolated"][k];
         const auto& x = j["reference_values"][k];
-        const std::string where = params[0] + " " + params[1] + " " + params[3] + " Ns=" + ns + " track " + std::to_string(k);
+        const std::string where =
+            params[0] + " " + params[1] + " " + params[3] + " Ns=" + ns + " track " + std::to_string(k);
         ASSERT_TRUE(e["error_estimate"].is_number()) << where << ": " << e["note"];
-        const double actual = std::hypot(e["re"].get<double>() - x["re"].get<double>(), e["im"].get<double>() - x["im"].get<double>());
+        const double actual =
+            std::hypot(e["re"].get<double>() - x["re"].get<double>(), e["im"].get<double>() - x["im"].get<double>());
         EXPECT_LE(actual, e["error_estimate"].get<double>()) << where << ": " << e["note"];
         if (ns == "50,100,200,400,800" || ns == "200,400,800,1600") {
           EXPECT_LT(e["error_estimate"].get<double>(), 1e-10 * j["reference_values"][0]["abs"].get<double>()) << where;
@@ -212,8 +213,8 @@ TEST(ConvergeCli, PwsddeThreeLevelsClaimNoLessThanTheFineReference) {
 // against a finer study (Ns = 200 .. 6400, its own estimate added): not independent of the
 // stepper, but of the stopping rule under test.
 TEST(ConvergeCli, TargetKeepsDoublingNUntilTheEstimateMeetsIt) {
-  const std::vector<std::string> mathieu{"converge", "--json", "--set", "model=mathieu", "--set", "kappa=0.1", "--set",
-                                         "delta=3", "--set", "eps=1", "--set", "b=-0.5"};
+  const std::vector<std::string> mathieu{"converge", "--json",  "--set", "model=mathieu", "--set", "kappa=0.1",
+                                         "--set",    "delta=3", "--set", "eps=1",         "--set", "b=-0.5"};
   std::vector<std::string> args = mathieu;
   args.insert(args.end(), {"--set", "converge_target=1e-10"});
   CliResult r = run(args);
@@ -232,7 +233,8 @@ TEST(ConvergeCli, TargetKeepsDoublingNUntilTheEstimateMeetsIt) {
     const double estimate = e["error_estimate"].get<double>();
     EXPECT_LE(estimate, 1e-10 * e["abs"].get<double>()) << k;
     const auto& g = f["extrapolated"][k];
-    const double distance = std::hypot(e["re"].get<double>() - g["re"].get<double>(), e["im"].get<double>() - g["im"].get<double>());
+    const double distance =
+        std::hypot(e["re"].get<double>() - g["re"].get<double>(), e["im"].get<double>() - g["im"].get<double>());
     EXPECT_LE(distance, estimate + g["error_estimate"].get<double>()) << k;
   }
 }
@@ -246,7 +248,8 @@ TEST(ConvergeCli, TargetStopsAtItsLimitsAndSaysWhich) {
   EXPECT_EQ(j["stopped_by"], "converge_max_N");
   EXPECT_EQ(j["rows"].back()["N"], 800);
   EXPECT_NE(j["stop_note"].get<std::string>().find("converge_max_N = 800"), std::string::npos) << j["stop_note"];
-  r = run({"converge", "--set", "model=mathieu", "--set", "converge_target=1e-10", "--set", "converge_max_seconds=1e-9"});
+  r = run(
+      {"converge", "--set", "model=mathieu", "--set", "converge_target=1e-10", "--set", "converge_max_seconds=1e-9"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("stopped: converge_max_seconds = 1e-09"), std::string::npos) << r.out;
   // without a target the JSON says so
@@ -263,9 +266,9 @@ namespace {
 
 // orbit = simulate: these tests are about a level whose simulated orbit fails (the default,
 // orbit = auto, finds the N = 100 orbit by Newton directly: AutoOrbitFindsTheLevelDirectly).
-const std::vector<std::string> kImpactK1{"converge", "--json", "--set", "tau_over_T=1", "--set", "k=1.0", "--set",
-                                         "Ns=100,200,400", "--set", "nev=2", "--set", "events=on",
-                                         "--set", "orbit=simulate"};
+const std::vector<std::string> kImpactK1{"converge", "--json",    "--set",          "tau_over_T=1",  "--set",
+                                         "k=1.0",    "--set",     "Ns=100,200,400", "--set",         "nev=2",
+                                         "--set",    "events=on", "--set",          "orbit=simulate"};
 
 std::vector<std::string> with(std::vector<std::string> args, std::initializer_list<std::string> more) {
   args.insert(args.end(), more);
@@ -371,7 +374,7 @@ TEST(ConvergeCli, ImpactShowsEventsOnAndOffSideBySideAndWritesCsv) {
   int lines = 0;
   while (std::getline(csv, line))
     if (line.rfind("#", 0) != 0) ++lines;  // the metadata comment lines first (docs/formats.md)
-  EXPECT_EQ(lines, 1 + 2 * 3 * 2);  // header, 2 events x 3 N x 2 tracks
+  EXPECT_EQ(lines, 1 + 2 * 3 * 2);         // header, 2 events x 3 N x 2 tracks
   EXPECT_TRUE(std::filesystem::exists(dir / "converge_richardson.csv"));
   std::filesystem::remove_all(dir);
 }

@@ -102,8 +102,8 @@ TEST(FloquetCli, JsonHasContractKeysAndSortedMultipliers) {
 
 TEST(FloquetCli, FractionalDelayRuns) {
   // issue 2: tau = 3.8 with omega = 0.8 (not a rational multiple of T) must run.
-  CliResult r = run({"floquet", "--json", "--set", "tau=3.8", "--set", "omega=0.8", "--set", "k=0.12", "--set",
-                     "N=40", "--set", "solver=dense", "--set", "events=off", "--set", "a=0.2"});
+  CliResult r = run({"floquet", "--json", "--set", "tau=3.8", "--set", "omega=0.8", "--set", "k=0.12", "--set", "N=40",
+                     "--set", "solver=dense", "--set", "events=off", "--set", "a=0.2"});
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   EXPECT_GT(j["dimension"].get<int>(), 80);

@@ -20,8 +20,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using delayspec::testing::fresh_dir;
 using delayspec::testing::CliResult;
+using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
@@ -78,8 +78,10 @@ TEST(KeyRegistry, EveryKeyReadHasAMeaningAndEveryMeaningIsRead) {
 TEST(UnreadKey, KeyOfAnotherCommandSaysItIsNotRead) {
   CliResult r = run({"lyapunov", "--set", "nev=4", "--set", "model=linear"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_TRUE(contains(r.err, "`nev` (= 4, from --set) is not read by lyapunov (it is a key of bench, chart, continue, "
-                              "converge, floquet")) << r.err;
+  EXPECT_TRUE(contains(r.err,
+                       "`nev` (= 4, from --set) is not read by lyapunov (it is a key of bench, chart, continue, "
+                       "converge, floquet"))
+      << r.err;
   EXPECT_TRUE(contains(r.err, "`delayspec lyapunov --help` lists the keys it reads")) << r.err;
   EXPECT_FALSE(contains(r.err, "did you mean")) << r.err;
 }
@@ -87,8 +89,10 @@ TEST(UnreadKey, KeyOfAnotherCommandSaysItIsNotRead) {
 TEST(UnreadKey, KeyOfAnotherModelNamesTheModel) {
   CliResult r = run({"floquet", "--set", "model=linear", "--set", "kappa=1", "--set", "solver=dense"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_TRUE(contains(r.err, "`kappa` (= 1, from --set) is not read by floquet with model = linear (only with "
-                              "model = mathieu)")) << r.err;
+  EXPECT_TRUE(contains(r.err,
+                       "`kappa` (= 1, from --set) is not read by floquet with model = linear (only with "
+                       "model = mathieu)"))
+      << r.err;
 }
 
 TEST(UnreadKey, MisspeltKeyStillGetsADidYouMean) {
@@ -103,8 +107,8 @@ TEST(UnreadKey, MisspeltKeyStillGetsADidYouMean) {
 
 TEST(UnreadKey, RunNamesTheAnalysesOfTheScene) {
   const fs::path dir = fresh_dir("keys_run_unread");
-  CliResult r = run({"run", DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml", "--out", dir.string(), "--set",
-                     "exponents=3"});
+  CliResult r =
+      run({"run", DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml", "--out", dir.string(), "--set", "exponents=3"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "`exponents` (= 3) is not read by floquet")) << r.err;
   EXPECT_FALSE(fs::exists(dir));
@@ -135,9 +139,9 @@ TEST(Metadata, EveryCsvStartsWithTheMetadataLines) {
   const std::string out = dir.string();
   const std::vector<std::vector<std::string>> commands = {
       {"simulate", "--set", "model=linear", "--set", "N=10", "--set", "t_end=4"},
-      {"sweep", "--set", "model=linear", "--set", "sweep_key=a", "--set", "sweep_from=-1", "--set", "sweep_to=-0.5",
-       "--set", "sweep_points=2", "--set", "N=10", "--set", "periods=20", "--set", "transient=2", "--set",
-       "exponents=1", "--set", "batches=2"},
+      {"sweep",      "--set",         "model=linear", "--set",          "sweep_key=a", "--set", "sweep_from=-1",
+       "--set",      "sweep_to=-0.5", "--set",        "sweep_points=2", "--set",       "N=10",  "--set",
+       "periods=20", "--set",         "transient=2",  "--set",          "exponents=1", "--set", "batches=2"},
       {"converge", "--set", "model=linear", "--set", "Ns=10,20,40", "--set", "nev=1", "--set", "solver=dense"},
       {"bench", "--set", "model=linear", "--set", "Ns=10,20", "--set", "nev=1", "--set", "solvers=dense"},
       {"chart", "--set", "model=mathieu", "--set", "N=10", "--set", "chart_x_points=2", "--set", "chart_y_points=2",
@@ -168,13 +172,21 @@ TEST(Metadata, EveryCsvStartsWithTheMetadataLines) {
 TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
   // `delayspec run SCENE` validates the whole scene before computing (plan_run): every key must
   // be read by one of its analyses; a scene without `analyses` runs the command reading all keys.
-  const std::map<std::string, std::string> expected = {
-      {"convergence", "converge"}, {"default", "floquet"},   {"fig6_1", "basin"},
-      {"fig6_2", "sweep"},         {"fig6_2_zoom", "sweep"}, {"fig6_3", "simulate"},
-      {"fig6_4", "sweep"},         {"mathieu_chart", "chart"}, {"paper-period1", "floquet"},
-      {"pwsdde-period2", "floquet"}, {"continue_grazing_e", "continue"}, {"continue_tau_half_k", "continue"},
-      {"continue_mathieu_delta2", "continue"}, {"continue_mathieu_delta3", "continue"},
-      {"continue_pwsdde_k", "continue"}};
+  const std::map<std::string, std::string> expected = {{"convergence", "converge"},
+                                                       {"default", "floquet"},
+                                                       {"fig6_1", "basin"},
+                                                       {"fig6_2", "sweep"},
+                                                       {"fig6_2_zoom", "sweep"},
+                                                       {"fig6_3", "simulate"},
+                                                       {"fig6_4", "sweep"},
+                                                       {"mathieu_chart", "chart"},
+                                                       {"paper-period1", "floquet"},
+                                                       {"pwsdde-period2", "floquet"},
+                                                       {"continue_grazing_e", "continue"},
+                                                       {"continue_tau_half_k", "continue"},
+                                                       {"continue_mathieu_delta2", "continue"},
+                                                       {"continue_mathieu_delta3", "continue"},
+                                                       {"continue_pwsdde_k", "continue"}};
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
     if (entry.path().extension() != ".toml") continue;

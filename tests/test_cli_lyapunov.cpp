@@ -16,8 +16,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using delayspec::testing::fresh_dir;
 using delayspec::testing::CliResult;
+using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
 
 std::string read(const fs::path& path) {
@@ -45,8 +45,8 @@ void PrintTo(const BadValue& b, std::ostream* os) { *os << b.key << "=" << b.val
 class LyapunovBadInput : public ::testing::TestWithParam<BadValue> {};
 class SweepBadInput : public ::testing::TestWithParam<BadValue> {};
 
-const std::vector<std::string> kSmallLinear = {"--set", "model=linear", "--set", "N=10", "--set", "periods=20",
-                                               "--set", "transient=0"};
+const std::vector<std::string> kSmallLinear = {"--set", "model=linear", "--set", "N=10",
+                                               "--set", "periods=20",   "--set", "transient=0"};
 
 }  // namespace
 
@@ -89,11 +89,13 @@ TEST(LyapunovCli, JsonHasContractKeys) {
     EXPECT_NEAR(j["standard_error_per_period"][i].get<double>(),
                 std::hypot(j["batch_standard_error_per_period"][i].get<double>(),
                            j["fluctuation_bound_per_period"][i].get<double>()),
-                1e-15 * j["standard_error_per_period"][i].get<double>()) << i;
+                1e-15 * j["standard_error_per_period"][i].get<double>())
+        << i;
   EXPECT_EQ(j["periods"], 40);
   EXPECT_EQ(j["transient"], 10);
   // period = tau = 1 by default for `linear`: per time equals per period
-  for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(j["exponents_per_time"][i].get<double>(), j["exponents_per_period"][i].get<double>());
+  for (int i = 0; i < 3; ++i)
+    EXPECT_DOUBLE_EQ(j["exponents_per_time"][i].get<double>(), j["exponents_per_period"][i].get<double>());
 }
 
 TEST(LyapunovCli, OverflowExitsThree) {
@@ -138,16 +140,16 @@ TEST(SweepCli, SweptKeyMustBeAParameterOfTheModel) {
 // A linear sweep over b: at each point the exponents must equal a lyapunov run at that point.
 TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
   const fs::path dir = fresh_dir("lyapunov_sweep");
-  std::vector<std::string> args = {"sweep", "--json", "--out", dir.string(), "--set", "sweep_key=b", "--set",
-                                   "sweep_from=-2", "--set", "sweep_to=-1", "--set", "sweep_points=3", "--set",
-                                   "section_points=4", "--set", "threads=2"};
+  std::vector<std::string> args = {"sweep", "--json",           "--out", dir.string(),  "--set", "sweep_key=b",
+                                   "--set", "sweep_from=-2",    "--set", "sweep_to=-1", "--set", "sweep_points=3",
+                                   "--set", "section_points=4", "--set", "threads=2"};
   args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
   CliResult r = run(args);
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["points"].size(), 3u);
-  CliResult single = run({"lyapunov", "--json", "--set", "model=linear", "--set", "N=10", "--set", "periods=20", "--set",
-                          "transient=0", "--set", "b=-1.5"});
+  CliResult single = run({"lyapunov", "--json", "--set", "model=linear", "--set", "N=10", "--set", "periods=20",
+                          "--set", "transient=0", "--set", "b=-1.5"});
   ASSERT_EQ(single.status, 0) << single.err;
   auto s = nlohmann::json::parse(single.out);
   // same arithmetic, different thread: identical to the last bit
@@ -161,7 +163,8 @@ TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
   EXPECT_NE(with_metadata.find("\n# sweep_key = b\n"), std::string::npos) << with_metadata;
   EXPECT_EQ(with_metadata.find("\n# b = "), std::string::npos) << with_metadata;
   const std::string csv = without_metadata(with_metadata);
-  EXPECT_EQ(csv.substr(0, csv.find('\n')), "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 points
   const std::string section = without_metadata(read(dir / "section.csv"));
   EXPECT_EQ(std::count(section.begin(), section.end(), '\n'), 1 + 3 * 4);
@@ -176,8 +179,9 @@ TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
 // points and produces the same tables as an uninterrupted sweep; other settings are refused.
 TEST(SweepCli, ResumeCompletesAnInterruptedSweep) {
   const fs::path dir = fresh_dir("lyapunov_resume");
-  std::vector<std::string> args = {"sweep", "--json", "--quiet", "--out", dir.string(), "--set", "sweep_key=a",
-                                   "--set", "sweep_from=-2", "--set", "sweep_to=0", "--set", "sweep_points=5"};
+  std::vector<std::string> args = {"sweep",      "--json",      "--quiet",       "--out",         dir.string(),
+                                   "--set",      "sweep_key=a", "--set",         "sweep_from=-2", "--set",
+                                   "sweep_to=0", "--set",       "sweep_points=5"};
   args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
   ASSERT_EQ(run(args).status, 0);
   const std::string complete_csv = read(dir / "exponents.csv");
@@ -209,8 +213,8 @@ TEST(SweepCli, ResumeCompletesAnInterruptedSweep) {
 }
 
 TEST(SweepCli, ResumeNeedsAnOutDirectoryWithASweep) {
-  std::vector<std::string> args = {"sweep", "--resume", "--set", "sweep_key=a", "--set", "sweep_from=-2", "--set",
-                                   "sweep_to=0"};
+  std::vector<std::string> args = {"sweep", "--resume",      "--set", "sweep_key=a",
+                                   "--set", "sweep_from=-2", "--set", "sweep_to=0"};
   args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
   EXPECT_EQ(run(args).status, 2);
   const fs::path dir = fresh_dir("lyapunov_noresume");

@@ -29,9 +29,10 @@ TEST(OrbitNewtonCli, JsonReportsNewtonAndMatchesSimulation) {
   EXPECT_GE(j["orbit"]["newton_iterations"].get<int>(), 1);
   EXPECT_EQ(j["orbit"]["newton_residuals"].size(), j["orbit"]["newton_iterations"].get<size_t>() + 1);
   EXPECT_LT(j["orbit"]["residual"].get<double>(), 1e-12);  // rounding of K = 60 steps
-  EXPECT_EQ(j["orbit"]["contacts"], 1);  // the paper's orbit touches the obstacle once per period
+  EXPECT_EQ(j["orbit"]["contacts"], 1);                    // the paper's orbit touches the obstacle once per period
 
-  CliResult simulated = run({"floquet", kScene, "--json", "--set", "N=60", "--set", "nev=3", "--set", "orbit=simulate"});
+  CliResult simulated =
+      run({"floquet", kScene, "--json", "--set", "N=60", "--set", "nev=3", "--set", "orbit=simulate"});
   ASSERT_EQ(simulated.status, 0) << simulated.err;
   auto s = nlohmann::json::parse(simulated.out);
   EXPECT_EQ(s["orbit"]["method"], "simulate");
@@ -43,8 +44,9 @@ TEST(OrbitNewtonCli, JsonReportsNewtonAndMatchesSimulation) {
 
 TEST(OrbitNewtonCli, UnstableOrbitNewtonSucceedsWhereSimulationFails) {
   // tau = T, negative gain: the period-1 orbit is unstable (see test_orbit_newton.cpp).
-  std::vector<std::string> common = {"floquet", kScene, "--set", "N=40", "--set", "k=-0.1", "--set", "nev=2",
-                                     "--set", "orbit_max_periods=400", "--set", "events=off"};
+  std::vector<std::string> common = {"floquet", kScene,      "--set", "N=40",  "--set",
+                                     "k=-0.1",  "--set",     "nev=2", "--set", "orbit_max_periods=400",
+                                     "--set",   "events=off"};
   auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = common;
     args.insert(args.end(), extra.begin(), extra.end());
@@ -71,15 +73,15 @@ TEST(OrbitNewtonCli, NewtonFailureIsExitThree) {
 
 TEST(OrbitNewtonCli, BadNewtonKeysAreExitTwo) {
   for (auto [key, value] : std::vector<std::pair<std::string, std::string>>{{"orbit_max_iterations", "0"},
-                                                                             {"orbit_max_iterations", "x"},
-                                                                             {"orbit_max_iterations", "1.5"},
-                                                                             {"orbit_guess_periods", "-1"},
-                                                                             {"orbit_guess_periods", "many"},
-                                                                             {"orbit_tolerance", "0"},
-                                                                             {"orbit_tolerance", "nan"},
-                                                                             {"orbit_tolerance", "-2"}}) {
-    CliResult r = run({"floquet", "--set", "orbit=newton", "--set", "N=8", "--set", "solver=dense", "--set",
-                       key + "=" + value});
+                                                                            {"orbit_max_iterations", "x"},
+                                                                            {"orbit_max_iterations", "1.5"},
+                                                                            {"orbit_guess_periods", "-1"},
+                                                                            {"orbit_guess_periods", "many"},
+                                                                            {"orbit_tolerance", "0"},
+                                                                            {"orbit_tolerance", "nan"},
+                                                                            {"orbit_tolerance", "-2"}}) {
+    CliResult r =
+        run({"floquet", "--set", "orbit=newton", "--set", "N=8", "--set", "solver=dense", "--set", key + "=" + value});
     EXPECT_EQ(r.status, 2) << key << "=" << value << ": " << r.err;
     EXPECT_NE(r.err.find("`" + key), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(value), std::string::npos) << r.err;

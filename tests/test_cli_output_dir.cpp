@@ -31,8 +31,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using delayspec::testing::fresh_dir;
 using delayspec::testing::CliResult;
+using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
 
 std::string read(const fs::path& path) {
@@ -87,9 +87,10 @@ std::string without_metadata(const std::string& csv) {
   return out;
 }
 
-const std::vector<std::string> kSweep = {"--quiet", "--set", "model=linear", "--set", "N=10", "--set", "periods=20",
-                                         "--set", "transient=0", "--set", "sweep_key=a", "--set", "sweep_from=-2",
-                                         "--set", "sweep_to=0", "--set", "sweep_points=5", "--set", "section_points=4"};
+const std::vector<std::string> kSweep = {"--quiet",         "--set", "model=linear", "--set", "N=10",           "--set",
+                                         "periods=20",      "--set", "transient=0",  "--set", "sweep_key=a",    "--set",
+                                         "sweep_from=-2",   "--set", "sweep_to=0",   "--set", "sweep_points=5", "--set",
+                                         "section_points=4"};
 
 }  // namespace
 
@@ -210,7 +211,8 @@ TEST(OutputDirectory, RunJsonAbsentAfterAFailedRun) {
 TEST(OutputDirectory, KilledRunIsIncompleteAndResumesToTheSameTables) {
   const fs::path dir = fresh_dir("outdir_killed");
   const fs::path reference = fresh_dir("outdir_killed_reference");
-  const fs::path scene = fs::temp_directory_path() / ("delayspec_test_outdir_killed_" + std::to_string(::getpid()) + ".toml");
+  const fs::path scene =
+      fs::temp_directory_path() / ("delayspec_test_outdir_killed_" + std::to_string(::getpid()) + ".toml");
   // ~200 points of several milliseconds each: the sweep runs long enough to be caught mid-way.
   std::ofstream(scene) << "analyses = [\"floquet\", \"sweep\"]\nmodel = \"linear\"\nb = -0.5\nN = 10\nsolver = "
                           "\"dense\"\nnev = 2\nperiods = 4000\ntransient = 0\nsweep_key = \"a\"\nsweep_from = -2\n"
@@ -368,10 +370,31 @@ INSTANTIATE_TEST_SUITE_P(Flags, OutputFlags, ::testing::Values(
 TEST(OutputDirectory, ChartAndBasinExitThreeWithFailedPointsRecorded) {
   const fs::path dir = fresh_dir("outdir_failing");
   // impact model, an orbit by simulation allowed 2 periods: it cannot settle at any point
-  CliResult chart = run({"chart", "--json", "--quiet", "--out", dir.string(), "--set", "model=impact", "--set", "N=8",
-                         "--set", "chart_x=k", "--set", "chart_y=zeta", "--set", "chart_x_range=0,0.2", "--set",
-                         "chart_y_range=0,0.1", "--set", "chart_x_points=2", "--set", "chart_y_points=2", "--set",
-                         "orbit=simulate", "--set", "orbit_max_periods=2"});
+  CliResult chart = run({"chart",
+                         "--json",
+                         "--quiet",
+                         "--out",
+                         dir.string(),
+                         "--set",
+                         "model=impact",
+                         "--set",
+                         "N=8",
+                         "--set",
+                         "chart_x=k",
+                         "--set",
+                         "chart_y=zeta",
+                         "--set",
+                         "chart_x_range=0,0.2",
+                         "--set",
+                         "chart_y_range=0,0.1",
+                         "--set",
+                         "chart_x_points=2",
+                         "--set",
+                         "chart_y_points=2",
+                         "--set",
+                         "orbit=simulate",
+                         "--set",
+                         "orbit_max_periods=2"});
   EXPECT_EQ(chart.status, 3) << chart.err;
   EXPECT_TRUE(contains(chart.err, "numerical failure at 4 of 4 point(s)")) << chart.err;
   auto j = nlohmann::json::parse(chart.out);
@@ -381,9 +404,27 @@ TEST(OutputDirectory, ChartAndBasinExitThreeWithFailedPointsRecorded) {
   EXPECT_TRUE(contains(read(dir / "chart.csv"), ",nan\n"));
   EXPECT_EQ(nlohmann::json::parse(read(dir / "complete.json"))["exit_status"], 3);
   // linear x' = a x + b x(t - 1): a = 10 overflows within the 400-period transient, a = -1 decays
-  CliResult basin = run({"basin", "--json", "--quiet", "--out", dir.string(), "--set", "model=linear", "--set", "N=8",
-                         "--set", "basin_x=a", "--set", "basin_y=b", "--set", "basin_x_range=-1,10", "--set",
-                         "basin_y_range=0,1", "--set", "basin_x_points=2", "--set", "basin_y_points=2"});
+  CliResult basin = run({"basin",
+                         "--json",
+                         "--quiet",
+                         "--out",
+                         dir.string(),
+                         "--set",
+                         "model=linear",
+                         "--set",
+                         "N=8",
+                         "--set",
+                         "basin_x=a",
+                         "--set",
+                         "basin_y=b",
+                         "--set",
+                         "basin_x_range=-1,10",
+                         "--set",
+                         "basin_y_range=0,1",
+                         "--set",
+                         "basin_x_points=2",
+                         "--set",
+                         "basin_y_points=2"});
   EXPECT_EQ(basin.status, 3) << basin.err;
   EXPECT_TRUE(contains(basin.err, "numerical failure at 2 of 4 point(s), first: (10, 0)")) << basin.err;
   j = nlohmann::json::parse(basin.out);
@@ -398,9 +439,19 @@ TEST(OutputDirectory, ChartAndBasinExitThreeWithFailedPointsRecorded) {
 // with a manifest naming each analysis's exit status.
 TEST(OutputDirectory, RunKeepsGoingAfterAnAnalysisExitsThree) {
   const fs::path dir = fresh_dir("outdir_run3");
-  CliResult r = run({"run", "--out", dir.string(), "--quiet", "--set", "analyses=basin,floquet", "--set", "model=linear", "--set", "N=8", "--set", "basin_x=a",
-                     "--set", "basin_y=b", "--set", "basin_x_range=-1,10", "--set", "basin_y_range=0,1", "--set",
-                     "basin_x_points=2", "--set", "basin_y_points=2", "--set", "solver=dense", "--set", "nev=2"});
+  CliResult r = run({"run",        "--out",
+                     dir.string(), "--quiet",
+                     "--set",      "analyses=basin,floquet",
+                     "--set",      "model=linear",
+                     "--set",      "N=8",
+                     "--set",      "basin_x=a",
+                     "--set",      "basin_y=b",
+                     "--set",      "basin_x_range=-1,10",
+                     "--set",      "basin_y_range=0,1",
+                     "--set",      "basin_x_points=2",
+                     "--set",      "basin_y_points=2",
+                     "--set",      "solver=dense",
+                     "--set",      "nev=2"});
   EXPECT_EQ(r.status, 3) << r.err;
   const auto manifest = nlohmann::json::parse(read(dir / "run.json"));
   EXPECT_EQ(manifest["analyses"][0]["exit_status"], 3);

@@ -41,12 +41,12 @@ std::string head(const fs::path& p, size_t n) {
 TEST(PlotCli, RendersMultipliersAndChartAsPngAndSvg) {
   const fs::path dir = fresh_plot_dir("render");
   // Inputs written by the commands themselves.
-  CliResult f = run({"floquet", "--json", "--set", "model=linear", "--set", "N=20", "--set", "solver=dense",
-                     "--set", "nev=4"});
+  CliResult f =
+      run({"floquet", "--json", "--set", "model=linear", "--set", "N=20", "--set", "solver=dense", "--set", "nev=4"});
   ASSERT_EQ(f.status, 0) << f.err;
   std::ofstream(dir / "floquet.json") << f.out;
-  CliResult c = run({"chart", "--out", dir.string(), "--set", "model=mathieu", "--set", "N=10", "--set",
-                     "solver=dense", "--set", "chart_x_points=3", "--set", "chart_y_points=3"});
+  CliResult c = run({"chart", "--out", dir.string(), "--set", "model=mathieu", "--set", "N=10", "--set", "solver=dense",
+                     "--set", "chart_x_points=3", "--set", "chart_y_points=3"});
   ASSERT_EQ(c.status, 0) << c.err;
 
   CliResult p = run({"plot", dir.string(), "--json", "--set", "plot_width=300", "--set", "plot_height=200"});
@@ -103,8 +103,9 @@ TEST(PlotCli, RendersSweepSimulateConvergeAndBenchFiles) {
   // Synthetic inputs in the formats the sweep, simulate, converge and bench commands write
   // (docs/formats.md): every figure is produced as a PNG and an SVG.
   const fs::path dir = fresh_plot_dir("formats");
-  std::ofstream(dir / "exponents.csv") << "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds\n"
-                                          "0,0.1,-0.2,0.01,0.01,0.0127,-0.025,1\n0.5,-0.1,-0.3,0.01,0.02,-0.0127,-0.038,1\n";
+  std::ofstream(dir / "exponents.csv")
+      << "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds\n"
+         "0,0.1,-0.2,0.01,0.01,0.0127,-0.025,1\n0.5,-0.1,-0.3,0.01,0.02,-0.0127,-0.038,1\n";
   std::ofstream(dir / "section.csv") << "parameter,x\n0,0.1\n0,0.2\n0.5,-0.05\n";
   std::ofstream(dir / "sweep.json") << R"({"sweep_key": "k"})";
   std::ofstream(dir / "trajectory.csv") << "t,x,v\n0,0,1\n0.1,0.1,0.99\n0.2,0.2,0.96\n0.3,0.29,0.9\n";
@@ -146,8 +147,9 @@ TEST(PlotCli, MetadataTextIsNeverExecuted) {
   const fs::path marker = dir / "pwned";
   const std::string touch = "system \"touch " + marker.string() + "\"";
   // A value that must be a number (the impact boundary e): exit 2 naming the value.
-  write(dir / "basin.csv", "# model = impact\n# e = 1; " + touch + "; x=1\nx0,v0,period,max_section_x\n"
-                           "1,0,1,0.5\n2,0,2,0.5\n\n1,1,1,0.5\n2,1,0,0.5\n");
+  write(dir / "basin.csv", "# model = impact\n# e = 1; " + touch +
+                               "; x=1\nx0,v0,period,max_section_x\n"
+                               "1,0,1,0.5\n2,0,2,0.5\n\n1,1,1,0.5\n2,1,0,0.5\n");
   CliResult basin = run({"plot", dir.string()});
   EXPECT_EQ(basin.status, 2) << basin.err;
   EXPECT_NE(basin.err.find("metadata `e = 1; system"), std::string::npos) << basin.err;
@@ -172,13 +174,15 @@ TEST(PlotCli, MetadataTextIsNeverExecuted) {
   const std::string evil = evil_line + "\n" + touch + "\\";  // (a CSV line cannot hold the newline)
   write(dir / "chart.csv", "# model = " + evil_line + "\n# N = 10\n" + "'x'; " + touch + "; b',y`touch " +
                                marker.string() + "`,spectral_radius\n0,0,0.5\n1,0,1.5\n\n0,1,0.7\n1,1,nan\n");
-  write(dir / "floquet.json", nlohmann::json{{"model", evil}, {"solver", evil}, {"N", 4},
-                                             {"multipliers", {{{"re", 0.5}, {"im", 0.1}}}}}
-                                  .dump());
+  write(dir / "floquet.json",
+        nlohmann::json{{"model", evil}, {"solver", evil}, {"N", 4}, {"multipliers", {{{"re", 0.5}, {"im", 0.1}}}}}
+            .dump());
   write(dir / "section.csv", "# sweep_key = " + evil_line + "\nparameter,x\n0,0.1\n0.5,0.2\n");
-  write(dir / "converge.json", nlohmann::json{{"reference", evil}, {"events", evil},
-                                              {"rows", {{{"N", 10}, {"error", 1e-3}, {"seconds", 0.1}, {"solver", evil}},
-                                                        {{"N", 20}, {"error", 2e-4}, {"seconds", 0.2}}}}}
+  write(dir / "converge.json", nlohmann::json{{"reference", evil},
+                                              {"events", evil},
+                                              {"rows",
+                                               {{{"N", 10}, {"error", 1e-3}, {"seconds", 0.1}, {"solver", evil}},
+                                                {{"N", 20}, {"error", 2e-4}, {"seconds", 0.2}}}}}
                                    .dump());
   CliResult text = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
   EXPECT_EQ(text.status, 0) << text.err;
@@ -350,9 +354,10 @@ TEST(PlotCli, GnuplotFailureIsExit3) {
 // from the metadata header sweep writes; old files without it fall back to "parameter".
 TEST(PlotCli, FiguresLabelWhatIsPlotted) {
   const fs::path dir = fresh_plot_dir("labels");
-  CliResult s = run({"sweep", "--out", dir.string(), "--quiet", "--set", "model=linear", "--set", "sweep_key=b",
-                     "--set", "sweep_from=-2", "--set", "sweep_to=-1", "--set", "sweep_points=2", "--set", "N=10",
-                     "--set", "periods=20", "--set", "transient=0", "--set", "section_points=2"});
+  CliResult s =
+      run({"sweep", "--out",         dir.string(), "--quiet",     "--set", "model=linear",    "--set", "sweep_key=b",
+           "--set", "sweep_from=-2", "--set",      "sweep_to=-1", "--set", "sweep_points=2",  "--set", "N=10",
+           "--set", "periods=20",    "--set",      "transient=0", "--set", "section_points=2"});
   ASSERT_EQ(s.status, 0) << s.err;
   fs::remove(dir / "sweep.json");  // the CSV's own metadata names the key
   write(dir / "bench.json", R"({"rows": [{"N": 10, "solver": "dense", "seconds": 0.01, "error": 1e-3},

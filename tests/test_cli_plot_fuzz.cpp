@@ -32,13 +32,16 @@ const std::vector<Files>& seeds() {
   static const std::vector<Files> all = {
       {{"floquet.json", R"({"model": "linear", "N": 20, "solver": "dense", "multipliers": [
           {"re": 0.5, "im": 0.25, "abs": 0.559}, {"re": -0.1, "im": 0, "abs": 0.1}]})"}},
-      {{"chart.csv", "# delayspec 0.1.0\n# model = mathieu\n# N = 10\ndelta,b,spectral_radius\n"
-                     "0,0,0.5\n1,0,1.2\n\n0,1,nan\n1,1,0.9\n"}},
-      {{"basin.csv", "# model = impact\n# e = 0x1.428f5c28f5c29p+0\n# k = 0.2\nx0,v0,period,max_section_x\n"
-                     "-3,-3,1,0.9\n3,-3,2,1.7\n\n-3,3,nan,nan\n3,3,0,2.2\n"}},
-      {{"exponents.csv", "# sweep_key = k\nparameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds\n"
-                         "0,0.1,-0.2,0.01,0.01,0.0127,-0.025,1\n0.5,nan,nan,nan,nan,nan,nan,nan\n"
-                         "1,-0.1,-0.3,0.01,0.02,-0.0127,-0.038,1\n"},
+      {{"chart.csv",
+        "# delayspec 0.1.0\n# model = mathieu\n# N = 10\ndelta,b,spectral_radius\n"
+        "0,0,0.5\n1,0,1.2\n\n0,1,nan\n1,1,0.9\n"}},
+      {{"basin.csv",
+        "# model = impact\n# e = 0x1.428f5c28f5c29p+0\n# k = 0.2\nx0,v0,period,max_section_x\n"
+        "-3,-3,1,0.9\n3,-3,2,1.7\n\n-3,3,nan,nan\n3,3,0,2.2\n"}},
+      {{"exponents.csv",
+        "# sweep_key = k\nparameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds\n"
+        "0,0.1,-0.2,0.01,0.01,0.0127,-0.025,1\n0.5,nan,nan,nan,nan,nan,nan,nan\n"
+        "1,-0.1,-0.3,0.01,0.02,-0.0127,-0.038,1\n"},
        {"section.csv", "# sweep_key = k\nparameter,x\n0,0.1\n0,0.2\n1,-0.05\n"},
        {"sweep.json", R"({"sweep_key": "k", "sweep_from": 0, "sweep_to": 1})"}},
       {{"trajectory.csv", "t,x,v\n0,0,1\n0.1,0.1,0.99\n0.2,0.2,0.96\n0.3,0.29,0.9\n"},
@@ -61,9 +64,12 @@ struct Mutator {
   size_t below(size_t n) { return n == 0 ? 0 : static_cast<size_t>(rng() % n); }
 
   void mutate(std::string& s) {
-    static const char* const tokens[] = {"nan", "inf", "-inf", "-1", "0", "1e999", "1e-320", "0x1p-1074", "\"x\"",
-                                         "null", "[]", "{}", "true", "[1,2]", ",", "\n", "\n\n", "#", "# e = x\n", "'",
-                                         "`", "\"", "\\", "\r\n", "9999999999999999999999", "2.5", ""};
+    static const char* const tokens[] = {"nan",   "inf",    "-inf",      "-1",        "0",
+                                         "1e999", "1e-320", "0x1p-1074", "\"x\"",     "null",
+                                         "[]",    "{}",     "true",      "[1,2]",     ",",
+                                         "\n",    "\n\n",   "#",         "# e = x\n", "'",
+                                         "`",     "\"",     "\\",        "\r\n",      "9999999999999999999999",
+                                         "2.5",   ""};
     const size_t at = below(s.size() + 1);
     switch (below(7)) {
       case 0:  // truncate
@@ -80,14 +86,17 @@ struct Mutator {
         break;
       case 4: {  // replace the number (or word) at `at` by a token
         size_t begin = at, end = at;
-        auto part = [&](size_t i) { return i < s.size() && (std::isalnum(static_cast<unsigned char>(s[i])) || s[i] == '.' || s[i] == '-'); };
+        auto part = [&](size_t i) {
+          return i < s.size() && (std::isalnum(static_cast<unsigned char>(s[i])) || s[i] == '.' || s[i] == '-');
+        };
         while (begin > 0 && part(begin - 1)) --begin;
         while (part(end)) ++end;
         s.replace(begin, end - begin, tokens[below(std::size(tokens))]);
         break;
       }
       case 5: {  // drop or repeat a line
-        const size_t begin = s.rfind('\n', at == 0 ? 0 : at - 1), line_begin = begin == std::string::npos ? 0 : begin + 1;
+        const size_t begin = s.rfind('\n', at == 0 ? 0 : at - 1),
+                     line_begin = begin == std::string::npos ? 0 : begin + 1;
         size_t line_end = s.find('\n', line_begin);
         line_end = line_end == std::string::npos ? s.size() : line_end + 1;
         const std::string line = s.substr(line_begin, line_end - line_begin);

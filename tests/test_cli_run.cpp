@@ -14,8 +14,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using delayspec::testing::fresh_dir;
 using delayspec::testing::CliResult;
+using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
 
 std::string scene(const std::string& name, const std::string& text) {
@@ -62,8 +62,8 @@ TEST(RunCli, WritesResultWithMetadataAndManifest) {
 
 TEST(RunCli, DefaultSceneRuns) {
   const fs::path dir = fresh_dir("run_default");
-  CliResult r = run({"run", DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml", "--out", dir.string(), "--set",
-                     "N=40", "--quiet"});
+  CliResult r =
+      run({"run", DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml", "--out", dir.string(), "--set", "N=40", "--quiet"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir / "floquet.json"));
 }
@@ -130,8 +130,9 @@ TEST(RunCli, EveryAnalysisCommandIsAcceptedByRun) {
 TEST(RunCli, SceneWithoutAnalysesRunsTheCommandItsKeysBelongTo) {
   // A chart scene written for `delayspec chart SCENE` (no `analyses`): run infers chart.
   const fs::path dir = fresh_dir("run_inferred");
-  const std::string path = scene("inferred", "model = \"mathieu\"\nN = 8\nsolver = \"dense\"\nchart_x_points = 2\n"
-                                             "chart_y_points = 2\n");
+  const std::string path = scene("inferred",
+                                 "model = \"mathieu\"\nN = 8\nsolver = \"dense\"\nchart_x_points = 2\n"
+                                 "chart_y_points = 2\n");
   CliResult r = run({"run", path, "--out", dir.string(), "--quiet"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir / "chart.json"));

@@ -45,9 +45,10 @@ Config with(const std::string& key, const std::string& value) {
 }  // namespace
 
 TEST(Config, SceneTablesAreFlattenedAndTypesSpelledAsSet) {
-  Config c = Config::from_scene_file(write_scene("flat", "model = \"impact\"\n[grid]\nN = 40\n[floquet]\n"
-                                                         "nev = 3\nk = 0.25\nanalyses = [\"floquet\", \"lyapunov\"]\n"
-                                                         "quiet = true\n"));
+  Config c = Config::from_scene_file(write_scene("flat",
+                                                 "model = \"impact\"\n[grid]\nN = 40\n[floquet]\n"
+                                                 "nev = 3\nk = 0.25\nanalyses = [\"floquet\", \"lyapunov\"]\n"
+                                                 "quiet = true\n"));
   EXPECT_EQ(c.get_string("model", ""), "impact");
   EXPECT_EQ(c.get_int("N", 0), 40);
   EXPECT_EQ(c.get_int("nev", 0), 3);
@@ -160,20 +161,22 @@ TEST(ConfigErrors, UnknownKeyFarFromEverythingHasNoSuggestion) {
 
 TEST(ClosestKey, ThresholdsByLength) {
   const std::vector<std::string> keys = {"N", "Ns", "nev", "solver", "transient", "k", "e"};
-  EXPECT_EQ(closest_key("ns", keys), "Ns");        // case only
-  EXPECT_EQ(closest_key("x", keys), "");           // 1-2 characters: case only, no guessing
-  EXPECT_EQ(closest_key("nve", keys), "");         // transposition = 2 edits > 1 for 3 characters
-  EXPECT_EQ(closest_key("neev", keys), "nev");     // 1 insertion
+  EXPECT_EQ(closest_key("ns", keys), "Ns");          // case only
+  EXPECT_EQ(closest_key("x", keys), "");             // 1-2 characters: case only, no guessing
+  EXPECT_EQ(closest_key("nve", keys), "");           // transposition = 2 edits > 1 for 3 characters
+  EXPECT_EQ(closest_key("neev", keys), "nev");       // 1 insertion
   EXPECT_EQ(closest_key("slover", keys), "solver");  // 2 edits, 6 characters
   EXPECT_EQ(closest_key("transiant", keys), "transient");
-  EXPECT_EQ(closest_key("solvers_x", keys), "");   // 3 edits
+  EXPECT_EQ(closest_key("solvers_x", keys), "");  // 3 edits
 }
 
 TEST(ConfigErrors, NonAsciiOutsideStringsAndCommentsIsRejected) {
   // Regression (fuzz_scene): toml++ 3.3.0 reaches undefined behaviour on U+00A1 after `=`.
   const std::string m = bad_input_message([] { Config::from_scene_text("N = 4\nmodel = \xc2\xa1\n", "x.toml"); });
   EXPECT_TRUE(contains(m, "non-ASCII character outside a string or comment (line 2, column 9)")) << m;
-  const std::string crash = "model =\xef\xbb\xbb" "abetau\"\newsrb\"\n_Cax_delta =3\n";  // the fuzzer's input
+  const std::string crash =
+      "model =\xef\xbb\xbb"
+      "abetau\"\newsrb\"\n_Cax_delta =3\n";  // the fuzzer's input
   EXPECT_TRUE(contains(bad_input_message([&] { Config::from_scene_text(crash, "c.toml"); }), "non-ASCII"));
 }
 
@@ -187,7 +190,8 @@ TEST(Config, NonAsciiInStringsAndCommentsIsFine) {
 }
 
 TEST(ConfigErrors, DirectoryIsNotAScene) {
-  const std::string m = bad_input_message([] { Config::from_scene_file(std::filesystem::temp_directory_path().string()); });
+  const std::string m =
+      bad_input_message([] { Config::from_scene_file(std::filesystem::temp_directory_path().string()); });
   EXPECT_TRUE(contains(m, "not a regular file")) << m;
 }
 
@@ -204,9 +208,12 @@ TEST(ConfigErrors, NonAsciiAfterABackslashInABasicStringIsRejected) {
   // value to the next space, `,`, `]`, `}` or `#` with the same undefined test (the fuzzer's
   // second input, shortened).
   using namespace std::string_literals;  // "..."s keeps the embedded NULs of the fuzzer's input
-  for (const std::string& text : {"ma = 0RRR;s\x04'''''''\x00\x00" "cobii\"\"\"\"\\\xc2\xa1'''\n"s,
+  for (const std::string& text : {"ma = 0RRR;s\x04'''''''\x00\x00"
+                                  "cobii\"\"\"\"\\\xc2\xa1'''\n"s,
                                   "x = 0'\xc2\xa1'\n"s, "x = true\"\xc2\xa1\"\n"s,
-                                  "ma = 0\"\".\"RRRE\xc4\xbd" "E0\x00\x00\x00" "EEE\n"s}) {
+                                  "ma = 0\"\".\"RRRE\xc4\xbd"
+                                  "E0\x00\x00\x00"
+                                  "EEE\n"s}) {
     const std::string m = bad_input_message([&] { Config::from_scene_text(text, "q.toml"); });
     EXPECT_TRUE(contains(m, "non-ASCII character outside a string or comment (line 1")) << m;
   }

@@ -105,7 +105,8 @@ TEST(Richardson, FirstOrderExpansion) {
   const std::vector<double> h{0.2, 0.1, 0.05};
   std::vector<cd> v;
   for (double s : h) v.push_back(0.9 + 0.7 * s - 2.0 * s * s);
-  const Extrapolation e = richardson_extrapolate(h, v, {.order = 1, .order_step = 1, .max_columns = 4, .check_orders = false});
+  const Extrapolation e =
+      richardson_extrapolate(h, v, {.order = 1, .order_step = 1, .max_columns = 4, .check_orders = false});
   EXPECT_LT(std::abs(e.value - 0.9), 1e-14);
   // Checked: the differences 0.01, 0.02 grow (the h^2 term dominates at h = 0.2): the data show
   // no first order, so nothing is extrapolated and no error estimate is claimed.
@@ -310,8 +311,8 @@ TEST(Matching, SurvivesAComplexPairBecomingTwoReals) {
   o.reference = ReferenceKind::finest;
   const ConvergenceStudy s = run_convergence_study(synthetic(values), o);
   for (const ConvergenceRow& row : s.rows) {
-    EXPECT_DOUBLE_EQ(row.multipliers[0].real(), 0.9) << "N " << row.N;  // the leader stays the leader
-    EXPECT_NE(row.multipliers[1], row.multipliers[2]) << "N " << row.N;   // no value used twice
+    EXPECT_DOUBLE_EQ(row.multipliers[0].real(), 0.9) << "N " << row.N;   // the leader stays the leader
+    EXPECT_NE(row.multipliers[1], row.multipliers[2]) << "N " << row.N;  // no value used twice
     // Both tracks 1 and 2 stay within the pair's reach, |mu - 0.5| <= max(|sqrt g|) = 0.1.
     EXPECT_LE(std::abs(row.multipliers[1] - 0.5), 0.1 + 1e-12) << "N " << row.N;
     EXPECT_LE(std::abs(row.multipliers[2] - 0.5), 0.1 + 1e-12) << "N " << row.N;
@@ -621,7 +622,8 @@ TEST(ConvergenceOnModels, MathieuIsSecondOrderAgainstItsOwnExtrapolation) {
     log_n.push_back(std::log(o.Ns[i + 1]));
     log_e.push_back(std::log(e));
     std::printf("mathieu N %4d |mu| %.13f err %.3e  two-level %.13f err %.3e\n", o.Ns[i + 1],
-                std::abs(s.rows[i + 1].multipliers[0]), std::abs(std::abs(s.rows[i + 1].multipliers[0]) - published) / published,
+                std::abs(s.rows[i + 1].multipliers[0]),
+                std::abs(std::abs(s.rows[i + 1].multipliers[0]) - published) / published,
                 std::abs(s.richardson.columns[1][i]), e);
   }
   for (size_t i = 0; i + 1 < log_e.size(); ++i) {

@@ -36,7 +36,7 @@ struct OrbitFixture {
         map(stepper, make_grid(model.tau(), model.period(), 100)) {
     static const PeriodicOrbit reference = [&] {  // computed once for all tests (N = 100 only)
       OrbitBySimulationOptions o;
-      o.tolerance = 1e-10;  // the checks need an orbit with impacts, not a converged one
+      o.tolerance = 1e-10;      // the checks need an orbit with impacts, not a converged one
       StepOptions one_substep;  // at N = 100 the default (4 sub-steps) orbit is not reached by simulation
       one_substep.contact_substeps = 1;
       const StroboscopicMap<ImpactModel> reference_map(TrapezoidStepper<ImpactModel>(model, one_substep), map.grid());

@@ -24,7 +24,7 @@ using namespace delayspec::testing;
 namespace {
 
 struct Resolution {
-  std::complex<double> mu;  // leading multiplier (the one with Im >= 0 of the leading pair)
+  std::complex<double> mu;   // leading multiplier (the one with Im >= 0 of the leading pair)
   double max_x = -INFINITY;  // largest displacement on the orbit (> e: it impacts)
 };
 

@@ -166,7 +166,8 @@ TEST(EventHardCases, GrazingPenetrationOneTenBillionth) {
   // term dominates both, plus an O(1) part).
   const GrazingCase deeper = grazing_case(1e-8);
   const TrapezoidStepper<ImpactModel> deeper_stepper{ImpactModel(deeper.parameters)};
-  const double growth = J.lpNorm<Eigen::Infinity>() / step_jacobian(deeper_stepper, deeper.input).lpNorm<Eigen::Infinity>();
+  const double growth =
+      J.lpNorm<Eigen::Infinity>() / step_jacobian(deeper_stepper, deeper.input).lpNorm<Eigen::Infinity>();
   EXPECT_NEAR(growth, 10, 3);
   // The frozen map has no such term: wrong by O(1).
   EXPECT_GT(relative_error(F, step_jacobian(frozen, g.input)), 0.5);

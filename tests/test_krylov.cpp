@@ -27,8 +27,15 @@ Monodromy<Model::d> zero_orbit_monodromy(const Model& model, int N) {
 // The default scene's period-1 orbit of the impact oscillator (paper parameters, tau = T,
 // k = 0.2), reached by simulation from its initial history (data/scenes/default.toml).
 Monodromy<2> impact_orbit_monodromy(int N) {
-  ImpactModel model({.zeta = 0.01, .e = 1.26, .a = 0.7, .beta = 28, .omega = 0.802, .k = 0.2, .tau_over_T = 1,
-                     .x0 = -0.0566, .v0 = 1.0101});
+  ImpactModel model({.zeta = 0.01,
+                     .e = 1.26,
+                     .a = 0.7,
+                     .beta = 28,
+                     .omega = 0.802,
+                     .k = 0.2,
+                     .tau_over_T = 1,
+                     .x0 = -0.0566,
+                     .v0 = 1.0101});
   HistoryGrid grid = make_grid(model.tau(), model.period(), N);
   StroboscopicMap<ImpactModel> map(TrapezoidStepper<ImpactModel>(model), grid);
   PeriodicOrbit orbit = orbit_by_simulation(map, map.constant_history(model.initial_state()));
@@ -108,7 +115,8 @@ TEST(Krylov, TwoMultipliersOfNearlyEqualModulus) {
   // is the union of the two spectra. The second has a = -1 + 1e-6, so the two leading (real)
   // multipliers differ by about 1e-6 relative.
   const int N = 300;
-  const LinearModel m1({.a = -1, .b = 0.5, .tau = 1, .period = 2}), m2({.a = -1 + 1e-6, .b = 0.5, .tau = 1, .period = 2});
+  const LinearModel m1({.a = -1, .b = 0.5, .tau = 1, .period = 2}),
+      m2({.a = -1 + 1e-6, .b = 0.5, .tau = 1, .period = 2});
   const HistoryGrid grid = make_grid(1, 2, N);
   std::vector<StepMap<1>> s1, s2;
   StroboscopicMap<LinearModel>(TrapezoidStepper<LinearModel>(m1), grid).apply(Eigen::VectorXd::Zero(N + 1), &s1);

@@ -22,8 +22,8 @@ const std::string kScene = DELAYSPEC_SOURCE_DIR "/data/scenes/default.toml";
 
 TEST(KrylovCli, JsonContractForBothBackends) {
   for (const char* solver : {"spectra", "arpack"}) {
-    CliResult r = run({"floquet", kScene, "--json", "--set", "N=80", "--set", "nev=8", "--set",
-                       std::string("solver=") + solver});
+    CliResult r =
+        run({"floquet", kScene, "--json", "--set", "N=80", "--set", "nev=8", "--set", std::string("solver=") + solver});
     ASSERT_EQ(r.status, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["solver"], solver);
@@ -60,12 +60,12 @@ TEST(KrylovCli, ForcedNonConvergenceExitsThree) {
 
 TEST(KrylovCli, BadKrylovKeysExitTwoNamingKeyAndValue) {
   const std::vector<std::pair<std::string, std::string>> bad = {
-      {"ncv", "-1"}, {"ncv", "7"},  // 7 < nev + 2 = 8
-      {"ncv", "many"}, {"tol", "0"}, {"tol", "-1e-9"}, {"tol", "nan"}, {"tol", "x"},
-      {"max_restarts", "-1"}, {"max_restarts", "1.5"}, {"seed", "-3"}, {"seed", "abc"}};
+      {"ncv", "-1"},           {"ncv", "7"},  // 7 < nev + 2 = 8
+      {"ncv", "many"},         {"tol", "0"},   {"tol", "-1e-9"}, {"tol", "nan"}, {"tol", "x"}, {"max_restarts", "-1"},
+      {"max_restarts", "1.5"}, {"seed", "-3"}, {"seed", "abc"}};
   for (const auto& [key, value] : bad) {
-    CliResult r = run({"floquet", "--set", "model=mathieu", "--set", "N=20", "--set", "solver=arpack", "--set",
-                       key + "=" + value});
+    CliResult r = run(
+        {"floquet", "--set", "model=mathieu", "--set", "N=20", "--set", "solver=arpack", "--set", key + "=" + value});
     EXPECT_EQ(r.status, 2) << key << "=" << value << ": " << r.err;
     EXPECT_NE(r.err.find("`" + key), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(value), std::string::npos) << r.err;

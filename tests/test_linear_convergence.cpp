@@ -53,18 +53,17 @@ TEST_P(LinearLeadingMultiplier, ConvergesAtSecondOrderToLambertW) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    TauEqualsT_T2_2T, LinearLeadingMultiplier,
-    ::testing::Values(LinearCase{"stable_tau_T", -1.0, 0.5, 1.0, 1.0},          // real root -0.4, mu < 1
-                      LinearCase{"unstable_tau_T", 0.2, 0.3, 1.0, 1.0},         // real root > 0, mu > 1
-                      LinearCase{"oscillatory_tau_T", -1.0, -2.0, 1.0, 1.0},    // complex pair leads
-                      LinearCase{"stable_tau_T2", -1.0, 0.5, 1.0, 2.0},         // tau = T/2
-                      LinearCase{"unstable_tau_T2", 0.2, 0.3, 1.0, 2.0},
-                      LinearCase{"oscillatory_tau_T2", -1.0, -2.0, 1.0, 2.0},
-                      LinearCase{"stable_tau_2T", -1.0, 0.5, 1.0, 0.5},         // tau = 2T
-                      LinearCase{"unstable_tau_2T", 0.2, 0.3, 1.0, 0.5},
-                      LinearCase{"oscillatory_tau_2T", -1.0, -2.0, 1.0, 0.5}),
-    [](const auto& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(TauEqualsT_T2_2T, LinearLeadingMultiplier,
+                         ::testing::Values(LinearCase{"stable_tau_T", -1.0, 0.5, 1.0, 1.0},   // real root -0.4, mu < 1
+                                           LinearCase{"unstable_tau_T", 0.2, 0.3, 1.0, 1.0},  // real root > 0, mu > 1
+                                           LinearCase{"oscillatory_tau_T", -1.0, -2.0, 1.0, 1.0},  // complex pair leads
+                                           LinearCase{"stable_tau_T2", -1.0, 0.5, 1.0, 2.0},       // tau = T/2
+                                           LinearCase{"unstable_tau_T2", 0.2, 0.3, 1.0, 2.0},
+                                           LinearCase{"oscillatory_tau_T2", -1.0, -2.0, 1.0, 2.0},
+                                           LinearCase{"stable_tau_2T", -1.0, 0.5, 1.0, 0.5},  // tau = 2T
+                                           LinearCase{"unstable_tau_2T", 0.2, 0.3, 1.0, 0.5},
+                                           LinearCase{"oscillatory_tau_2T", -1.0, -2.0, 1.0, 0.5}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 TEST(MathieuSpectralRadius, ConvergesAtSecondOrder) {
   // kappa = 0.1, delta = 3, eps = 2, b = -0.15 (issue 2): rho = 0.512052284098 (12 digits).

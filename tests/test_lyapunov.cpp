@@ -139,7 +139,7 @@ TEST(Lyapunov, LinearDdeExponentsAreRealPartsOfExactRoots) {
   o.periods = 16000;
   const LyapunovResult long_run = run(model, N, o);
   for (int i = 0; i < 4; ++i) {
-    const double exact = roots[i].real();                // roots come sorted by real part
+    const double exact = roots[i].real();                 // roots come sorted by real part
     const double same_N = std::log(std::abs(mu[i])) / 1;  // the discrete map's own value, T = 1
     // trapezoid rule: O(h^2) discretisation error, h = 1e-2, constant |lambda|^3/12 ~ 40 for the second pair
     EXPECT_NEAR(same_N, exact, 40 * 1e-4) << i;
@@ -282,9 +282,10 @@ TEST(Lyapunov, ImpactPeriodOneOrbitGivesLogOfFloquetMultipliers) {
   // 2 pi here, every batch sees the same phase change, and the batch means agree to ~2e-6 while
   // the exponents are off by ~1.1e-4 (a named regression of the old error bar: 60 SE).
   for (int i = 0; i < 2; ++i) {
-    std::printf("impact pair: lambda_%d %.9f err %.3e (batch SE %.3e, fluctuation bound %.3e), |lambda - log|mu|| %.3e, phase bound %.3e\n",
-                i + 1, r.per_period[i], r.error_per_period[i], r.batch_standard_error_per_period[i],
-                r.fluctuation_bound_per_period[i], std::abs(r.per_period[i] - log_mu), phase_bound);
+    std::printf(
+        "impact pair: lambda_%d %.9f err %.3e (batch SE %.3e, fluctuation bound %.3e), |lambda - log|mu|| %.3e, phase bound %.3e\n",
+        i + 1, r.per_period[i], r.error_per_period[i], r.batch_standard_error_per_period[i],
+        r.fluctuation_bound_per_period[i], std::abs(r.per_period[i] - log_mu), phase_bound);
     EXPECT_LE(std::abs(r.per_period[i] - log_mu), r.error_per_period[i]) << i;
     EXPECT_GT(std::abs(r.per_period[i] - log_mu), 10 * r.batch_standard_error_per_period[i]) << i;
     // and it is no looser than the a-priori bound: g in [-log cond S, log cond S] with g(0) = 0
@@ -370,8 +371,9 @@ TEST(Lyapunov, ChaoticErrorMatchesTheSpreadOfIndependentWindows) {
     double ss = 0;
     for (int w = 0; w < windows; ++w) ss += (value[i][w] - mean) * (value[i][w] - mean);
     const double sd = std::sqrt(ss / (windows - 1));
-    std::printf("mackey-glass lambda_%d: mean %.6f, sd of %d windows %.3e, mean reported error %.3e (ratio %.2f), batch SE %.3e\n", i + 1,
-                mean, windows, sd, mean_error, mean_error / sd, mean_batch);
+    std::printf(
+        "mackey-glass lambda_%d: mean %.6f, sd of %d windows %.3e, mean reported error %.3e (ratio %.2f), batch SE %.3e\n",
+        i + 1, mean, windows, sd, mean_error, mean_error / sd, mean_batch);
     EXPECT_GE(mean_error, sd) << i;
     EXPECT_LT(mean_error, 2 * mean_batch) << i;
     if (i == 0) {
@@ -394,7 +396,7 @@ TEST(LyapunovStatistics, BoundedOscillationResonantWithTheBatchesIsCovered) {
   for (long i = 1; i <= I; ++i) x[i - 1] = c + A * (std::cos(theta * i) - std::cos(theta * (i - 1)));
   const ds::LyapunovStatistics st = ds::lyapunov_statistics(x, 1, 1, 20);
   const double bias = A * (std::cos(theta * I) - 1) / I;
-  EXPECT_NEAR(st.mean_per_period[0] - c, bias, 1e-15);  // the mean is S(I) / I, rounding only
+  EXPECT_NEAR(st.mean_per_period[0] - c, bias, 1e-15);        // the mean is S(I) / I, rounding only
   EXPECT_NEAR(bias, -2 * A / I, 1e-12);                       // cos(theta I) = cos(41 pi) = -1
   EXPECT_LT(st.batch_standard_error[0], std::abs(bias) / 5);  // the old error bar: blind
   EXPECT_GE(st.error[0], std::abs(bias));

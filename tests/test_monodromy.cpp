@@ -115,9 +115,12 @@ void expect_step_map_matches_finite_differences(const Model& model, double t, do
   for (int c = 0; c < D; ++c) {
     Vec<D> e = Vec<D>::Zero();
     e[c] = delta;
-    P.col(c) = (stepper.step(t, h, u0 + e, w0, w1, scratch) - stepper.step(t, h, u0 - e, w0, w1, scratch)) / (2 * delta);
-    Q.col(c) = (stepper.step(t, h, u0, w0 + e, w1, scratch) - stepper.step(t, h, u0, w0 - e, w1, scratch)) / (2 * delta);
-    R.col(c) = (stepper.step(t, h, u0, w0, w1 + e, scratch) - stepper.step(t, h, u0, w0, w1 - e, scratch)) / (2 * delta);
+    P.col(c) =
+        (stepper.step(t, h, u0 + e, w0, w1, scratch) - stepper.step(t, h, u0 - e, w0, w1, scratch)) / (2 * delta);
+    Q.col(c) =
+        (stepper.step(t, h, u0, w0 + e, w1, scratch) - stepper.step(t, h, u0, w0 - e, w1, scratch)) / (2 * delta);
+    R.col(c) =
+        (stepper.step(t, h, u0, w0, w1 + e, scratch) - stepper.step(t, h, u0, w0, w1 - e, scratch)) / (2 * delta);
   }
   const double scale = 1 + map.P.norm() + map.Q.norm() + map.R.norm();
   EXPECT_LE((P - map.P).norm(), 1e-7 * scale) << "P\n" << P << "\nvs\n" << map.P;
@@ -126,8 +129,8 @@ void expect_step_map_matches_finite_differences(const Model& model, double t, do
 }
 
 TEST(StepMap, MatchesFiniteDifferencesLinear) {
-  expect_step_map_matches_finite_differences(LinearModel({.a = -1.3, .b = 0.7}), 0.0, 0.05, Vec<1>(0.4),
-                                             Vec<1>(-0.2), Vec<1>(0.9));
+  expect_step_map_matches_finite_differences(LinearModel({.a = -1.3, .b = 0.7}), 0.0, 0.05, Vec<1>(0.4), Vec<1>(-0.2),
+                                             Vec<1>(0.9));
 }
 
 TEST(StepMap, MatchesFiniteDifferencesMathieu) {
@@ -138,10 +141,8 @@ TEST(StepMap, MatchesFiniteDifferencesMathieu) {
 TEST(StepMap, MatchesFiniteDifferencesImpactBothRegions) {
   ImpactModel model({.k = 0.8});
   // free flight (x < e) and contact (x > e) with both nodes on the same side
-  expect_step_map_matches_finite_differences(model, 0.7, 0.02, Vec<2>(0.5, 0.3), Vec<2>(0.2, 0.1),
-                                             Vec<2>(0.25, 0.0));
-  expect_step_map_matches_finite_differences(model, 0.7, 0.02, Vec<2>(1.3, 0.3), Vec<2>(0.2, 0.1),
-                                             Vec<2>(0.25, 0.0));
+  expect_step_map_matches_finite_differences(model, 0.7, 0.02, Vec<2>(0.5, 0.3), Vec<2>(0.2, 0.1), Vec<2>(0.25, 0.0));
+  expect_step_map_matches_finite_differences(model, 0.7, 0.02, Vec<2>(1.3, 0.3), Vec<2>(0.2, 0.1), Vec<2>(0.25, 0.0));
 }
 
 // Central differences of the whole stroboscopic map of a linear model against the monodromy

@@ -55,10 +55,7 @@ struct MapSetup {
   TrapezoidStepper<Model> stepper;
   StroboscopicMap<Model> map;
   MapSetup(const Model& m, int N, int periods = 1, StepOptions options = {})
-      : model(m),
-        grid(make_grid(m.tau(), m.period(), N, periods)),
-        stepper(m, options),
-        map(stepper, grid) {}
+      : model(m), grid(make_grid(m.tau(), m.period(), N, periods)), stepper(m, options), map(stepper, grid) {}
 };
 
 // Central finite differences of the residual, column by column.
@@ -150,8 +147,8 @@ TEST(OrbitNewton, ConvergesQuadraticallyFromPerturbedOrbit) {
   const double floor = 100 * kEps * (1 + x_star.lpNorm<Eigen::Infinity>());  // rounding of F
   for (size_t i = 0; i + 1 < r.size(); ++i) {
     if (r[i] < floor) break;
-    EXPECT_LE(r[i + 1], C * r[i] * r[i] + floor) << "step " << i << ": r = " << r[i] << " -> " << r[i + 1]
-                                                 << ", C = " << C;
+    EXPECT_LE(r[i + 1], C * r[i] * r[i] + floor)
+        << "step " << i << ": r = " << r[i] << " -> " << r[i + 1] << ", C = " << C;
   }
   for (double lambda : orbit.newton_step_fractions) EXPECT_EQ(lambda, 1.0) << "near the orbit every step is full";
   EXPECT_LE(orbit.newton_iterations, 4);

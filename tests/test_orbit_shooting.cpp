@@ -189,7 +189,7 @@ TEST(OrbitShooting, UnstableOrbitSimulationCannotReach) {
   o.guess_periods = 0;
   OrbitLinearisation<2> at_orbit;
   const PeriodicOrbit shot = orbit_by_nested_shooting(s.map, s.model.initial_state(), o, &at_orbit);
-  ASSERT_EQ(shot.levels.size(), 2u);  // 128, 1024
+  ASSERT_EQ(shot.levels.size(), 2u);               // 128, 1024
   EXPECT_LE(shot.levels[1].newton_iterations, 4);  // measured 4: 1.2e-3, 1.1e-4, 6.8e-7, 5.1e-11, 6.7e-14
   const PeriodicOrbit newton = sparse_newton(s, 0);
   EXPECT_LT(relative_distance(shot.history, newton.history), 1e-10);
@@ -197,9 +197,9 @@ TEST(OrbitShooting, UnstableOrbitSimulationCannotReach) {
   f.nev = 2;
   const FloquetResult mu = floquet_multipliers(Monodromy<2>(s.grid, std::move(at_orbit.maps)), f);
   EXPECT_GT(std::abs(mu.multipliers[0]), 1.5);
-  EXPECT_THROW(orbit_by_simulation(s.map, shot.history + Eigen::VectorXd::Constant(shot.history.size(), 1e-6),
-                                   {1e-12, 300}),
-               NumericalFailure);
+  EXPECT_THROW(
+      orbit_by_simulation(s.map, shot.history + Eigen::VectorXd::Constant(shot.history.size(), 1e-6), {1e-12, 300}),
+      NumericalFailure);
 }
 
 // Failures: too few Newton steps names the level's N and |P(U) - U|; bad options are bad input.
@@ -240,7 +240,8 @@ TEST(OrbitShootingCli, DefaultAutoMatchesSimulationAndReportsLevels) {
   EXPECT_EQ(a["orbit"]["levels"][0]["method"], "newton");
   EXPECT_EQ(a["orbit"]["levels"][1]["N"], 600);
   EXPECT_TRUE(a.contains("orbit_seconds"));
-  CliResult simulated = run({"floquet", scene, "--json", "--set", "N=600", "--set", "nev=4", "--set", "orbit=simulate"});
+  CliResult simulated =
+      run({"floquet", scene, "--json", "--set", "N=600", "--set", "nev=4", "--set", "orbit=simulate"});
   ASSERT_EQ(simulated.status, 0) << simulated.err;
   const auto s = nlohmann::json::parse(simulated.out);
   for (int i = 0; i < 4; ++i)

@@ -81,8 +81,8 @@ TEST(Simulation, BadWindowIsBadInput) {
 TEST(CliSimulate, JsonAndCsvFiles) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "delayspec_test_simulate";
   std::filesystem::remove_all(dir);
-  const CliResult r = run({"simulate", kScene, "--set", "N=50", "--set", "t_end=100", "--set", "t_start=50",
-                           "--set", "sample_every=5", "--json", "--out", dir.string()});
+  const CliResult r = run({"simulate", kScene, "--set", "N=50", "--set", "t_end=100", "--set", "t_start=50", "--set",
+                           "sample_every=5", "--json", "--out", dir.string()});
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"impacts", "impact_times", "poincare", "steps", "t_end", "t_start", "h", "N", "files"})
@@ -137,9 +137,9 @@ TEST(CliSimulate, BadKeysExitTwoNamingThem) {
 // differently). Without the key the chaotic uncontrolled phase already separates them.
 TEST(CliSimulate, EventsBeforeControlGivesBothRunsTheSameStateAtTheSwitch) {
   auto poincare = [](const std::vector<std::string>& extra) {
-    std::vector<std::string> args = {"simulate", kScene, "--set", "N=100", "--set", "k=1.4", "--set", "e=1.2609",
-                                     "--set", "x0=0", "--set", "v0=0", "--set", "control_on_at=300", "--set", "t_end=600",
-                                     "--json"};
+    std::vector<std::string> args = {"simulate", kScene,      "--set", "N=100", "--set", "k=1.4", "--set",
+                                     "e=1.2609", "--set",     "x0=0",  "--set", "v0=0",  "--set", "control_on_at=300",
+                                     "--set",    "t_end=600", "--json"};
     args.insert(args.end(), extra.begin(), extra.end());
     const CliResult r = run(args);
     EXPECT_EQ(r.status, 0) << r.err;

@@ -32,8 +32,8 @@
 // Step control (Newton's convergence): a corrector that converges in <= 3 iterations grows the
 // next step by 1.5 (at most step_max); 6 or more shrink it by 0.7; one that fails (not converged
 // in newton.max_iterations, the residual 1e3 times above the one after the first iteration, a
-// singular matrix, a step the stepper cannot take), whose tangent turns by more than ~37 degrees (cos < 0.8: a jump to another branch is
-// the usual cause), or whose secant turns back against the previous one (a corner of a piecewise-
+// singular matrix, a step the stepper cannot take), whose tangent turns by more than ~37 degrees (cos < 0.8: a jump to
+// another branch is the usual cause), or whose secant turns back against the previous one (a corner of a piecewise-
 // smooth branch, where the branch would retrace itself) is retried with half the step. A step
 // below step_min ends the branch with `failure` set: the point reached and the reason (the
 // points so far are kept).
@@ -70,9 +70,8 @@
 // bracket's two ends differ by <= tolerance in p (a test function crossing transversally:
 // superlinear). Where the corrector fails on one side (near grazing the discrete problem is only
 // piecewise smooth and Newton may stall in contact), the root is the secant through the last two
-// points of the other side, accepted when it moves by <= tolerance (`note` says so). A multiplier is real when |Im mu| <=
-// 1e-10 |mu|. Only the nev leading multipliers are watched: more than nev outside the circle
-// make the counts wrong.
+// points of the other side, accepted when it moves by <= tolerance (`note` says so). A multiplier is real when |Im mu|
+// <= 1e-10 |mu|. Only the nev leading multipliers are watched: more than nev outside the circle make the counts wrong.
 //
 // Errors: BadInput for invalid options (from == to, steps <= 0 or step_min > step_max, max_points
 // < 2, a parameter that changes the size of the problem); NumericalFailure when the start (Newton
@@ -608,10 +607,8 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
         break;
       }
       const Sample m{s, test(mid), mid.parameter, mid, st->x};
-      if (changes_here(neg.point, mid))
-        pos = m;  // (neg, pos) keep the order of s until the sign change
-      else
-        neg = m;
+      if (changes_here(neg.point, mid)) pos = m;  // (neg, pos) keep the order of s until the sign change
+      else neg = m;
     }
     if (neg.g > 0) std::swap(neg, pos);
     std::optional<Sample> prev_neg;       // the negative sample before `neg`
@@ -806,10 +803,8 @@ ContinuationResult continuation_detail::trace_branch(const ModelAt& model_at, co
     current = std::move(next);
     add_point(std::move(point));
     if (last) break;
-    if (iterations <= 3)
-      ds = std::min(1.5 * ds, o.step_max);
-    else if (iterations >= 6)
-      ds = std::max(0.7 * ds, o.step_min);
+    if (iterations <= 3) ds = std::min(1.5 * ds, o.step_max);
+    else if (iterations >= 6) ds = std::max(0.7 * ds, o.step_min);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   return result;

@@ -114,48 +114,48 @@ ReferenceKind parse_reference_kind(const std::string& name);
 std::string to_string(ReferenceKind kind);
 
 struct ConvergenceOptions {
-  std::vector<int> Ns;              // strictly increasing, each >= 1
-  int nev = 1;                      // multipliers tracked
-  int extra = 2;                    // computed beyond nev at each level, as matching candidates
+  std::vector<int> Ns;  // strictly increasing, each >= 1
+  int nev = 1;          // multipliers tracked
+  int extra = 2;        // computed beyond nev at each level, as matching candidates
   ReferenceKind reference = ReferenceKind::automatic;
-  Multipliers exact;                // exact multipliers (>= nev of them), for `exact` / `automatic`
-  double exact_precision = 1e-14;   // relative accuracy of `exact`
-  RichardsonOptions richardson;     // the error expansion (order 2, step 2: trapezoid, smooth)
-  double settled_spread = 0.3;      // pair orders within this band count as settled
+  Multipliers exact;               // exact multipliers (>= nev of them), for `exact` / `automatic`
+  double exact_precision = 1e-14;  // relative accuracy of `exact`
+  RichardsonOptions richardson;    // the error expansion (order 2, step 2: trapezoid, smooth)
+  double settled_spread = 0.3;     // pair orders within this band count as settled
   // Target (header comment); 0: none, the study is Ns.
-  double target = 0;                // relative error estimate wanted of every tracked multiplier
-  int max_N = 51200;                // no level beyond this N
-  double max_seconds = 600;         // total wall time of the levels
+  double target = 0;         // relative error estimate wanted of every tracked multiplier
+  int max_N = 51200;         // no level beyond this N
+  double max_seconds = 600;  // total wall time of the levels
 };
 
 struct ConvergenceRow {
   int N = 0;
-  std::string failure;                  // non-empty: the level failed (then the vectors below are empty
-                                        // and error is NaN)
-  std::string note;                     // LevelResult::note
-  Multipliers multipliers;              // matched: multipliers[k] is track k
-  std::vector<double> errors;           // relative error of each track
-  std::vector<double> correct_digits;   // LRE of each track, capped
-  double error = 0;                     // errors[0], the leading track
+  std::string failure;                 // non-empty: the level failed (then the vectors below are empty
+                                       // and error is NaN)
+  std::string note;                    // LevelResult::note
+  Multipliers multipliers;             // matched: multipliers[k] is track k
+  std::vector<double> errors;          // relative error of each track
+  std::vector<double> correct_digits;  // LRE of each track, capped
+  double error = 0;                    // errors[0], the leading track
   double seconds = 0;
   long operator_applications = 0;
 };
 
 struct OrderReport {
-  std::string basis;                    // "error" (exact reference) or "difference"
-  std::vector<double> pair_orders;      // basis error: rows (i, i+1); difference: rows (i, i+1, i+2)
-  std::vector<int> pair_N;              // the finest N involved in each pair order
-  double least_squares = 0;             // slope over all usable levels (NaN when < 2 points)
-  std::optional<double> observed;       // set only when the orders are settled
+  std::string basis;                // "error" (exact reference) or "difference"
+  std::vector<double> pair_orders;  // basis error: rows (i, i+1); difference: rows (i, i+1, i+2)
+  std::vector<int> pair_N;          // the finest N involved in each pair order
+  double least_squares = 0;         // slope over all usable levels (NaN when < 2 points)
+  std::optional<double> observed;   // set only when the orders are settled
   bool settled = false;
-  std::string note;                     // why `observed` is empty, or a caveat
+  std::string note;  // why `observed` is empty, or a caveat
 };
 
 struct ExtrapolatedMultiplier {
   std::complex<double> value;
-  double error_estimate = 0;            // absolute (see richardson.hpp; infinity: no estimate possible)
-  int levels = 0;                       // Richardson levels combined (the column used, see richardson.hpp)
-  std::string note;                     // why that column
+  double error_estimate = 0;  // absolute (see richardson.hpp; infinity: no estimate possible)
+  int levels = 0;             // Richardson levels combined (the column used, see richardson.hpp)
+  std::string note;           // why that column
 };
 
 // Richardson columns of the leading track: columns[j][i] = T[i][j] (entries with fewer than j + 1
@@ -164,15 +164,15 @@ struct ExtrapolatedMultiplier {
 struct RichardsonReport {
   std::vector<int> Ns;
   std::vector<std::vector<std::complex<double>>> columns;
-  std::vector<std::vector<double>> errors;   // relative, NaN where the reference is not independent
+  std::vector<std::vector<double>> errors;           // relative, NaN where the reference is not independent
   std::vector<std::optional<double>> column_orders;  // least-squares order of each column's errors
-  std::vector<double> expected_orders;       // e_{j+1} for column j
+  std::vector<double> expected_orders;               // e_{j+1} for column j
   // Reference-free, what the choice of column rests on (richardson.hpp): the order of each column
   // from its last three entries' differences, and whether the column is consistent with its
   // expected order (1), not (0), or too short to tell (-1).
   std::vector<double> difference_orders;
   std::vector<int> consistent;
-  int levels_used = 0;                       // the column the extrapolated value comes from (+1)
+  int levels_used = 0;  // the column the extrapolated value comes from (+1)
 };
 
 struct ConvergenceStudy {

@@ -63,25 +63,25 @@ std::string to_string(FloquetSolver solver);
 FloquetSolver choose_floquet_solver(long n);
 
 struct FloquetOptions {
-  int nev = 6;                              // multipliers wanted
+  int nev = 6;                                      // multipliers wanted
   FloquetSolver solver = FloquetSolver::automatic;  // choose_floquet_solver(n)
   // Krylov only:
-  int ncv = 0;                  // Krylov subspace dimension; 0 = default_ncv(nev, n); clamped to n
-  double tolerance = 1e-12;     // relative Ritz residual at which a pair counts as converged
-  int max_iterations = 300;     // Arnoldi iterations (1 + implicit restarts), ARPACK's MXITER
-  std::uint64_t seed = 1;       // start vector = start_vector(n, seed) for both backends
-  Eigen::VectorXd start;        // when non-empty: the start vector instead (n finite entries, not all 0)
-  bool keep_vectors = false;    // fill FloquetResult::subspace (Krylov only)
-  double residual_bound = 1e-8; // the residual gate (header comment): max(residual_bound, 100 tolerance)
-  bool retry_failed_gate = true; // retry a pair failing the gate (false: report the backend's first answer)
+  int ncv = 0;                    // Krylov subspace dimension; 0 = default_ncv(nev, n); clamped to n
+  double tolerance = 1e-12;       // relative Ritz residual at which a pair counts as converged
+  int max_iterations = 300;       // Arnoldi iterations (1 + implicit restarts), ARPACK's MXITER
+  std::uint64_t seed = 1;         // start vector = start_vector(n, seed) for both backends
+  Eigen::VectorXd start;          // when non-empty: the start vector instead (n finite entries, not all 0)
+  bool keep_vectors = false;      // fill FloquetResult::subspace (Krylov only)
+  double residual_bound = 1e-8;   // the residual gate (header comment): max(residual_bound, 100 tolerance)
+  bool retry_failed_gate = true;  // retry a pair failing the gate (false: report the backend's first answer)
 };
 
 struct FloquetResult {
   std::vector<std::complex<double>> multipliers;  // sorted by modulus, largest first (sort_by_modulus)
-  std::string solver;                            // backend that produced them
-  long operator_applications = 0;                // single-vector applications of the operator (all of them)
-  double seconds = 0;                            // wall time of the eigen-solve (incl. assembly / residuals)
-  std::string note;                              // e.g. why a Krylov request went dense
+  std::string solver;                             // backend that produced them
+  long operator_applications = 0;                 // single-vector applications of the operator (all of them)
+  double seconds = 0;                             // wall time of the eigen-solve (incl. assembly / residuals)
+  std::string note;                               // e.g. why a Krylov request went dense
   // Krylov only (dense: converged = nev, the rest 0 / empty):
   int ncv = 0;                    // subspace dimension used
   int converged = 0;              // Ritz values the backend reports converged (ARPACK iparam(5)), >= nev

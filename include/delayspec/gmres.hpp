@@ -32,10 +32,10 @@ struct GmresOptions {
 };
 
 struct GmresResult {
-  Eigen::VectorXd x;              // the approximate solution (from x = 0)
-  double relative_residual = 1;   // |b - A x|_2 / |b|_2, recomputed from x
-  int iterations = 0;             // applications of A inside Arnoldi
-  bool converged = false;         // relative_residual <= tolerance
+  Eigen::VectorXd x;             // the approximate solution (from x = 0)
+  double relative_residual = 1;  // |b - A x|_2 / |b|_2, recomputed from x
+  int iterations = 0;            // applications of A inside Arnoldi
+  bool converged = false;        // relative_residual <= tolerance
 };
 
 // apply(x, y): y = A x, called as apply(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::VectorXd& y)

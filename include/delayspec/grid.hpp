@@ -28,16 +28,16 @@ struct DelayTap {
 };
 
 struct HistoryGrid {
-  int N = 0;             // requested steps per delay
-  double tau = 0;        // delay
-  double period = 0;     // forcing period T
+  int N = 0;          // requested steps per delay
+  double tau = 0;     // delay
+  double period = 0;  // forcing period T
   int periods_per_map = 1;
-  double h = 0;          // step
+  double h = 0;              // step
   int steps_per_period = 0;  // K_1 = T / h
-  int K = 0;             // steps per stroboscopic map = periods_per_map * steps_per_period
-  int m = 0;             // delayed slot index (see above)
-  double theta = 0;      // fractional part of tau / h; 0 when aligned
-  int M = 0;             // last history slot: the history has M + 1 blocks
+  int K = 0;                 // steps per stroboscopic map = periods_per_map * steps_per_period
+  int m = 0;                 // delayed slot index (see above)
+  double theta = 0;          // fractional part of tau / h; 0 when aligned
+  int M = 0;                 // last history slot: the history has M + 1 blocks
 
   bool aligned() const { return theta == 0; }
 

@@ -89,22 +89,22 @@ namespace delayspec {
 inline constexpr int kMaxTangentVectors = 64;
 
 struct LyapunovOptions {
-  int exponents = 2;         // k: tangent vectors (exponents wanted), 1 <= k <= min(n, kMaxTangentVectors)
-  long periods = 1000;       // stroboscopic periods averaged (a multiple of qr_every)
-  long transient = 100;      // periods discarded first (>= 0)
-  std::uint64_t seed = 1;    // initial tangent block: a fixed pseudo-random n x k block, orthonormalised
-  int qr_every = 1;          // periods between QR factorisations (see the header comment)
-  int batches = 20;          // batch means: measured QR intervals are split into this many batches
-  long section_points = 0;   // record u_0 at this many forcing-period boundaries after the transient
+  int exponents = 2;        // k: tangent vectors (exponents wanted), 1 <= k <= min(n, kMaxTangentVectors)
+  long periods = 1000;      // stroboscopic periods averaged (a multiple of qr_every)
+  long transient = 100;     // periods discarded first (>= 0)
+  std::uint64_t seed = 1;   // initial tangent block: a fixed pseudo-random n x k block, orthonormalised
+  int qr_every = 1;         // periods between QR factorisations (see the header comment)
+  int batches = 20;         // batch means: measured QR intervals are split into this many batches
+  long section_points = 0;  // record u_0 at this many forcing-period boundaries after the transient
   // Called after every period with (periods done, periods in total incl. the transient); may be empty.
   std::function<void(long, long)> progress;
 };
 
 struct LyapunovResult {
-  std::vector<double> per_period;                  // sum log |R_ii| / periods, largest first as computed
-  std::vector<double> per_time;                    // per_period / (K h)
-  std::vector<double> error_per_period;   // the error: sqrt(batch SE^2 + fluctuation bound^2) (header comment)
-  std::vector<double> error_per_time;     // error_per_period / (K h)
+  std::vector<double> per_period;        // sum log |R_ii| / periods, largest first as computed
+  std::vector<double> per_time;          // per_period / (K h)
+  std::vector<double> error_per_period;  // the error: sqrt(batch SE^2 + fluctuation bound^2) (header comment)
+  std::vector<double> error_per_time;    // error_per_period / (K h)
   std::vector<double> batch_standard_error_per_period;  // batch means: sd(batch means) / sqrt(batches)
   std::vector<double> fluctuation_bound_per_period;     // range of the detrended cumulative sum / periods
   long periods = 0, transient = 0;

@@ -117,16 +117,15 @@ class PeriodicOrbitProblem {
   }
   void check_size(const Eigen::VectorXd& x) const {
     if (x.size() != unknowns())
-      throw BadInput("periodic orbit problem: sequence has " + std::to_string(x.size()) + " entries, expected d K = " +
-                     std::to_string(unknowns()));
+      throw BadInput("periodic orbit problem: sequence has " + std::to_string(x.size()) +
+                     " entries, expected d K = " + std::to_string(unknowns()));
   }
   void add_block(std::vector<Eigen::Triplet<double>>& triplets, long row_block, long col_block,
                  const Mat<D>& block) const {
     const long r0 = D * row_block, c0 = D * wrap(col_block);
     for (int i = 0; i < D; ++i)
       for (int j = 0; j < D; ++j)
-        if (block(i, j) != 0)
-          triplets.emplace_back(static_cast<int>(r0 + i), static_cast<int>(c0 + j), block(i, j));
+        if (block(i, j) != 0) triplets.emplace_back(static_cast<int>(r0 + i), static_cast<int>(c0 + j), block(i, j));
   }
 
   const Map& map_;

@@ -48,10 +48,10 @@
 namespace delayspec {
 
 struct OrbitByShootingOptions {
-  double tolerance = 1e-12;   // accept |P(U) - U|_inf <= tolerance (1 + |U|_inf)
-  int max_iterations = 30;    // Newton steps per level
-  double forcing_max = 1e-4;  // eta_max of the Eisenstat-Walker forcing terms (below)
-  int gmres_restart = 40;     // GMRES basis size per cycle
+  double tolerance = 1e-12;        // accept |P(U) - U|_inf <= tolerance (1 + |U|_inf)
+  int max_iterations = 30;         // Newton steps per level
+  double forcing_max = 1e-4;       // eta_max of the Eisenstat-Walker forcing terms (below)
+  int gmres_restart = 40;          // GMRES basis size per cycle
   int gmres_max_iterations = 400;  // GMRES products per Newton step
 };
 
@@ -97,8 +97,8 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
   double r = NAN;
   auto failure = [&](const std::string& why) {
     return NumericalFailure("orbit by shooting (N = " + std::to_string(map.grid().N) + "): " + why + " after " +
-                            std::to_string(orbit.newton_iterations) + " Newton iterations, |P(U) - U|_inf = " +
-                            format_number(r) + " (tolerance " +
+                            std::to_string(orbit.newton_iterations) +
+                            " Newton iterations, |P(U) - U|_inf = " + format_number(r) + " (tolerance " +
                             format_number(opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>())) + ")");
   };
   if (!evaluate(U, G)) throw failure("the map cannot be evaluated at the starting history");
@@ -116,7 +116,7 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
     }
     const double tol_abs = opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>());
     eta = std::max(eta, 0.5 * tol_abs / g_norm);  // |r|_inf <= |r|_2 <= eta |G|_2: enough for the test
-    eta = std::max(eta, 1e-13);                    // GMRES' own rounding floor
+    eta = std::max(eta, 1e-13);                   // GMRES' own rounding floor
     // (M - I) s = -G with M the monodromy at U (the step maps of the evaluation of G).
     const Monodromy<D> monodromy(map.grid(), std::move(lin.maps));
     const GmresResult step = gmres(
@@ -157,7 +157,7 @@ enum class CoarseOrbitMethod { newton, shooting };
 
 struct NestedShootingOptions {
   OrbitByShootingOptions shooting;
-  OrbitByNewtonOptions newton;                       // coarsest level, sparse LU
+  OrbitByNewtonOptions newton;  // coarsest level, sparse LU
   CoarseOrbitMethod coarse_method = CoarseOrbitMethod::newton;
   long guess_periods = 100;  // maps simulated from the initial history for the coarsest guess
   int coarse_N = 64;         // the coarsest level is the last N_i >= coarse_N (or N itself)
@@ -208,19 +208,21 @@ PeriodicOrbit orbit_by_nested_shooting(const StroboscopicMap<Model, Stepper>& ma
     orbit = orbit_by_shooting(coarse, U, opt.shooting, &lin);
   }
   linear_iterations += orbit.linear_iterations;
-  levels.push_back({Ns.front(), orbit.method, orbit.newton_iterations, orbit.linear_iterations, orbit.residual,
-                    since(t0)});
+  levels.push_back(
+      {Ns.front(), orbit.method, orbit.newton_iterations, orbit.linear_iterations, orbit.residual, since(t0)});
 
   // Finer levels: shooting from the coarser orbit prolonged.
   for (size_t i = 1; i < Ns.size(); ++i) {
     t0 = clock();
     const Map level = level_map(Ns[i]);
     Eigen::VectorXd sequence(static_cast<long>(Model::d) * static_cast<long>(lin.states.size() - 1));
-    for (size_t l = 0; l + 1 < lin.states.size(); ++l) sequence.segment<Model::d>(Model::d * static_cast<long>(l)) = lin.states[l];
+    for (size_t l = 0; l + 1 < lin.states.size(); ++l)
+      sequence.segment<Model::d>(Model::d * static_cast<long>(l)) = lin.states[l];
     const Eigen::VectorXd guess = prolong_periodic_sequence(sequence, Model::d, level.grid().K);
     orbit = orbit_by_shooting(level, PeriodicOrbitProblem<Map>(level).history(guess), opt.shooting, &lin);
     linear_iterations += orbit.linear_iterations;
-    levels.push_back({Ns[i], orbit.method, orbit.newton_iterations, orbit.linear_iterations, orbit.residual, since(t0)});
+    levels.push_back(
+        {Ns[i], orbit.method, orbit.newton_iterations, orbit.linear_iterations, orbit.residual, since(t0)});
   }
   orbit.maps = opt.guess_periods;
   orbit.linear_iterations = linear_iterations;

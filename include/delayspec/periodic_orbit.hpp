@@ -10,30 +10,30 @@
 namespace delayspec {
 
 struct PeriodicOrbit {
-  Eigen::VectorXd history;  // U with P(U) ~ U (the history the Monodromy is taken at)
-  double residual = NAN;    // |P(U) - U|_inf, one application of the stroboscopic map
-  long maps = 0;            // stroboscopic maps simulated (simulate: to settle; newton: for the guess)
+  Eigen::VectorXd history;          // U with P(U) ~ U (the history the Monodromy is taken at)
+  double residual = NAN;            // |P(U) - U|_inf, one application of the stroboscopic map
+  long maps = 0;                    // stroboscopic maps simulated (simulate: to settle; newton: for the guess)
   std::string method = "simulate";  // "simulate" | "newton" | "zero" (linear models)
 
   // Newton only (empty / zero otherwise).
-  int newton_iterations = 0;               // linear solves performed
-  std::vector<double> newton_residuals;    // |F(x_i)|_inf of each iterate, the guess first
-  std::vector<double> newton_step_fractions;  // line-search fraction of each Newton step (1 = full)
-  double jacobian_reciprocal_condition = NAN; // UMFPACK's estimate at the last factorisation
-  long jacobian_nonzeros = 0;              // nonzeros of the assembled periodic Jacobian
-  long factor_nonzeros = 0;                // nonzeros of its L and U factors
+  int newton_iterations = 0;                   // linear solves performed
+  std::vector<double> newton_residuals;        // |F(x_i)|_inf of each iterate, the guess first
+  std::vector<double> newton_step_fractions;   // line-search fraction of each Newton step (1 = full)
+  double jacobian_reciprocal_condition = NAN;  // UMFPACK's estimate at the last factorisation
+  long jacobian_nonzeros = 0;                  // nonzeros of the assembled periodic Jacobian
+  long factor_nonzeros = 0;                    // nonzeros of its L and U factors
 
   // Shooting only (orbit_shooting.hpp; empty / zero otherwise).
   long linear_iterations = 0;  // GMRES iterations (applications of M - I), all levels
   struct Level {
-    int N = 0;                   // steps per delay at this level
-    std::string method;          // "newton" (sparse LU, the coarsest level) or "shooting"
+    int N = 0;           // steps per delay at this level
+    std::string method;  // "newton" (sparse LU, the coarsest level) or "shooting"
     int newton_iterations = 0;
     long linear_iterations = 0;
-    double residual = NAN;       // |P(U) - U|_inf at the level's orbit
+    double residual = NAN;  // |P(U) - U|_inf at the level's orbit
     double seconds = 0;
   };
-  std::vector<Level> levels;     // coarsest first; the last is the orbit returned
+  std::vector<Level> levels;  // coarsest first; the last is the orbit returned
 };
 
 // The states of a periodic orbit over one map, x = (u_0, ..., u_{K-1}), u_l = y(l h), d each

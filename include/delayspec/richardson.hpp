@@ -70,8 +70,8 @@ struct RichardsonOptions {
 };
 
 struct RichardsonTableau {
-  std::vector<double> h;                                  // the steps, coarsest first
-  std::vector<std::vector<std::complex<double>>> T;       // T[i][j], j = 0 .. min(i, max_columns - 1)
+  std::vector<double> h;                             // the steps, coarsest first
+  std::vector<std::vector<std::complex<double>>> T;  // T[i][j], j = 0 .. min(i, max_columns - 1)
   // Error exponent of entry column j: what remains after eliminating e_1..e_j (= e_{j+1}).
   double remaining_order(int column) const { return order + column * order_step; }
   double order = 2, order_step = 2;
@@ -79,20 +79,20 @@ struct RichardsonTableau {
 
 // Extrapolated value with an error estimate.
 struct Extrapolation {
-  std::complex<double> value;   // the finest entry of the column used: T[L-1][J] (J: header comment)
-  double error_estimate = 0;    // max(|T[L-1][J] - T[L-1][J-1]|, the correction the last column made,
-                                //     sum_i |w_i| a_i, the amplified accuracy of the inputs);
-                                // when column J is inconsistent: max(that column's tail estimate,
-                                // round-off); infinity when J = 0 and column 0 cannot be checked, or
-                                // when column J's differences grow
-  std::vector<double> column_orders;  // per column: order from its last three entries, log(d1 / d2) / log r
-                                      // (NaN with fewer than three entries or a zero difference)
-  std::vector<int> column_consistent; // per column: 1 consistent, 0 inconsistent, -1 not checkable
-  std::string note;                   // why column J, in words with the numbers
-  double amplification = 1;     // sum_i |w_i| of value = sum_i w_i x_i
-  double roundoff = 0;          // sum_i |w_i| a_i of value: the floor of error_estimate
-  int levels = 0;               // levels combined in value (J + 1)
-  double remaining_order = 0;   // the error exponent of value, e_{J+1}, if the expansion holds
+  std::complex<double> value;          // the finest entry of the column used: T[L-1][J] (J: header comment)
+  double error_estimate = 0;           // max(|T[L-1][J] - T[L-1][J-1]|, the correction the last column made,
+                                       //     sum_i |w_i| a_i, the amplified accuracy of the inputs);
+                                       // when column J is inconsistent: max(that column's tail estimate,
+                                       // round-off); infinity when J = 0 and column 0 cannot be checked, or
+                                       // when column J's differences grow
+  std::vector<double> column_orders;   // per column: order from its last three entries, log(d1 / d2) / log r
+                                       // (NaN with fewer than three entries or a zero difference)
+  std::vector<int> column_consistent;  // per column: 1 consistent, 0 inconsistent, -1 not checkable
+  std::string note;                    // why column J, in words with the numbers
+  double amplification = 1;            // sum_i |w_i| of value = sum_i w_i x_i
+  double roundoff = 0;                 // sum_i |w_i| a_i of value: the floor of error_estimate
+  int levels = 0;                      // levels combined in value (J + 1)
+  double remaining_order = 0;          // the error exponent of value, e_{J+1}, if the expansion holds
 };
 
 // The whole tableau. BadInput: sizes differ, fewer than one level, steps not strictly

@@ -24,21 +24,21 @@
 namespace delayspec {
 
 struct SimulationOptions {
-  double t_end = 0;          // simulate [0, t_end]: ceil(t_end / h) steps
-  double t_start = 0;        // record (trajectory, Poincare points, impacts) only for t >= t_start
-  long sample_every = 1;     // keep every sample_every-th grid point of the trajectory
+  double t_end = 0;               // simulate [0, t_end]: ceil(t_end / h) steps
+  double t_start = 0;             // record (trajectory, Poincare points, impacts) only for t >= t_start
+  long sample_every = 1;          // keep every sample_every-th grid point of the trajectory
   double switch_time = INFINITY;  // steps starting at t >= switch_time use the second stepper
 };
 
 template <int D>
 struct SimulationRecord {
-  std::vector<double> t;              // sampled trajectory
+  std::vector<double> t;  // sampled trajectory
   std::vector<Vec<D>> y;
-  std::vector<double> poincare_t;     // t = m T (grid points that are whole periods)
+  std::vector<double> poincare_t;  // t = m T (grid points that are whole periods)
   std::vector<Vec<D>> poincare_y;
-  std::vector<double> impact_times;   // entries into region 1
+  std::vector<double> impact_times;  // entries into region 1
   long steps = 0;
-  double max_H = -INFINITY;           // largest H at grid points in the window
+  double max_H = -INFINITY;  // largest H at grid points in the window
 };
 
 // Simulates from history U0 (oldest block first, as StroboscopicMap). `before` runs the steps
@@ -72,7 +72,7 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
   const double h = grid.h;
   std::vector<V> b(static_cast<size_t>(ring));
   auto slot = [&](long i) -> V& { return b[static_cast<size_t>(i % ring)]; };  // linear index -> ring
-  for (long j = 0; j <= M; ++j) slot(j) = U0.template segment<D>(j * D);  // u_M .. u_0 at t = 0
+  for (long j = 0; j <= M; ++j) slot(j) = U0.template segment<D>(j * D);       // u_M .. u_0 at t = 0
   SimulationRecord<D> rec;
   rec.steps = steps;
   auto record_point = [&](long l, const V& y) {
@@ -97,8 +97,7 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
     const TrapezoidStepper<Model>& stepper = t_abs >= options.switch_time ? after : before;
     const V u = slot(M + l);
     const V next = stepper.step(tap.t, h, u, tap.w0, tap.w1, scratch, &events);
-    if (!next.allFinite())
-      throw NumericalFailure("simulate: the trajectory diverged at t = " + format_number(t_abs));
+    if (!next.allFinite()) throw NumericalFailure("simulate: the trajectory diverged at t = " + format_number(t_abs));
     slot(M + l + 1) = next;
     if constexpr (Model::has_switching) {
       if (stepper.options().events != EventMode::off) {

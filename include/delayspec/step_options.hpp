@@ -29,7 +29,7 @@ struct StepOptions {
 struct StepEvents {
   static constexpr int kMaxEvents = 16;  // more crossings than this in one step: NumericalFailure
   int count = 0;
-  std::array<double, kMaxEvents> offset{};  // event time minus step start, in [0, h]
+  std::array<double, kMaxEvents> offset{};   // event time minus step start, in [0, h]
   std::array<int, kMaxEvents> new_region{};  // region entered at the event (1: H > 0, contact)
   // Number of entries into region 1 (impacts, for the impact model).
   int entries_into_region1() const {

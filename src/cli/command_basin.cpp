@@ -34,7 +34,6 @@ namespace delayspec::cli {
 
 namespace {
 
-
 struct Classification {
   int period = 0;  // 0: no period <= max_period found
   double max_section_x = NAN;
@@ -113,12 +112,24 @@ int command_basin(Config& config, const Invocation& inv) {
   }
   nlohmann::json count_json = nlohmann::json::object();
   for (const auto& [period, n] : counts) count_json[std::to_string(period)] = n;
-  nlohmann::json json = {{"model", problem.model_name}, {"N", problem.N}, {"events", to_string(problem.events)},
-                         {"jacobian", to_string(problem.jacobian)}, {"x", x.name}, {"y", y.name},
-                         {"x_range", {x.min, x.max}}, {"y_range", {y.min, y.max}}, {"x_points", x.points},
-                         {"y_points", y.points}, {"transient", transient}, {"max_period", max_period},
-                         {"tolerance", tolerance}, {"counts", count_json}, {"failed_points", failed},
-                         {"threads", threads}, {"seconds", seconds}, {"rows", rows}};
+  nlohmann::json json = {{"model", problem.model_name},
+                         {"N", problem.N},
+                         {"events", to_string(problem.events)},
+                         {"jacobian", to_string(problem.jacobian)},
+                         {"x", x.name},
+                         {"y", y.name},
+                         {"x_range", {x.min, x.max}},
+                         {"y_range", {y.min, y.max}},
+                         {"x_points", x.points},
+                         {"y_points", y.points},
+                         {"transient", transient},
+                         {"max_period", max_period},
+                         {"tolerance", tolerance},
+                         {"counts", count_json},
+                         {"failed_points", failed},
+                         {"threads", threads},
+                         {"seconds", seconds},
+                         {"rows", rows}};
   if (inv.out_dir) {
     AtomicFile csv(std::filesystem::path(*inv.out_dir) / "basin.csv");
     csv.stream() << metadata_comment_lines(make_metadata("basin", inv.scene, config, json, seconds));
@@ -127,10 +138,8 @@ int command_basin(Config& config, const Invocation& inv) {
     for (long i = 0; i < count; ++i) {
       if (i > 0 && i % x.points == 0) csv.stream() << "\n";
       csv.stream() << x.value(i % x.points) << "," << y.value(i / x.points) << ",";
-      if (failure[i].empty())
-        csv.stream() << result[i].period << "," << result[i].max_section_x << "\n";
-      else
-        csv.stream() << "nan,nan\n";
+      if (failure[i].empty()) csv.stream() << result[i].period << "," << result[i].max_section_x << "\n";
+      else csv.stream() << "nan,nan\n";
     }
     csv.commit();
   }
@@ -141,7 +150,8 @@ int command_basin(Config& config, const Invocation& inv) {
             << x.min << ", " << x.max << "] x " << y.name << " in [" << y.min << ", " << y.max << "], " << count
             << " points, transient " << transient << " periods\n";
     for (const auto& [period, n] : counts)
-      inv.out << "  " << (period == 0 ? "no period <= " + std::to_string(max_period) : "period " + std::to_string(period))
+      inv.out << "  "
+              << (period == 0 ? "no period <= " + std::to_string(max_period) : "period " + std::to_string(period))
               << ": " << n << " points\n";
     if (failed) inv.out << "  failed: " << failed << " points\n";
     inv.out << "time: " << seconds << " s\n";

@@ -46,7 +46,7 @@ struct BenchRow {
   double seconds = NAN, setup_seconds = NAN;
   long peak_bytes = -1;
   long operator_applications = 0;  // of one solve
-  int repeats = 0;                  // solves timed (seconds = the fastest)
+  int repeats = 0;                 // solves timed (seconds = the fastest)
   double error = NAN, max_error = NAN, correct_digits = NAN, deviation_from_dense = NAN;
 };
 
@@ -75,7 +75,8 @@ BenchSettings read_bench_settings(Config& config) {
   // bench compares several solvers: `solver` on the command line is a mistake; in a scene shared
   // with floquet it is floquet's key (ignored here).
   if (config.has("solver") && config.origin("solver") == "--set")
-    throw BadInput("`solver = " + config.get_string("solver", "") + "`: bench compares several: use `solvers` (a comma list)");
+    throw BadInput("`solver = " + config.get_string("solver", "") +
+                   "`: bench compares several: use `solvers` (a comma list)");
   s.problem = read_problem(config, 100);
   s.orbit = read_orbit_settings(config);
   s.Ns = read_N_list(config, s.problem, 100, 400);
@@ -95,7 +96,8 @@ BenchSettings read_bench_settings(Config& config) {
   const long n_min = coarsest.dimension();  // the dimension at the coarsest N, the smallest
   validate_floquet_options(s.base, n_min);
   // A Krylov row with nev > n - 2 would run the dense path (floquet.hpp): not a comparison.
-  const bool krylov_listed = std::any_of(s.solvers.begin(), s.solvers.end(), [](FloquetSolver f) { return !is_dense(f); });
+  const bool krylov_listed =
+      std::any_of(s.solvers.begin(), s.solvers.end(), [](FloquetSolver f) { return !is_dense(f); });
   if (krylov_listed && s.base.nev > n_min - 2)
     throw BadInput("`nev = " + std::to_string(s.base.nev) + "`: the Krylov solvers need nev <= n - 2 = " +
                    std::to_string(n_min - 2) + " at the coarsest N = " + std::to_string(s.Ns.front()));
@@ -124,8 +126,9 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
         const double need_mb = dense_bytes_estimate(row.n) / (1024.0 * 1024.0);
         if (is_dense(solver) && need_mb > limit_mb) {
           char buf[200];
-          std::snprintf(buf, sizeof buf, "dense needs about %.0f MB (3 n^2 doubles, n = %ld) > dense_memory_limit_mb = %g",
-                        need_mb, row.n, limit_mb);
+          std::snprintf(buf, sizeof buf,
+                        "dense needs about %.0f MB (3 n^2 doubles, n = %ld) > dense_memory_limit_mb = %g", need_mb,
+                        row.n, limit_mb);
           row.status = "skipped";
           row.message = buf;
           inv.err << "bench: N = " << N << ", " << row.solver << ": skipped: " << buf << "\n";
@@ -222,9 +225,11 @@ void score_rows(std::vector<BenchRow>& rows, const BenchReference& reference) {
     }
     for (const auto& dense : rows)
       if (dense.N == r.N && dense.status == "ok" && is_dense(parse_floquet_solver(dense.solver)) && &dense != &r) {
-        const MatchedErrors m = errors_against(r.multipliers, dense.multipliers, std::vector<double>(dense.multipliers.size(), 0));
+        const MatchedErrors m =
+            errors_against(r.multipliers, dense.multipliers, std::vector<double>(dense.multipliers.size(), 0));
         double dev = 0;
-        for (size_t k = 0; k < m.matched.size(); ++k) dev = std::max(dev, std::abs(m.matched[k] - dense.multipliers[k]));
+        for (size_t k = 0; k < m.matched.size(); ++k)
+          dev = std::max(dev, std::abs(m.matched[k] - dense.multipliers[k]));
         r.deviation_from_dense = dev / std::abs(dense.multipliers[0]);
         break;
       }
@@ -241,8 +246,8 @@ void write_bench_csv(const std::filesystem::path& path, const std::string& metad
   csv.stream().precision(10);
   for (const auto& r : rows)
     csv.stream() << r.N << "," << r.n << "," << r.solver << "," << r.status << "," << r.seconds << ","
-                 << r.setup_seconds << "," << r.peak_bytes << "," << r.operator_applications << "," << r.error
-                 << "," << r.max_error << "," << r.correct_digits << "," << r.deviation_from_dense << ","
+                 << r.setup_seconds << "," << r.peak_bytes << "," << r.operator_applications << "," << r.error << ","
+                 << r.max_error << "," << r.correct_digits << "," << r.deviation_from_dense << ","
                  << (r.multipliers.empty() ? NAN : std::abs(r.multipliers[0])) << "\n";
   csv.commit();
 }
@@ -316,19 +321,18 @@ void print_bench(std::ostream& out, const BenchSettings& s, const std::vector<Be
 int command_bench(Config& config, const Invocation& inv) {
   const auto command_start = std::chrono::steady_clock::now();
   const BenchSettings settings = read_bench_settings(config);  // read and check
-  std::vector<BenchRow> rows = run_bench(settings, inv);        // compute
+  std::vector<BenchRow> rows = run_bench(settings, inv);       // compute
   const BenchReference reference = bench_reference(settings, rows);
   score_rows(rows, reference);
   if (inv.out_dir) {  // report
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count();
-    write_bench_csv(std::filesystem::path(*inv.out_dir) / "bench.csv",
-                    metadata_comment_lines(make_metadata("bench", inv.scene, config, nlohmann::json::object(), seconds)),
-                    settings, rows, reference);
+    write_bench_csv(
+        std::filesystem::path(*inv.out_dir) / "bench.csv",
+        metadata_comment_lines(make_metadata("bench", inv.scene, config, nlohmann::json::object(), seconds)), settings,
+        rows, reference);
   }
-  if (inv.json)
-    inv.out << bench_json(settings, rows, reference).dump(2) << "\n";
-  else
-    print_bench(inv.out, settings, rows, reference);
+  if (inv.json) inv.out << bench_json(settings, rows, reference).dump(2) << "\n";
+  else print_bench(inv.out, settings, rows, reference);
   return 0;
 }
 

@@ -84,11 +84,22 @@ int command_chart(Config& config, const Invocation& inv) {
     }
     rows.push_back(row);
   }
-  nlohmann::json json = {{"model", problem.model_name}, {"N", problem.N}, {"events", to_string(problem.events)},
-                         {"jacobian", to_string(problem.jacobian)}, {"x", x.name}, {"y", y.name},
-                         {"x_range", {x.min, x.max}}, {"y_range", {y.min, y.max}}, {"x_points", x.points},
-                         {"y_points", y.points}, {"points", count}, {"stable_points", stable},
-                         {"failed_points", failed}, {"threads", threads}, {"seconds", seconds}, {"rows", rows}};
+  nlohmann::json json = {{"model", problem.model_name},
+                         {"N", problem.N},
+                         {"events", to_string(problem.events)},
+                         {"jacobian", to_string(problem.jacobian)},
+                         {"x", x.name},
+                         {"y", y.name},
+                         {"x_range", {x.min, x.max}},
+                         {"y_range", {y.min, y.max}},
+                         {"x_points", x.points},
+                         {"y_points", y.points},
+                         {"points", count},
+                         {"stable_points", stable},
+                         {"failed_points", failed},
+                         {"threads", threads},
+                         {"seconds", seconds},
+                         {"rows", rows}};
 
   if (inv.out_dir) {
     AtomicFile csv(std::filesystem::path(*inv.out_dir) / "chart.csv");
@@ -98,10 +109,8 @@ int command_chart(Config& config, const Invocation& inv) {
     for (long i = 0; i < count; ++i) {
       if (i > 0 && i % x.points == 0) csv.stream() << "\n";  // a blank line ends each y block
       csv.stream() << x.value(i % x.points) << "," << y.value(i / x.points) << ",";
-      if (failure[i].empty())
-        csv.stream() << radius[i] << "\n";
-      else
-        csv.stream() << "nan\n";
+      if (failure[i].empty()) csv.stream() << radius[i] << "\n";
+      else csv.stream() << "nan\n";
     }
     csv.commit();
   }

@@ -36,7 +36,6 @@ namespace delayspec::cli {
 
 namespace {
 
-
 // A failure message on one line (for a CSV comment).
 std::string one_line(std::string text) {
   std::replace(text.begin(), text.end(), '\n', ' ');
@@ -96,8 +95,8 @@ nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) 
         s.richardson.column_orders[c] ? nlohmann::json(*s.richardson.column_orders[c]) : nlohmann::json(nullptr);
     if (c < s.richardson.difference_orders.size()) {
       col["difference_order"] = number_or_null(s.richardson.difference_orders[c]);
-      col["consistent"] = s.richardson.consistent[c] < 0 ? nlohmann::json(nullptr)
-                                                         : nlohmann::json(s.richardson.consistent[c] == 1);
+      col["consistent"] =
+          s.richardson.consistent[c] < 0 ? nlohmann::json(nullptr) : nlohmann::json(s.richardson.consistent[c] == 1);
       col["used"] = static_cast<int>(c) + 1 == s.richardson.levels_used;
     }
     nlohmann::json entries = nlohmann::json::array();
@@ -254,7 +253,8 @@ class ConvergeLevels {
           },
           {guess, &sequence});
       if (sequence.size() > 0) sequences_[N] = std::move(sequence);
-      if (guess) r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);
+      if (guess)
+        r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);
     } catch (const NumericalFailure& e) {
       r = {};
       r.failure = e.what();
@@ -295,7 +295,8 @@ int command_converge(Config& config, const Invocation& inv) {
   const FloquetSolver solver = solver_options.solver;
   base.nev = solver_options.nev;
   base.extra = std::max(2, base.nev / 2);
-  base.reference = parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
+  base.reference =
+      parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
   const bool order_given = config.has("extrapolation_order"), step_given = config.has("extrapolation_order_step");
   const double x_order = config.get_double("extrapolation_order", 2);
   const double x_step = config.get_double("extrapolation_order_step", 2);
@@ -338,19 +339,20 @@ int command_converge(Config& config, const Invocation& inv) {
     options.richardson.order = order_given ? x_order : first_order ? 1 : 2;
     options.richardson.order_step = step_given ? x_step : first_order ? 1 : 2;
     ConvergeLevels levels(problem, parse_event_mode(ev), orbit_settings, solver_options, progress);
-    studies.push_back(run_convergence_study(
-        [&](int N, int count) { return levels.level(N, count); }, options,
-        [&](int N, int count, int from_N) { return levels.retry(N, count, from_N); }));
+    studies.push_back(
+        run_convergence_study([&](int N, int count) { return levels.level(N, count); }, options,
+                              [&](int N, int count, int from_N) { return levels.retry(N, count, from_N); }));
   }
   progress.finish();
 
   if (inv.out_dir) {
     const std::filesystem::path dir(*inv.out_dir);
-    const std::string header = metadata_comment_lines(make_metadata(
-        "converge", inv.scene, config, nlohmann::json::object(),
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
+    const std::string header = metadata_comment_lines(
+        make_metadata("converge", inv.scene, config, nlohmann::json::object(),
+                      std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
     AtomicFile rows(dir / "converge.csv");
-    rows.stream() << header << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver) << "\n";
+    rows.stream() << header << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver)
+                  << "\n";
     for (size_t v = 0; v < studies.size(); ++v)  // failed levels have no multipliers: named here
       for (const auto& r : studies[v].rows)
         if (!r.failure.empty())
@@ -358,7 +360,9 @@ int command_converge(Config& config, const Invocation& inv) {
     rows.stream() << "events,N,track,re,im,abs,error,correct_digits,seconds,operator_applications\n";
     rows.stream().precision(17);
     AtomicFile rich(dir / "converge_richardson.csv");
-    rich.stream() << header << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";
+    rich.stream()
+        << header
+        << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";
     rich.stream().precision(17);
     for (size_t v = 0; v < studies.size(); ++v) {
       const auto& s = studies[v];

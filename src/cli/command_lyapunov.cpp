@@ -48,9 +48,9 @@ int command_lyapunov(Config& config, const Invocation& inv) {
     inv.out << "delayspec lyapunov: model " << problem.model_name << ", " << problem.grid().describe() << ", n = " << n
             << "\n";
     inv.out << r.per_period.size() << " leading Lyapunov exponents after a transient of " << r.transient
-            << " periods, averaged over " << r.periods << " periods (period = " << r.map_time << " time units, QR every "
-            << r.qr_every << "; error = sqrt(SE^2 + F^2), SE the standard error of " << r.batches
-            << " batch means, F the range of the detrended cumulative sum / periods):\n";
+            << " periods, averaged over " << r.periods << " periods (period = " << r.map_time
+            << " time units, QR every " << r.qr_every << "; error = sqrt(SE^2 + F^2), SE the standard error of "
+            << r.batches << " batch means, F the range of the detrended cumulative sum / periods):\n";
     char line[200];
     std::snprintf(line, sizeof line, "  %3s  %24s  %24s\n", "#", "per period", "per unit time");
     inv.out << line;

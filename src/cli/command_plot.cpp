@@ -98,18 +98,20 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
   std::string rows;
   bool any_radius = false;
   for (const auto& row : t.rows) {
-    rows += row.empty() ? "\n" : gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(row[2]) + "\n";
+    rows += row.empty() ? "\n"
+                        : gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(row[2]) + "\n";
     any_radius = any_radius || (!row.empty() && !std::isnan(row[2]));
   }
   // gnuplot cannot draw a chart without one value: say why instead of its "all points undefined".
-  if (!any_radius) throw NumericalFailure("`" + file.string() + "`: every point failed (spectral_radius nan): nothing to draw");
+  if (!any_radius)
+    throw NumericalFailure("`" + file.string() + "`: every point failed (spectral_radius nan): nothing to draw");
   std::ostringstream gp;
   gp << gnuplot_datablock("chart", rows);
   gp << "set table $boundary\nset contour base\nset cntrparam levels discrete 1.0\nunset surface\n"
         "splot $chart using 1:2:3 with lines\nunset table\nunset contour\nset surface\n";
   gp << "set title "
-     << gnuplot_string("Spectral radius |{/Symbol m}_1|, model " + t.metadata_text("model", "?") + ", N = " +
-                       title_N(t) + " (white line: |{/Symbol m}_1| = 1)")
+     << gnuplot_string("Spectral radius |{/Symbol m}_1|, model " + t.metadata_text("model", "?") +
+                       ", N = " + title_N(t) + " (white line: |{/Symbol m}_1| = 1)")
      << "\n";
   gp << "set xlabel " << gnuplot_string(t.columns[0]) << "\nset ylabel " << gnuplot_string(t.columns[1]) << "\n";
   gp << "set cblabel '|{/Symbol m}_1| (clipped at 2)'\nset cbrange [0:2]\n"
@@ -150,8 +152,8 @@ void plot_basin(FigureRenderer& renderer, const fs::path& file) {
   std::ostringstream gp;
   gp << gnuplot_datablock("basin", rows);
   gp << "set title "
-     << gnuplot_string("Basins of attraction, model " + t.metadata_text("model", "?") + ", k = " +
-                       gnuplot_number(t.metadata_number("k", 0)) + ", N = " + title_N(t))
+     << gnuplot_string("Basins of attraction, model " + t.metadata_text("model", "?") +
+                       ", k = " + gnuplot_number(t.metadata_number("k", 0)) + ", N = " + title_N(t))
      << "\n";
   gp << "set xlabel " << gnuplot_string(t.columns[0]) << "\nset ylabel " << gnuplot_string(t.columns[1]) << "\n";
   gp << "set autoscale fix\nset key outside right top box opaque\nset style fill solid 1.0\n";
@@ -260,7 +262,8 @@ void plot_speed_error(FigureRenderer& renderer, const std::vector<std::pair<std:
         const double s = row.number_or("seconds", NAN);
         if (!(e > 0) || !(s > 0)) continue;
         const std::string solver = source + ": " + row.text_or("solver", label);
-        by_solver[solver] += gnuplot_number(e) + " " + gnuplot_number(s) + " " + gnuplot_number(row.number_or("N", 0)) + "\n";
+        by_solver[solver] +=
+            gnuplot_number(e) + " " + gnuplot_number(s) + " " + gnuplot_number(row.number_or("N", 0)) + "\n";
       }
       for (const auto& [solver, rows] : by_solver) {
         std::string name("s");  // (append: GCC 12 warns falsely on "s" + string)
@@ -317,7 +320,8 @@ void plot_exponents(FigureRenderer& renderer, const fs::path& dir) {
          << colours[i % 6] << "' title '{/Symbol l}_" << i + 1 << "'";
   }
   gp << "set title " << gnuplot_string("Lyapunov exponents per period against " + label + " (zero line green)") << "\n";
-  gp << "set xlabel " << gnuplot_string(label) << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
+  gp << "set xlabel " << gnuplot_string(label)
+     << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
   gp << plot.str() << ", \\\n     0 with lines lc rgb '#2ca02c' lw 2 title 'zero'\n";
   renderer.figure("exponents", gp.str());
 }
@@ -392,12 +396,13 @@ void plot_phase(FigureRenderer& renderer, const fs::path& dir) {
     }
   }
   const std::string e = gnuplot_number(impact_boundary(dir, trajectory));
-  gp << "set title " << gnuplot_string(std::string("Phase portrait") + (thin ? " (trajectory thinned for drawing)" : ""))
-     << "\n";
+  gp << "set title "
+     << gnuplot_string(std::string("Phase portrait") + (thin ? " (trajectory thinned for drawing)" : "")) << "\n";
   gp << "set xlabel 'x'\nset ylabel 'v = dx/dt'\nset grid\nset key outside bottom center horizontal\n";
   gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#1f77b4' lw 2 front\n";
   gp << "plot $trajectory using 1:2 with lines lc rgb '#999999' title 'trajectory'" << section_plot
-     << ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title " << gnuplot_string("impact boundary x = e = " + e) << "\n";
+     << ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title " << gnuplot_string("impact boundary x = e = " + e)
+     << "\n";
   renderer.figure("phase", gp.str());
 }
 
@@ -429,7 +434,8 @@ int command_plot(Config& config, const Invocation& inv) {
   if (dir_text.empty()) throw BadInput("`delayspec plot` needs a results directory: delayspec plot DIR");
   const fs::path dir = dir_text;
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw BadInput("`" + dir.string() + "`: not a directory (expected a results directory)");
+  if (!fs::is_directory(dir, ec))
+    throw BadInput("`" + dir.string() + "`: not a directory (expected a results directory)");
 
   FigureRenderer renderer(dir, settings, inv.json ? nullptr : &inv.out);
   // The JSON documents live here; JsonFields and the speed sources point into them.

@@ -52,7 +52,8 @@ std::string inferred_analysis(const Config& config) {
     if (!command_table().count(name)) continue;
     std::set<std::string> read = {"analyses", "title"};
     for (const auto& r : probe_command(name, config).reads) read.insert(r.key);
-    if (std::all_of(config.values().begin(), config.values().end(), [&](const auto& kv) { return read.count(kv.first) > 0; }))
+    if (std::all_of(config.values().begin(), config.values().end(),
+                    [&](const auto& kv) { return read.count(kv.first) > 0; }))
       return name;
   }
   return "floquet";
@@ -77,8 +78,8 @@ std::vector<std::string> read_analyses(Config& config) {
     if (command_table().count(name)) continue;
     const std::string suggestion = closest_key(name, available);
     throw BadInput("`analyses = " + text + "`: unknown analysis `" + name + "`" +
-                   (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?") + " (available: " +
-                   available_list + ")");
+                   (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?") +
+                   " (available: " + available_list + ")");
   }
   return names;
 }
@@ -121,8 +122,8 @@ int command_run(Config& config, const Invocation& inv) {
   // manifest) goes first and comes back last: while it is absent the set is not complete.
   std::error_code removed;
   if (fs::remove(dir / "run.json", removed); removed)
-    throw BadInput("cannot write `" + (dir / "run.json").string() + "`: cannot remove the previous one: " +
-                   removed.message());
+    throw BadInput("cannot write `" + (dir / "run.json").string() +
+                   "`: cannot remove the previous one: " + removed.message());
   nlohmann::json manifest;
   manifest["analyses"] = nlohmann::json::array();
   if (!title.empty()) manifest["title"] = title;
@@ -132,8 +133,14 @@ int command_run(Config& config, const Invocation& inv) {
     Config analysis_config = config;
     for (const auto& key : known) analysis_config.mark_used(key);  // keys of the other analyses
     std::ostringstream json_out;
-    Invocation analysis{.command = name, .scene = inv.scene, .json = true, .out_dir = inv.out_dir,
-                        .quiet = inv.quiet, .resume = inv.resume, .out = json_out, .err = inv.err};
+    Invocation analysis{.command = name,
+                        .scene = inv.scene,
+                        .json = true,
+                        .out_dir = inv.out_dir,
+                        .quiet = inv.quiet,
+                        .resume = inv.resume,
+                        .out = json_out,
+                        .err = inv.err};
     const auto start = std::chrono::steady_clock::now();
     const int status = command_table().at(name)(analysis_config, analysis);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -162,8 +169,8 @@ int command_run(Config& config, const Invocation& inv) {
     manifest["out"] = dir.string();
     inv.out << manifest.dump(2) << "\n";
   } else {
-    inv.out << "run: " << analyses.size() << " analyses in " << format_duration(wall) << "; results in "
-            << dir.string() << " (plot them: delayspec plot " << dir.string() << ")\n";
+    inv.out << "run: " << analyses.size() << " analyses in " << format_duration(wall) << "; results in " << dir.string()
+            << " (plot them: delayspec plot " << dir.string() << ")\n";
   }
   return worst_status;
 }

@@ -70,13 +70,15 @@ int command_simulate(Config& config, const Invocation& inv) {
   if (control_on_at > 0 && problem.model_name != "impact")
     throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: only for model = impact (it switches k)");
   Problem before_problem = problem;
-  before_problem.events = parse_event_mode(
-      config.get_choice("events_before_control", to_string(problem.events), event_mode_names()), "events_before_control");
+  before_problem.events =
+      parse_event_mode(config.get_choice("events_before_control", to_string(problem.events), event_mode_names()),
+                       "events_before_control");
   if (before_problem.events != problem.events && !(control_on_at > 0))
     throw BadInput("`events_before_control = " + to_string(before_problem.events) + "`: needs control_on_at > 0");
   // A scene shared with the analysis commands (e.g. the default scene) may carry their keys.
-  for (const char* key : {"nev", "solver", "ncv", "tol", "max_restarts", "seed", "residual_bound", "orbit", "orbit_tolerance",
-                          "orbit_max_periods", "orbit_max_iterations", "orbit_guess_periods", "exponents", "periods", "transient", "Ns"})
+  for (const char* key :
+       {"nev", "solver", "ncv", "tol", "max_restarts", "seed", "residual_bound", "orbit", "orbit_tolerance",
+        "orbit_max_periods", "orbit_max_iterations", "orbit_guess_periods", "exponents", "periods", "transient", "Ns"})
     config.mark_used(key);
   config.check_all_used();
 
@@ -107,7 +109,8 @@ int command_simulate(Config& config, const Invocation& inv) {
           const std::filesystem::path dir(*inv.out_dir);
           const std::string header = metadata_comment_lines(make_metadata(
               "simulate", inv.scene, config,
-              {{"N", problem.N}, {"events", to_string(problem.events)}, {"jacobian", to_string(problem.jacobian)}}, seconds));
+              {{"N", problem.N}, {"events", to_string(problem.events)}, {"jacobian", to_string(problem.jacobian)}},
+              seconds));
           AtomicFile traj(dir / "trajectory.csv");
           traj.stream() << header;
           write_points<D>(traj.stream(), rec.t, rec.y);
@@ -118,7 +121,8 @@ int command_simulate(Config& config, const Invocation& inv) {
           poincare.commit();
           AtomicFile impacts(dir / "impacts.csv");
           impacts.stream() << header << std::setprecision(std::numeric_limits<double>::max_digits10) << "t,count\n";
-          for (size_t i = 0; i < rec.impact_times.size(); ++i) impacts.stream() << rec.impact_times[i] << "," << i + 1 << "\n";
+          for (size_t i = 0; i < rec.impact_times.size(); ++i)
+            impacts.stream() << rec.impact_times[i] << "," << i + 1 << "\n";
           impacts.commit();
           files = {traj.path().string(), poincare.path().string(), impacts.path().string()};
         }
@@ -146,11 +150,12 @@ int command_simulate(Config& config, const Invocation& inv) {
                << to_string(problem.events) << "\n";
           text << "window [" << options.t_start << ", " << options.t_end << "], " << rec.steps << " steps";
           if (control_on_at > 0)
-            text << ", control (k) on from t = " << control_on_at << " (events " << to_string(before_problem.events) << " before)";
+            text << ", control (k) on from t = " << control_on_at << " (events " << to_string(before_problem.events)
+                 << " before)";
           text << "\n";
           if constexpr (Model::has_switching)
-            text << "impacts (entries into H > 0): " << rec.impact_times.size() << "; max H at grid points: " << rec.max_H
-                 << "\n";
+            text << "impacts (entries into H > 0): " << rec.impact_times.size()
+                 << "; max H at grid points: " << rec.max_H << "\n";
           text << "Poincare points (t = m T): " << rec.poincare_t.size();
           if (!rec.poincare_y.empty()) text << ", last " << rec.poincare_y.back().transpose();
           text << "\n";

@@ -152,7 +152,8 @@ json resume_settings(const Config& config, const std::string& key) {
 
 // --resume: the stored settings must equal these (BadInput naming each differing key with both
 // values); the finished point files of this sweep are taken, a point of another sweep refused.
-void resume_points(const fs::path& dir, const json& settings, const std::string& hash, std::vector<SweepPoint>& points) {
+void resume_points(const fs::path& dir, const json& settings, const std::string& hash,
+                   std::vector<SweepPoint>& points) {
   const fs::path settings_path = dir / "sweep_settings.json";
   std::ifstream in(settings_path);
   if (!in) throw BadInput("`--resume`: `" + settings_path.string() + "` not found (no sweep to resume there)");
@@ -229,7 +230,8 @@ SweepTables sweep_tables(const std::vector<SweepPoint>& points, int k) {
       for (int i = 0; i < k; ++i) exponents_csv << "," << csv_number(ok ? number_or_nan(r[field][i]) : NAN);
     exponents_csv << "," << csv_number(ok ? number_or_nan(r["seconds"]) : NAN) << "\n";
     if (ok)
-      for (const auto& x : r["section_x"]) section_csv << csv_number(p.parameter) << "," << csv_number(number_or_nan(x)) << "\n";
+      for (const auto& x : r["section_x"])
+        section_csv << csv_number(p.parameter) << "," << csv_number(number_or_nan(x)) << "\n";
     t.points.push_back(r);
   }
   t.exponents_csv = exponents_csv.str();
@@ -324,8 +326,9 @@ int command_sweep(Config& config, const Invocation& inv) {
             << " (" << s.count << " points, " << thread_count << " threads), N = " << s.first.N << ", transient "
             << options.transient << ", periods " << options.periods << "\n";
     inv.out << tables.exponents_csv;
-    if (dir) inv.out << "files: " << (*dir / "exponents.csv").string() << ", " << (*dir / "section.csv").string() << ", "
-                     << (*dir / "sweep.json").string() << "\n";
+    if (dir)
+      inv.out << "files: " << (*dir / "exponents.csv").string() << ", " << (*dir / "section.csv").string() << ", "
+              << (*dir / "sweep.json").string() << "\n";
     inv.out << "time: " << seconds << " s\n";
   }
   if (!tables.failed.empty()) {

@@ -109,8 +109,8 @@ void require_ascii_outside_strings(const std::string& text, const std::string& p
           break;
         }
         bare_value = false;
-        if ((last == '=' || last == '[' || last == ',') && c != ' ' && c != '\t' && c != '"' && c != '\'' &&
-            c != '[' && c != '{' && !terminates_bare_value(c) && c != '\r') {
+        if ((last == '=' || last == '[' || last == ',') && c != ' ' && c != '\t' && c != '"' && c != '\'' && c != '[' &&
+            c != '{' && !terminates_bare_value(c) && c != '\r') {
           bare_value = true;  // a value not starting with a quote, `[` or `{`
           last = c;
           break;
@@ -123,8 +123,7 @@ void require_ascii_outside_strings(const std::string& text, const std::string& p
         else if (c == '\'') state = State::literal;
         else if (c != ' ' && c != '\t') last = c;
         break;
-      case State::comment:
-        break;
+      case State::comment: break;
       case State::basic:
         if (c == '\\' && non_ascii_at(i + 1)) reject_after_backslash();
         if (c == '\\') ++i, ++column;  // an escape: skip the escaped character
@@ -142,8 +141,7 @@ void require_ascii_outside_strings(const std::string& text, const std::string& p
           while (j < text.size() && (text[j] == ' ' || text[j] == '\t' || text[j] == '\r' || text[j] == '\n')) ++j;
           if (j > i + 1 && non_ascii_at(j)) reject_after_backslash();
           if (i + 1 < text.size() && text[i + 1] != '\n') ++i, ++column;  // skip the escaped character
-        }
-        else if (starts("\"\"\"")) state = State::code, last = c, i += 2, column += 2;
+        } else if (starts("\"\"\"")) state = State::code, last = c, i += 2, column += 2;
         break;
       case State::multi_literal:
         if (starts("'''")) state = State::code, last = c, i += 2, column += 2;
@@ -318,7 +316,8 @@ std::string Config::get_choice(const std::string& key, const std::string& fallba
 std::vector<long> Config::get_int_list(const std::string& key, const std::vector<long>& fallback) {
   auto join = [](const std::vector<long>& list) {
     std::string out;
-    for (long v : list) out.append(out.empty() ? "" : ",").append(std::to_string(v));  // (append: GCC 12 warns falsely on "," + string)
+    for (long v : list)
+      out.append(out.empty() ? "" : ",").append(std::to_string(v));  // (append: GCC 12 warns falsely on "," + string)
     return out;
   };
   auto text = lookup(key);
@@ -373,7 +372,8 @@ std::string closest_key(const std::string& key, const std::vector<std::string>& 
     if (candidate == key) continue;
     // the distance is at least the difference in length: skip without the O(|key| |candidate|)
     // table (a 5 MB key is answered at once)
-    const size_t length_gap = key.size() > candidate.size() ? key.size() - candidate.size() : candidate.size() - key.size();
+    const size_t length_gap =
+        key.size() > candidate.size() ? key.size() - candidate.size() : candidate.size() - key.size();
     if (length_gap > threshold) continue;
     const size_t d = edit_distance(key, candidate);
     if (d < best_distance || (d == best_distance && !best.empty() && candidate < best)) {

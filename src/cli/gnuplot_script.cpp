@@ -64,8 +64,8 @@ void FigureRenderer::figure(const std::string& name, const std::string& body) {
   std::ostringstream gp;
   gp << "# delayspec plot: " << name << " (run: gnuplot " << name << ".gp; writes " << name << ".png and " << name
      << ".svg)\n";
-  gp << "png_file = " << gnuplot_string(png.filename().string()) << "\nsvg_file = "
-     << gnuplot_string(svg.filename().string()) << "\n";
+  gp << "png_file = " << gnuplot_string(png.filename().string())
+     << "\nsvg_file = " << gnuplot_string(svg.filename().string()) << "\n";
   gp << "if (exists('DELAYSPEC_PNG')) png_file = DELAYSPEC_PNG; svg_file = DELAYSPEC_SVG\n";
   gp << "set terminal pngcairo size " << settings_.width << "," << settings_.height
      << " enhanced font 'sans,12' background rgb 'white'\nset output png_file\n";
@@ -76,11 +76,11 @@ void FigureRenderer::figure(const std::string& name, const std::string& body) {
   write_file_atomically(script, gp.str());
   // Run in plots/ so that the script's relative names work; the temporaries become the images.
   const std::string log_name = "." + name + ".log";  // relative to plots/ (the cd)
-  const std::string command =
-      "cd " + shell_quoted(plots_.string()) + " && " + shell_quoted(settings_.program) + " -e " +
-      shell_quoted("DELAYSPEC_PNG=" + gnuplot_string(png_tmp.filename().string()) +
-                   "; DELAYSPEC_SVG=" + gnuplot_string(svg_tmp.filename().string())) +
-      " " + shell_quoted(script.filename().string()) + " 2>" + shell_quoted(log_name);
+  const std::string command = "cd " + shell_quoted(plots_.string()) + " && " + shell_quoted(settings_.program) +
+                              " -e " +
+                              shell_quoted("DELAYSPEC_PNG=" + gnuplot_string(png_tmp.filename().string()) +
+                                           "; DELAYSPEC_SVG=" + gnuplot_string(svg_tmp.filename().string())) +
+                              " " + shell_quoted(script.filename().string()) + " 2>" + shell_quoted(log_name);
   const int status = std::system(command.c_str());
   const int system_errno = errno;
   std::string log_text;
@@ -108,8 +108,7 @@ void FigureRenderer::figure(const std::string& name, const std::string& body) {
   if (code != 0)
     throw NumericalFailure("gnuplot failed (exit status " + std::to_string(code) + ") on " + script.string() + ":\n" +
                            tail(log_text, 2000));
-  if (!images)
-    throw NumericalFailure("gnuplot wrote no image from " + script.string() + ":\n" + tail(log_text, 2000));
+  if (!images) throw NumericalFailure("gnuplot wrote no image from " + script.string() + ":\n" + tail(log_text, 2000));
   for (const auto& [from, to] : {std::pair{png_tmp, png}, std::pair{svg_tmp, svg}}) {
     fs::rename(from, to, ec);
     if (ec) throw BadInput("cannot write `" + to.string() + "`: " + ec.message());

@@ -36,7 +36,8 @@ const Probes& all_probes() {
   static const Probes probes = [] {
     Probes p;
     for (const auto& [command, fn] : command_table())
-      for (const auto& model : model_names()) p[command][model] = probe_command(command, probe_config(command, model)).reads;
+      for (const auto& model : model_names())
+        p[command][model] = probe_command(command, probe_config(command, model)).reads;
     return p;
   }();
   return probes;
@@ -59,8 +60,14 @@ std::string default_text(const std::string& command, const Config::Read& r) {
 Probe probe_command(const std::string& command, Config config, OnBadInput on_bad_input) {
   config.collect_keys_only(true);
   std::ostringstream sink_out, sink_err;
-  Invocation dry{.command = command, .scene = std::nullopt, .json = true, .out_dir = std::nullopt, .quiet = true,
-                 .resume = false, .out = sink_out, .err = sink_err};
+  Invocation dry{.command = command,
+                 .scene = std::nullopt,
+                 .json = true,
+                 .out_dir = std::nullopt,
+                 .quiet = true,
+                 .resume = false,
+                 .out = sink_out,
+                 .err = sink_err};
   try {
     command_table().at(command)(config, dry);
   } catch (const KeysCollected&) {
@@ -117,10 +124,12 @@ const std::map<std::string, std::string>& key_meanings() {
       {"orbit_guess_periods", "newton, auto, shooting: periods simulated from the initial history before the guess"},
       {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this; one level below 8x it"},
       {"nev", "multipliers wanted, >= 1"},
-      {"solver", "eigensolver: auto (dense n <= 100, spectra n < 2000, else arpack), spectra, arpack, dense, dense-eigen"},
+      {"solver",
+       "eigensolver: auto (dense n <= 100, spectra n < 2000, else arpack), spectra, arpack, dense, dense-eigen"},
       {"ncv", "Krylov subspace dimension; 0 = max(2 nev + 1, nev + 10), at most n"},
       {"tol", "Krylov: converged when residual estimate <= tol max(|mu|, eps^(2/3))"},
-      {"residual_bound", "Krylov: a returned pair needs a true residual |M v - mu v| / (|mu| |v|) <= max(residual_bound, 100 tol) (else retried, then exit 3)"},
+      {"residual_bound",
+       "Krylov: a returned pair needs a true residual |M v - mu v| / (|mu| |v|) <= max(residual_bound, 100 tol) (else retried, then exit 3)"},
       {"max_restarts", "Krylov: implicit restarts allowed (more: exit 3), 0..1000000"},
       {"seed", "seed of the random start vector (Krylov) or initial tangent block (Lyapunov)"},
       // lyapunov (lyapunov_settings.cpp), sweep
@@ -143,7 +152,8 @@ const std::map<std::string, std::string>& key_meanings() {
       {"extrapolation_order", "Richardson: leading error order p (impact with events off: 1)"},
       {"extrapolation_order_step", "Richardson: order step q of c1 h^p + c2 h^(p+q) + ..."},
       {"extrapolation_levels", "Richardson: most levels combined, >= 1"},
-      {"converge_target", "converge: keep doubling N past Ns until every tracked multiplier's relative error estimate is <= this (none: off)"},
+      {"converge_target",
+       "converge: keep doubling N past Ns until every tracked multiplier's relative error estimate is <= this (none: off)"},
       {"converge_max_N", "converge_target: the largest N tried, 1..1e7"},
       {"converge_max_seconds", "converge_target: stop when the next level would end past this many seconds"},
       {"solvers", "bench: solvers compared (comma list)"},
@@ -243,7 +253,8 @@ std::string unread_key_message(const std::string& key, const std::string& value_
       for (const auto& [k, by] : key_readers()) all.push_back(k);
       suggestion = closest_key(key, all);
     }
-    return "unknown key `" + key + "` " + value_note + (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?");
+    return "unknown key `" + key + "` " + value_note +
+           (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?");
   }
   // A key of another command or model: say so, not a did-you-mean to a different key; only a
   // key differing in case from one this command reads (`n` for `N`) gets a suggestion.
@@ -255,8 +266,9 @@ std::string unread_key_message(const std::string& key, const std::string& value_
     if (auto it = known->second.find(reader); it != known->second.end())
       other_models.insert(it->second.begin(), it->second.end());
   if (!other_models.empty()) {
-    message += " with model = " + model_name + " (only with model = " +
-               join(std::vector<std::string>(other_models.begin(), other_models.end()), ", ") + ")";
+    message += " with model = " + model_name +
+               " (only with model = " + join(std::vector<std::string>(other_models.begin(), other_models.end()), ", ") +
+               ")";
   } else {
     std::vector<std::string> commands;
     for (const auto& [command, models] : known->second) commands.push_back(command);

@@ -17,8 +17,8 @@ LyapunovOptions read_lyapunov_options(Config& config, int default_exponents) {
   o.qr_every = static_cast<int>(config.get_int_in_range("qr_every", 1, 1, kMaxPeriods));
   o.batches = static_cast<int>(config.get_int_in_range("batches", o.batches, 2, kMaxPeriods));
   if (o.periods % o.qr_every != 0)
-    throw BadInput("`periods = " + std::to_string(o.periods) + "` must be a multiple of `qr_every = " +
-                   std::to_string(o.qr_every) + "`");
+    throw BadInput("`periods = " + std::to_string(o.periods) +
+                   "` must be a multiple of `qr_every = " + std::to_string(o.qr_every) + "`");
   if (o.periods / o.qr_every > kMaxLogs / o.exponents)
     throw BadInput("`periods = " + std::to_string(o.periods) + "`: with `exponents = " + std::to_string(o.exponents) +
                    "` and `qr_every = " + std::to_string(o.qr_every) +

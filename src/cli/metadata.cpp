@@ -17,8 +17,8 @@ std::string utc_now_iso8601() {
   return buf;
 }
 
-OutputMetadata make_metadata(const std::string& command, const std::optional<std::string>& scene,
-                             const Config& config, const nlohmann::json& result, double wall_seconds) {
+OutputMetadata make_metadata(const std::string& command, const std::optional<std::string>& scene, const Config& config,
+                             const nlohmann::json& result, double wall_seconds) {
   OutputMetadata m;
   m.command = command;
   m.scene = scene;
@@ -74,8 +74,7 @@ std::string metadata_comment_lines(const OutputMetadata& m) {
   out << "# command: " << m.command << "\n";
   out << "# scene: " << (m.scene ? one_line(*m.scene) : "(none)") << "\n";
   for (const auto& [key, value] : m.parameters) out << "# " << one_line(key) << " = " << one_line(value) << "\n";
-  for (const auto& [key, value] : m.defaults)
-    out << "# default: " << one_line(key) << " = " << one_line(value) << "\n";
+  for (const auto& [key, value] : m.defaults) out << "# default: " << one_line(key) << " = " << one_line(value) << "\n";
   if (m.N > 0) out << "# N: " << m.N << "\n";
   out << "# events: " << m.events << "\n";
   out << "# jacobian: " << m.jacobian << "\n";

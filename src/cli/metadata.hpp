@@ -43,8 +43,8 @@ struct OutputMetadata {
 
 // Fills the metadata of `command` run with `config`, taking N/events/jacobian from `result`
 // when present.
-OutputMetadata make_metadata(const std::string& command, const std::optional<std::string>& scene,
-                             const Config& config, const nlohmann::json& result, double wall_seconds);
+OutputMetadata make_metadata(const std::string& command, const std::optional<std::string>& scene, const Config& config,
+                             const nlohmann::json& result, double wall_seconds);
 
 nlohmann::json metadata_json(const OutputMetadata& metadata);
 // The "# ..." comment lines (each ends with a newline).

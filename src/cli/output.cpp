@@ -30,8 +30,8 @@ void print_multipliers(std::ostream& out, const std::vector<std::complex<double>
   std::snprintf(line, sizeof line, "  %3s  %22s  %22s  %18s\n", "#", "re", "im", "|mu|");
   out << line;
   for (size_t i = 0; i < values.size(); ++i) {
-    std::snprintf(line, sizeof line, "  %3zu  %22.15e  %22.15e  %18.15f\n", i + 1, values[i].real(),
-                  values[i].imag(), std::abs(values[i]));
+    std::snprintf(line, sizeof line, "  %3zu  %22.15e  %22.15e  %18.15f\n", i + 1, values[i].real(), values[i].imag(),
+                  std::abs(values[i]));
     out << line;
   }
 }
@@ -58,8 +58,12 @@ nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& cont
   if (!orbit.levels.empty()) {
     nlohmann::json levels = nlohmann::json::array();
     for (const PeriodicOrbit::Level& l : orbit.levels)
-      levels.push_back({{"N", l.N}, {"method", l.method}, {"newton_iterations", l.newton_iterations},
-                        {"linear_iterations", l.linear_iterations}, {"residual", l.residual}, {"seconds", l.seconds}});
+      levels.push_back({{"N", l.N},
+                        {"method", l.method},
+                        {"newton_iterations", l.newton_iterations},
+                        {"linear_iterations", l.linear_iterations},
+                        {"residual", l.residual},
+                        {"seconds", l.seconds}});
     j["levels"] = levels;
   }
   return j;
@@ -78,8 +82,7 @@ void print_orbit(std::ostream& out, const PeriodicOrbit& orbit, const ContactSum
   if (orbit.method == "newton" || orbit.method == "shooting")
     out << " (first guess simulated for " << orbit.maps << " periods"
         << (orbit.levels.size() > 1 ? " at N = " + std::to_string(orbit.levels.front().N) : std::string()) << ")";
-  else
-    out << " after " << orbit.maps << " periods";
+  else out << " after " << orbit.maps << " periods";
   out << "\n";
   if (orbit.method == "newton" || orbit.method == "shooting") {
     out << "  Newton " << (orbit.method == "newton" ? "|F|_inf" : "|P(U) - U|_inf") << ":";

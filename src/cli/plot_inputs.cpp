@@ -47,7 +47,7 @@ std::optional<double> parse_number(const std::string& text) {
   const size_t last = text.find_last_not_of(" \t");
   const std::string trimmed = text.substr(first, last - first + 1);
   char* end = nullptr;
-  const double value = std::strtod(trimmed.c_str(), &end);  // underflow (subnormals, 0) is a number
+  const double value = std::strtod(trimmed.c_str(), &end);           // underflow (subnormals, 0) is a number
   if (end != trimmed.c_str() + trimmed.size()) return std::nullopt;  // also stops at an embedded NUL
   return value;
 }
@@ -88,9 +88,11 @@ size_t ResultTable::data_rows() const {
 
 void ResultTable::require_header(const std::vector<std::string>& expected) const {
   bool ok = columns.size() >= expected.size();
-  for (size_t i = 0; ok && i < expected.size(); ++i) ok = expected[i] == "X" || expected[i] == "Y" || columns[i] == expected[i];
+  for (size_t i = 0; ok && i < expected.size(); ++i)
+    ok = expected[i] == "X" || expected[i] == "Y" || columns[i] == expected[i];
   if (!ok)
-    throw BadInput("`" + path.string() + "`: header `" + shown(joined(columns)) + "`: expected columns " + joined(expected));
+    throw BadInput("`" + path.string() + "`: header `" + shown(joined(columns)) + "`: expected columns " +
+                   joined(expected));
 }
 
 void ResultTable::require_rows() const {
@@ -166,7 +168,8 @@ ResultTable read_result_table(const fs::path& path, const std::function<bool(con
 // ---- JSON ----
 
 void JsonField::fail(const std::string& what) const {
-  throw BadInput("`" + file_ + "`: " + (path_.empty() ? std::string("the top level") : "`" + path_ + "`") + ": " + what);
+  throw BadInput("`" + file_ + "`: " + (path_.empty() ? std::string("the top level") : "`" + path_ + "`") + ": " +
+                 what);
 }
 
 void JsonField::require_object() const {

@@ -18,8 +18,7 @@ ImpactModel read_impact(Config& c) {
   p.k = c.get_double("k", p.k);
   p.x0 = c.get_double("x0", p.x0);
   p.v0 = c.get_double("v0", p.v0);
-  if (c.has("tau") && c.has("tau_over_T"))
-    throw BadInput("`tau` and `tau_over_T` are both given: give one of them");
+  if (c.has("tau") && c.has("tau_over_T")) throw BadInput("`tau` and `tau_over_T` are both given: give one of them");
   if (c.has("tau")) {
     p.tau = c.get_double("tau", 0);
     require_positive("tau", p.tau);
@@ -122,7 +121,8 @@ Problem read_problem(Config& config, int default_N) {
   problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"}) == "frozen"
                          ? JacobianMode::frozen
                          : JacobianMode::consistent;
-  problem.contact_substeps = static_cast<int>(config.get_int_in_range("contact_substeps", problem.contact_substeps, 1, 1000));
+  problem.contact_substeps =
+      static_cast<int>(config.get_int_in_range("contact_substeps", problem.contact_substeps, 1, 1000));
   problem.grid();  // BadInput now when N does not fit the delay/period ratio
   return problem;
 }

@@ -16,12 +16,9 @@ bool stderr_is_terminal(const std::ostream& err) { return &err == &std::cerr && 
 
 std::string format_rate(double per_second) {
   char buf[32];
-  if (per_second >= 100)
-    std::snprintf(buf, sizeof buf, "%.0f/s", per_second);
-  else if (per_second >= 1)
-    std::snprintf(buf, sizeof buf, "%.1f/s", per_second);
-  else
-    std::snprintf(buf, sizeof buf, "%.2f/s", per_second);
+  if (per_second >= 100) std::snprintf(buf, sizeof buf, "%.0f/s", per_second);
+  else if (per_second >= 1) std::snprintf(buf, sizeof buf, "%.1f/s", per_second);
+  else std::snprintf(buf, sizeof buf, "%.2f/s", per_second);
   return buf;
 }
 
@@ -30,10 +27,8 @@ std::string format_rate(double per_second) {
 std::string format_duration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "?";
   char buf[48];
-  if (seconds < 10)
-    std::snprintf(buf, sizeof buf, "%.1f s", seconds);
-  else if (seconds < 60)
-    std::snprintf(buf, sizeof buf, "%.0f s", seconds);
+  if (seconds < 10) std::snprintf(buf, sizeof buf, "%.1f s", seconds);
+  else if (seconds < 60) std::snprintf(buf, sizeof buf, "%.0f s", seconds);
   else if (seconds < 3600)
     std::snprintf(buf, sizeof buf, "%d min %02d s", static_cast<int>(seconds / 60), static_cast<int>(seconds) % 60);
   else
@@ -79,7 +74,8 @@ std::string Progress::describe(long done, double seconds) const {
     text << ", " << format_rate(rate);
   }
   // ETA = remaining / mean rate since the start.
-  if (total_ > 0 && done < total_ && rate > 0) text << (bar_ ? "  ETA " : ", ETA ") << format_duration((total_ - done) / rate);
+  if (total_ > 0 && done < total_ && rate > 0)
+    text << (bar_ ? "  ETA " : ", ETA ") << format_duration((total_ - done) / rate);
   return text.str();
 }
 

@@ -16,17 +16,10 @@ namespace delayspec::cli {
 
 const std::map<std::string, CommandFunction>& command_table() {
   static const std::map<std::string, CommandFunction> table = {
-      {"floquet", command_floquet},
-      {"lyapunov", command_lyapunov},
-      {"sweep", command_sweep},
-      {"converge", command_converge},
-      {"bench", command_bench},
-      {"run", command_run},
-      {"chart", command_chart},
-      {"basin", command_basin},
-      {"plot", command_plot},
-      {"simulate", command_simulate},
-      {"continue", command_continue},
+      {"floquet", command_floquet},   {"lyapunov", command_lyapunov}, {"sweep", command_sweep},
+      {"converge", command_converge}, {"bench", command_bench},       {"run", command_run},
+      {"chart", command_chart},       {"basin", command_basin},       {"plot", command_plot},
+      {"simulate", command_simulate}, {"continue", command_continue},
   };
   return table;
 }
@@ -35,12 +28,9 @@ OutputUse output_use(const std::string& command) {
   static const std::map<std::string, OutputUse> table = {
       {"sweep", {OutDirUse::written, true}},  // point files: --resume computes only the missing points
       {"run", {OutDirUse::written, true}},    // passes --resume to its analyses (command_run.cpp)
-      {"converge", {OutDirUse::written, false}},
-      {"bench", {OutDirUse::written, false}},
-      {"chart", {OutDirUse::written, false}},
-      {"basin", {OutDirUse::written, false}},
-      {"simulate", {OutDirUse::written, false}},
-      {"continue", {OutDirUse::written, false}},
+      {"converge", {OutDirUse::written, false}}, {"bench", {OutDirUse::written, false}},
+      {"chart", {OutDirUse::written, false}},    {"basin", {OutDirUse::written, false}},
+      {"simulate", {OutDirUse::written, false}}, {"continue", {OutDirUse::written, false}},
       {"plot", {OutDirUse::read, false}},  // `plot --out DIR` = `plot DIR`
   };
   auto it = table.find(command);
@@ -71,9 +61,10 @@ std::string command_list() {
 }  // namespace
 
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-  CLI::App app{"delayspec: stability spectra (Floquet multipliers, Lyapunov exponents) of periodically forced "
-               "delay differential equations, matrix-free.\nCommands: " +
-               command_list()};
+  CLI::App app{
+      "delayspec: stability spectra (Floquet multipliers, Lyapunov exponents) of periodically forced "
+      "delay differential equations, matrix-free.\nCommands: " +
+      command_list()};
   app.set_version_flag("--version", std::string("delayspec ") + DELAYSPEC_VERSION);
   std::string command;
   std::string scene;
@@ -145,8 +136,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
     // The Krylov hint only where a dense solver was asked for (bench compares dense by default).
     const std::string solver = config.values().count("solver") ? config.values().at("solver") : "";
     const bool dense = solver.rfind("dense", 0) == 0 || command == "bench";
-    err << "delayspec " << command << ": out of memory (reduce N" << (dense ? " or use a Krylov solver" : "")
-        << ")\n";
+    err << "delayspec " << command << ": out of memory (reduce N" << (dense ? " or use a Krylov solver" : "") << ")\n";
     return 3;
   } catch (const std::length_error& e) {
     err << "delayspec " << command << ": out of memory: a buffer larger than the address space (" << e.what()

@@ -22,8 +22,7 @@ namespace delayspec {
 // u0: the current slot; d0: the delayed slot j (its neighbours j - 1 and j + 1 are d0 -+ D k);
 // out: the new slot (must not alias the inputs).
 template <int D>
-inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, long k, double theta,
-                       double* out) {
+inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, long k, double theta, double* out) {
   constexpr long kChunk = 64;  // vectors per pass when the delayed values need interpolating
   const long stride = static_cast<long>(D) * k;
   const double c0 = 1 - theta;

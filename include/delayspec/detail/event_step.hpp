@@ -88,10 +88,12 @@ class EventStepSolver {
 
   EventStepSolver(const TrapezoidStepper<Model>& stepper, double t, double h, const V& w0, const V& w1)
       : stepper_(stepper), model_(stepper.model()), options_(stepper.options()), t_(t), h_(h), w0_(w0), w1_(w1) {
-    static_assert(requires(const Model& m, V y) {
-      { m.f_t(1, 0.0, y, y) } -> std::convertible_to<V>;
-      { m.f_tt(1, 0.0, y, y) } -> std::convertible_to<V>;
-    }, "a model with switching must provide f_t and f_tt (model.hpp)");
+    static_assert(
+        requires(const Model& m, V y) {
+          { m.f_t(1, 0.0, y, y) } -> std::convertible_to<V>;
+          { m.f_tt(1, 0.0, y, y) } -> std::convertible_to<V>;
+        },
+        "a model with switching must provide f_t and f_tt (model.hpp)");
     wdot_ = (w1 - w0) / h;
   }
 
@@ -135,8 +137,9 @@ class EventStepSolver {
       a = b;
       if (!exit.event) break;
       if (count == StepEvents::kMaxEvents)
-        throw NumericalFailure("event step at t = " + format_number(t_) + ", h = " + format_number(h_) + ": more than " +
-                               std::to_string(StepEvents::kMaxEvents) + " events in one step (reduce h)");
+        throw NumericalFailure("event step at t = " + format_number(t_) + ", h = " + format_number(h_) +
+                               ": more than " + std::to_string(StepEvents::kMaxEvents) +
+                               " events in one step (reduce h)");
       j = 3 - j;
       if (events) {
         events->offset[count] = b;
@@ -216,7 +219,7 @@ class EventStepSolver {
       const M Bl = model_.B(j, tl, zl, wl), Br = model_.B(j, tr, zr, wr);
       const V ftl = model_.f_t(j, tl, zl, wl), ftr = model_.f_t(j, tr, zr, wr);
       const detail::SmallSolve<D> lu(M(M::Identity() - 0.5 * L * Ar));  // S = I - L/2 A_r
-      const M Jz = lu.solve(M(M::Identity() + 0.5 * L * Al));             // dz_i/dz_{i-1}
+      const M Jz = lu.solve(M(M::Identity() + 0.5 * L * Al));           // dz_i/dz_{i-1}
       // dz_i/ds_{i-1} and dz_i/ds_i: the length changes by -1/+1, the node's time and delayed
       // value move with it (d/ds f(t + s, z, w(s)) = f_t + B w').
       const V Js0 = lu.solve(V(-0.5 * (fl + fr) + 0.5 * L * (ftl + Bl * wdot_)));
@@ -287,7 +290,8 @@ class EventStepSolver {
     if (!from_surface) {
       b = a - model_.H(za) / H1;
     } else {
-      const double H2 = g.dot(model_.f_t(j, ta, za, wa) + model_.A(j, ta, za, wa) * F + model_.B(j, ta, za, wa) * wdot_);
+      const double H2 =
+          g.dot(model_.f_t(j, ta, za, wa) + model_.A(j, ta, za, wa) * F + model_.B(j, ta, za, wa) * wdot_);
       b = a - 2 * H1 / H2;
     }
     Exit e{true, b, from_surface, false};
@@ -318,7 +322,7 @@ class EventStepSolver {
       return into * gs > 0;
     };
     double lo, glo;
-    if (wrong(gL)) {  // case 1: the piece ends on the other side
+    if (wrong(gL)) {                                                        // case 1: the piece ends on the other side
       if (!inside_point(h_, lo, glo)) return {true, a, on_surface, false};  // no resolvable time inside region j
       if (options_.events == EventMode::linear) return linear_estimate(a, za, j, on_surface, h_);
       return {true, root(g, lo, h_, glo, gL), on_surface, false};
@@ -385,8 +389,7 @@ class EventStepSolver {
 
 template <class Model>
 Vec<Model::d> event_step(const TrapezoidStepper<Model>& stepper, double t, double h, const Vec<Model::d>& u0,
-                         const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepMap<Model::d>& map,
-                         StepEvents* events) {
+                         const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepMap<Model::d>& map, StepEvents* events) {
   return detail::EventStepSolver<Model>(stepper, t, h, w0, w1).run(u0, map, events);
 }
 

@@ -18,8 +18,8 @@
 namespace delayspec {
 
 struct ScalarSearchResult {
-  double x = 0;   // the abscissa found
-  double g = 0;   // g(x)
+  double x = 0;  // the abscissa found
+  double g = 0;  // g(x)
   int evaluations = 0;
 };
 
@@ -123,12 +123,14 @@ ScalarSearchResult bounded_minimum(const G& g, double a, double b, int max_evalu
     const double gu = g(u);
     ++r.evaluations;
     if (gu <= gx) {
-      if (u >= x) a = x; else b = x;
+      if (u >= x) a = x;
+      else b = x;
       v = w, gv = gw;
       w = x, gw = gx;
       x = u, gx = gu;
     } else {
-      if (u < x) a = u; else b = u;
+      if (u < x) a = u;
+      else b = u;
       if (gu <= gw || w == x) {
         v = w, gv = gw;
         w = u, gw = gu;
