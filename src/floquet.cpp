@@ -18,6 +18,7 @@ FloquetSolver parse_floquet_solver(const std::string& name) {
   if (name == "auto") return FloquetSolver::automatic;
   if (name == "spectra") return FloquetSolver::spectra;
   if (name == "arpack") return FloquetSolver::arpack;
+  if (name == "block") return FloquetSolver::block;
   if (name == "dense" || name == "dense-lapack") return FloquetSolver::dense_lapack;
   if (name == "dense-eigen") return FloquetSolver::dense_eigen;
   throw BadInput("`solver = " + name + "`: must be one of auto, spectra, arpack, dense, dense-eigen, dense-lapack");
@@ -33,6 +34,7 @@ std::string to_string(FloquetSolver solver) {
     case FloquetSolver::automatic: return "auto";
     case FloquetSolver::spectra: return "spectra";
     case FloquetSolver::arpack: return "arpack";
+    case FloquetSolver::block: return "block";
     case FloquetSolver::dense_eigen: return "dense-eigen";
     case FloquetSolver::dense_lapack: return "dense-lapack";
   }
@@ -55,6 +57,8 @@ void validate_floquet_options(const FloquetOptions& options, long n) {
     throw BadInput("`max_iterations = " + std::to_string(options.max_iterations) + "`: must be >= 1");
   if (!(options.residual_bound > 0) || !std::isfinite(options.residual_bound))
     throw BadInput("`residual_bound = " + format_number(options.residual_bound) + "`: must be > 0 and finite");
+  if (options.block_size < 1 || options.block_size > 64)
+    throw BadInput("`block_size = " + std::to_string(options.block_size) + "`: must be between 1 and 64");
 }
 
 int default_ncv(int nev, long n) {
@@ -268,6 +272,7 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
   settings.ncv = options.ncv == 0 ? default_ncv(options.nev, n) : options.ncv;
   settings.tolerance = options.tolerance;
   settings.max_iterations = options.max_iterations;
+  settings.block_size = options.block_size;
   if (settings.ncv < options.nev + 2)
     throw BadInput("`ncv = " + std::to_string(settings.ncv) +
                    "`: must be >= nev + 2 = " + std::to_string(options.nev + 2));
@@ -307,7 +312,8 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
   for (int attempt = 0;; ++attempt) {
     krylov::RitzPairs pairs;
     try {
-      pairs = options.solver == FloquetSolver::spectra ? krylov::spectra_ritz_pairs(op, settings, start)
+      pairs = options.solver == FloquetSolver::block     ? krylov::block_ritz_pairs(op, settings, start)
+              : options.solver == FloquetSolver::spectra ? krylov::spectra_ritz_pairs(op, settings, start)
                                                        : krylov::arpack_ritz_pairs(op, settings, start);
     } catch (const NumericalFailure&) {
       // The same absolute thresholds can also keep Spectra from converging at all on an operator
@@ -357,7 +363,8 @@ FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& 
   validate_floquet_options(requested, n);
   FloquetOptions options = requested;
   if (options.solver == FloquetSolver::automatic) options.solver = choose_floquet_solver(n);
-  const bool krylov = options.solver == FloquetSolver::spectra || options.solver == FloquetSolver::arpack;
+  const bool krylov = options.solver == FloquetSolver::spectra || options.solver == FloquetSolver::arpack ||
+                      options.solver == FloquetSolver::block;
   const auto start = std::chrono::steady_clock::now();
   FloquetResult result;
   const long applications_before = op.applications();
@@ -370,7 +377,8 @@ FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& 
   switch (solver) {
     case FloquetSolver::automatic:  // resolved above
     case FloquetSolver::spectra:
-    case FloquetSolver::arpack: krylov_solve(op, options, result); break;
+    case FloquetSolver::arpack:
+    case FloquetSolver::block: krylov_solve(op, options, result); break;
     case FloquetSolver::dense_eigen:
     case FloquetSolver::dense_lapack: {
       const DenseBackend backend = solver == FloquetSolver::dense_eigen ? DenseBackend::eigen : DenseBackend::lapack;

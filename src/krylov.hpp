@@ -1,6 +1,6 @@
 #pragma once
-// Internal interface between floquet.cpp and the two Krylov backends (krylov_spectra.cpp,
-// krylov_arpack.cpp). Not installed: users call floquet_multipliers().
+// Internal interface between floquet.cpp and the Krylov backends (krylov_spectra.cpp,
+// krylov_arpack.cpp, krylov_block.cpp). Not installed: users call floquet_multipliers().
 #include <complex>
 #include <string>
 #include <vector>
@@ -19,6 +19,7 @@ struct Settings {
   double tolerance = 0;
   int max_iterations = 0;
   double scale = 1;  // Spectra only: the solver works on M / scale (a power of two), see krylov_spectra.cpp
+  int block_size = 8;  // block only: vectors per block (krylov_block.cpp)
 };
 
 // Converged Ritz pairs, each real eigenvalue and each complex-conjugate pair once.
@@ -41,6 +42,8 @@ template <int D>
 RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& settings, const Eigen::VectorXd& start);
 template <int D>
 RitzPairs arpack_ritz_pairs(const Monodromy<D>& op, const Settings& settings, const Eigen::VectorXd& start);
+template <int D>
+RitzPairs block_ritz_pairs(const Monodromy<D>& op, const Settings& settings, const Eigen::VectorXd& start);
 
 // Largest relative Ritz estimate est_i / max(|theta_i|, eps^(2/3)) over the nev largest-modulus
 // Ritz values theta (the quantity both backends compare with the tolerance).

@@ -1,5 +1,5 @@
-// The two Krylov backends (Spectra, ARPACK) against the dense LAPACK reference on the same
-// matrix-free monodromy: agreement of the leading multipliers, true residuals of the returned
+// The Krylov backends (Spectra, ARPACK, block Krylov-Schur) against the dense LAPACK reference on
+// the same matrix-free monodromy: agreement of the leading multipliers, true residuals of the returned
 // pairs, forced non-convergence, routing of tiny problems to dense, bad options.
 #include <gtest/gtest.h>
 
@@ -61,7 +61,7 @@ FloquetResult solve(const auto& op, FloquetSolver solver, int nev, int ncv = 0, 
 void expect_backends_agree(const auto& op, int nev) {
   const FloquetResult dense = solve(op, FloquetSolver::dense_lapack, nev);
   const double scale = std::abs(dense.multipliers[0]);
-  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     const FloquetResult r = solve(op, solver, nev);
     SCOPED_TRACE(r.solver);
     EXPECT_EQ(r.solver, to_string(solver));
@@ -140,10 +140,43 @@ TEST(Krylov, TwoMultipliersOfNearlyEqualModulus) {
   expect_backends_agree(op, 10);
 }
 
+// Block Krylov-Schur with block sizes 1, 2, 4, 8 (nev = 20 and 7: not multiples of most of
+// them) against dense and ARPACK on the top multipliers of the linear (complex pair leading),
+// Mathieu and impact monodromies; tolerances as expect_backends_agree.
+TEST(KrylovBlock, BlockSizesAgreeWithDenseAndArpack) {
+  const auto linear = zero_orbit_monodromy(LinearModel({.a = -1, .b = -2, .tau = 1, .period = 1}), 300);
+  const auto mathieu = zero_orbit_monodromy(MathieuModel(), 150);
+  const auto impact = impact_orbit_monodromy(150);
+  auto check = [](const auto& op, int nev) {
+    const FloquetResult dense = solve(op, FloquetSolver::dense_lapack, nev);
+    const FloquetResult arpack = solve(op, FloquetSolver::arpack, nev);
+    const double scale = std::abs(dense.multipliers[0]);
+    for (int b : {1, 2, 4, 8}) {
+      SCOPED_TRACE("block size " + std::to_string(b) + ", nev " + std::to_string(nev));
+      FloquetOptions o;
+      o.nev = nev;
+      o.solver = FloquetSolver::block;
+      o.block_size = b;
+      const FloquetResult r = floquet_multipliers(op, o);
+      EXPECT_EQ(r.solver, "block");
+      ASSERT_EQ(r.multipliers.size(), static_cast<size_t>(nev));
+      for (int k = 0; k < nev; ++k) {
+        EXPECT_LE(std::abs(r.multipliers[k] - dense.multipliers[k]), 1e-10 * scale) << k;
+        EXPECT_LE(std::abs(r.multipliers[k] - arpack.multipliers[k]), 1e-10 * scale) << k;
+        EXPECT_LE(r.residuals[k], 1e-9) << k;
+      }
+    }
+  };
+  check(linear, 20);
+  check(mathieu, 20);
+  check(impact, 20);
+  check(impact, 7);
+}
+
 TEST(Krylov, ForcedNonConvergenceThrowsForBothBackends) {
   // One Arnoldi iteration with the smallest subspace cannot resolve 10 multipliers to 1e-12.
   auto op = impact_orbit_monodromy(200);
-  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     try {
       solve(op, solver, 10, 12, 1);
       ADD_FAILURE() << to_string(solver) << ": no exception";
@@ -158,7 +191,7 @@ TEST(Krylov, ForcedNonConvergenceThrowsForBothBackends) {
 
 TEST(Krylov, SameStartVectorGivesReproducibleResults) {
   auto op = zero_orbit_monodromy(MathieuModel(), 100);
-  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     const FloquetResult a = solve(op, solver, 6), b = solve(op, solver, 6);
     EXPECT_EQ(a.multipliers, b.multipliers) << to_string(solver);
     EXPECT_EQ(a.operator_applications, b.operator_applications) << to_string(solver);
@@ -175,7 +208,7 @@ TEST(Krylov, SameStartVectorGivesReproducibleResults) {
 TEST(Krylov, NevAboveDimensionMinusTwoRoutesToDense) {
   auto op = zero_orbit_monodromy(LinearModel({.a = -1, .b = -2, .tau = 1, .period = 1}), 5);  // n = 6
   const auto dense = solve(op, FloquetSolver::dense_lapack, 5).multipliers;
-  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     const FloquetResult r = solve(op, solver, 5);
     EXPECT_EQ(r.solver, "dense-lapack");
     EXPECT_NE(r.note.find("nev = 5 > n - 2 = 4"), std::string::npos) << r.note;
@@ -260,7 +293,7 @@ TEST(Krylov, BadOptionsAreBadInput) {
 TEST(Krylov, UserStartVectorAndInvariantSubspace) {
   auto op = zero_orbit_monodromy(MathieuModel(), 120);
   const FloquetResult base = solve(op, FloquetSolver::spectra, 6);
-  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     FloquetOptions o;
     o.nev = 6;
     o.solver = solver;
@@ -319,7 +352,7 @@ TEST(KrylovResidualGate, RankOneMonodromyLeadingMultiplierIsExact) {
   // after one step up to the rounding of a few applications (O(K eps) = 1e-14).
   auto op = zero_orbit_monodromy(LinearModel({.a = 5, .b = 0, .tau = 1, .period = 1}), 50);
   const double g = (1 + 5 * 0.01) / (1 - 5 * 0.01), exact = std::pow(g, 50);
-  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     SCOPED_TRACE(to_string(solver));
     const FloquetResult r = solve(op, solver, 1);
     ASSERT_EQ(r.multipliers.size(), 1u);
@@ -360,7 +393,7 @@ TEST(KrylovResidualGate, StronglyUnstableMonodromy) {
   auto op = zero_orbit_monodromy(LinearModel({.a = 50, .b = 0.5, .tau = 1, .period = 1}), 200);
   const auto dense = solve(op, FloquetSolver::dense_lapack, 1).multipliers[0];
   ASSERT_GT(std::abs(dense), 1e21);  // the case is what it claims
-  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack}) {
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     SCOPED_TRACE(to_string(solver));
     const FloquetResult r = solve(op, solver, 1);
     // 1e-10: as expect_backends_agree (stopping rule 1e-12 times a moderate condition number)

@@ -3,6 +3,9 @@
 // One entry point, several backends on the same matrix-free operator:
 //   spectra: Spectra 1.0 GenEigsSolver (implicitly restarted Arnoldi) with the Monodromy as op;
 //   arpack:  ARPACK-ng dnaupd/dneupd reverse communication calling the same perform_op;
+//   block:   block Krylov-Schur on apply_block (krylov_block.cpp: BLAS-3 CGS2 + Cholesky QR2 with
+//            deflation, restarts by LAPACK dgees with the wanted values first), block_size vectors;
+//            measured slower than ARPACK here (docs/benchmarks.md), so auto does not pick it;
 //   dense_eigen / dense_lapack: form the n x n matrix, all eigenvalues (reference, O(n^3)).
 //
 // Both Krylov backends start from the same vector (start_vector(n, seed), reproducible),
@@ -50,7 +53,7 @@
 
 namespace delayspec {
 
-enum class FloquetSolver { automatic, spectra, arpack, dense_eigen, dense_lapack };
+enum class FloquetSolver { automatic, spectra, arpack, block, dense_eigen, dense_lapack };
 
 // "auto", "spectra", "arpack", "dense" (= dense_lapack), "dense-eigen", "dense-lapack"; BadInput otherwise.
 FloquetSolver parse_floquet_solver(const std::string& name);
@@ -70,6 +73,7 @@ struct FloquetOptions {
   double tolerance = 1e-12;       // relative Ritz residual at which a pair counts as converged
   int max_iterations = 300;       // Arnoldi iterations (1 + implicit restarts), ARPACK's MXITER
   std::uint64_t seed = 1;         // start vector = start_vector(n, seed) for both backends
+  int block_size = 8;             // solver = block: vectors per block (1..64)
   Eigen::VectorXd start;          // when non-empty: the start vector instead (n finite entries, not all 0)
   bool keep_vectors = false;      // fill FloquetResult::subspace (Krylov only)
   double residual_bound = 1e-8;   // the residual gate (header comment): max(residual_bound, 100 tolerance)
