@@ -82,6 +82,35 @@ Eigen::VectorXd start_vector(long n, std::uint64_t seed) {
 
 namespace krylov {
 
+RitzPairs ritz_pairs_in_basis(const std::vector<std::complex<double>>& theta, const std::vector<Eigen::VectorXcd>& y,
+                              const Eigen::Ref<const Eigen::MatrixXd>& V) {
+  RitzPairs pairs;
+  std::vector<Eigen::VectorXcd> coefficients;
+  for (size_t i = 0; i < theta.size(); ++i) {
+    std::complex<double> mu = theta[i];
+    Eigen::VectorXcd c = y[i];
+    if (mu.imag() < 0) {
+      if (std::find(theta.begin(), theta.end(), std::conj(mu)) != theta.end()) continue;  // partner listed
+      mu = std::conj(mu);
+      c = c.conjugate();
+    }
+    pairs.values.push_back(mu);
+    coefficients.push_back(std::move(c));
+  }
+  long columns = 0;
+  for (const auto& mu : pairs.values) {
+    pairs.column.push_back(columns);
+    columns += mu.imag() == 0 ? 1 : 2;
+  }
+  Eigen::MatrixXd C(V.cols(), columns);
+  for (size_t i = 0; i < pairs.values.size(); ++i) {
+    C.col(pairs.column[i]) = coefficients[i].real();
+    if (pairs.values[i].imag() != 0) C.col(pairs.column[i] + 1) = coefficients[i].imag();
+  }
+  pairs.vectors.noalias() = V * C;  // Ritz vectors x = V y, real form
+  return pairs;
+}
+
 double largest_relative_estimate(const std::vector<std::complex<double>>& theta, const std::vector<double>& estimate,
                                  int nev) {
   const double eps23 = std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);

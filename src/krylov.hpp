@@ -45,6 +45,14 @@ RitzPairs arpack_ritz_pairs(const Monodromy<D>& op, const Settings& settings, co
 template <int D>
 RitzPairs block_ritz_pairs(const Monodromy<D>& op, const Settings& settings, const Eigen::VectorXd& start);
 
+// The RitzPairs of the leading Ritz values `theta` (sorted by modulus) with coefficient vectors
+// `y` (Ritz vector = V y) in the orthonormal basis V: representatives (real values, and each
+// complex pair once with imag > 0; a pair split by the list is completed from its conjugate) and
+// their vectors in real form (one column per real value, Re and Im columns per pair).
+// converged and iterations are left for the caller.
+RitzPairs ritz_pairs_in_basis(const std::vector<std::complex<double>>& theta, const std::vector<Eigen::VectorXcd>& y,
+                              const Eigen::Ref<const Eigen::MatrixXd>& V);
+
 // Largest relative Ritz estimate est_i / max(|theta_i|, eps^(2/3)) over the nev largest-modulus
 // Ritz values theta (the quantity both backends compare with the tolerance).
 double largest_relative_estimate(const std::vector<std::complex<double>>& theta, const std::vector<double>& estimate,

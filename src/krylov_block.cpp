@@ -198,35 +198,15 @@ RitzPairs block_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eige
       all = all && ok;
     }
     if (all) {
+      std::vector<std::complex<double>> wanted_theta;
+      std::vector<Eigen::VectorXcd> wanted_y;
+      for (int i = 0; i < wanted; ++i) {
+        wanted_theta.push_back(theta[order[i]]);
+        wanted_y.push_back(Yc.col(order[i]));
+      }
+      pairs = ritz_pairs_in_basis(wanted_theta, wanted_y, V.leftCols(p));
       pairs.converged = converged;
       pairs.iterations = iteration;
-      // Representatives (imag >= 0) and the real coefficient matrix; vectors = V(:, 0:p) C.
-      std::vector<Eigen::VectorXcd> coefficients;
-      for (int i = 0; i < wanted; ++i) {
-        std::complex<double> mu = theta[order[i]];
-        Eigen::VectorXcd y = Yc.col(order[i]);
-        if (mu.imag() < 0) {
-          bool partner_listed = false;
-          for (int q = 0; q < wanted; ++q) partner_listed = partner_listed || theta[order[q]] == std::conj(mu);
-          if (partner_listed) continue;
-          mu = std::conj(mu);
-          y = y.conjugate();
-        }
-        pairs.values.push_back(mu);
-        coefficients.push_back(std::move(y));
-      }
-      long columns = 0;
-      for (const auto& mu : pairs.values) {
-        pairs.column.push_back(columns);
-        columns += mu.imag() == 0 ? 1 : 2;
-      }
-      Eigen::MatrixXd C(p, columns);
-      for (size_t i = 0; i < pairs.values.size(); ++i) {
-        C.col(pairs.column[i]) = coefficients[i].real();
-        if (pairs.values[i].imag() != 0) C.col(pairs.column[i] + 1) = coefficients[i].imag();
-      }
-      pairs.vectors.resize(n, columns);
-      gemm('N', 'N', n, columns, p, 1.0, V.data(), n, C.data(), p, 0.0, pairs.vectors.data(), n);
       return pairs;
     }
     if (iteration >= s.max_iterations)

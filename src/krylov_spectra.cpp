@@ -104,34 +104,16 @@ RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Ei
         " = 1 + max_restarts, ncv = " + std::to_string(s.ncv) + "), largest relative residual estimate " +
         format_number(solver.largest_estimate()) + " > tol " + short_number(s.tolerance));
 
-  // Representatives: real values, and each complex pair once with imag > 0 (a pair split by nev
-  // is completed from its conjugate).
-  std::vector<Eigen::VectorXcd> coeffs;
+  std::vector<std::complex<double>> theta;
+  std::vector<Eigen::VectorXcd> y;
   for (int i = 0; i < s.nev; ++i) {
-    std::complex<double> mu = solver.value(i) * scale;  // exact: scale is a power of two
-    Eigen::VectorXcd y = solver.coefficients(i);
-    if (mu.imag() < 0) {
-      bool partner_listed = false;
-      for (int j = 0; j < s.nev; ++j) partner_listed = partner_listed || solver.value(j) * scale == std::conj(mu);
-      if (partner_listed) continue;
-      mu = std::conj(mu);
-      y = y.conjugate();
-    }
-    pairs.values.push_back(mu);
-    coeffs.push_back(std::move(y));
+    theta.push_back(solver.value(i) * scale);  // exact: scale is a power of two
+    y.push_back(solver.coefficients(i));
   }
-  // Real coefficient matrix C (one column per real value, Re/Im columns per pair); vectors = V C.
-  long columns = 0;
-  for (const auto& mu : pairs.values) {
-    pairs.column.push_back(columns);
-    columns += mu.imag() == 0 ? 1 : 2;
-  }
-  Eigen::MatrixXd C(s.ncv, columns);
-  for (size_t i = 0; i < pairs.values.size(); ++i) {
-    C.col(pairs.column[i]) = coeffs[i].real();
-    if (pairs.values[i].imag() != 0) C.col(pairs.column[i] + 1) = coeffs[i].imag();
-  }
-  pairs.vectors.noalias() = solver.basis() * C;  // Ritz vectors x = V y, real form
+  const int converged = pairs.converged, iterations = pairs.iterations;
+  pairs = ritz_pairs_in_basis(theta, y, solver.basis());
+  pairs.converged = converged;
+  pairs.iterations = iterations;
   return pairs;
 }
 
