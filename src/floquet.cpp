@@ -343,7 +343,7 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
     try {
       pairs = options.solver == FloquetSolver::block     ? krylov::block_ritz_pairs(op, settings, start)
               : options.solver == FloquetSolver::spectra ? krylov::spectra_ritz_pairs(op, settings, start)
-                                                       : krylov::arpack_ritz_pairs(op, settings, start);
+                                                         : krylov::arpack_ritz_pairs(op, settings, start);
     } catch (const NumericalFailure&) {
       // The same absolute thresholds can also keep Spectra from converging at all on an operator
       // of norm >> 1 (measured: x' = 5 x, N = 50, rank one, 0 of 1 converged in 300 restarts after

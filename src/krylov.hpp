@@ -18,7 +18,7 @@ struct Settings {
   int ncv = 0;
   double tolerance = 0;
   int max_iterations = 0;
-  double scale = 1;  // Spectra only: the solver works on M / scale (a power of two), see krylov_spectra.cpp
+  double scale = 1;    // Spectra only: the solver works on M / scale (a power of two), see krylov_spectra.cpp
   int block_size = 8;  // block only: vectors per block (krylov_block.cpp)
 };
 

@@ -47,8 +47,8 @@ namespace delayspec::krylov {
 namespace {
 
 // C = alpha op(A) op(B) + beta C (column-major, BLAS dgemm).
-void gemm(char ta, char tb, long m, long n, long k, double alpha, const double* A, long lda, const double* B,
-          long ldb, double beta, double* C, long ldc) {
+void gemm(char ta, char tb, long m, long n, long k, double alpha, const double* A, long lda, const double* B, long ldb,
+          double beta, double* C, long ldc) {
   const int im = static_cast<int>(m), in = static_cast<int>(n), ik = static_cast<int>(k);
   const int ilda = static_cast<int>(lda), ildb = static_cast<int>(ldb), ildc = static_cast<int>(ldc);
   dgemm_(&ta, &tb, &im, &in, &ik, &alpha, A, &ilda, B, &ildb, &beta, C, &ildc);
@@ -68,7 +68,7 @@ class BlockKrylovSchur {
     c = Eigen::MatrixXd::Zero(j, b_);
     if (j > 0) {
       Eigen::MatrixXd pass(j, b_);
-      for (int twice = 0; twice < 2; ++twice) {  // CGS2
+      for (int twice = 0; twice < 2; ++twice) {                                             // CGS2
         gemm('T', 'N', j, b_, n_, 1.0, V_.data(), n_, W.data(), n_, 0.0, pass.data(), j);   // pass = V^T W
         gemm('N', 'N', n_, b_, j, -1.0, V_.data(), n_, pass.data(), j, 1.0, W.data(), n_);  // W -= V pass
         c += pass;
@@ -173,16 +173,18 @@ RitzPairs block_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eige
     const Eigen::MatrixXd coupling = H.block(p, 0, b, p);
     Eigen::EigenSolver<Eigen::MatrixXd> es(Hp);
     if (es.info() != Eigen::Success)
-      throw NumericalFailure("Krylov (block): the eigenvalues of the " + std::to_string(p) + " x " +
-                             std::to_string(p) + " Rayleigh quotient did not converge");
+      throw NumericalFailure("Krylov (block): the eigenvalues of the " + std::to_string(p) + " x " + std::to_string(p) +
+                             " Rayleigh quotient did not converge");
     const Eigen::VectorXcd theta = es.eigenvalues();
     const Eigen::MatrixXcd Yc = es.eigenvectors();  // unit columns
     std::vector<long> order(p);
     for (long i = 0; i < p; ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](long a, long c2) { return std::abs(theta[a]) > std::abs(theta[c2]); });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](long a, long c2) { return std::abs(theta[a]) > std::abs(theta[c2]); });
     // A pair split by nev counts whole.
     int wanted = nev;
-    if (wanted < p && theta[order[wanted - 1]].imag() != 0 && theta[order[wanted]] == std::conj(theta[order[wanted - 1]]))
+    if (wanted < p && theta[order[wanted - 1]].imag() != 0 &&
+        theta[order[wanted]] == std::conj(theta[order[wanted - 1]]))
       ++wanted;
     std::vector<std::complex<double>> values;
     std::vector<double> estimates;
@@ -210,13 +212,12 @@ RitzPairs block_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eige
       return pairs;
     }
     if (iteration >= s.max_iterations)
-      throw NumericalFailure("Krylov (block) did not converge: " + std::to_string(converged) + " of nev = " +
-                             std::to_string(nev) + " Ritz values converged after " + std::to_string(iteration) +
-                             " iterations (max_iterations = " + std::to_string(s.max_iterations) +
-                             " = 1 + max_restarts, basis " + std::to_string(m) + ", block " + std::to_string(b) +
-                             "), largest relative residual estimate " +
-                             format_number(largest_relative_estimate(values, estimates, nev)) + " > tol " +
-                             short_number(s.tolerance));
+      throw NumericalFailure(
+          "Krylov (block) did not converge: " + std::to_string(converged) + " of nev = " + std::to_string(nev) +
+          " Ritz values converged after " + std::to_string(iteration) +
+          " iterations (max_iterations = " + std::to_string(s.max_iterations) + " = 1 + max_restarts, basis " +
+          std::to_string(m) + ", block " + std::to_string(b) + "), largest relative residual estimate " +
+          format_number(largest_relative_estimate(values, estimates, nev)) + " > tol " + short_number(s.tolerance));
 
     // Restart: ordered real Schur form, the `keep` largest moduli first. dgees selects by modulus;
     // ties (exact zeros of a rank-deficient monodromy, round-off-level values of a strongly

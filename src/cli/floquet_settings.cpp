@@ -10,8 +10,8 @@ namespace delayspec::cli {
 FloquetOptions read_floquet_options(Config& config, int default_nev) {
   FloquetOptions options;
   options.nev = static_cast<int>(config.get_int_in_range("nev", default_nev, 1, std::numeric_limits<int>::max()));
-  options.solver = parse_floquet_solver(
-      config.get_choice("solver", "auto", {"auto", "spectra", "arpack", "block", "dense", "dense-eigen", "dense-lapack"}));
+  options.solver = parse_floquet_solver(config.get_choice(
+      "solver", "auto", {"auto", "spectra", "arpack", "block", "dense", "dense-eigen", "dense-lapack"}));
   options.block_size = static_cast<int>(config.get_int_in_range("block_size", options.block_size, 1, 64));
   // 0 = automatic; otherwise >= nev + 2 (checked by floquet_multipliers)
   options.ncv = static_cast<int>(config.get_int_in_range("ncv", 0, 0, std::numeric_limits<int>::max()));
