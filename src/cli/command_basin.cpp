@@ -112,24 +112,15 @@ int command_basin(Config& config, const Invocation& inv) {
   }
   nlohmann::json count_json = nlohmann::json::object();
   for (const auto& [period, n] : counts) count_json[std::to_string(period)] = n;
-  nlohmann::json json = {{"model", problem.model_name},
-                         {"N", problem.N},
-                         {"events", to_string(problem.events)},
-                         {"jacobian", to_string(problem.jacobian)},
-                         {"x", x.name},
-                         {"y", y.name},
-                         {"x_range", {x.min, x.max}},
-                         {"y_range", {y.min, y.max}},
-                         {"x_points", x.points},
-                         {"y_points", y.points},
-                         {"transient", transient},
-                         {"max_period", max_period},
-                         {"tolerance", tolerance},
-                         {"counts", count_json},
-                         {"failed_points", failed},
-                         {"threads", threads},
-                         {"seconds", seconds},
-                         {"rows", rows}};
+  nlohmann::json json = grid_json(problem, x, y);
+  json.update(nlohmann::json{{"transient", transient},
+                             {"max_period", max_period},
+                             {"tolerance", tolerance},
+                             {"counts", count_json},
+                             {"failed_points", failed},
+                             {"threads", threads},
+                             {"seconds", seconds},
+                             {"rows", rows}});
   if (inv.out_dir) {
     AtomicFile csv(std::filesystem::path(*inv.out_dir) / "basin.csv");
     csv.stream() << metadata_comment_lines(make_metadata("basin", inv.scene, config, json, seconds));

@@ -84,22 +84,13 @@ int command_chart(Config& config, const Invocation& inv) {
     }
     rows.push_back(row);
   }
-  nlohmann::json json = {{"model", problem.model_name},
-                         {"N", problem.N},
-                         {"events", to_string(problem.events)},
-                         {"jacobian", to_string(problem.jacobian)},
-                         {"x", x.name},
-                         {"y", y.name},
-                         {"x_range", {x.min, x.max}},
-                         {"y_range", {y.min, y.max}},
-                         {"x_points", x.points},
-                         {"y_points", y.points},
-                         {"points", count},
-                         {"stable_points", stable},
-                         {"failed_points", failed},
-                         {"threads", threads},
-                         {"seconds", seconds},
-                         {"rows", rows}};
+  nlohmann::json json = grid_json(problem, x, y);
+  json.update(nlohmann::json{{"points", count},
+                             {"stable_points", stable},
+                             {"failed_points", failed},
+                             {"threads", threads},
+                             {"seconds", seconds},
+                             {"rows", rows}});
 
   if (inv.out_dir) {
     AtomicFile csv(std::filesystem::path(*inv.out_dir) / "chart.csv");

@@ -73,4 +73,17 @@ int report_failed_points(std::ostream& err, const std::string& command, const nl
   return 3;
 }
 
+nlohmann::json grid_json(const Problem& problem, const ParameterAxis& x, const ParameterAxis& y) {
+  return {{"model", problem.model_name},
+          {"N", problem.N},
+          {"events", to_string(problem.events)},
+          {"jacobian", to_string(problem.jacobian)},
+          {"x", x.name},
+          {"y", y.name},
+          {"x_range", {x.min, x.max}},
+          {"y_range", {y.min, y.max}},
+          {"x_points", x.points},
+          {"y_points", y.points}};
+}
+
 }  // namespace delayspec::cli

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "config.hpp"
+#include "problem.hpp"
 
 namespace delayspec::cli {
 
@@ -43,5 +44,9 @@ int read_threads(Config& config);
 // 0 when no row has a "failure"; else 3 with one line on `err` (how many points failed, the first
 // one and its reason), as sweep does for its failed points.
 int report_failed_points(std::ostream& err, const std::string& command, const nlohmann::json& rows);
+
+// The JSON fields a grid command shares (chart, basin): model, N, events, jacobian and the two
+// axes (x, y, x_range, y_range, x_points, y_points). The command adds its own.
+nlohmann::json grid_json(const Problem& problem, const ParameterAxis& x, const ParameterAxis& y);
 
 }  // namespace delayspec::cli
