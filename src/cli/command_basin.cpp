@@ -6,6 +6,8 @@
 // none (chaotic, quasi-periodic, a longer period, or not yet settled). Each point also reports
 // max x over the section points (telling apart attractors of equal period) and the impacts.
 //
+// Points run in parallel (`threads`), under mpirun over the ranks too (distributed_points.hpp).
+//
 // Keys: basin_x, basin_y (default x0, v0), basin_x_range, basin_y_range ([min, max]),
 // basin_x_points, basin_y_points (>= 2), basin_transient (default 400), basin_max_period
 // (default 8), basin_tolerance (default 1e-6), threads; plus the problem keys.
@@ -14,7 +16,9 @@
 // A point whose trajectory fails (not finite, or a numerical failure of the stepper) is recorded
 // (period null, its "failure"; nan in the CSV), the others still run, and the command exits 3
 // after writing everything, as sweep does.
+#include <bit>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -24,7 +28,7 @@
 #include "commands.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 #include "metadata.hpp"
-#include "parallel_points.hpp"
+#include "distributed_points.hpp"
 #include "parameter_grid.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
@@ -60,7 +64,8 @@ int command_basin(Config& config, const Invocation& inv) {
   std::vector<Classification> result(static_cast<size_t>(count));
   std::vector<std::string> failure(static_cast<size_t>(count));
   Progress progress(inv.err, "basin", count, inv.quiet);
-  parallel_points(count, threads, [&](long i) {
+  PointTasks tasks;
+  tasks.compute = [&](long i) {
     Config point = config;
     point.set(x.name, format_number(x.value(i % x.points)), "basin");
     point.set(y.name, format_number(y.value(i / x.points)), "basin");
@@ -90,7 +95,22 @@ int command_basin(Config& config, const Invocation& inv) {
       failure[i] = e.what();  // reported with the point, not fatal to the basin
     }
     progress.add();
-  });
+  };
+  // A worker's point for the lead: the classification bit for bit, or the failure.
+  tasks.encode = [&](long i) {
+    return nlohmann::json{{"period", result[i].period},
+                          {"max_section_x", std::bit_cast<std::uint64_t>(result[i].max_section_x)},
+                          {"failure", failure[i]}}
+        .dump();
+  };
+  tasks.decode = [&](long i, const std::string& bytes) {
+    const nlohmann::json point = nlohmann::json::parse(bytes);
+    result[i].period = point.at("period").get<int>();
+    result[i].max_section_x = std::bit_cast<double>(point.at("max_section_x").get<std::uint64_t>());
+    failure[i] = point.at("failure").get<std::string>();
+    progress.add();
+  };
+  distributed_points(all_points(count), threads, tasks);
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

@@ -1,6 +1,7 @@
 // delayspec chart: a stability chart, the spectral radius |mu_1| of the monodromy over a grid of
 // two model parameters (default: the delayed Mathieu equation's (delta, b) plane, the classic
-// chart of Insperger & Stepan). Points run in parallel (`threads`).
+// chart of Insperger & Stepan). Points run in parallel (`threads`), under mpirun over the ranks too
+// (distributed_points.hpp).
 //
 // Keys: chart_x, chart_y (parameter names, default delta and b), chart_x_range, chart_y_range
 // (two numbers [min, max]), chart_x_points, chart_y_points (>= 2), threads; plus the problem,
@@ -10,7 +11,9 @@
 // blank line (gnuplot's grid format), metadata as "#" comment lines first. A point that fails
 // numerically (e.g. no periodic orbit) is recorded (spectral_radius null, its "failure"; nan in
 // the CSV), the others still run, and the command exits 3 after writing everything, as sweep does.
+#include <bit>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -23,7 +26,7 @@
 #include "floquet_settings.hpp"
 #include "metadata.hpp"
 #include "orbit_settings.hpp"
-#include "parallel_points.hpp"
+#include "distributed_points.hpp"
 #include "parameter_grid.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
@@ -48,7 +51,8 @@ int command_chart(Config& config, const Invocation& inv) {
   std::vector<double> radius(static_cast<size_t>(count), NAN);
   std::vector<std::string> failure(static_cast<size_t>(count));
   Progress progress(inv.err, "chart", count, inv.quiet);
-  parallel_points(count, threads, [&](long i) {
+  PointTasks tasks;
+  tasks.compute = [&](long i) {
     Config point = config;  // each point: its own copy with the two coordinates set
     point.set(x.name, format_number(x.value(i % x.points)), "chart");
     point.set(y.name, format_number(y.value(i / x.points)), "chart");
@@ -66,7 +70,18 @@ int command_chart(Config& config, const Invocation& inv) {
       failure[i] = e.what();  // e.g. no periodic orbit at this point: reported, not fatal
     }
     progress.add();
-  });
+  };
+  // A worker's point for the lead: the radius bit for bit, or the failure.
+  tasks.encode = [&](long i) {
+    return nlohmann::json{{"radius", std::bit_cast<std::uint64_t>(radius[i])}, {"failure", failure[i]}}.dump();
+  };
+  tasks.decode = [&](long i, const std::string& bytes) {
+    const nlohmann::json point = nlohmann::json::parse(bytes);
+    radius[i] = std::bit_cast<double>(point.at("radius").get<std::uint64_t>());
+    failure[i] = point.at("failure").get<std::string>();
+    progress.add();
+  };
+  distributed_points(all_points(count), threads, tasks);
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

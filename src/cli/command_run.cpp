@@ -20,9 +20,11 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "delayspec/errors.hpp"
+#include "distributed_points.hpp"
 #include "key_registry.hpp"
 #include "metadata.hpp"
 #include "progress.hpp"
+#include "ranks.hpp"
 
 namespace delayspec::cli {
 
@@ -84,6 +86,41 @@ std::vector<std::string> read_analyses(Config& config) {
   return names;
 }
 
+// The Config and Invocation of one analysis of the scene: the keys of the other analyses count
+// as read; --json (its result is kept in NAME.json) and `out` given.
+Config config_of_analysis(const Config& config, const std::set<std::string>& known) {
+  Config analysis = config;
+  for (const auto& key : known) analysis.mark_used(key);
+  return analysis;
+}
+
+Invocation analysis_invocation(const std::string& name, const Invocation& inv, std::ostream& out) {
+  return Invocation{.command = name,
+                    .scene = inv.scene,
+                    .json = true,
+                    .out_dir = inv.out_dir,
+                    .quiet = inv.quiet,
+                    .resume = inv.resume,
+                    .out = out,
+                    .err = inv.err};
+}
+
+// Under mpirun, a worker rank (ranks.hpp): it takes part in the point loops of the analyses that
+// have them (distributed_points.hpp), in the lead's order, and writes nothing but point files.
+int run_worker_analyses(const Config& config, const Invocation& inv, const RunPlan& plan) {
+  for (const auto& name : plan.analyses) {
+    if (!distributes_points(name)) continue;
+    Config worker_config = config_of_analysis(config, plan.known_keys);
+    const Invocation analysis = analysis_invocation(name, inv, inv.out);
+    try {
+      command_table().at(name)(worker_config, analysis);
+    } catch (const WorkerPointsDone&) {
+      // this rank's points of the analysis are with the lead
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 RunPlan plan_run(Config& config) {
@@ -118,6 +155,8 @@ int command_run(Config& config, const Invocation& inv) {
   if (inv.resume && !resumable)
     throw BadInput("`--resume`: no analysis of this scene has anything to resume (only sweep does)");
 
+  if (!is_lead_rank()) return run_worker_analyses(config, inv, plan);
+
   // 2. Run the analyses; each result file appears only once it is complete. run.json (the
   // manifest) goes first and comes back last: while it is absent the set is not complete.
   std::error_code removed;
@@ -130,17 +169,9 @@ int command_run(Config& config, const Invocation& inv) {
   int worst_status = 0;
   Progress progress(inv.err, "run", static_cast<long>(analyses.size()), inv.quiet);
   for (const auto& name : analyses) {
-    Config analysis_config = config;
-    for (const auto& key : known) analysis_config.mark_used(key);  // keys of the other analyses
+    Config analysis_config = config_of_analysis(config, known);
     std::ostringstream json_out;
-    Invocation analysis{.command = name,
-                        .scene = inv.scene,
-                        .json = true,
-                        .out_dir = inv.out_dir,
-                        .quiet = inv.quiet,
-                        .resume = inv.resume,
-                        .out = json_out,
-                        .err = inv.err};
+    const Invocation analysis = analysis_invocation(name, inv, json_out);
     const auto start = std::chrono::steady_clock::now();
     const int status = command_table().at(name)(analysis_config, analysis);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

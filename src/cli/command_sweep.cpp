@@ -2,7 +2,7 @@
 // and the Poincare-section values x(t0 + jT) after the transient (bifurcation-diagram data).
 //
 // Points run in parallel (`threads`, default: all cores), each thread with its own stepper and
-// buffers. With --out DIR the results are kept point by point, so an interrupted sweep loses
+// buffers, and under mpirun over the ranks too (distributed_points.hpp; docs/parallel.md). With --out DIR the results are kept point by point, so an interrupted sweep loses
 // only the points in flight and `--resume` completes it:
 //   DIR/sweep_settings.json     the effective settings of the sweep (resume refuses other settings)
 //   DIR/points/point_NNNNN.json one file per finished point, written atomically, with the
@@ -33,10 +33,11 @@
 #include "lyapunov_settings.hpp"
 #include "metadata.hpp"
 #include "output.hpp"
-#include "parallel_points.hpp"
+#include "distributed_points.hpp"
 #include "parameter_grid.hpp"  // read_threads
 #include "problem.hpp"
 #include "progress.hpp"
+#include "ranks.hpp"
 
 namespace delayspec::cli {
 
@@ -250,8 +251,10 @@ int command_sweep(Config& config, const Invocation& inv) {
   const json settings = resume_settings(config, s.key);
   const std::string hash = settings_hash(settings);
   std::optional<fs::path> dir;
-  if (inv.out_dir) {
-    dir = fs::path(*inv.out_dir);
+  if (inv.out_dir) dir = fs::path(*inv.out_dir);
+  // Under mpirun only the lead reads and writes DIR before the points (ranks.hpp): the workers'
+  // views of DIR could differ, and the lead alone decides which points are still to do.
+  if (dir && is_lead_rank()) {
     if (inv.resume) {
       resume_points(*dir, settings, hash, s.points);
     } else {
@@ -262,17 +265,19 @@ int command_sweep(Config& config, const Invocation& inv) {
     }
   }
 
-  // Compute the points not done yet, in parallel; a point's file is written as it finishes.
-  std::vector<SweepPoint*> todo;
-  for (SweepPoint& p : s.points)
-    if (!p.done) todo.push_back(&p);
+  // Compute the points not done yet, in parallel (threads, and ranks under mpirun); a point's
+  // file is written as it finishes, by the rank that computed it.
+  std::vector<long> todo;
+  for (const SweepPoint& p : s.points)
+    if (!p.done) todo.push_back(p.index);
   const long todo_count = static_cast<long>(todo.size());
   const long thread_count = std::clamp<long>(s.threads, 1, std::max<long>(todo_count, 1));  // as parallel_points
   if (!inv.quiet && inv.resume)
     inv.err << "sweep: resuming, " << (s.count - todo_count) << " of " << s.count << " points already done\n";
   Progress progress(inv.err, "sweep", todo_count, inv.quiet);
-  parallel_points(todo_count, s.threads, [&](long i) {
-    SweepPoint& p = *todo[i];
+  PointTasks tasks;
+  tasks.compute = [&](long index) {
+    SweepPoint& p = s.points[static_cast<size_t>(index)];
     try {
       p.result = point_record(p, run_lyapunov(p.problem, options), d);
     } catch (const NumericalFailure& e) {
@@ -282,7 +287,16 @@ int command_sweep(Config& config, const Invocation& inv) {
     if (dir) write_file_atomically(point_path(*dir, p.index), p.result.dump() + "\n");
     p.done = true;
     progress.add();
-  });
+  };
+  // A worker's point travels as the text of its point file, read back as --resume reads it.
+  tasks.encode = [&](long index) { return s.points[static_cast<size_t>(index)].result.dump(); };
+  tasks.decode = [&](long index, const std::string& text) {
+    SweepPoint& p = s.points[static_cast<size_t>(index)];
+    p.result = json::parse(text);
+    p.done = true;
+    progress.add();
+  };
+  distributed_points(todo, s.threads, tasks);
   progress.finish();
 
   // Report: the tables and the summary.

@@ -9,8 +9,10 @@
 #include "commands.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/version.hpp"
+#include "distributed_points.hpp"
 #include "key_registry.hpp"
 #include "output_directory.hpp"
+#include "ranks.hpp"
 
 namespace delayspec::cli {
 
@@ -104,7 +106,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
                  .scene = scene.empty() ? std::nullopt : std::optional<std::string>(scene),
                  .json = json,
                  .out_dir = out_dir.empty() ? std::nullopt : std::optional<std::string>(out_dir),
-                 .quiet = quiet,
+                 .quiet = quiet || !is_lead_rank(),  // progress from the lead only
                  .resume = resume,
                  .out = out,
                  .err = err};
@@ -121,7 +123,11 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
     // Scene-level keys (for `run`): any command may be given a scene that has them.
     config.mark_used("analyses");
     config.mark_used("title");
-    if (!inv.out_dir || output_use(command).out != OutDirUse::written) return it->second(config, inv);
+    // Under mpirun the workers only compute points (ranks.hpp): the lead runs any other command
+    // alone and owns --out (its lock and completeness marker).
+    if (!is_lead_rank() && !distributes_points(command)) return 0;
+    if (!inv.out_dir || output_use(command).out != OutDirUse::written || !is_lead_rank())
+      return it->second(config, inv);
     OutputDirectory directory(*inv.out_dir);  // held until the command returns: one run per DIR
     const int status = it->second(config, inv);
     directory.finish(command, status);

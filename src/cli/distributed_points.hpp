@@ -1,0 +1,44 @@
+#pragma once
+// distributed_points: the point loop of sweep, chart and basin, over the threads of this
+// process and, under mpirun, over MPI ranks (ranks.hpp). One rank: exactly parallel_points over
+// `todo`. R ranks: dynamic scheduling from the lead (rank 0): a thread of any rank asks the lead
+// for the next index of `todo` when it has finished one (the lead's own threads take theirs
+// from the same counter, so rank 0 computes too), and sends the finished point's result with
+// that request. After the loop the lead holds every point's result (decode), as after a run of
+// one rank, and assembles the output with the same code; a worker throws WorkerPointsDone.
+//
+// Per point and rank: one request (16 bytes + the encoded result) and one 8-byte reply; the
+// lead decodes while its threads compute. A point whose compute throws stops the hand-out on
+// every rank, and the first such exception is rethrown on the lead, with its type (BadInput,
+// NumericalFailure, bad_alloc, other) and message, as parallel_points does.
+//
+// Test hook (for the tests of resuming a killed run, tests/mpi_test.py; not a user setting):
+// DELAYSPEC_TEST_KILL_RANK=R:K makes rank R (0 without MPI) kill itself with SIGKILL right
+// after it has computed its K-th point of a loop (its point file, if any, written).
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace delayspec::cli {
+
+struct PointTasks {
+  // Computes point `index` and keeps its result (any rank; concurrently for distinct indices).
+  std::function<void(long index)> compute;
+  // A worker: the result compute(index) kept, as bytes for the lead.
+  std::function<std::string(long index)> encode;
+  // The lead: stores the result of `index` that a worker computed (called on one thread, while
+  // the lead's threads compute other points; exactly once per index of todo not computed here).
+  std::function<void(long index, const std::string& bytes)> decode;
+};
+
+// Computes every index of `todo` (the lead's list; ignored on the workers) once.
+void distributed_points(const std::vector<long>& todo, int threads, const PointTasks& tasks);
+
+// 0, 1, ..., count - 1: the todo list of a grid computed whole.
+std::vector<long> all_points(long count);
+
+// Commands whose points distributed_points spreads over the ranks (and `run`, which calls
+// them); under mpirun the worker ranks skip every other command.
+bool distributes_points(const std::string& command);
+
+}  // namespace delayspec::cli
