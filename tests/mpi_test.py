@@ -155,6 +155,19 @@ def main():
                 same_files(reference, out, f"sweep resumed after rank {killed} was killed",
                            leave_out=("complete.json", "sweep.json"))
 
+        # The grids keep point files too: the lead killed after its first point, the workers stop
+        # at their next request; --resume without MPI computes the rest.
+        for name in ("chart", "basin"):
+            out = scratch / f"{name}_killed"
+            env = dict(os.environ, DELAYSPEC_TEST_KILL_RANK="0:1")
+            r = run(mpirun(3, program, *cases[name], "--quiet", "--out", str(out)), env=env)
+            check(r.returncode != 0, f"{name} with the lead killed: exit 0 (the test hook did not fire)")
+            check(not (out / f"{name}.csv").exists(), f"{name} with the lead killed: {name}.csv exists")
+            r = run([program, *cases[name], "--quiet", "--resume", "--out", str(out)])
+            if check(r.returncode == 0, f"{name} resumed: exit {r.returncode}: {r.stderr}"):
+                same_files(scratch / f"{name}_ref", out, f"{name} resumed after the lead was killed",
+                           leave_out=("complete.json",))
+
         # 3. Bad input: every rank exits 2, one message. A wrapper reports each rank's own exit
         # status. Two kinds: found by every rank (a bad key value), and found only by the lead
         # (an --out directory that already holds a sweep: the workers never look at it).

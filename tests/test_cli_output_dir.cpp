@@ -299,6 +299,36 @@ TEST(OutputDirectory, ResumeRefusesAPointFileOfOtherSettings) {
   fs::remove_all(other);
 }
 
+// chart and basin keep their points as sweep does (point_files.hpp): with some point files and
+// the table gone, --resume computes only the missing points, and the table is the one of the
+// uninterrupted run. A second run without --resume is refused instead of mixing two runs.
+TEST(OutputDirectory, ChartAndBasinResumeToTheSameTable) {
+  const std::vector<std::pair<std::string, std::vector<std::string>>> grids = {
+      {"chart", {"chart", "--quiet", "--set", "model=mathieu", "--set", "N=10", "--set", "solver=dense", "--set",
+                 "chart_x_points=3", "--set", "chart_y_points=2"}},
+      {"basin", {"basin", "--quiet", "--set", "N=10", "--set", "basin_x_points=3", "--set", "basin_y_points=2",
+                 "--set", "basin_transient=5", "--set", "basin_max_period=2"}}};
+  for (const auto& [name, args] : grids) {
+    const fs::path dir = fresh_dir("outdir_resume_" + name);
+    ASSERT_EQ(run(with(args, {"--out", dir.string()})).status, 0) << name;
+    const std::string complete = without_metadata(read(dir / (name + ".csv")));
+    EXPECT_TRUE(fs::exists(dir / (name + "_settings.json"))) << name;
+    for (int i = 0; i < 6; ++i) EXPECT_TRUE(fs::exists(dir / (name + "_points/point_0000" + std::to_string(i) + ".json")));
+    CliResult again = run(with(args, {"--out", dir.string()}));
+    EXPECT_EQ(again.status, 2) << name;
+    EXPECT_TRUE(contains(again.err, "already holds a " + name + ": add --resume")) << again.err;
+
+    fs::remove(dir / (name + ".csv"));
+    fs::remove(dir / (name + "_points/point_00001.json"));
+    fs::remove(dir / (name + "_points/point_00004.json"));
+    CliResult resumed = run(with(args, {"--out", dir.string(), "--resume", "--json"}));
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(without_metadata(read(dir / (name + ".csv"))), complete) << name;
+    EXPECT_TRUE(fs::exists(dir / (name + "_points/point_00004.json"))) << name;
+    fs::remove_all(dir);
+  }
+}
+
 // The settings --resume compares are the effective ones: a scene or --set stating keys at their
 // default values (in any spelling of the number) resumes a sweep made without them.
 TEST(OutputDirectory, ResumeAcceptsExplicitDefaults) {
@@ -355,8 +385,10 @@ INSTANTIATE_TEST_SUITE_P(Flags, OutputFlags, ::testing::Values(
     FlagCase{"out_without_value", {"chart", "--out="}, "--out"},  // CLI11's own parse error
     FlagCase{"floquet_out", {"floquet", "--out", "somewhere"}, "`--out somewhere`: `floquet` writes no files"},
     FlagCase{"lyapunov_out", {"lyapunov", "--out", "somewhere"}, "`--out somewhere`: `lyapunov` writes no files"},
-    FlagCase{"chart_resume", {"chart", "--out", "somewhere", "--resume"}, "`--resume`: `chart` has nothing to resume"},
-    FlagCase{"basin_resume", {"basin", "--out", "somewhere", "--resume"}, "`--resume`: `basin` has nothing to resume"},
+    FlagCase{"chart_resume_nothing_there", {"chart", "--out", "somewhere", "--resume"},
+             "`--resume`: `somewhere/chart_settings.json` not found (no chart to resume there)"},
+    FlagCase{"basin_resume_nothing_there", {"basin", "--out", "somewhere", "--resume"},
+             "`--resume`: `somewhere/basin_settings.json` not found (no basin to resume there)"},
     FlagCase{"simulate_resume", {"simulate", "--out", "somewhere", "--resume"}, "`--resume`: `simulate` has nothing"},
     FlagCase{"converge_resume", {"converge", "--out", "somewhere", "--resume"}, "`--resume`: `converge` has nothing"},
     FlagCase{"floquet_resume", {"floquet", "--resume"}, "`--resume`: `floquet` has nothing to resume"},

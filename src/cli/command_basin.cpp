@@ -16,12 +16,11 @@
 // A point whose trajectory fails (not finite, or a numerical failure of the stepper) is recorded
 // (period null, its "failure"; nan in the CSV), the others still run, and the command exits 3
 // after writing everything, as sweep does.
-#include <bit>
 #include <chrono>
-#include <cstdint>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "atomic_file.hpp"
@@ -30,6 +29,7 @@
 #include "metadata.hpp"
 #include "distributed_points.hpp"
 #include "parameter_grid.hpp"
+#include "point_files.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
 #include "section_period.hpp"
@@ -63,7 +63,32 @@ int command_basin(Config& config, const Invocation& inv) {
   const long count = grid_point_count(x, y, "basin");
   std::vector<Classification> result(static_cast<size_t>(count));
   std::vector<std::string> failure(static_cast<size_t>(count));
-  Progress progress(inv.err, "basin", count, inv.quiet);
+  // A point's record: its row of the result, its file in --out DIR (point_files.hpp), and its
+  // message to the lead under mpirun (distributed_points.hpp).
+  auto record = [&](long i) {
+    nlohmann::json row = {{"index", i}, {"x", x.value(i % x.points)}, {"y", y.value(i / x.points)}};
+    if (failure[i].empty()) {
+      row["period"] = result[i].period;
+      row["max_section_x"] = result[i].max_section_x;
+    } else {
+      row["period"] = nullptr;
+      row["failure"] = failure[i];
+    }
+    return row;
+  };
+  auto take_record = [&](long i, const nlohmann::json& row) {
+    if (row.contains("failure")) {
+      failure[i] = row.at("failure").get<std::string>();
+    } else {
+      result[i].period = row.at("period").get<int>();
+      result[i].max_section_x = row.at("max_section_x").is_number() ? row["max_section_x"].get<double>() : NAN;
+    }
+    return true;
+  };
+  std::optional<PointFiles> files;
+  if (inv.out_dir) files.emplace(*inv.out_dir, "basin", resume_settings(config, {x.name, y.name}));
+  const std::vector<long> todo = points_to_do(files, inv.resume, count, take_record);
+  Progress progress(inv.err, "basin", static_cast<long>(todo.size()), inv.quiet);
   PointTasks tasks;
   tasks.compute = [&](long i) {
     Config point = config;
@@ -94,23 +119,15 @@ int command_basin(Config& config, const Invocation& inv) {
     } catch (const NumericalFailure& e) {
       failure[i] = e.what();  // reported with the point, not fatal to the basin
     }
+    if (files) files->write(i, record(i));
     progress.add();
   };
-  // A worker's point for the lead: the classification bit for bit, or the failure.
-  tasks.encode = [&](long i) {
-    return nlohmann::json{{"period", result[i].period},
-                          {"max_section_x", std::bit_cast<std::uint64_t>(result[i].max_section_x)},
-                          {"failure", failure[i]}}
-        .dump();
-  };
-  tasks.decode = [&](long i, const std::string& bytes) {
-    const nlohmann::json point = nlohmann::json::parse(bytes);
-    result[i].period = point.at("period").get<int>();
-    result[i].max_section_x = std::bit_cast<double>(point.at("max_section_x").get<std::uint64_t>());
-    failure[i] = point.at("failure").get<std::string>();
+  tasks.encode = [&](long i) { return record(i).dump(); };
+  tasks.decode = [&](long i, const std::string& text) {
+    take_record(i, nlohmann::json::parse(text));
     progress.add();
   };
-  distributed_points(all_points(count), threads, tasks);
+  distributed_points(todo, threads, tasks);
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -118,16 +135,10 @@ int command_basin(Config& config, const Invocation& inv) {
   long failed = 0;
   nlohmann::json rows = nlohmann::json::array();
   for (long i = 0; i < count; ++i) {
-    nlohmann::json row = {{"x", x.value(i % x.points)}, {"y", y.value(i / x.points)}};
-    if (failure[i].empty()) {
-      row["period"] = result[i].period;
-      row["max_section_x"] = result[i].max_section_x;
-      ++counts[result[i].period];
-    } else {
-      row["period"] = nullptr;
-      row["failure"] = failure[i];
-      ++failed;
-    }
+    nlohmann::json row = record(i);
+    row.erase("index");
+    if (failure[i].empty()) ++counts[result[i].period];
+    else ++failed;
     rows.push_back(row);
   }
   nlohmann::json count_json = nlohmann::json::object();

@@ -11,9 +11,8 @@
 // blank line (gnuplot's grid format), metadata as "#" comment lines first. A point that fails
 // numerically (e.g. no periodic orbit) is recorded (spectral_radius null, its "failure"; nan in
 // the CSV), the others still run, and the command exits 3 after writing everything, as sweep does.
-#include <bit>
 #include <chrono>
-#include <cstdint>
+#include <optional>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -28,6 +27,7 @@
 #include "orbit_settings.hpp"
 #include "distributed_points.hpp"
 #include "parameter_grid.hpp"
+#include "point_files.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
 
@@ -50,7 +50,23 @@ int command_chart(Config& config, const Invocation& inv) {
   const long count = grid_point_count(x, y, "chart");
   std::vector<double> radius(static_cast<size_t>(count), NAN);
   std::vector<std::string> failure(static_cast<size_t>(count));
-  Progress progress(inv.err, "chart", count, inv.quiet);
+  // A point's record: its row of the result, its file in --out DIR (point_files.hpp), and its
+  // message to the lead under mpirun (distributed_points.hpp).
+  auto record = [&](long i) {
+    nlohmann::json row = {{"index", i}, {"x", x.value(i % x.points)}, {"y", y.value(i / x.points)}};
+    row["spectral_radius"] = failure[i].empty() ? nlohmann::json(radius[i]) : nlohmann::json(nullptr);
+    if (!failure[i].empty()) row["failure"] = failure[i];
+    return row;
+  };
+  auto take_record = [&](long i, const nlohmann::json& row) {
+    if (row.contains("failure")) failure[i] = row.at("failure").get<std::string>();
+    else radius[i] = row.at("spectral_radius").is_number() ? row["spectral_radius"].get<double>() : NAN;
+    return true;
+  };
+  std::optional<PointFiles> files;
+  if (inv.out_dir) files.emplace(*inv.out_dir, "chart", resume_settings(config, {x.name, y.name}));
+  const std::vector<long> todo = points_to_do(files, inv.resume, count, take_record);
+  Progress progress(inv.err, "chart", static_cast<long>(todo.size()), inv.quiet);
   PointTasks tasks;
   tasks.compute = [&](long i) {
     Config point = config;  // each point: its own copy with the two coordinates set
@@ -69,34 +85,25 @@ int command_chart(Config& config, const Invocation& inv) {
     } catch (const NumericalFailure& e) {
       failure[i] = e.what();  // e.g. no periodic orbit at this point: reported, not fatal
     }
+    if (files) files->write(i, record(i));
     progress.add();
   };
-  // A worker's point for the lead: the radius bit for bit, or the failure.
-  tasks.encode = [&](long i) {
-    return nlohmann::json{{"radius", std::bit_cast<std::uint64_t>(radius[i])}, {"failure", failure[i]}}.dump();
-  };
-  tasks.decode = [&](long i, const std::string& bytes) {
-    const nlohmann::json point = nlohmann::json::parse(bytes);
-    radius[i] = std::bit_cast<double>(point.at("radius").get<std::uint64_t>());
-    failure[i] = point.at("failure").get<std::string>();
+  tasks.encode = [&](long i) { return record(i).dump(); };
+  tasks.decode = [&](long i, const std::string& text) {
+    take_record(i, nlohmann::json::parse(text));
     progress.add();
   };
-  distributed_points(all_points(count), threads, tasks);
+  distributed_points(todo, threads, tasks);
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   long stable = 0, failed = 0;
   nlohmann::json rows = nlohmann::json::array();
   for (long i = 0; i < count; ++i) {
-    nlohmann::json row = {{"x", x.value(i % x.points)}, {"y", y.value(i / x.points)}};
-    if (failure[i].empty()) {
-      row["spectral_radius"] = radius[i];
-      stable += radius[i] < 1;
-    } else {
-      row["spectral_radius"] = nullptr;
-      row["failure"] = failure[i];
-      ++failed;
-    }
+    nlohmann::json row = record(i);
+    row.erase("index");
+    if (failure[i].empty()) stable += radius[i] < 1;
+    else ++failed;
     rows.push_back(row);
   }
   nlohmann::json json = grid_json(problem, x, y);

@@ -153,7 +153,7 @@ int command_run(Config& config, const Invocation& inv) {
   bool resumable = false;
   for (const auto& name : analyses) resumable = resumable || output_use(name).resume;
   if (inv.resume && !resumable)
-    throw BadInput("`--resume`: no analysis of this scene has anything to resume (only sweep does)");
+    throw BadInput("`--resume`: no analysis of this scene has anything to resume (only sweep, chart and basin do)");
 
   if (!is_lead_rank()) return run_worker_analyses(config, inv, plan);
 

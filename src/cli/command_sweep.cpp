@@ -18,11 +18,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <sstream>
 
@@ -35,6 +33,7 @@
 #include "output.hpp"
 #include "distributed_points.hpp"
 #include "parameter_grid.hpp"  // read_threads
+#include "point_files.hpp"
 #include "problem.hpp"
 #include "progress.hpp"
 #include "ranks.hpp"
@@ -54,19 +53,6 @@ struct SweepPoint {
   bool done = false;
 };
 
-// FNV-1a (64 bit) of the settings' JSON text, as 16 hex digits: a point file's label of the
-// sweep it belongs to (nlohmann::json keeps object keys sorted, so the text is canonical).
-std::string settings_hash(const json& settings) {
-  std::uint64_t hash = 14695981039346656037ull;
-  for (const unsigned char c : settings.dump()) {
-    hash ^= c;
-    hash *= 1099511628211ull;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
-}
-
 std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : "nan"; }
 
 double number_or_nan(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
@@ -85,12 +71,6 @@ json point_record(const SweepPoint& p, const LyapunovResult& r, int d) {
   }
   j["seconds"] = r.seconds;
   return j;
-}
-
-fs::path point_path(const fs::path& dir, long index) {
-  char name[32];
-  std::snprintf(name, sizeof name, "point_%05ld.json", index);
-  return dir / "points" / name;
 }
 
 // What the command reads and checks before any work.
@@ -140,72 +120,6 @@ SweepSettings read_sweep_settings(Config& config) {
   return s;
 }
 
-// Settings of the sweep for --resume: the effective values (a key stated at its default equals
-// the key left out), except the thread count (results do not depend on it) and the scene-level
-// keys of `run` (analyses, title).
-json resume_settings(const Config& config, const std::string& key) {
-  json settings = json::object();
-  for (const auto& [k, v] : config.effective_values())
-    if (k != "threads" && k != "analyses" && k != "title") settings[k] = v;
-  settings[key] = nullptr;  // the swept key's value is per point
-  return settings;
-}
-
-// --resume: the stored settings must equal these (BadInput naming each differing key with both
-// values); the finished point files of this sweep are taken, a point of another sweep refused.
-void resume_points(const fs::path& dir, const json& settings, const std::string& hash,
-                   std::vector<SweepPoint>& points) {
-  const fs::path settings_path = dir / "sweep_settings.json";
-  std::ifstream in(settings_path);
-  if (!in) throw BadInput("`--resume`: `" + settings_path.string() + "` not found (no sweep to resume there)");
-  json stored;
-  try {
-    stored = json::parse(in);
-  } catch (const std::exception&) {
-    throw BadInput("`--resume`: `" + settings_path.string() + "` is not valid JSON");
-  }
-  if (stored != settings) {
-    // Name each differing key with both values (a missing key shows as null).
-    std::string diff;
-    auto add = [&](const std::string& k) {
-      diff += (diff.empty() ? "`" : ", `") + k + "` (now " + settings.value(k, json()).dump() + ", the sweep's " +
-              (stored.is_object() ? stored.value(k, json()) : json()).dump() + ")";
-    };
-    for (const auto& [k, v] : settings.items())
-      if (!stored.is_object() || !stored.contains(k) || stored[k] != v) add(k);
-    if (stored.is_object())
-      for (const auto& [k, v] : stored.items())
-        if (!settings.contains(k)) add(k);
-    throw BadInput("`--resume`: the settings differ from the interrupted sweep in " + diff);
-  }
-  for (SweepPoint& p : points) {
-    const fs::path path = point_path(dir, p.index);
-    std::ifstream pin(path);
-    if (!pin) continue;
-    json record;
-    try {
-      record = json::parse(pin);
-    } catch (const std::exception&) {
-      continue;  // unreadable point file: recompute the point
-    }
-    // A point of another sweep (other settings) is never merged into this one.
-    const json stored_hash = record.is_object() ? record.value("settings_hash", json()) : json();
-    if (stored_hash != hash)
-      throw BadInput("`--resume`: `" + path.string() + "` belongs to a sweep with other settings (settings_hash " +
-                     (stored_hash.is_string() ? stored_hash.get<std::string>() : std::string("missing")) +
-                     ", this sweep " + hash + ", settings in " + settings_path.string() +
-                     "): remove the file, or resume with the settings it was computed with");
-    try {
-      if (record.at("index").get<long>() == p.index && record.at("parameter").get<double>() == p.parameter) {
-        p.result = record;
-        p.done = true;
-      }
-    } catch (const std::exception&) {
-      // a point record without index/parameter: recompute the point
-    }
-  }
-}
-
 // The tables of a finished sweep: exponents.csv and section.csv (without the metadata header),
 // and the points' records with the failed ones listed.
 struct SweepTables {
@@ -248,28 +162,17 @@ int command_sweep(Config& config, const Invocation& inv) {
   SweepSettings s = read_sweep_settings(config);
   const LyapunovOptions& options = s.options;
   const int d = s.first.state_dimension();
-  const json settings = resume_settings(config, s.key);
+  const json settings = resume_settings(config, {s.key});
   const std::string hash = settings_hash(settings);
-  std::optional<fs::path> dir;
-  if (inv.out_dir) dir = fs::path(*inv.out_dir);
-  // Under mpirun only the lead reads and writes DIR before the points (ranks.hpp): the workers'
-  // views of DIR could differ, and the lead alone decides which points are still to do.
-  if (dir && is_lead_rank()) {
-    if (inv.resume) {
-      resume_points(*dir, settings, hash, s.points);
-    } else {
-      if (fs::exists(*dir / "sweep_settings.json") || fs::exists(*dir / "points"))
-        throw BadInput("`--out " + dir->string() +
-                       "` already holds a sweep: add --resume to complete it, or choose another directory");
-      write_file_atomically(*dir / "sweep_settings.json", settings.dump(2) + "\n");
-    }
-  }
-
-  // Compute the points not done yet, in parallel (threads, and ranks under mpirun); a point's
-  // file is written as it finishes, by the rank that computed it.
-  std::vector<long> todo;
-  for (const SweepPoint& p : s.points)
-    if (!p.done) todo.push_back(p.index);
+  std::optional<PointFiles> files;
+  if (inv.out_dir) files.emplace(fs::path(*inv.out_dir), "sweep", settings);
+  const std::vector<long> todo = points_to_do(files, inv.resume, s.count, [&](long index, const json& record) {
+    SweepPoint& p = s.points[static_cast<size_t>(index)];
+    if (record.at("parameter").get<double>() != p.parameter) return false;
+    p.result = record;
+    p.done = true;
+    return true;
+  });
   const long todo_count = static_cast<long>(todo.size());
   const long thread_count = std::clamp<long>(s.threads, 1, std::max<long>(todo_count, 1));  // as parallel_points
   if (!inv.quiet && inv.resume)
@@ -284,7 +187,7 @@ int command_sweep(Config& config, const Invocation& inv) {
       p.result = {{"index", p.index}, {"parameter", p.parameter}, {"error", e.what()}};
     }
     p.result["settings_hash"] = hash;
-    if (dir) write_file_atomically(point_path(*dir, p.index), p.result.dump() + "\n");
+    if (files) files->write(p.index, p.result);
     p.done = true;
     progress.add();
   };
@@ -322,15 +225,16 @@ int command_sweep(Config& config, const Invocation& inv) {
   summary["points_computed_now"] = todo.size();
   summary["failed"] = tables.failed;
   summary["seconds"] = seconds;
-  if (dir) {
+  if (inv.out_dir) {
+    const fs::path dir(*inv.out_dir);
     // The files carry the metadata header (it names the swept key: `plot` labels the x axis
     // with it); the swept key's own value is per row, so it is not a metadata line.
     OutputMetadata metadata = make_metadata("sweep", inv.scene, config, summary, seconds);
     metadata.parameters.erase(s.key);
     const std::string header = metadata_comment_lines(metadata);
-    write_file_atomically(*dir / "exponents.csv", header + tables.exponents_csv);
-    write_file_atomically(*dir / "section.csv", header + tables.section_csv);
-    write_file_atomically(*dir / "sweep.json", summary.dump(1) + "\n");
+    write_file_atomically(dir / "exponents.csv", header + tables.exponents_csv);
+    write_file_atomically(dir / "section.csv", header + tables.section_csv);
+    write_file_atomically(dir / "sweep.json", summary.dump(1) + "\n");
   }
 
   if (inv.json) {
@@ -340,9 +244,11 @@ int command_sweep(Config& config, const Invocation& inv) {
             << " (" << s.count << " points, " << thread_count << " threads), N = " << s.first.N << ", transient "
             << options.transient << ", periods " << options.periods << "\n";
     inv.out << tables.exponents_csv;
-    if (dir)
-      inv.out << "files: " << (*dir / "exponents.csv").string() << ", " << (*dir / "section.csv").string() << ", "
-              << (*dir / "sweep.json").string() << "\n";
+    if (inv.out_dir) {
+      const fs::path dir(*inv.out_dir);
+      inv.out << "files: " << (dir / "exponents.csv").string() << ", " << (dir / "section.csv").string() << ", "
+              << (dir / "sweep.json").string() << "\n";
+    }
     inv.out << "time: " << seconds << " s\n";
   }
   if (!tables.failed.empty()) {

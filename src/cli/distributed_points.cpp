@@ -8,7 +8,6 @@
 #include <cstring>
 #include <exception>
 #include <new>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -52,12 +51,6 @@ class KillHook {
 };
 
 }  // namespace
-
-std::vector<long> all_points(long count) {
-  std::vector<long> all(static_cast<size_t>(std::max<long>(count, 0)));
-  std::iota(all.begin(), all.end(), 0L);
-  return all;
-}
 
 bool distributes_points(const std::string& command) {
   return command == "sweep" || command == "chart" || command == "basin" || command == "run";

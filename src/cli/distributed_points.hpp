@@ -34,9 +34,6 @@ struct PointTasks {
 // Computes every index of `todo` (the lead's list; ignored on the workers) once.
 void distributed_points(const std::vector<long>& todo, int threads, const PointTasks& tasks);
 
-// 0, 1, ..., count - 1: the todo list of a grid computed whole.
-std::vector<long> all_points(long count);
-
 // Commands whose points distributed_points spreads over the ranks (and `run`, which calls
 // them); under mpirun the worker ranks skip every other command.
 bool distributes_points(const std::string& command);

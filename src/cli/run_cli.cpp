@@ -31,7 +31,7 @@ OutputUse output_use(const std::string& command) {
       {"sweep", {OutDirUse::written, true}},  // point files: --resume computes only the missing points
       {"run", {OutDirUse::written, true}},    // passes --resume to its analyses (command_run.cpp)
       {"converge", {OutDirUse::written, false}}, {"bench", {OutDirUse::written, false}},
-      {"chart", {OutDirUse::written, false}},    {"basin", {OutDirUse::written, false}},
+      {"chart", {OutDirUse::written, true}},     {"basin", {OutDirUse::written, true}},  // point files, as sweep
       {"simulate", {OutDirUse::written, false}}, {"continue", {OutDirUse::written, false}},
       {"plot", {OutDirUse::read, false}},  // `plot --out DIR` = `plot DIR`
   };
@@ -50,7 +50,7 @@ void check_output_flags(const std::string& command, bool out_given, const std::s
                    "analysis's result in a file)");
   if (out_given && out_dir.empty()) throw BadInput("`--out ''`: the directory name is empty");
   if (resume && !use.resume)
-    throw BadInput("`--resume`: `" + command + "` has nothing to resume (only sweep, and run with a sweep, do)");
+    throw BadInput("`--resume`: `" + command + "` has nothing to resume (only sweep, chart, basin, and run with one of them, do)");
   if (resume && !out_given) throw BadInput("`--resume` needs `--out DIR` (the directory of the interrupted run)");
 }
 
