@@ -385,7 +385,7 @@ INSTANTIATE_TEST_SUITE_P(Flags, OutputFlags, ::testing::Values(
     FlagCase{"out_without_value", {"chart", "--out="}, "--out"},  // CLI11's own parse error
     FlagCase{"floquet_out", {"floquet", "--out", "somewhere"}, "`--out somewhere`: `floquet` writes no files"},
     FlagCase{"lyapunov_out", {"lyapunov", "--out", "somewhere"}, "`--out somewhere`: `lyapunov` writes no files"},
-    FlagCase{"chart_resume_nothing_there", {"chart", "--out", "somewhere", "--resume"},
+    FlagCase{"chart_resume_nothing_there", {"chart", "--out", "somewhere", "--resume", "--set", "model=mathieu"},
              "`--resume`: `somewhere/chart_settings.json` not found (no chart to resume there)"},
     FlagCase{"basin_resume_nothing_there", {"basin", "--out", "somewhere", "--resume"},
              "`--resume`: `somewhere/basin_settings.json` not found (no basin to resume there)"},
