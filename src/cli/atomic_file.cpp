@@ -30,7 +30,7 @@ std::filesystem::path temporary_name(const std::filesystem::path& target) {
 
 }  // namespace
 
-void write_file_atomically(const std::filesystem::path& target, const std::string& contents) {
+void write_file_atomically(const std::filesystem::path& target, const std::string& contents, Flush flush) {
   if (target.filename().empty()) throw BadInput("cannot write `" + target.string() + "`: not a file name");
   before_output_write(target);  // the lock and the completeness marker of --out DIR
   const std::filesystem::path parent = target.parent_path().empty() ? "." : target.parent_path();
@@ -53,8 +53,8 @@ void write_file_atomically(const std::filesystem::path& target, const std::strin
     }
     written += static_cast<size_t>(n);
   }
-  // fsync before rename: after a crash the new name never points at unwritten blocks.
-  int error = ::fsync(fd) == 0 ? 0 : errno;
+  // fsync before rename: after a crash the new name never points at unwritten blocks (Flush).
+  int error = flush == Flush::skip || ::fsync(fd) == 0 ? 0 : errno;
   if (::close(fd) != 0 && error == 0) error = errno;
   if (error != 0) {
     ::unlink(temp.c_str());

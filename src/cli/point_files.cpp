@@ -71,7 +71,7 @@ fs::path PointFiles::point_path(long index) const {
 
 void PointFiles::write(long index, json record) const {
   record["settings_hash"] = hash_;
-  write_file_atomically(point_path(index), record.dump() + "\n");
+  write_file_atomically(point_path(index), record.dump() + "\n", Flush::skip);  // see Flush
 }
 
 std::map<long, json> PointFiles::start(bool resume, long count) const {
