@@ -1,5 +1,7 @@
 #include "parameter_grid.hpp"
 
+#include <sched.h>
+
 #include <algorithm>
 #include <sstream>
 #include <thread>
@@ -52,8 +54,11 @@ void require_model_parameter(const Config& config, const std::string& key, const
 }
 
 int read_threads(Config& config) {
-  const long hardware = std::max(1u, std::thread::hardware_concurrency());
-  // 0 = all cores
+  // 0 = all cores this process may run on: its CPU affinity mask, which mpirun and Slurm set
+  // per rank (a rank bound to one core gets one thread, not one per core of the node).
+  long hardware = std::max(1u, std::thread::hardware_concurrency());
+  cpu_set_t allowed;
+  if (sched_getaffinity(0, sizeof allowed, &allowed) == 0) hardware = std::max(1, CPU_COUNT(&allowed));
   const long threads = config.get_int_in_range("threads", 0, 0, 4096);
   return static_cast<int>(threads == 0 ? hardware : threads);
 }

@@ -36,8 +36,8 @@ long grid_point_count(const ParameterAxis& x, const ParameterAxis& y, const std:
 void require_model_parameter(const Config& config, const std::string& key, const std::string& name,
                              const std::string& model_name);
 
-// The `threads` key (as `sweep`): 0 (the default) = the machine's hardware threads; BadInput
-// unless 0..4096.
+// The `threads` key (as `sweep`): 0 (the default) = the cores this process may run on (its CPU
+// affinity: all hardware threads, or those mpirun / Slurm gave the rank); BadInput unless 0..4096.
 int read_threads(Config& config);
 
 // The exit status of a grid command whose `rows` ([{"x", "y", ..., "failure"?}]) are written:
