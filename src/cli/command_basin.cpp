@@ -20,18 +20,15 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
-#include <optional>
 #include <sstream>
 
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 #include "metadata.hpp"
-#include "distributed_points.hpp"
 #include "parameter_grid.hpp"
-#include "point_files.hpp"
+#include "point_loop.hpp"
 #include "problem.hpp"
-#include "progress.hpp"
 #include "section_period.hpp"
 
 namespace delayspec::cli {
@@ -85,12 +82,10 @@ int command_basin(Config& config, const Invocation& inv) {
     }
     return true;
   };
-  std::optional<PointFiles> files;
-  if (inv.out_dir) files.emplace(*inv.out_dir, "basin", resume_settings(config, {x.name, y.name}));
-  const std::vector<long> todo = points_to_do(files, inv.resume, count, take_record);
-  Progress progress(inv.err, "basin", static_cast<long>(todo.size()), inv.quiet);
-  PointTasks tasks;
-  tasks.compute = [&](long i) {
+  PointLoop loop{.command = "basin", .count = count, .threads = threads, .per_point_keys = {x.name, y.name}};
+  loop.record = record;
+  loop.take = take_record;
+  loop.compute = [&](long i) {
     Config point = config;
     point.set(x.name, format_number(x.value(i % x.points)), "basin");
     point.set(y.name, format_number(y.value(i / x.points)), "basin");
@@ -119,16 +114,8 @@ int command_basin(Config& config, const Invocation& inv) {
     } catch (const NumericalFailure& e) {
       failure[i] = e.what();  // reported with the point, not fatal to the basin
     }
-    if (files) files->write(i, record(i));
-    progress.add();
   };
-  tasks.encode = [&](long i) { return record(i).dump(); };
-  tasks.decode = [&](long i, const std::string& text) {
-    take_record(i, nlohmann::json::parse(text));
-    progress.add();
-  };
-  distributed_points(todo, threads, tasks);
-  progress.finish();
+  run_point_loop(loop, config, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   std::map<int, long> counts;

@@ -12,7 +12,6 @@
 // numerically (e.g. no periodic orbit) is recorded (spectral_radius null, its "failure"; nan in
 // the CSV), the others still run, and the command exits 3 after writing everything, as sweep does.
 #include <chrono>
-#include <optional>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -25,11 +24,9 @@
 #include "floquet_settings.hpp"
 #include "metadata.hpp"
 #include "orbit_settings.hpp"
-#include "distributed_points.hpp"
 #include "parameter_grid.hpp"
-#include "point_files.hpp"
+#include "point_loop.hpp"
 #include "problem.hpp"
-#include "progress.hpp"
 
 namespace delayspec::cli {
 
@@ -63,12 +60,10 @@ int command_chart(Config& config, const Invocation& inv) {
     else radius[i] = row.at("spectral_radius").is_number() ? row["spectral_radius"].get<double>() : NAN;
     return true;
   };
-  std::optional<PointFiles> files;
-  if (inv.out_dir) files.emplace(*inv.out_dir, "chart", resume_settings(config, {x.name, y.name}));
-  const std::vector<long> todo = points_to_do(files, inv.resume, count, take_record);
-  Progress progress(inv.err, "chart", static_cast<long>(todo.size()), inv.quiet);
-  PointTasks tasks;
-  tasks.compute = [&](long i) {
+  PointLoop loop{.command = "chart", .count = count, .threads = threads, .per_point_keys = {x.name, y.name}};
+  loop.record = record;
+  loop.take = take_record;
+  loop.compute = [&](long i) {
     Config point = config;  // each point: its own copy with the two coordinates set
     point.set(x.name, format_number(x.value(i % x.points)), "chart");
     point.set(y.name, format_number(y.value(i / x.points)), "chart");
@@ -85,16 +80,8 @@ int command_chart(Config& config, const Invocation& inv) {
     } catch (const NumericalFailure& e) {
       failure[i] = e.what();  // e.g. no periodic orbit at this point: reported, not fatal
     }
-    if (files) files->write(i, record(i));
-    progress.add();
   };
-  tasks.encode = [&](long i) { return record(i).dump(); };
-  tasks.decode = [&](long i, const std::string& text) {
-    take_record(i, nlohmann::json::parse(text));
-    progress.add();
-  };
-  distributed_points(todo, threads, tasks);
-  progress.finish();
+  run_point_loop(loop, config, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   long stable = 0, failed = 0;

@@ -21,7 +21,6 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -31,12 +30,10 @@
 #include "lyapunov_settings.hpp"
 #include "metadata.hpp"
 #include "output.hpp"
-#include "distributed_points.hpp"
 #include "parameter_grid.hpp"  // read_threads
 #include "point_files.hpp"
+#include "point_loop.hpp"
 #include "problem.hpp"
-#include "progress.hpp"
-#include "ranks.hpp"
 
 namespace delayspec::cli {
 
@@ -50,7 +47,6 @@ struct SweepPoint {
   double parameter = 0;
   Problem problem;
   json result;  // the point's record (also its file)
-  bool done = false;
 };
 
 std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : "nan"; }
@@ -162,24 +158,11 @@ int command_sweep(Config& config, const Invocation& inv) {
   SweepSettings s = read_sweep_settings(config);
   const LyapunovOptions& options = s.options;
   const int d = s.first.state_dimension();
-  const json settings = resume_settings(config, {s.key});
-  const std::string hash = settings_hash(settings);
-  std::optional<PointFiles> files;
-  if (inv.out_dir) files.emplace(fs::path(*inv.out_dir), "sweep", settings);
-  const std::vector<long> todo = points_to_do(files, inv.resume, s.count, [&](long index, const json& record) {
-    SweepPoint& p = s.points[static_cast<size_t>(index)];
-    if (record.at("parameter").get<double>() != p.parameter) return false;
-    p.result = record;
-    p.done = true;
-    return true;
-  });
-  const long todo_count = static_cast<long>(todo.size());
-  const long thread_count = std::clamp<long>(s.threads, 1, std::max<long>(todo_count, 1));  // as parallel_points
-  if (!inv.quiet && inv.resume)
-    inv.err << "sweep: resuming, " << (s.count - todo_count) << " of " << s.count << " points already done\n";
-  Progress progress(inv.err, "sweep", todo_count, inv.quiet);
-  PointTasks tasks;
-  tasks.compute = [&](long index) {
+  const std::string hash = settings_hash(resume_settings(config, {s.key}));  // the point files' label
+  // Compute the points not done yet, in parallel (threads, and ranks under mpirun); with
+  // --out DIR a point's file is written as it finishes, by the rank that computed it.
+  PointLoop loop{.command = "sweep", .count = s.count, .threads = s.threads, .per_point_keys = {s.key}};
+  loop.compute = [&](long index) {
     SweepPoint& p = s.points[static_cast<size_t>(index)];
     try {
       p.result = point_record(p, run_lyapunov(p.problem, options), d);
@@ -187,20 +170,16 @@ int command_sweep(Config& config, const Invocation& inv) {
       p.result = {{"index", p.index}, {"parameter", p.parameter}, {"error", e.what()}};
     }
     p.result["settings_hash"] = hash;
-    if (files) files->write(p.index, p.result);
-    p.done = true;
-    progress.add();
   };
-  // A worker's point travels as the text of its point file, read back as --resume reads it.
-  tasks.encode = [&](long index) { return s.points[static_cast<size_t>(index)].result.dump(); };
-  tasks.decode = [&](long index, const std::string& text) {
+  loop.record = [&](long index) { return s.points[static_cast<size_t>(index)].result; };
+  loop.take = [&](long index, const json& record) {
     SweepPoint& p = s.points[static_cast<size_t>(index)];
-    p.result = json::parse(text);
-    p.done = true;
-    progress.add();
+    if (record.at("parameter").get<double>() != p.parameter) return false;
+    p.result = record;
+    return true;
   };
-  distributed_points(todo, s.threads, tasks);
-  progress.finish();
+  const long todo_count = run_point_loop(loop, config, inv);
+  const long thread_count = std::clamp<long>(s.threads, 1, std::max<long>(todo_count, 1));  // as parallel_points
 
   // Report: the tables and the summary.
   const SweepTables tables = sweep_tables(s.points, options.exponents);
@@ -222,7 +201,7 @@ int command_sweep(Config& config, const Invocation& inv) {
   summary["events"] = to_string(s.first.events);
   summary["jacobian"] = to_string(s.first.jacobian);
   summary["threads"] = thread_count;
-  summary["points_computed_now"] = todo.size();
+  summary["points_computed_now"] = todo_count;
   summary["failed"] = tables.failed;
   summary["seconds"] = seconds;
   if (inv.out_dir) {

@@ -1,16 +1,17 @@
 #pragma once
 // distributed_points: the point loop of sweep, chart and basin, over the threads of this
 // process and, under mpirun, over MPI ranks (ranks.hpp). One rank: exactly parallel_points over
-// `todo`. R ranks: dynamic scheduling from the lead (rank 0): a thread of any rank asks the lead
-// for the next index of `todo` when it has finished one (the lead's own threads take theirs
-// from the same counter, so rank 0 computes too), and sends the finished point's result with
-// that request. After the loop the lead holds every point's result (decode), as after a run of
+// `todo`. R ranks: dynamic scheduling from the lead (rank 0): a thread of a worker rank asks the
+// lead for a chunk of indices of `todo` (about 20 ms of work at its measured cost per point, at
+// least 1) when it has finished the previous one, and sends the finished points' results with
+// that request; the lead's own threads take single indices from the same counter, so rank 0
+// computes too. After the loop the lead holds every point's result (decode), as after a run of
 // one rank, and assembles the output with the same code; a worker throws WorkerPointsDone.
 //
-// Per point and rank: one request (16 bytes + the encoded result) and one 8-byte reply; the
-// lead decodes while its threads compute. A point whose compute throws stops the hand-out on
-// every rank, and the first such exception is rethrown on the lead, with its type (BadInput,
-// NumericalFailure, bad_alloc, other) and message, as parallel_points does.
+// Per chunk and thread: one request (the encoded results, plus 20 bytes per point) and one
+// reply (8 bytes per index). A point whose compute throws stops the hand-out on every rank, and
+// the first such exception is rethrown on the lead, with its type (BadInput, NumericalFailure,
+// bad_alloc, other) and message, as parallel_points does. docs/parallel.md: use and scaling.
 //
 // Test hook (for the tests of resuming a killed run, tests/mpi_test.py; not a user setting):
 // DELAYSPEC_TEST_KILL_RANK=R:K makes rank R (0 without MPI) kill itself with SIGKILL right

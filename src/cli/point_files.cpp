@@ -6,7 +6,6 @@
 
 #include "atomic_file.hpp"
 #include "delayspec/errors.hpp"
-#include "ranks.hpp"
 
 namespace delayspec::cli {
 
@@ -116,26 +115,6 @@ std::map<long, json> PointFiles::start(bool resume, long count) const {
     if (stored_index.is_number_integer() && stored_index.get<long>() == index) finished[index] = record;
   }
   return finished;
-}
-
-std::vector<long> points_to_do(const std::optional<PointFiles>& files, bool resume, long count,
-                               const std::function<bool(long, const json&)>& take) {
-  std::map<long, json> finished;
-  // Only the lead reads and writes DIR before the points: the workers' views of DIR could
-  // differ, and the lead alone decides which points are still to do.
-  if (files && is_lead_rank()) finished = files->start(resume, count);
-  std::vector<long> todo;
-  for (long index = 0; index < count; ++index) {
-    const auto it = finished.find(index);
-    bool kept = false;
-    try {
-      kept = it != finished.end() && take(index, it->second);
-    } catch (const std::exception&) {
-      // a record without the fields of its point: compute the point again
-    }
-    if (!kept) todo.push_back(index);
-  }
-  return todo;
 }
 
 }  // namespace delayspec::cli

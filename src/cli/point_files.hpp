@@ -14,9 +14,7 @@
 //     for (auto& [index, record] : files.start(inv.resume, count)) ...;   // the lead, before the points
 //     files.write(index, record);                                  // as each point finishes
 #include <filesystem>
-#include <functional>
 #include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,12 +58,5 @@ class PointFiles {
   nlohmann::json settings_;
   std::string hash_;
 };
-
-// The indices of 0..count-1 still to compute. Without files, and on a worker rank under mpirun
-// (ranks.hpp), all of them; on the lead, files->start(resume, count) first, then take(index,
-// record) for each finished point, which keeps the point's result and returns true (false, or
-// an exception reading the record: the point is computed again).
-std::vector<long> points_to_do(const std::optional<PointFiles>& files, bool resume, long count,
-                               const std::function<bool(long index, const nlohmann::json& record)>& take);
 
 }  // namespace delayspec::cli
