@@ -1,7 +1,10 @@
 #include "ranks.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <iostream>
+#include <thread>
 #include <vector>
 
 #ifdef DELAYSPEC_MPI
@@ -37,9 +40,20 @@ bool started_by_mpi_launcher() {
   return false;
 }
 
+// MPI_Bcast would spin on a worker while the lead works alone (OpenMPI polls: a core at 100%,
+// taken from the lead when ranks share a node, e.g. during `run`'s floquet analysis): the
+// workers test a non-blocking broadcast and sleep in between, up to 1 ms.
 int broadcast_from_lead(int value) {
-  MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  return value;
+  using namespace std::chrono_literals;
+  MPI_Request request;
+  MPI_Ibcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD, &request);
+  auto pause = 20us;
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return value;
+    std::this_thread::sleep_for(pause);
+    pause = std::min<std::chrono::microseconds>(2 * pause, 1000us);
+  }
 }
 
 long gather_threads(int threads) {
