@@ -39,6 +39,14 @@ CHART = ["chart", "--set", "model=mathieu", "--set", "N=20", "--set", "solver=de
 BASIN = ["basin", "--set", "model=impact", "--set", "N=30", "--set", "k=0", "--set", "basin_x_points=5",
          "--set", "basin_y_points=4", "--set", "basin_transient=60", "--set", "basin_max_period=4",
          "--set", "threads=1"]
+# Every point fails (an orbit by simulation allowed 2 periods cannot settle): exit 3.
+FAILING_CHART = ["chart", "--set", "model=impact", "--set", "N=8", "--set", "chart_x=k", "--set", "chart_y=zeta",
+                 "--set", "chart_x_range=0,0.2", "--set", "chart_y_range=0,0.1", "--set", "chart_x_points=3",
+                 "--set", "chart_y_points=2", "--set", "orbit=simulate", "--set", "orbit_max_periods=2",
+                 "--set", "threads=1"]
+# Runs the program given as $0 and reports this rank's own exit status on stderr; exits 0, so
+# that mpirun does not end the other ranks before they report theirs.
+EACH_RANK_STATUS = '"$0" "$@"; s=$?; echo "rank $OMPI_COMM_WORLD_RANK exit $s" >&2'
 # `run`: analyses with and without point loops; the workers must skip floquet and follow the
 # lead through the two grids.
 RUN_SCENE = """analyses = ["floquet", "chart", "basin"]
@@ -115,20 +123,29 @@ def main():
         scratch = Path(scratch)
         scene = scratch / "run_scene.toml"
         scene.write_text(RUN_SCENE)
-        cases = {"sweep": SWEEP, "chart": CHART, "basin": BASIN, "run": ["run", str(scene)]}
+        cases = {"sweep": SWEEP, "chart": CHART, "basin": BASIN, "run": ["run", str(scene)],
+                 "failing_chart": FAILING_CHART}
 
-        # 1. Same files as a single process with threads = 1, for R = 2 and 3.
+        # 1. Same files as a single process with threads = 1, for R = 2 and 3, and the same exit
+        # status (3 for failed points, recorded in the files), the summary printed once.
         for name, command in cases.items():
+            status = 3 if name == "failing_chart" else 0
             reference = scratch / f"{name}_ref"
             r = run([program, *command, "--quiet", "--out", str(reference)])
-            check(r.returncode == 0, f"{name} without mpirun: exit {r.returncode}: {r.stderr}")
+            check(r.returncode == status, f"{name} without mpirun: exit {r.returncode}: {r.stderr}")
             for ranks in (2, 3):
                 out = scratch / f"{name}_{ranks}"
-                r = run(mpirun(ranks, program, *command, "--out", str(out)))
-                if check(r.returncode == 0, f"{name} on {ranks} ranks: exit {r.returncode}: {r.stderr}"):
+                r = run(mpirun(ranks, "sh", "-c", EACH_RANK_STATUS, program, *command, "--out", str(out)))
+                statuses = sorted(line for line in r.stderr.splitlines() if line.startswith("rank "))
+                if check(statuses == [f"rank {i} exit {status}" for i in range(ranks)],
+                         f"{name} on {ranks} ranks: rank statuses {statuses}\n{r.stderr}"):
                     same_files(reference, out, f"{name} on {ranks} ranks")
-                    check(r.stdout.count("delayspec " + name if name != "run" else "run: ") == 1,
+                    summary = "run: " if name == "run" else "delayspec " + command[0]
+                    check(r.stdout.count(summary) == 1,
                           f"{name} on {ranks} ranks: the summary is not printed exactly once:\n{r.stdout}")
+                    if status == 3:
+                        check(r.stderr.count("numerical failure at") == 1,
+                              f"{name} on {ranks} ranks: the failure is not reported once:\n{r.stderr}")
 
         # 2. A rank killed mid-run: the finished points are on disk, --resume completes the sweep
         # with the reference's values (killed worker -> resume without MPI; killed lead -> R = 2).
@@ -168,14 +185,13 @@ def main():
                 same_files(scratch / f"{name}_ref", out, f"{name} resumed after the lead was killed",
                            leave_out=("complete.json",))
 
-        # 3. Bad input: every rank exits 2, one message. A wrapper reports each rank's own exit
-        # status. Two kinds: found by every rank (a bad key value), and found only by the lead
-        # (an --out directory that already holds a sweep: the workers never look at it).
-        wrapper = '"$0" "$@"; s=$?; echo "rank $OMPI_COMM_WORLD_RANK exit $s" >&2'
+        # 3. Bad input: every rank exits 2, one message. Two kinds: found by every rank (a bad key
+        # value), and found only by the lead (an --out directory that already holds a sweep: the
+        # workers never look at it).
         for what, command in (("bad key", [*SWEEP, "--set", "sweep_points=0"]),
                               ("bad --out", [*SWEEP, "--out", str(reference)]),
                               ("bad chart", [*CHART, "--set", "chart_x_points=1"])):
-            r = run(mpirun(3, "sh", "-c", wrapper, program, *command))
+            r = run(mpirun(3, "sh", "-c", EACH_RANK_STATUS, program, *command))
             statuses = sorted(line for line in r.stderr.splitlines() if line.startswith("rank "))
             check(statuses == [f"rank {i} exit 2" for i in range(3)], f"{what}: rank statuses {statuses}\n{r.stderr}")
             check(r.stderr.count("bad input") == 1, f"{what}: the message is not printed once:\n{r.stderr}")
