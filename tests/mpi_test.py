@@ -12,7 +12,8 @@ distributed runs are checked against the code path that has no MPI in it.
 Compared: every file of the output directory. Timings are the only thing left out: the JSON keys
 "seconds", "*_seconds" and "finished_utc", the CSV comment lines of the same names, and the last
 column (`seconds`) of sweep's exponents.csv. Everything else, including every number
-printed with 17 significant digits, must be identical byte for byte.
+printed with 17 significant digits, must be identical byte for byte. Without --out, the JSON
+printed on stdout is compared the same way.
 
 The killed run uses the test hook DELAYSPEC_TEST_KILL_RANK=R:K (src/cli/distributed_points.hpp):
 rank R raises SIGKILL after its K-th point, as a node failure or `scancel` would end it.
@@ -146,6 +147,14 @@ def main():
                     if status == 3:
                         check(r.stderr.count("numerical failure at") == 1,
                               f"{name} on {ranks} ranks: the failure is not reported once:\n{r.stderr}")
+
+        # Without --out the points reach rank 0 only as messages: the JSON on stdout is the same.
+        for name in ("sweep", "basin"):
+            alone = run([program, *cases[name], "--quiet", "--json"])
+            r = run(mpirun(3, program, *cases[name], "--quiet", "--json"))
+            if check(alone.returncode == 0 and r.returncode == 0, f"{name} --json: exit {r.returncode}: {r.stderr}"):
+                check(strip_timing(json.loads(r.stdout)) == strip_timing(json.loads(alone.stdout)),
+                      f"{name} --json on 3 ranks differs from one process")
 
         # 2. A rank killed mid-run: the finished points are on disk, --resume completes the sweep
         # with the reference's values (killed worker -> resume without MPI; killed lead -> R = 2).
