@@ -17,10 +17,6 @@ namespace {
 
 int rank = 0;
 int ranks = 1;
-bool mpi_started = false;
-
-// The lead's broadcast at a loop start; any exit status is >= 0.
-constexpr int loop_starts = -1;
 
 }  // namespace
 
@@ -30,6 +26,11 @@ int rank_count() { return ranks; }
 #ifdef DELAYSPEC_MPI
 
 namespace {
+
+bool mpi_started = false;
+
+// The lead's broadcast at a loop start; any exit status is >= 0.
+constexpr int loop_starts = -1;
 
 // Set by the launchers: OpenMPI's mpirun, PMIx (OpenMPI 5, `srun --mpi=pmix`), MPICH's Hydra and
 // Slurm's PMI/PMI2. Without one, this is a plain run: no MPI_Init (it would cost a singleton
