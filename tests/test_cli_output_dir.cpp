@@ -304,16 +304,19 @@ TEST(OutputDirectory, ResumeRefusesAPointFileOfOtherSettings) {
 // uninterrupted run. A second run without --resume is refused instead of mixing two runs.
 TEST(OutputDirectory, ChartAndBasinResumeToTheSameTable) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> grids = {
-      {"chart", {"chart", "--quiet", "--set", "model=mathieu", "--set", "N=10", "--set", "solver=dense", "--set",
-                 "chart_x_points=3", "--set", "chart_y_points=2"}},
-      {"basin", {"basin", "--quiet", "--set", "N=10", "--set", "basin_x_points=3", "--set", "basin_y_points=2",
-                 "--set", "basin_transient=5", "--set", "basin_max_period=2"}}};
+      {"chart",
+       {"chart", "--quiet", "--set", "model=mathieu", "--set", "N=10", "--set", "solver=dense", "--set",
+        "chart_x_points=3", "--set", "chart_y_points=2"}},
+      {"basin",
+       {"basin", "--quiet", "--set", "N=10", "--set", "basin_x_points=3", "--set", "basin_y_points=2", "--set",
+        "basin_transient=5", "--set", "basin_max_period=2"}}};
   for (const auto& [name, args] : grids) {
     const fs::path dir = fresh_dir("outdir_resume_" + name);
     ASSERT_EQ(run(with(args, {"--out", dir.string()})).status, 0) << name;
     const std::string complete = without_metadata(read(dir / (name + ".csv")));
     EXPECT_TRUE(fs::exists(dir / (name + "_settings.json"))) << name;
-    for (int i = 0; i < 6; ++i) EXPECT_TRUE(fs::exists(dir / (name + "_points/point_0000" + std::to_string(i) + ".json")));
+    for (int i = 0; i < 6; ++i)
+      EXPECT_TRUE(fs::exists(dir / (name + "_points/point_0000" + std::to_string(i) + ".json")));
     CliResult again = run(with(args, {"--out", dir.string()}));
     EXPECT_EQ(again.status, 2) << name;
     EXPECT_TRUE(contains(again.err, "already holds a " + name + ": add --resume")) << again.err;

@@ -2,8 +2,9 @@
 // and the Poincare-section values x(t0 + jT) after the transient (bifurcation-diagram data).
 //
 // Points run in parallel (`threads`, default: all cores), each thread with its own stepper and
-// buffers, and under mpirun over the ranks too (distributed_points.hpp; docs/parallel.md). With --out DIR the results are kept point by point, so an interrupted sweep loses
-// only the points in flight and `--resume` completes it:
+// buffers, and under mpirun over the ranks too (point_loop.hpp; docs/parallel.md). With --out
+// DIR the results are kept point by point, so an interrupted sweep loses only the points in
+// flight and `--resume` completes it:
 //   DIR/sweep_settings.json     the effective settings of the sweep (resume refuses other settings)
 //   DIR/points/point_NNNNN.json one file per finished point, written atomically, with the
 //                               settings_hash of its sweep (resume refuses a point of another sweep)

@@ -219,8 +219,7 @@ void lead_points(const std::vector<long>& todo, int threads, long worker_threads
       std::vector<std::int64_t> chunk;
       for (long i = first; i < end; ++i) chunk.push_back(todo[static_cast<size_t>(i)]);
       if (chunk.empty()) --requesters;
-      MPI_Send(chunk.data(), static_cast<int>(chunk.size()), MPI_INT64_T, status.MPI_SOURCE, reply_tag,
-               MPI_COMM_WORLD);
+      MPI_Send(chunk.data(), static_cast<int>(chunk.size()), MPI_INT64_T, status.MPI_SOURCE, reply_tag, MPI_COMM_WORLD);
     }
   });
   auto compute = [&] {

@@ -30,9 +30,7 @@ namespace {
   throw BadInput("`--resume`: the settings differ from the interrupted " + command + " in " + diff);
 }
 
-std::string points_directory(const std::string& command) {
-  return command == "sweep" ? "points" : command + "_points";
-}
+std::string points_directory(const std::string& command) { return command == "sweep" ? "points" : command + "_points"; }
 
 }  // namespace
 
@@ -57,7 +55,9 @@ json resume_settings(const Config& config, const std::vector<std::string>& per_p
 }
 
 PointFiles::PointFiles(fs::path dir, std::string command, json settings)
-    : dir_(std::move(dir)), command_(std::move(command)), settings_(std::move(settings)),
+    : dir_(std::move(dir)),
+      command_(std::move(command)),
+      settings_(std::move(settings)),
       hash_(settings_hash(settings_)) {}
 
 fs::path PointFiles::settings_path() const { return dir_ / (command_ + "_settings.json"); }

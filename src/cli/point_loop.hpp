@@ -24,8 +24,8 @@ struct PointLoop {
   std::string command;  // names the point files (point_files.hpp) and the progress report
   long count = 0;       // points 0..count-1
   int threads = 1;
-  std::vector<std::string> per_point_keys;  // keys whose value differs per point (resume_settings)
-  std::function<void(long index)> compute = {};  // computes the point and keeps its result
+  std::vector<std::string> per_point_keys;                // keys whose value differs per point (resume_settings)
+  std::function<void(long index)> compute = {};           // computes the point and keeps its result
   std::function<nlohmann::json(long index)> record = {};  // the kept result as a record with "index"
   // Keeps the result a record holds (a resumed point, or a worker's); false (or an exception)
   // when the record does not fit the point: it is computed again.

@@ -50,7 +50,8 @@ void check_output_flags(const std::string& command, bool out_given, const std::s
                    "analysis's result in a file)");
   if (out_given && out_dir.empty()) throw BadInput("`--out ''`: the directory name is empty");
   if (resume && !use.resume)
-    throw BadInput("`--resume`: `" + command + "` has nothing to resume (only sweep, chart, basin, and run with one of them, do)");
+    throw BadInput("`--resume`: `" + command +
+                   "` has nothing to resume (only sweep, chart, basin, and run with one of them, do)");
   if (resume && !out_given) throw BadInput("`--resume` needs `--out DIR` (the directory of the interrupted run)");
 }
 
