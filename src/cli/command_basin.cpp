@@ -6,7 +6,9 @@
 // none (chaotic, quasi-periodic, a longer period, or not yet settled). Each point also reports
 // max x over the section points (telling apart attractors of equal period) and the impacts.
 //
-// Points run in parallel (`threads`), under mpirun over the ranks too (distributed_points.hpp).
+// Points run in parallel (`threads`), under mpirun over the ranks too; with --out DIR each
+// finished point is kept in DIR/basin_points/ and --resume completes an interrupted basin
+// (point_loop.hpp).
 //
 // Keys: basin_x, basin_y (default x0, v0), basin_x_range, basin_y_range ([min, max]),
 // basin_x_points, basin_y_points (>= 2), basin_transient (default 400), basin_max_period

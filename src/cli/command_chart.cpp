@@ -1,7 +1,8 @@
 // delayspec chart: a stability chart, the spectral radius |mu_1| of the monodromy over a grid of
 // two model parameters (default: the delayed Mathieu equation's (delta, b) plane, the classic
-// chart of Insperger & Stepan). Points run in parallel (`threads`), under mpirun over the ranks too
-// (distributed_points.hpp).
+// chart of Insperger & Stepan). Points run in parallel (`threads`), under mpirun over the ranks
+// too; with --out DIR each finished point is kept in DIR/chart_points/ and --resume completes an
+// interrupted chart (point_loop.hpp).
 //
 // Keys: chart_x, chart_y (parameter names, default delta and b), chart_x_range, chart_y_range
 // (two numbers [min, max]), chart_x_points, chart_y_points (>= 2), threads; plus the problem,
