@@ -64,7 +64,7 @@ TEST(CommandHelp, RequiredKeysAndCommandSpecificDefaults) {
   EXPECT_TRUE(contains(chart.out, "N = 40 ")) << chart.out;
   // converge's events default depends on the model (impact: on and off side by side).
   CliResult converge = run({"converge", "--help"});
-  EXPECT_TRUE(contains(converge.out, "events = on (linear, mathieu, mackey-glass); on,off (impact)")) << converge.out;
+  EXPECT_TRUE(contains(converge.out, "events = on (linear, mathieu, mackey-glass); on,off (impact, milling)")) << converge.out;
 }
 
 TEST(KeyRegistry, EveryKeyReadHasAMeaningAndEveryMeaningIsRead) {

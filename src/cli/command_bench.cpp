@@ -3,7 +3,10 @@
 // (CLI contract `bench`). Library parts: floquet.hpp, convergence.hpp.
 //
 // Keys: Ns (comma list) or N_min/N_max (doubling); solvers (comma list of spectra, arpack,
-// dense-lapack, dense-eigen; default all but dense-eigen); nev (default 10), ncv, tol,
+// dense-lapack, dense-eigen; default all but dense-eigen; and the classic dense discretisations
+// sdm0, fdm1 of linear models with tau = T, classic_discretisation.hpp: their N is m, the steps
+// per period, and their seconds include forming the product; classic_max_N, default 640: they
+// run at the listed N up to this one only, their cost being O(N^3)); nev (default 10), ncv, tol,
 // max_restarts, seed; reference = exact | extrapolated | finest | auto (the reference values:
 // exact multipliers, or Richardson / the finest level of the solver with the most levels);
 // dense_memory_limit_mb (default 2048): a dense row whose matrices would need more is skipped
@@ -22,6 +25,7 @@
 
 #include "atomic_file.hpp"
 #include "commands.hpp"
+#include "delayspec/classic_discretisation.hpp"
 #include "delayspec/convergence.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
@@ -52,6 +56,18 @@ struct BenchRow {
 
 bool is_dense(FloquetSolver s) { return s == FloquetSolver::dense_lapack || s == FloquetSolver::dense_eigen; }
 
+// The classic reference discretisations (not solvers of delayspec's map: their own maps).
+const std::vector<std::string>& classic_names() {
+  static const std::vector<std::string> names = {"sdm0", "fdm1"};
+  return names;
+}
+bool is_classic(const std::string& name) {
+  return std::find(classic_names().begin(), classic_names().end(), name) != classic_names().end();
+}
+ClassicMethod parse_classic(const std::string& name) { return name == "sdm0" ? ClassicMethod::sdm0 : ClassicMethod::fdm1; }
+// A row of a dense delayspec solver (the `vs dense` comparison and the speed-up line use them).
+bool is_dense_row(const std::string& solver) { return !is_classic(solver) && is_dense(parse_floquet_solver(solver)); }
+
 // Bytes the dense path holds at its peak: the assembled matrix, the copy LAPACK overwrites (or
 // Eigen's Schur form), and the QR workspace / Householder blocks: about 3 n^2 doubles.
 double dense_bytes_estimate(long n) { return 3.0 * 8.0 * static_cast<double>(n) * static_cast<double>(n); }
@@ -62,11 +78,14 @@ struct BenchSettings {
   OrbitSettings orbit;
   std::vector<int> Ns;
   std::vector<std::string> solver_names;  // as given (`dense` stays `dense`)
-  std::vector<FloquetSolver> solvers;
+  std::vector<FloquetSolver> solvers;      // delayspec's
+  std::vector<ClassicMethod> classics;     // the classic discretisations listed
+  std::vector<std::string> classic_names;  // their names, in the order listed
   FloquetOptions base;  // nev, ncv, tol, ... (the solver is set per row)
   ReferenceKind reference_kind = ReferenceKind::automatic;
   long repeats = 1;
   double limit_mb = 2048;
+  long classic_max_N = 640;  // the classic rows stop here (O(N^3) each)
   Multipliers exact;  // the exact multipliers when the model has them
 };
 
@@ -81,16 +100,36 @@ BenchSettings read_bench_settings(Config& config) {
   s.orbit = read_orbit_settings(config);
   s.Ns = read_N_list(config, s.problem, 100, 400);
   s.solver_names = read_word_list(config, "solvers", "spectra,arpack,dense-lapack",
-                                  {"spectra", "arpack", "dense", "dense-lapack", "dense-eigen"});
+                                  {"spectra", "arpack", "dense", "dense-lapack", "dense-eigen", "sdm0", "fdm1"});
   s.base = read_floquet_options(config, 10);
   s.reference_kind =
       parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
   s.repeats = config.get_int_in_range("repeats", 1, 1, 1000);
+  if (std::any_of(s.solver_names.begin(), s.solver_names.end(), is_classic))
+    s.classic_max_N = config.get_int_in_range("classic_max_N", s.classic_max_N, 2, 1'000'000);
   s.limit_mb = config.get_double("dense_memory_limit_mb", 2048);
   require_positive("dense_memory_limit_mb", s.limit_mb);
   config.check_all_used();
 
-  for (const auto& name : s.solver_names) s.solvers.push_back(parse_floquet_solver(name));
+  for (const auto& name : s.solver_names) {
+    if (is_classic(name)) {
+      s.classics.push_back(parse_classic(name));
+      s.classic_names.push_back(name);
+    } else {
+      s.solvers.push_back(parse_floquet_solver(name));
+    }
+  }
+  if (!s.classics.empty()) {
+    // Checked now, before any work: the classic paths need a linear model with tau = T.
+    const std::string key = "`solvers = " + s.classic_names.front() + "`: ";
+    try {
+      with_map(s.problem, [&](const auto& model, const auto&) { classic_monodromy(model, 2, s.classics.front()); });
+    } catch (const BadInput& e) {
+      throw BadInput(key + e.what());
+    }
+    if (s.Ns.front() < 2) throw BadInput(key + "the classic discretisations need N >= 2");
+    if (s.problem.orbit_period != 1) throw BadInput(key + "the classic discretisations need orbit_period = 1");
+  }
   Problem coarsest = s.problem;
   coarsest.N = s.Ns.front();
   const long n_min = coarsest.dimension();  // the dimension at the coarsest N, the smallest
@@ -114,8 +153,34 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
   const long repeats = s.repeats;
   const double limit_mb = s.limit_mb;
   std::vector<BenchRow> rows;
-  Progress progress(inv.err, "bench", static_cast<long>(s.Ns.size() * solvers.size()), inv.quiet);
+  long planned = static_cast<long>(s.Ns.size() * solvers.size());
+  for (int N : s.Ns) planned += N <= s.classic_max_N ? static_cast<long>(s.classics.size()) : 0;
+  Progress progress(inv.err, "bench", planned, inv.quiet);
   for (int N : s.Ns) {
+    for (size_t c = 0; c < s.classics.size() && N <= s.classic_max_N; ++c) {
+      BenchRow row;
+      row.N = N;
+      row.solver = s.classic_names[c];
+      try {
+        with_map(s.problem, [&](const auto& model, const auto&) {
+          const MemoryProbe probe;
+          const ClassicResult r = classic_multipliers(model, N, s.classics[c], base.nev);
+          row.peak_bytes = probe.peak_bytes();
+          row.n = r.dimension;
+          row.multipliers = r.multipliers;
+          row.seconds = r.seconds;
+          for (row.repeats = 1; row.repeats < repeats && row.seconds < 1.0; ++row.repeats)
+            row.seconds = std::min(row.seconds, classic_multipliers(model, N, s.classics[c], base.nev).seconds);
+        });
+      } catch (const NumericalFailure& e) {
+        row.status = "failed";
+        row.message = e.what();
+        inv.err << "bench: N = " << N << ", " << row.solver << ": failed: " << e.what() << "\n";
+      }
+      rows.push_back(row);
+      progress.add();
+    }
+    if (solvers.empty()) continue;
     with_monodromy(s.problem, s.problem.events, s.orbit, N, [&](const auto& op, const PeriodicOrbit&, double setup) {
       for (FloquetSolver solver : solvers) {
         BenchRow row;
@@ -181,6 +246,7 @@ BenchReference bench_reference(const BenchSettings& s, const std::vector<BenchRo
     std::string best;
     size_t best_count = 0;
     for (const auto& name : s.solver_names) {
+      if (is_classic(name)) continue;  // the reference is delayspec's (the classic rows are scored)
       const std::string canonical = to_string(parse_floquet_solver(name));
       size_t count = 0;
       for (const auto& r : rows) count += r.solver == canonical && r.status == "ok";
@@ -224,7 +290,7 @@ void score_rows(std::vector<BenchRow>& rows, const BenchReference& reference) {
       r.correct_digits = m.correct_digits[0];
     }
     for (const auto& dense : rows)
-      if (dense.N == r.N && dense.status == "ok" && is_dense(parse_floquet_solver(dense.solver)) && &dense != &r) {
+      if (dense.N == r.N && dense.status == "ok" && is_dense_row(dense.solver) && &dense != &r && !is_classic(r.solver)) {
         const MatchedErrors m =
             errors_against(r.multipliers, dense.multipliers, std::vector<double>(dense.multipliers.size(), 0));
         double dev = 0;
@@ -307,7 +373,7 @@ void print_bench(std::ostream& out, const BenchSettings& s, const std::vector<Be
   for (const auto& dense : rows) {
     if (dense.solver != "dense-lapack" || dense.status != "ok") continue;
     for (const auto& r : rows)
-      if (r.N == dense.N && r.status == "ok" && !is_dense(parse_floquet_solver(r.solver))) {
+      if (r.N == dense.N && r.status == "ok" && !is_classic(r.solver) && !is_dense_row(r.solver)) {
         std::snprintf(line, sizeof line, "  N = %d: %s is %.0fx faster than dense-lapack\n", r.N, r.solver.c_str(),
                       dense.seconds / r.seconds);
         out << line;

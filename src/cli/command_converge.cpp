@@ -281,13 +281,18 @@ class ConvergeLevels {
 int command_converge(Config& config, const Invocation& inv) {
   const auto command_start = std::chrono::steady_clock::now();
   // events may be a list here (side by side); the problem reads the first of them.
-  const bool switching_default = config.get_string("model", "impact") == "impact";
+  // Models that switch (the impact wall, milling's cutting windows): located and not, side by side.
+  const std::string model_name = config.get_string("model", "impact");
+  const bool switching_default = model_name == "impact" || model_name == "milling";
   const std::vector<std::string> events =
       read_word_list(config, "events", switching_default ? "on,off" : "on", event_mode_names());
   config.set("events", events.front(), "converge");
   Problem problem = read_problem(config, 100);
   const bool switching =
-      std::visit([](const auto& model) { return std::decay_t<decltype(model)>::has_switching; }, problem.model);
+      std::visit([](const auto& model) {
+        using Model = std::decay_t<decltype(model)>;
+        return Model::has_switching || TimeSwitchedModel<Model>;
+      }, problem.model);
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   ConvergenceOptions base;
   base.Ns = read_N_list(config, problem, 25, 400);

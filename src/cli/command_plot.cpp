@@ -113,7 +113,7 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
      << gnuplot_string("Spectral radius |{/Symbol m}_1|, model " + t.metadata_text("model", "?") +
                        ", N = " + title_N(t) + " (white line: |{/Symbol m}_1| = 1)")
      << "\n";
-  gp << "set xlabel " << gnuplot_string(t.columns[0]) << "\nset ylabel " << gnuplot_string(t.columns[1]) << "\n";
+  gp << "set xlabel " << gnuplot_label(t.columns[0]) << "\nset ylabel " << gnuplot_label(t.columns[1]) << "\n";
   gp << "set cblabel '|{/Symbol m}_1| (clipped at 2)'\nset cbrange [0:2]\n"
         "set palette defined (0 '#08306b', 0.5 '#4292c6', 0.999 '#c6dbef', 1.001 '#fee391', 1.5 '#fb6a4a', 2 '#67000d')\n";
   gp << "set autoscale fix\nset key off\n";
@@ -155,7 +155,7 @@ void plot_basin(FigureRenderer& renderer, const fs::path& file) {
      << gnuplot_string("Basins of attraction, model " + t.metadata_text("model", "?") +
                        ", k = " + gnuplot_number(t.metadata_number("k", 0)) + ", N = " + title_N(t))
      << "\n";
-  gp << "set xlabel " << gnuplot_string(t.columns[0]) << "\nset ylabel " << gnuplot_string(t.columns[1]) << "\n";
+  gp << "set xlabel " << gnuplot_label(t.columns[0]) << "\nset ylabel " << gnuplot_label(t.columns[1]) << "\n";
   gp << "set autoscale fix\nset key outside right top box opaque\nset style fill solid 1.0\n";
   std::ostringstream legend;
   for (const auto& [period, n] : present) {
@@ -320,7 +320,7 @@ void plot_exponents(FigureRenderer& renderer, const fs::path& dir) {
          << colours[i % 6] << "' title '{/Symbol l}_" << i + 1 << "'";
   }
   gp << "set title " << gnuplot_string("Lyapunov exponents per period against " + label + " (zero line green)") << "\n";
-  gp << "set xlabel " << gnuplot_string(label)
+  gp << "set xlabel " << gnuplot_label(label)
      << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
   gp << plot.str() << ", \\\n     0 with lines lc rgb '#2ca02c' lw 2 title 'zero'\n";
   renderer.figure("exponents", gp.str());
@@ -338,7 +338,7 @@ void plot_bifurcation(FigureRenderer& renderer, const fs::path& dir) {
   std::ostringstream gp;
   gp << gnuplot_datablock("section", rows);
   gp << "set title " << gnuplot_string("Bifurcation diagram: x on the Poincare section against " + label) << "\n";
-  gp << "set xlabel " << gnuplot_string(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
+  gp << "set xlabel " << gnuplot_label(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
   gp << "plot $section using 1:2 with points pt 7 ps 0.3 lc rgb '#000000'\n";
   renderer.figure("bifurcation", gp.str());
 }

@@ -1,5 +1,7 @@
 #include "gnuplot_script.hpp"
 
+#include <string_view>
+
 #include <sys/wait.h>
 
 #include <cerrno>
@@ -33,6 +35,15 @@ std::string gnuplot_string(const std::string& text) {
     else out += c;
   }
   return out + "'";
+}
+
+std::string gnuplot_label(const std::string& text) {
+  std::string escaped;
+  for (const char c : text) {
+    if (std::string_view("_^{}@&~").find(c) != std::string_view::npos) escaped += '\\';
+    escaped += c;
+  }
+  return gnuplot_string(escaped);
 }
 
 std::string gnuplot_datablock(const std::string& name, const std::string& rows) {

@@ -24,6 +24,9 @@ std::string gnuplot_number(double value);
 // line. Backslashes stay as they are: inside single quotes gnuplot reads them literally, and the
 // literal never ends a line (its closing quote does).
 std::string gnuplot_string(const std::string& text);
+// The same for text drawn in enhanced mode (axis labels from key names): enhanced-text controls
+// (_ ^ { } @ & ~) are escaped, so that `spindle_rpm` is not drawn as spindle with subscript r.
+std::string gnuplot_label(const std::string& text);
 
 // A datablock: $name << EOD, the rows (numbers only), EOD.
 std::string gnuplot_datablock(const std::string& name, const std::string& rows);

@@ -76,7 +76,7 @@ void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& di
        << gnuplot_string("Branch of " + t.metadata_text("model", "?") + " against " + key +
                          " (stable solid, unstable dashed)")
        << "\n";
-    gp << "set xlabel " << gnuplot_string(key) << "\nset ylabel " << gnuplot_string(ylabel)
+    gp << "set xlabel " << gnuplot_label(key) << "\nset ylabel " << gnuplot_string(ylabel)
        << "\nset grid\nset key top left\n"
        << labels;
     gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
