@@ -1,0 +1,270 @@
+"""The Python module against the program it fronts: every function's to_dict() equals the JSON
+`delayspec COMMAND --json` prints for the same keys, to the last bit (timings aside), since both
+run the same command code; the numpy views hold the same numbers with the documented dtypes and
+shapes; errors are the CLI's, with its messages; Ctrl-C stops a long run; threads are safe.
+Small N throughout: a few seconds in all."""
+import os
+import pathlib
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import delayspec
+from conftest import SCENES, cli_json, run_cli, without_timings
+
+DEFAULT = SCENES / "default.toml"  # impact model, k = 0.2: a stable period-1 orbit
+FLOQUET_KEYS = dict(N=40, nev=4, solver="spectra")
+LYAPUNOV_KEYS = dict(N=20, transient=10, periods=30, exponents=2)
+
+
+def same_as_cli(result, command, scene=None, **keys):
+    assert without_timings(result.to_dict()) == without_timings(cli_json(command, scene, **keys))
+
+
+# ---- every function against the CLI's JSON --------------------------------------------------
+
+def test_floquet_equals_cli_json():
+    r = delayspec.floquet(DEFAULT, **FLOQUET_KEYS)
+    same_as_cli(r, "floquet", DEFAULT, **FLOQUET_KEYS)
+
+
+def test_floquet_without_scene_equals_cli_json():
+    r = delayspec.floquet(N=20, k=0.1, orbit="newton")
+    same_as_cli(r, "floquet", N=20, k=0.1, orbit="newton")
+
+
+def test_floquet_dict_scene_equals_the_file():
+    """A dict stands for a scene file: default.toml's keys as a dict give the file's result."""
+    scene = dict(model="impact", zeta=0.01, e=1.26, a=0.7, beta=28, omega=0.802, k=0.2, tau_over_T=1,
+                 x0=-0.0566, v0=1.0101, N=200, nev=6, solver="spectra", analyses=["floquet"])
+    r = delayspec.floquet(scene, N=40, nev=4)
+    same_as_cli(r, "floquet", DEFAULT, N=40, nev=4)
+
+
+def test_lyapunov_equals_cli_json():
+    r = delayspec.lyapunov(**LYAPUNOV_KEYS)
+    same_as_cli(r, "lyapunov", **LYAPUNOV_KEYS)
+
+
+def test_converge_equals_cli_json():
+    keys = dict(Ns=[10, 20, 40], nev=2)
+    r = delayspec.converge(**keys)
+    same_as_cli(r, "converge", **keys)
+    assert r.Ns.dtype == np.int64 and list(r.Ns) == [10, 20, 40]
+    assert r.multipliers_by_N.shape == (3, 2) and r.multipliers_by_N.dtype == np.complex128
+    assert r.errors_by_N.shape == (3, 2)
+    assert r.extrapolated.dtype == np.complex128 and r.extrapolated.shape == (2,)
+
+
+def test_simulate_equals_cli_json_and_files(tmp_path):
+    keys = dict(N=10, t_end=40, sample_every=2)
+    r = delayspec.simulate(out=tmp_path, **keys)
+    cli = cli_json("simulate", **keys)
+    mine = without_timings(r.to_dict())
+    assert mine.pop("files") == [str(tmp_path / f) for f in ("trajectory.csv", "poincare.csv", "impacts.csv")]
+    cli.pop("files")
+    assert mine == without_timings(cli)
+    # The trajectory is the one --out writes (17 significant digits: the same doubles).
+    lines = [l for l in (tmp_path / "trajectory.csv").read_text().splitlines() if not l.startswith("#")]
+    assert lines[0] == "t,x,v"
+    written = np.array([[float(x) for x in l.split(",")] for l in lines[1:]])
+    assert r.trajectory.dtype == np.float64 and r.trajectory.shape == (r.samples, 3)
+    np.testing.assert_array_equal(r.trajectory, written)
+    assert r.poincare.shape == (len(cli["poincare"]), 3)
+    np.testing.assert_array_equal(r.poincare, np.array(cli["poincare"]))
+    assert r.impact_times.dtype == np.float64 and r.impact_times.shape == (r.impacts,)
+
+
+def test_sweep_equals_cli_json():
+    keys = dict(N=20, sweep_points=3, transient=10, periods=20, section_points=4)
+    r = delayspec.sweep(SCENES / "fig6_2.toml", **keys)
+    same_as_cli(r, "sweep", SCENES / "fig6_2.toml", **keys)
+    assert r.parameter.shape == (3,) and np.array_equal(r.parameter, [0.0, 0.7, 1.4])
+    assert r.exponents_per_period.shape == (3, 2) and r.exponents_per_period.dtype == np.float64
+    assert r.section_x.shape == (3, 4)
+
+
+def test_chart_equals_cli_json():
+    keys = dict(N=10, chart_x_points=3, chart_y_points=2)
+    r = delayspec.chart(SCENES / "mathieu_chart.toml", **keys)
+    same_as_cli(r, "chart", SCENES / "mathieu_chart.toml", **keys)
+    assert r.spectral_radius.shape == (2, 3) and r.spectral_radius.dtype == np.float64
+    np.testing.assert_array_equal(r.x, [-1.0, 2.0, 5.0])
+    np.testing.assert_array_equal(r.y, [-1.5, 1.5])
+    rows = r["rows"]
+    for row in rows:  # spectral_radius[j, i] is the row at (x[i], y[j])
+        i, j = list(r.x).index(row["x"]), list(r.y).index(row["y"])
+        assert r.spectral_radius[j, i] == row["spectral_radius"]
+
+
+def test_continue_equals_cli_json():
+    keys = dict(continue_Ns=[10, 20], N=20)
+    scene = SCENES / "continue_mathieu_delta2.toml"
+    r = delayspec.continue_(scene, **keys)
+    same_as_cli(r, "continue", scene, **keys)
+    assert r.multipliers.dtype == np.complex128 and r.multipliers.shape == (len(r["points"]), 6)
+
+
+# ---- numpy views -----------------------------------------------------------------------------
+
+def test_floquet_arrays_hold_the_json_numbers():
+    r = delayspec.floquet(DEFAULT, **FLOQUET_KEYS)
+    d = r.to_dict()
+    assert r.multipliers.dtype == np.complex128 and r.multipliers.shape == (4,)
+    assert [complex(m["re"], m["im"]) for m in d["multipliers"]] == list(r.multipliers)
+    assert np.all(np.diff(np.abs(r.multipliers)) <= 0)  # by modulus, largest first (CLI contract)
+    assert r.residuals.dtype == np.float64 and list(r.residuals) == d["residuals"]
+    assert isinstance(r.operator_applications, int) and r.operator_applications == d["operator_applications"]
+    assert isinstance(r.seconds, float)
+    assert r.orbit["newton_residuals"].dtype == np.float64
+    assert r.N == 40 and r.model == "impact"
+
+
+def test_lyapunov_arrays():
+    r = delayspec.lyapunov(**LYAPUNOV_KEYS)
+    for field in ("exponents_per_period", "exponents_per_time", "standard_error_per_period"):
+        a = getattr(r, field)
+        assert a.dtype == np.float64 and a.shape == (2,)
+        assert list(a) == r[field]
+
+
+def test_numpy_and_float_key_values_read_as_the_cli_reads_text():
+    """k = 0.1 as a float, numpy scalar or text: the same double as `--set k=0.1`."""
+    a = delayspec.floquet(N=20, k=0.1).to_dict()
+    b = delayspec.floquet(N=np.int64(20), k=np.float64(0.1)).to_dict()
+    c = delayspec.floquet(N="20", k="0.1").to_dict()
+    assert without_timings(a) == without_timings(b) == without_timings(c)
+
+
+# ---- errors ------------------------------------------------------------------------------------
+
+def cli_error(command, scene=None, **keys):
+    status, out, err = run_cli(command, scene, **keys)
+    return status, out, err
+
+
+@pytest.mark.parametrize("keys", [dict(nevv=3), dict(N=0), dict(solver="lanczos"), dict(tol=-1), dict(nev="x")])
+def test_bad_input_raises_with_the_cli_message(keys):
+    status, out, err = cli_error("floquet", **keys)
+    assert status == 2 and out is None
+    prefix = "delayspec floquet: bad input: "
+    assert err.startswith(prefix)
+    with pytest.raises(delayspec.BadInput) as caught:
+        delayspec.floquet(**keys)
+    assert str(caught.value) == err[len(prefix):].rstrip("\n")
+    assert isinstance(caught.value, ValueError)
+
+
+def test_bad_scene_file_raises_bad_input(tmp_path):
+    scene = tmp_path / "bad.toml"
+    scene.write_text("N = = 3\n")
+    status, _, err = cli_error("floquet", scene)
+    with pytest.raises(delayspec.BadInput) as caught:
+        delayspec.floquet(scene)
+    assert status == 2 and str(caught.value) == err[len("delayspec floquet: bad input: "):].rstrip("\n")
+
+
+def test_bad_value_type_raises_bad_input():
+    with pytest.raises(delayspec.BadInput, match="`k`: a value of Python type object"):
+        delayspec.floquet(k=object())
+
+
+def test_forced_krylov_failure_raises_numerical_failure():
+    """As tests/test_krylov_cli.cpp: one Arnoldi iteration (max_restarts = 0) cannot converge 10
+    Ritz values with ncv = 12 at N = 100."""
+    keys = dict(N=100, nev=10, ncv=12, max_restarts=0, solver="spectra")
+    status, out, err = cli_error("floquet", DEFAULT, **keys)
+    assert status == 3 and out is None
+    with pytest.raises(delayspec.NumericalFailure) as caught:
+        delayspec.floquet(DEFAULT, **keys)
+    assert isinstance(caught.value, RuntimeError)
+    assert "did not converge" in str(caught.value)
+    assert str(caught.value) == err[len("delayspec floquet: numerical failure: "):].rstrip("\n")
+
+
+def test_out_for_a_command_that_writes_no_files_is_bad_input(tmp_path):
+    with pytest.raises(delayspec.BadInput, match="writes no files"):
+        delayspec._run("floquet", delayspec.FloquetResult, None, {}, out=tmp_path)
+
+
+# ---- interrupt, threads ------------------------------------------------------------------------
+
+def interrupt_after(seconds):
+    timer = threading.Timer(seconds, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+@pytest.mark.parametrize("command,keys", [
+    ("lyapunov", dict(N=100, transient=0, periods=10_000_000)),               # periods
+    ("floquet", dict(N=100, orbit="simulate", orbit_max_periods=10_000_000,   # orbit periods
+                     orbit_tolerance=1e-300)),
+    ("sweep", dict(N=100, sweep_key="k", sweep_from=0, sweep_to=1, sweep_points=4, threads=2,
+                   transient=0, periods=10_000_000)),                          # points on 2 threads
+])
+def test_sigint_raises_keyboard_interrupt_promptly(command, keys):
+    """A run of hours, interrupted after 0.3 s: KeyboardInterrupt within a second (the module
+    polls the signal handlers every 50 ms between periods; a period at N = 100 takes < 1 ms)."""
+    function = getattr(delayspec, command)
+    timer = interrupt_after(0.3)
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        function(**keys)
+    elapsed = time.monotonic() - start
+    timer.join()
+    assert elapsed < 1.5, elapsed
+    # The module still works afterwards.
+    assert delayspec.floquet(N=10).N == 10
+
+
+def test_two_threads_calling_floquet_at_once_give_the_sequential_results():
+    cases = [dict(N=60, k=0.2, nev=4, solver="spectra"), dict(N=60, k=0.3, nev=4, solver="arpack")]
+    expected = [without_timings(delayspec.floquet(**keys).to_dict()) for keys in cases]
+    results = [None] * len(cases)
+    barrier = threading.Barrier(len(cases))
+
+    def work(i):
+        barrier.wait()
+        for _ in range(3):
+            got = without_timings(delayspec.floquet(**cases[i]).to_dict())
+            if got != expected[i]:
+                results[i] = got
+                return
+        results[i] = expected[i]
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(len(cases))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert results == expected
+
+
+def test_gil_is_released_during_a_run():
+    """A Python thread keeps running while another computes."""
+    ticks = []
+    done = threading.Event()
+
+    def ticker():
+        while not done.is_set():
+            ticks.append(time.monotonic())
+            time.sleep(0.01)
+
+    t = threading.Thread(target=ticker)
+    t.start()
+    start = time.monotonic()
+    delayspec.lyapunov(N=100, transient=0, periods=400)
+    end = time.monotonic()
+    done.set()
+    t.join()
+    during = [x for x in ticks if start < x < end]
+    assert end - start < 0.05 or len(during) >= (end - start) / 0.01 / 4
+
+
+def test_docstrings_list_the_keys():
+    for function, key in [(delayspec.floquet, "nev = 6"), (delayspec.lyapunov, "exponents"),
+                          (delayspec.sweep, "sweep_key"), (delayspec.chart, "chart_x")]:
+        assert key in function.__doc__, function.__name__
