@@ -14,6 +14,7 @@
 // atomic as in the CLI.
 #include <atomic>
 #include <chrono>
+#include <mutex>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -71,6 +72,17 @@ class PythonSignals final : public delayspec::CancellationCheck {
   std::atomic<bool> stop_{false};
   std::optional<py::error_already_set> raised_;
 };
+
+// The CLI layer tracks the open output directory per process (output_directory.hpp: run_cli runs
+// one command at a time), so calls that write files (out=DIR) take turns; a call waiting for its
+// turn stays interruptible.
+std::timed_mutex output_turn;
+
+std::unique_lock<std::timed_mutex> wait_for_output_turn() {
+  std::unique_lock<std::timed_mutex> turn(output_turn, std::defer_lock);
+  while (!turn.try_lock_for(std::chrono::milliseconds(50))) delayspec::throw_if_cancelled();
+  return turn;
+}
 
 bool on_main_thread() {
   static const unsigned long main_ident =
@@ -170,6 +182,8 @@ py::tuple run(const std::string& command, const py::object& scene, const py::dic
                                          .err = err,
                                          .arrays = &arrays};
     try {
+      std::unique_lock<std::timed_mutex> turn;
+      if (out) turn = wait_for_output_turn();
       status = delayspec::cli::run_command(config, inv);
       result = nlohmann::json::parse(json_text.str());
     } catch (const delayspec::Cancelled&) {
