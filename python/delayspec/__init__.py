@@ -245,35 +245,35 @@ def _run(command, result_type, scene, keys, out=None, resume=False):
     return result_type(command, data, arrays, status)
 
 
-def floquet(scene=None, /, **keys):
+def floquet(scene=None, **keys):
     return _run("floquet", FloquetResult, scene, keys)
 
 
-def lyapunov(scene=None, /, **keys):
+def lyapunov(scene=None, **keys):
     return _run("lyapunov", Result, scene, keys)
 
 
-def converge(scene=None, /, *, out=None, **keys):
+def converge(scene=None, *, out=None, **keys):
     return _run("converge", ConvergeResult, scene, keys, out)
 
 
-def simulate(scene=None, /, *, out=None, **keys):
+def simulate(scene=None, *, out=None, **keys):
     return _run("simulate", SimulateResult, scene, keys, out)
 
 
-def sweep(scene=None, /, *, out=None, resume=False, **keys):
+def sweep(scene=None, *, out=None, resume=False, **keys):
     return _run("sweep", SweepResult, scene, keys, out, resume)
 
 
-def chart(scene=None, /, *, out=None, **keys):
+def chart(scene=None, *, out=None, **keys):
     return _run("chart", GridResult, scene, keys, out)
 
 
-def basin(scene=None, /, *, out=None, **keys):
+def basin(scene=None, *, out=None, **keys):
     return _run("basin", GridResult, scene, keys, out)
 
 
-def continue_(scene=None, /, *, out=None, **keys):
+def continue_(scene=None, *, out=None, **keys):
     return _run("continue", ContinueResult, scene, keys, out)
 
 

@@ -100,6 +100,15 @@ def test_chart_equals_cli_json():
         assert r.spectral_radius[j, i] == row["spectral_radius"]
 
 
+def test_basin_equals_cli_json():
+    keys = dict(N=10, basin_x_points=3, basin_y_points=2, basin_transient=20)
+    r = delayspec.basin(**keys)
+    same_as_cli(r, "basin", **keys)
+    assert r.period.shape == (2, 3) and r.period.dtype == np.int64
+    np.testing.assert_array_equal(r.x, [-3.0, 0.0, 3.0])
+    assert r["x"] == "x0"  # the axis' key; r.x its values
+
+
 def test_continue_equals_cli_json():
     keys = dict(continue_Ns=[10, 20], N=20)
     scene = SCENES / "continue_mathieu_delta2.toml"
@@ -202,6 +211,7 @@ def interrupt_after(seconds):
     ("lyapunov", dict(N=100, transient=0, periods=10_000_000)),               # periods
     ("floquet", dict(N=100, orbit="simulate", orbit_max_periods=10_000_000,   # orbit periods
                      orbit_tolerance=1e-300)),
+    ("simulate", dict(N=100, t_end=1e7, sample_every=1_000_000)),              # simulation periods
     ("sweep", dict(N=100, sweep_key="k", sweep_from=0, sweep_to=1, sweep_points=4, threads=2,
                    transient=0, periods=10_000_000)),                          # points on 2 threads
 ])
