@@ -16,6 +16,7 @@
 #include <chrono>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -113,14 +114,26 @@ std::string key_text(const std::string& key, py::handle value) {
                  " (give a number, a string, a boolean or a list of them)");
 }
 
+// A dict standing for a scene file, read as config.cpp reads one: nested dicts are tables, flattened
+// (a key may appear once in all), and a key another command reads is no error.
+void read_scene_dict(const py::dict& table, Config& config, std::set<std::string>& seen) {
+  const std::string name = "the scene dict";
+  for (auto [k, v] : table) {
+    const std::string key = py::str(k);
+    if (py::isinstance<py::dict>(v)) {
+      read_scene_dict(v.cast<py::dict>(), config, seen);
+      continue;
+    }
+    if (!seen.insert(key).second) throw BadInput(name + ": key `" + key + "` is given twice");
+    config.set_from_scene(key, key_text(key, v), name);
+  }
+}
+
 Config make_config(const py::object& scene, const py::dict& keys, std::optional<std::string>& scene_path) {
   Config config;
   if (py::isinstance<py::dict>(scene)) {
-    // A dict stands for a scene file: a key another command reads is no error (Config).
-    for (auto [k, v] : scene.cast<py::dict>()) {
-      const std::string key = py::str(k);
-      config.set_from_scene(key, key_text(key, v), "the scene dict");
-    }
+    std::set<std::string> seen;
+    read_scene_dict(scene.cast<py::dict>(), config, seen);
   } else if (!scene.is_none()) {
     scene_path = py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>();
     config = Config::from_scene_file(*scene_path);
