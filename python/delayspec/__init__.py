@@ -18,6 +18,7 @@ See docs/python.md.
 """
 
 import copy
+import inspect
 import sys
 import warnings
 
@@ -305,8 +306,8 @@ def _document():
         function.__doc__ = (
             f"{summary}\n\n"
             f"delayspec.{function.__name__}(scene=None{extra}, **keys) runs `delayspec {command} [SCENE] "
-            f"--set KEY=VALUE... --json`{' [--out OUT]' if extra else ''}; scene: a TOML file or a dict.\n"
-            f"Returns {result_type.__name__}: {(result_type.__doc__ or '').strip()}\n"
+            f"--set KEY=VALUE... --json{' [--out OUT]' if extra else ''}`; scene: a TOML file or a dict.\n\n"
+            f"Returns {result_type.__name__}: {inspect.cleandoc(result_type.__doc__ or '')}\n\n"
             f"Raises BadInput (ValueError) for bad keys or values, NumericalFailure (RuntimeError) when a "
             f"method fails; KeyboardInterrupt on Ctrl-C.\n\n"
             f"Keys (KEY = default):\n{keys_help(command)}")

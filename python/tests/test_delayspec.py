@@ -205,6 +205,21 @@ def test_forced_krylov_failure_raises_numerical_failure():
     assert str(caught.value) == err[len("delayspec floquet: numerical failure: "):].rstrip("\n")
 
 
+def test_failed_points_give_the_complete_result_status_3_and_a_warning():
+    """Exit 3 with a complete result in the CLI (failures recorded per point): the same result,
+    status 3, and the CLI's stderr message as a RuntimeWarning."""
+    keys = dict(N=40, chart_x_points=3, chart_y_points=2, solver="spectra", nev=6, ncv=8, max_restarts=0)
+    scene = SCENES / "mathieu_chart.toml"
+    status, cli, err = run_cli("chart", scene, **keys)
+    assert status == 3 and cli is not None
+    with pytest.warns(RuntimeWarning) as warned:
+        r = delayspec.chart(scene, **keys)
+    assert r.status == 3
+    assert str(warned[0].message) == err.strip()
+    assert without_timings(r.to_dict()) == without_timings(cli)
+    assert all("failure" in row for row in r["rows"])
+
+
 def test_out_for_a_command_that_writes_no_files_is_bad_input(tmp_path):
     with pytest.raises(delayspec.BadInput, match="writes no files"):
         delayspec._run("floquet", delayspec.FloquetResult, None, {}, out=tmp_path)
