@@ -27,9 +27,25 @@
 // Jacobian also assumes A and B constant within a region (true for the impact model).
 //
 // Regions: j = 1 is the strict side H > 0 (design.md 1.5 conventions).
+//
+// Time switches. A model whose field changes at known times, independent of the state (a
+// cutting window in milling: a tooth is in the cut or not), declares
+//   static constexpr bool has_time_switches = true;
+//   int time_segment(double t) const;   // the branch j in force on [t, next switch): j >= 1
+//   double next_time_switch(double t0, double t1) const;  // first switch in (t0, t1), else t1
+// and its f, A, B for branch j are smooth in t on the whole step (the branch's own formula,
+// evaluated past the window's ends when a piece ends there). The step is then split at the
+// switches (time_switch_step.hpp); with events = off it is the plain grid trapezoid, each node
+// evaluated in the branch of its own time (first order across a jump). Such a model has no
+// state switching (has_switching = false): the two kinds are not combined.
 #include "delayspec/types.hpp"
 
 namespace delayspec {
+
+// Does Model switch its field at given times (see above)? Models that do not declare
+// has_time_switches do not.
+template <class Model>
+concept TimeSwitchedModel = requires { requires Model::has_time_switches; };
 
 // Region of a state: 1 on the strict side H > 0, else 2. Models without switching: 1.
 template <class Model>

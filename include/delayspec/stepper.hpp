@@ -19,6 +19,7 @@
 
 #include "delayspec/detail/event_step.hpp"  // event_step(), called by step()
 #include "delayspec/detail/small_solve.hpp"
+#include "delayspec/detail/time_switch_step.hpp"  // time_switch_step(), called by step()
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
 #include "delayspec/step_map.hpp"
@@ -76,12 +77,19 @@ class TrapezoidStepper {
       if (options_.events != EventMode::off) return event_step(*this, t, h, u0, w0, w1, map, events);
     }
     if (events) events->count = 0;
+    if constexpr (TimeSwitchedModel<Model>) {
+      // The switch times are known exactly: `on` and `linear` both split the step there.
+      if (options_.events != EventMode::off) return detail::time_switch_step(*this, t, h, u0, w0, w1, map);
+    }
     return plain_step(t, h, u0, w0, w1, map);
   }
 
-  // The plain (unsplit) trapezoid step, whatever the options: each node in its own region.
+  // The plain (unsplit) trapezoid step, whatever the options: each node in its own region (the
+  // region of its state, or for time switches the branch in force at its time).
   V plain_step(double t, double h, const V& u0, const V& w0, const V& w1, StepMap<D>& map) const {
-    SubStepResult<D> s = sub_step(t, h, u0, w0, w1, region_of(model_, u0), kRegionOfEndpoint);
+    int left = region_of(model_, u0), right = kRegionOfEndpoint;
+    if constexpr (TimeSwitchedModel<Model>) left = model_.time_segment(t), right = model_.time_segment(t + h);
+    SubStepResult<D> s = sub_step(t, h, u0, w0, w1, left, right);
     map.P = s.dz0;
     map.Q = s.dw0;
     map.R = s.dw1;

@@ -93,7 +93,7 @@ const KeyReaders& key_readers() {
 const std::map<std::string, std::string>& key_meanings() {
   static const std::map<std::string, std::string> meanings = {
       // the problem (problem.cpp)
-      {"model", "the system: impact, linear, mathieu, mackey-glass"},
+      {"model", "the system: impact, linear, mathieu, mackey-glass, milling"},
       {"N", "steps per delay (h = tau / N), integer >= 1"},
       {"orbit_period", "forcing periods per stroboscopic map (period-p orbits; forced models only)"},
       {"events", "impact events: on (located), linear (first-order estimate), off"},
@@ -116,6 +116,15 @@ const std::map<std::string, std::string>& key_meanings() {
       {"eps", "Mathieu: amplitude of the periodic stiffness eps cos t"},
       {"gamma", "mackey-glass: decay rate"},
       {"n", "mackey-glass: exponent of the nonlinearity x_tau^n"},
+      {"spindle_rpm", "milling: spindle speed Omega (rpm); tau = T = 60 / (teeth Omega)"},
+      {"depth", "milling: axial depth of cut a_p (m), >= 0"},
+      {"radial_immersion", "milling: radial immersion a/D, in (0, 1]"},
+      {"teeth", "milling: number of teeth N_t, 1 to 30"},
+      {"Kt", "milling: tangential cutting coefficient (N/m^2)"},
+      {"Kn", "milling: normal cutting coefficient (N/m^2)"},
+      {"omega_n", "milling: natural angular frequency (rad/s)"},
+      {"mass", "milling: modal mass (kg)"},
+      {"milling", "milling: down or up (which side of the cut the tooth enters)"},
       // orbit and eigensolver (orbit_settings.cpp, floquet_settings.cpp)
       {"orbit", "periodic orbit: auto (coarse Newton, then shooting), shooting, simulate, newton"},
       {"orbit_tolerance", "orbit settled (simulate) / Newton's relative residual |P(U) - U|, > 0"},

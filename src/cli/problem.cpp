@@ -58,6 +58,25 @@ MackeyGlassModel read_mackey_glass(Config& c) {
   return MackeyGlassModel(p);
 }
 
+MillingModel read_milling(Config& c) {
+  MillingParameters p;
+  p.spindle_rpm = c.get_double("spindle_rpm", p.spindle_rpm);
+  p.depth = c.get_double("depth", p.depth);
+  p.radial_immersion = c.get_double("radial_immersion", p.radial_immersion);
+  // The model names the allowed range (1..kMaxTeeth) in its own message; the wide range here
+  // only keeps the cast safe.
+  p.teeth = static_cast<int>(c.get_int_in_range("teeth", p.teeth, 1, MillingModel::kMaxTeeth));
+  p.Kt = c.get_double("Kt", p.Kt);
+  p.Kn = c.get_double("Kn", p.Kn);
+  p.omega_n = c.get_double("omega_n", p.omega_n);
+  p.zeta = c.get_double("zeta", p.zeta);
+  p.mass = c.get_double("mass", p.mass);
+  p.direction = c.get_choice("milling", "down", {"down", "up"}) == "up" ? MillingDirection::up : MillingDirection::down;
+  p.x0 = c.get_double("x0", p.x0);
+  p.v0 = c.get_double("v0", p.v0);
+  return MillingModel(p);
+}
+
 }  // namespace
 
 StepOptions step_options(const Problem& problem) {
@@ -99,7 +118,7 @@ EventMode parse_event_mode(const std::string& text, const std::string& key) {
 }
 
 const std::vector<std::string>& model_names() {
-  static const std::vector<std::string> names = {"impact", "linear", "mathieu", "mackey-glass"};
+  static const std::vector<std::string> names = {"impact", "linear", "mathieu", "mackey-glass", "milling"};
   return names;
 }
 
@@ -110,13 +129,14 @@ Problem read_problem(Config& config, int default_N) {
   if (problem.model_name == "linear") problem.model = read_linear(config);
   if (problem.model_name == "mathieu") problem.model = read_mathieu(config);
   if (problem.model_name == "mackey-glass") problem.model = read_mackey_glass(config);
+  if (problem.model_name == "milling") problem.model = read_milling(config);
   // N up to 1e9 (the history alone is then 16 GB at d = 2); orbit_period and contact_substeps
   // multiply the work per step or per period, 1000 is far beyond any use.
   problem.N = static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000));
   problem.orbit_period = static_cast<int>(config.get_int_in_range("orbit_period", 1, 1, 1000));
   if (problem.orbit_period != 1 && (problem.model_name == "linear" || problem.model_name == "mackey-glass"))
     throw BadInput("`orbit_period = " + std::to_string(problem.orbit_period) +
-                   "`: only for forced models (impact, mathieu); for linear and mackey-glass set `period`");
+                   "`: only for forced models (impact, mathieu, milling); for linear and mackey-glass set `period`");
   problem.events = parse_event_mode(config.get_choice("events", "on", event_mode_names()));
   problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"}) == "frozen"
                          ? JacobianMode::frozen

@@ -13,12 +13,13 @@
 #include "delayspec/model_linear.hpp"
 #include "delayspec/model_mackey_glass.hpp"
 #include "delayspec/model_mathieu.hpp"
+#include "delayspec/model_milling.hpp"
 #include "delayspec/stepper.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec::cli {
 
-using AnyModel = std::variant<ImpactModel, LinearModel, MathieuModel, MackeyGlassModel>;
+using AnyModel = std::variant<ImpactModel, LinearModel, MathieuModel, MackeyGlassModel, MillingModel>;
 
 struct Problem {
   std::string model_name;

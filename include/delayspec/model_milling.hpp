@@ -1,0 +1,164 @@
+#pragma once
+// Regenerative chatter in milling, one degree of freedom (the standard benchmark of Insperger &
+// Stepan, and of Ding et al.'s full discretisation):
+//
+//   m x'' + 2 m zeta omega_n x' + m omega_n^2 x = -a_p h(t) (x(t) - x(t - tau)),
+//
+//   h(t) = sum_j g_j(t) sin(phi_j) (K_t cos(phi_j) + K_n sin(phi_j)),
+//   phi_j(t) = 2 pi Omega t / 60 + 2 pi j / N_t,   j = 0 .. N_t - 1,
+//
+// g_j = 1 while tooth j is in the cut, phi_st <= phi_j mod 2 pi < phi_ex, else 0. Down-milling:
+// phi_st = arccos(2 a/D - 1), phi_ex = pi; up-milling: phi_st = 0, phi_ex = arccos(1 - 2 a/D).
+// The delay is the tooth-passing period, tau = T = 60 / (N_t Omega) (Omega in rpm, t in s); h
+// is T-periodic, so the stroboscopic map is over T. y = (x, v); linear in (y, y_tau).
+//
+// The cutting windows are time switches (model.hpp): branch j = 1 + (bit mask of the teeth in
+// the cut), and each branch's h is the sum of its teeth's terms at any t (smooth). Where a tooth
+// enters or leaves the cut with sin(phi) (K_t cos + K_n sin) != 0 (down-milling entry at a/D < 1,
+// up-milling exit) h jumps; at a/D = 1 it is continuous with a kink.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "delayspec/errors.hpp"
+#include "delayspec/model.hpp"
+
+namespace delayspec {
+
+enum class MillingDirection { down, up };
+
+struct MillingParameters {
+  double spindle_rpm = 10000;    // Omega
+  double depth = 0.5e-3;         // a_p, axial depth of cut (m)
+  double radial_immersion = 1;   // a/D, in (0, 1]
+  int teeth = 2;                 // N_t
+  double Kt = 6e8;               // tangential cutting coefficient (N/m^2)
+  double Kn = 2e8;               // normal cutting coefficient (N/m^2)
+  double omega_n = 922 * 2 * std::numbers::pi;  // natural angular frequency (rad/s)
+  double zeta = 0.011;           // relative damping
+  double mass = 0.03993;         // modal mass (kg)
+  MillingDirection direction = MillingDirection::down;
+  double x0 = 1e-5, v0 = 0;      // constant initial history (m, m/s), for simulations
+};
+
+class MillingModel {
+ public:
+  static constexpr int d = 2;
+  static constexpr bool has_switching = false;
+  static constexpr bool has_time_switches = true;
+  static constexpr bool affine_in_state = true;
+  static constexpr bool is_linear = true;
+  // Branch j encodes the teeth in the cut as bits of j - 1: at most this many teeth.
+  static constexpr int kMaxTeeth = 30;
+  using V = Vec<2>;
+  using M = Mat<2>;
+
+  // BadInput naming the key for a value outside its range.
+  explicit MillingModel(const MillingParameters& p = {}) : p_(p) {
+    require_positive("spindle_rpm", p.spindle_rpm);
+    require_finite("depth", p.depth);
+    if (p.depth < 0) throw BadInput("`depth = " + format_number(p.depth) + "`: must be >= 0 (m)");
+    require_finite("radial_immersion", p.radial_immersion);
+    if (!(p.radial_immersion > 0 && p.radial_immersion <= 1))
+      throw BadInput("`radial_immersion = " + format_number(p.radial_immersion) + "`: must be in (0, 1] (a/D)");
+    if (p.teeth < 1 || p.teeth > kMaxTeeth)
+      throw BadInput("`teeth = " + std::to_string(p.teeth) + "`: must be between 1 and " + std::to_string(kMaxTeeth));
+    require_finite("Kt", p.Kt);
+    require_finite("Kn", p.Kn);
+    require_positive("omega_n", p.omega_n);
+    require_finite("zeta", p.zeta);
+    require_positive("mass", p.mass);
+    require_finite("x0", p.x0);
+    require_finite("v0", p.v0);
+    const double ratio = 2 * p.radial_immersion - 1;  // in (-1, 1]
+    if (p.direction == MillingDirection::down) {
+      phi_start_ = std::acos(ratio);
+      phi_exit_ = std::numbers::pi;
+    } else {
+      phi_start_ = 0;
+      phi_exit_ = std::acos(-ratio);
+    }
+    spindle_ = 2 * std::numbers::pi * p.spindle_rpm / 60;
+    cut_ = p.depth / p.mass;
+  }
+  const MillingParameters& parameters() const { return p_; }
+  double tau() const { return 60 / (p_.teeth * p_.spindle_rpm); }
+  double period() const { return tau(); }
+
+  // The teeth in the cut on [t, next switch): branch 1 + mask.
+  int time_segment(double t) const {
+    int mask = 0;
+    for (int j = 0; j < p_.teeth; ++j) {
+      const double phase = wrapped_angle(j, t);
+      if (phase >= phi_start_ && phase < phi_exit_) mask |= 1 << j;
+    }
+    return 1 + mask;
+  }
+  // The first time in (t0, t1) at which a tooth enters or leaves the cut, else t1.
+  double next_time_switch(double t0, double t1) const {
+    double next = t1;
+    for (int j = 0; j < p_.teeth; ++j)
+      for (double boundary : {phi_start_, phi_exit_}) next = std::min(next, next_crossing(j, boundary, t0));
+    return next;
+  }
+
+  // h(t) of branch j (the teeth of mask j - 1 in the cut).
+  double cutting_coefficient(int j, double t) const {
+    double h = 0;
+    for (int tooth = 0, mask = j - 1; mask != 0; ++tooth, mask >>= 1) {
+      if (!(mask & 1)) continue;
+      const double phi = spindle_ * t + tooth_offset(tooth);
+      const double s = std::sin(phi), c = std::cos(phi);
+      h += s * (p_.Kt * c + p_.Kn * s);
+    }
+    return h;
+  }
+
+  V f(int j, double t, const V& y, const V& y_tau) const {
+    const double w = p_.omega_n;
+    return V(y[1], -2 * p_.zeta * w * y[1] - w * w * y[0] - cut_ * cutting_coefficient(j, t) * (y[0] - y_tau[0]));
+  }
+  M A(int j, double t, const V&, const V&) const {
+    const double w = p_.omega_n;
+    M a;
+    a << 0, 1, -w * w - cut_ * cutting_coefficient(j, t), -2 * p_.zeta * w;
+    return a;
+  }
+  M B(int j, double t, const V&, const V&) const {
+    M b;
+    b << 0, 0, cut_ * cutting_coefficient(j, t), 0;
+    return b;
+  }
+  double H(const V&) const { return 1; }
+  V grad_H(const V&) const { return V::Zero(); }
+  V initial_state() const { return V(p_.x0, p_.v0); }
+
+  double entry_angle() const { return phi_start_; }
+  double exit_angle() const { return phi_exit_; }
+
+ private:
+  double tooth_offset(int j) const { return 2 * std::numbers::pi * j / p_.teeth; }
+  // phi_j(t) mod 2 pi, in [0, 2 pi).
+  double wrapped_angle(int j, double t) const {
+    const double two_pi = 2 * std::numbers::pi;
+    double phase = std::fmod(spindle_ * t + tooth_offset(j), two_pi);
+    if (phase < 0) phase += two_pi;
+    return phase;
+  }
+  // The first t > t0 with phi_j(t) = boundary (mod 2 pi): t = (boundary - offset + 2 pi n) / spindle.
+  double next_crossing(int j, double boundary, double t0) const {
+    const double two_pi = 2 * std::numbers::pi;
+    const double base = boundary - tooth_offset(j);
+    double n = std::floor((spindle_ * t0 - base) / two_pi);
+    auto time = [&](double k) { return (base + two_pi * k) / spindle_; };
+    while (time(n) <= t0) n += 1;  // rounding may leave n one short (or, below, one long)
+    while (time(n - 1) > t0) n -= 1;
+    return time(n);
+  }
+
+  MillingParameters p_;
+  double phi_start_ = 0, phi_exit_ = 0, spindle_ = 0, cut_ = 0;
+};
+
+}  // namespace delayspec
