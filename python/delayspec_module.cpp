@@ -93,15 +93,17 @@ bool on_main_thread() {
 
 // A Python value -> the text `--set KEY=VALUE` would carry (and a TOML scene value becomes,
 // config.cpp): booleans true/false, integers in decimal, floats in the shortest round-trip form,
-// sequences joined by commas (Ns = [100, 200] -> "100,200").
+// sequences joined by commas (Ns = [100, 200] -> "100,200"); numpy scalars and arrays likewise.
 std::string key_text(const std::string& key, py::handle value) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  // numpy scalars and arrays as the Python values they hold (an array's __index__ would fail).
+  if (py::hasattr(value, "__array__") && py::hasattr(value, "ndim"))
+    return key_text(key, value.attr(value.attr("ndim").cast<int>() == 0 ? "item" : "tolist")());
   PyObject* p = value.ptr();
-  if (PyIndex_Check(p) && !PyFloat_Check(p)) return py::str(py::reinterpret_steal<py::object>(PyNumber_Index(p)));
-  if (PyFloat_Check(p) || PyObject_HasAttrString(p, "__float__"))
-    return delayspec::format_number(py::float_(py::reinterpret_borrow<py::object>(value)).cast<double>());
-  if (py::isinstance<py::sequence>(value) || py::hasattr(value, "__array__")) {
+  if (PyLong_Check(p)) return py::str(value);
+  if (PyFloat_Check(p)) return delayspec::format_number(value.cast<double>());
+  if (py::isinstance<py::sequence>(value)) {
     std::string text;
     for (py::handle element : value) {
       if (!text.empty()) text += ",";

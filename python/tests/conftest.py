@@ -47,3 +47,20 @@ def without_timings(value):
 @pytest.fixture
 def cli():
     return cli_json
+
+
+def bitwise(value):
+    """The JSON value with each float as its exact bit pattern (float.hex: -0.0 differs from 0.0)
+    and each number tagged with its type: `bitwise(a) == bitwise(b)` is equality to the last bit,
+    where == alone would let 1 == 1.0 and 0.0 == -0.0 pass."""
+    if isinstance(value, dict):
+        return {k: bitwise(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [bitwise(v) for v in value]
+    if isinstance(value, float):
+        return ("float", value.hex())
+    if isinstance(value, bool):
+        return ("bool", value)
+    if isinstance(value, int):
+        return ("int", value)
+    return value

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import delayspec
-from conftest import SCENES, cli_json, run_cli, without_timings
+from conftest import SCENES, bitwise, cli_json, run_cli, without_timings
 
 DEFAULT = SCENES / "default.toml"  # impact model, k = 0.2: a stable period-1 orbit
 FLOQUET_KEYS = dict(N=40, nev=4, solver="spectra")
@@ -21,7 +21,7 @@ LYAPUNOV_KEYS = dict(N=20, transient=10, periods=30, exponents=2)
 
 
 def same_as_cli(result, command, scene=None, **keys):
-    assert without_timings(result.to_dict()) == without_timings(cli_json(command, scene, **keys))
+    assert bitwise(without_timings(result.to_dict())) == bitwise(without_timings(cli_json(command, scene, **keys)))
 
 
 # ---- every function against the CLI's JSON --------------------------------------------------
@@ -77,7 +77,7 @@ def test_simulate_equals_cli_json_and_files(tmp_path):
     mine = without_timings(r.to_dict())
     assert mine.pop("files") == [str(tmp_path / f) for f in ("trajectory.csv", "poincare.csv", "impacts.csv")]
     cli.pop("files")
-    assert mine == without_timings(cli)
+    assert bitwise(mine) == bitwise(without_timings(cli))
     # The trajectory is the one --out writes (17 significant digits: the same doubles).
     lines = [l for l in (tmp_path / "trajectory.csv").read_text().splitlines() if not l.startswith("#")]
     assert lines[0] == "t,x,v"
@@ -153,10 +153,14 @@ def test_lyapunov_arrays():
 
 def test_numpy_and_float_key_values_read_as_the_cli_reads_text():
     """k = 0.1 as a float, numpy scalar or text: the same double as `--set k=0.1`."""
-    a = delayspec.floquet(N=20, k=0.1).to_dict()
-    b = delayspec.floquet(N=np.int64(20), k=np.float64(0.1)).to_dict()
-    c = delayspec.floquet(N="20", k="0.1").to_dict()
-    assert without_timings(a) == without_timings(b) == without_timings(c)
+    a = bitwise(without_timings(delayspec.floquet(N=20, k=0.1).to_dict()))
+    b = bitwise(without_timings(delayspec.floquet(N=np.int64(20), k=np.float64(0.1)).to_dict()))
+    c = bitwise(without_timings(delayspec.floquet(N="20", k="0.1").to_dict()))
+    assert a == b == c
+    # List keys from numpy arrays: Ns = np.array([...]) is Ns = "10,20,40".
+    d = delayspec.converge(Ns=np.array([10, 20, 40]), nev=2).to_dict()
+    e = delayspec.converge(Ns="10,20,40", nev=2).to_dict()
+    assert bitwise(without_timings(d)) == bitwise(without_timings(e))
 
 
 # ---- errors ------------------------------------------------------------------------------------
@@ -216,7 +220,7 @@ def test_failed_points_give_the_complete_result_status_3_and_a_warning():
         r = delayspec.chart(scene, **keys)
     assert r.status == 3
     assert str(warned[0].message) == err.strip()
-    assert without_timings(r.to_dict()) == without_timings(cli)
+    assert bitwise(without_timings(r.to_dict())) == bitwise(without_timings(cli))
     assert all("failure" in row for row in r["rows"])
 
 
@@ -284,21 +288,21 @@ def test_interrupted_sweep_keeps_finished_points_and_resumes(tmp_path):
     assert (out / "complete.json").exists()
     mine, cli = without_timings(r.to_dict()), without_timings(cli_json("sweep", **keys))
     mine.pop("points_computed_now"), cli.pop("points_computed_now")
-    assert mine == cli
+    assert bitwise(mine) == bitwise(cli)
 
 
 def test_threads_calling_floquet_at_once_give_the_sequential_results():
     """Three threads at once, two of them on ARPACK (whose Fortran state the library serialises)."""
     cases = [dict(N=150, k=0.2, nev=4, solver="spectra"), dict(N=150, k=0.3, nev=4, solver="arpack"),
              dict(N=120, k=0.25, nev=3, solver="arpack")]
-    expected = [without_timings(cli_json("floquet", **keys)) for keys in cases]
+    expected = [bitwise(without_timings(cli_json("floquet", **keys))) for keys in cases]
     results = [None] * len(cases)
     barrier = threading.Barrier(len(cases))
 
     def work(i):
         barrier.wait()
         for _ in range(3):
-            got = without_timings(delayspec.floquet(**cases[i]).to_dict())
+            got = bitwise(without_timings(delayspec.floquet(**cases[i]).to_dict()))
             if got != expected[i]:
                 results[i] = got
                 return
