@@ -29,6 +29,7 @@
 #include "config.hpp"
 #include "delayspec/cancellation.hpp"
 #include "delayspec/errors.hpp"
+#include "delayspec/version.hpp"
 #include "key_registry.hpp"
 
 namespace py = pybind11;
@@ -216,6 +217,7 @@ py::tuple run(const std::string& command, const py::object& scene, const py::dic
 
 PYBIND11_MODULE(_delayspec, m) {
   m.doc() = "delayspec's command layer (use the package `delayspec`, not this module)";
+  m.attr("__version__") = DELAYSPEC_VERSION;
   py::register_exception<BadInput>(m, "BadInput", PyExc_ValueError);
   py::register_exception<NumericalFailure>(m, "NumericalFailure", PyExc_RuntimeError);
   m.def("run", &run, py::arg("command"), py::arg("scene"), py::arg("keys"), py::arg("out"), py::arg("resume"),

@@ -25,7 +25,7 @@ import warnings
 import numpy as np
 
 from . import _delayspec
-from ._delayspec import BadInput, NumericalFailure
+from ._delayspec import BadInput, NumericalFailure, __version__
 
 BadInput.__module__ = NumericalFailure.__module__ = "delayspec"
 

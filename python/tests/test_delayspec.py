@@ -6,6 +6,7 @@ Small N throughout: a few seconds in all."""
 import os
 import pathlib
 import signal
+import subprocess
 import threading
 import time
 
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 import delayspec
-from conftest import SCENES, bitwise, cli_json, run_cli, without_timings
+from conftest import CLI, SCENES, bitwise, cli_json, run_cli, without_timings
 
 DEFAULT = SCENES / "default.toml"  # impact model, k = 0.2: a stable period-1 orbit
 FLOQUET_KEYS = dict(N=40, nev=4, solver="spectra")
@@ -338,6 +339,11 @@ def test_gil_is_released_during_a_run():
     # for a loaded machine.
     during = [x for x in ticks if start < x < end]
     assert len(during) >= (end - start) / 0.01 / 4
+
+
+def test_version_is_the_programs():
+    out = subprocess.run([CLI, "--version"], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == f"delayspec {delayspec.__version__}"
 
 
 def test_docstrings_list_the_keys():
