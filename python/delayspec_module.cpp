@@ -205,8 +205,8 @@ py::tuple run(const std::string& command, const py::object& scene, const py::dic
     } catch (const delayspec::Cancelled&) {
       cancelled = true;
     } catch (const nlohmann::json::exception& e) {
-      throw std::runtime_error("delayspec " + command + ": internal error (please report): no single JSON result: " +
-                               e.what());
+      throw std::runtime_error("delayspec " + command +
+                               ": internal error (please report): no single JSON result: " + e.what());
     }
   }
   if (cancelled) signals.rethrow();
