@@ -2,7 +2,7 @@
 # Installs what is missing, builds and runs the whole test suite:
 #  1. Release build, all tests (ctest);
 #  2. install into a temporary prefix; build and run examples/user_model against the installed
-#     package (find_package(delayspec));
+#     package (find_package(delayspec)); import the installed Python package;
 #  3. AddressSanitizer + UndefinedBehaviorSanitizer build, all tests
 #     (skip with DELAYSPEC_NO_SANITIZE=1 for a quick local run).
 set -euo pipefail
@@ -18,6 +18,12 @@ cmake -S "$here/examples/user_model" -B "$prefix/example" -G Ninja -DCMAKE_BUILD
 cmake --build "$prefix/example" >/dev/null
 "$prefix/example/user_model"
 "$prefix/install/bin/delayspec" --version
+# The installed Python package (when built) imports from the prefix's site directory.
+if grep -q '^DELAYSPEC_PYTHON:BOOL=ON' "$here/build/CMakeCache.txt"; then
+  site=$(sed -n 's/^DELAYSPEC_PYTHON_INSTALL_DIR:STRING=//p' "$here/build/CMakeCache.txt")
+  (cd "$prefix" && PYTHONPATH="$prefix/install/$site" /usr/bin/python3 -c \
+    "import delayspec; assert delayspec.__file__.startswith('$prefix/install/'); print('python:', delayspec.floquet(N=20).multipliers[0])")
+fi
 if [ "${DELAYSPEC_NO_SANITIZE:-0}" != 1 ]; then
   "$here/scripts/build.sh" "$here/build-sanitize" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDELAYSPEC_SANITIZE=ON \
     -DDELAYSPEC_BUILD_BENCH=OFF

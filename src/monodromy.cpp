@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "delayspec/cancellation.hpp"
 #include "delayspec/detail/block_kernel.hpp"
 #include "delayspec/errors.hpp"
 
@@ -19,6 +20,7 @@ Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
 
 template <int D>
 void Monodromy<D>::perform_op(const double* x, double* y) const {
+  throw_if_cancelled();  // one application = one period: the front end may stop here
   using V = Vec<D>;
   const int M = grid_.M, m = grid_.m, K = grid_.K;
   const double theta = grid_.theta;
@@ -54,6 +56,7 @@ void Monodromy<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
 
 template <int D>
 void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const {
+  throw_if_cancelled();
   const long M = grid_.M, K = grid_.K;
   const double theta = grid_.theta;
   const size_t need = static_cast<size_t>(M + 1 + K) * D * k;

@@ -186,7 +186,10 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"continue_tau_half_k", "continue"},
                                                        {"continue_mathieu_delta2", "continue"},
                                                        {"continue_mathieu_delta3", "continue"},
-                                                       {"continue_pwsdde_k", "continue"}};
+                                                       {"continue_pwsdde_k", "continue"},
+                                                       {"milling_lobes", "chart"},
+                                                       {"milling_lobes_full", "chart"},
+                                                       {"milling_point", "converge"}};
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
     if (entry.path().extension() != ".toml") continue;

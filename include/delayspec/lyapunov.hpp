@@ -77,6 +77,7 @@
 
 #include <Eigen/Core>
 
+#include "delayspec/cancellation.hpp"
 #include "delayspec/detail/block_kernel.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/stroboscopic_map.hpp"
@@ -219,6 +220,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
       std::copy(result_slots, result_slots + n * k, block.data());
     }
     if (options.progress) options.progress(++done, total);
+    throw_if_cancelled();  // between periods (cancellation.hpp)
   }
   // Measurement.
   const long intervals = options.periods / options.qr_every;
@@ -228,6 +230,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
       advance(true);
       if (q + 1 < options.qr_every) std::copy(result_slots, result_slots + n * k, block.data());
       if (options.progress) options.progress(++done, total);
+      throw_if_cancelled();  // between periods (cancellation.hpp)
     }
     reorthonormalise();
     check_interval(options.qr_every);

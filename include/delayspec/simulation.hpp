@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "delayspec/cancellation.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/grid.hpp"
 #include "delayspec/model.hpp"
@@ -92,6 +93,8 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
   StepMap<D> scratch;
   StepEvents events;
   for (long l = 0; l < steps; ++l) {
+    // Between periods a front end may stop the run (cancellation.hpp).
+    if (l % grid.steps_per_period == 0) throw_if_cancelled();
     const DelayTap<V> tap = grid.delay_tap<V>(l, slot);  // tap.t: the time in the period, as StroboscopicMap
     const double t_abs = static_cast<double>(l) * h;
     const TrapezoidStepper<Model>& stepper = t_abs >= options.switch_time ? after : before;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "delayspec/cancellation.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/grid.hpp"
 #include "delayspec/model.hpp"
@@ -43,6 +44,7 @@ class StroboscopicMap {
     if (U.size() != dimension())
       throw BadInput("StroboscopicMap: history has " + std::to_string(U.size()) + " entries, expected " +
                      std::to_string(dimension()));
+    throw_if_cancelled();  // one period: the front end may stop here (cancellation.hpp)
     const long M = grid_.M, K = grid_.K;
     std::vector<V> b(static_cast<size_t>(M + 1 + K));
     for (long j = 0; j <= M; ++j) b[j] = U.segment<D>(j * D);

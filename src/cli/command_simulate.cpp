@@ -126,6 +126,7 @@ int command_simulate(Config& config, const Invocation& inv) {
           impacts.commit();
           files = {traj.path().string(), poincare.path().string(), impacts.path().string()};
         }
+        if (inv.arrays) (*inv.arrays)["trajectory"] = points_json<D>(rec.t, rec.y);
         if (inv.json) {
           json["model"] = problem.model_name;
           json["N"] = problem.N;

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "config.hpp"
 
 namespace delayspec::cli {
@@ -24,6 +26,9 @@ struct Invocation {
   bool resume = false;
   std::ostream& out;
   std::ostream& err;
+  // Bulk results the JSON leaves to --out files, for a front end that takes values (the Python
+  // module): when set, `simulate` puts its trajectory rows here under "trajectory".
+  nlohmann::json* arrays = nullptr;
 };
 
 using CommandFunction = int (*)(Config&, const Invocation&);
@@ -61,6 +66,17 @@ struct OutputUse {
   bool resume = false;
 };
 OutputUse output_use(const std::string& command);
+
+// Bad input in `--out DIR` / `--resume` for `command` (BadInput naming the flag and the command):
+// `out_given` whether an output directory was given at all, `out_dir` its name.
+void check_output_flags(const std::string& command, bool out_given, const std::string& out_dir, bool resume);
+
+// Runs `inv.command` on `config` (scene and overrides already applied), as the program does
+// after parsing its arguments: marks the scene-level keys, and holds the output directory's lock
+// while a command writes there. Returns the command's exit status (0, or 3 for failures recorded
+// in a complete result); throws BadInput and NumericalFailure. The one entry of the CLI and the
+// Python module.
+int run_command(Config& config, const Invocation& inv);
 
 // Runs the program: parses argv, dispatches, maps errors to exit codes. Never throws.
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err);

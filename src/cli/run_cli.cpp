@@ -39,9 +39,6 @@ OutputUse output_use(const std::string& command) {
   return it == table.end() ? OutputUse{} : it->second;  // floquet, lyapunov: results on stdout only
 }
 
-namespace {
-
-// Bad input in --out / --resume for `command` (BadInput naming the flag and the command).
 void check_output_flags(const std::string& command, bool out_given, const std::string& out_dir, bool resume) {
   const OutputUse use = output_use(command);
   if (out_given && use.out == OutDirUse::ignored)
@@ -54,6 +51,25 @@ void check_output_flags(const std::string& command, bool out_given, const std::s
                    "` has nothing to resume (only sweep, chart, basin, and run with one of them, do)");
   if (resume && !out_given) throw BadInput("`--resume` needs `--out DIR` (the directory of the interrupted run)");
 }
+
+int run_command(Config& config, const Invocation& inv) {
+  const CommandFunction command = command_table().at(inv.command);
+  config.set_reader(inv.command);
+  // Scene-level keys (for `run`): any command may be given a scene that has them.
+  config.mark_used("analyses");
+  config.mark_used("title");
+  // Under mpirun the workers only compute points (ranks.hpp): the lead runs any other command
+  // alone and owns --out (its lock and completeness marker).
+  if (!is_lead_rank() && !distributes_points(inv.command)) return 0;
+  if (!inv.out_dir || output_use(inv.command).out != OutDirUse::written || !is_lead_rank())
+    return command(config, inv);
+  OutputDirectory directory(*inv.out_dir);  // held until the command returns: one run per DIR
+  const int status = command(config, inv);
+  directory.finish(inv.command, status);
+  return status;
+}
+
+namespace {
 
 std::string command_list() {
   std::string list;
@@ -120,19 +136,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
     // `plot DIR`: the positional argument is a results directory, not a scene.
     if (!scene.empty() && command != "plot") config = Config::from_scene_file(scene);
     for (const auto& a : assignments) config.set_from_assignment(a);
-    config.set_reader(command);
-    // Scene-level keys (for `run`): any command may be given a scene that has them.
-    config.mark_used("analyses");
-    config.mark_used("title");
-    // Under mpirun the workers only compute points (ranks.hpp): the lead runs any other command
-    // alone and owns --out (its lock and completeness marker).
-    if (!is_lead_rank() && !distributes_points(command)) return 0;
-    if (!inv.out_dir || output_use(command).out != OutDirUse::written || !is_lead_rank())
-      return it->second(config, inv);
-    OutputDirectory directory(*inv.out_dir);  // held until the command returns: one run per DIR
-    const int status = it->second(config, inv);
-    directory.finish(command, status);
-    return status;
+    return run_command(config, inv);
   } catch (const BadInput& e) {
     err << "delayspec " << command << ": bad input: " << e.what() << "\n";
     return 2;

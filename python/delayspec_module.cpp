@@ -1,0 +1,228 @@
+// The extension module delayspec._delayspec: runs a command of the CLI library on a Config built
+// exactly as the program builds it (a scene file, or a dict standing for one, then the keyword
+// arguments as `--set KEY=VALUE`), and returns the command's JSON result as Python objects. The
+// pure-Python front end (delayspec/__init__.py) turns those into results with numpy arrays.
+//
+// One code path with the CLI: the keys, defaults, validation and messages are the command's own;
+// the result is the object `COMMAND --json` prints, read back from that text, as `run` reads its
+// analyses (nlohmann::json writes each double in its shortest round-trip form, so the numbers are
+// the CLI's to the last bit).
+//
+// The GIL is released while the command runs. A call from Python's main thread polls Python's
+// signal handlers between periods (delayspec/cancellation.hpp): Ctrl-C stops the run with
+// KeyboardInterrupt (or whatever the SIGINT handler raises), output files written so far stay
+// atomic as in the CLI.
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "commands.hpp"
+#include "config.hpp"
+#include "delayspec/cancellation.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec/version.hpp"
+#include "key_registry.hpp"
+
+namespace py = pybind11;
+using delayspec::BadInput;
+using delayspec::NumericalFailure;
+using delayspec::cli::Config;
+
+namespace {
+
+// Python runs signal handlers only in its main thread. The call made there polls them (taking the
+// GIL at most every poll_interval, so other Python threads keep running); the threads working for
+// it (a parallel sweep's workers) see the flag. A call from another thread is not interruptible,
+// as Python code in such a thread is not.
+class PythonSignals final : public delayspec::CancellationCheck {
+ public:
+  explicit PythonSignals(bool main_thread) : main_thread_(main_thread), owner_(std::this_thread::get_id()) {}
+
+  bool requested() override {
+    if (stop_.load(std::memory_order_relaxed)) return true;
+    if (!main_thread_ || std::this_thread::get_id() != owner_) return false;
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_poll_) return false;
+    next_poll_ = now + poll_interval;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() == 0) return false;
+    raised_.emplace();  // fetches (and clears) what the handler raised, e.g. KeyboardInterrupt
+    stop_.store(true, std::memory_order_relaxed);
+    return true;
+  }
+
+  // Rethrows what the signal handler raised (call with the GIL held).
+  [[noreturn]] void rethrow() {
+    if (raised_) throw *raised_;
+    throw py::error_already_set();  // unreachable: stop_ is set only with raised_
+  }
+
+ private:
+  static constexpr std::chrono::milliseconds poll_interval{50};
+  const bool main_thread_;
+  const std::thread::id owner_;
+  std::chrono::steady_clock::time_point next_poll_{};
+  std::atomic<bool> stop_{false};
+  std::optional<py::error_already_set> raised_;
+};
+
+// The CLI layer tracks the open output directory per process (output_directory.hpp: run_cli runs
+// one command at a time), so calls that write files (out=DIR) take turns; a call waiting for its
+// turn stays interruptible.
+std::timed_mutex output_turn;
+
+std::unique_lock<std::timed_mutex> wait_for_output_turn() {
+  std::unique_lock<std::timed_mutex> turn(output_turn, std::defer_lock);
+  while (!turn.try_lock_for(std::chrono::milliseconds(50))) delayspec::throw_if_cancelled();
+  return turn;
+}
+
+bool on_main_thread() {
+  static const unsigned long main_ident =
+      py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+  return PyThread_get_thread_ident() == main_ident;
+}
+
+// A Python value -> the text `--set KEY=VALUE` would carry (and a TOML scene value becomes,
+// config.cpp): booleans true/false, integers in decimal, floats in the shortest round-trip form,
+// sequences joined by commas (Ns = [100, 200] -> "100,200"); numpy scalars and arrays likewise.
+std::string key_text(const std::string& key, py::handle value) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  // numpy scalars and arrays as the Python values they hold (an array's __index__ would fail).
+  if (py::hasattr(value, "__array__") && py::hasattr(value, "ndim"))
+    return key_text(key, value.attr(value.attr("ndim").cast<int>() == 0 ? "item" : "tolist")());
+  PyObject* p = value.ptr();
+  if (PyLong_Check(p)) return py::str(value);
+  if (PyFloat_Check(p)) return delayspec::format_number(value.cast<double>());
+  if (py::isinstance<py::sequence>(value)) {
+    std::string text;
+    for (py::handle element : value) {
+      if (!text.empty()) text += ",";
+      text += key_text(key, element);
+    }
+    return text;
+  }
+  throw BadInput("`" + key + "`: a value of Python type " +
+                 py::str(py::type::handle_of(value).attr("__name__")).cast<std::string>() +
+                 " (give a number, a string, a boolean or a list of them)");
+}
+
+// A dict standing for a scene file, read as config.cpp reads one: nested dicts are tables, flattened
+// (a key may appear once in all), and a key another command reads is no error.
+void read_scene_dict(const py::dict& table, Config& config, std::set<std::string>& seen) {
+  const std::string name = "the scene dict";
+  for (auto [k, v] : table) {
+    const std::string key = py::str(k);
+    if (py::isinstance<py::dict>(v)) {
+      read_scene_dict(v.cast<py::dict>(), config, seen);
+      continue;
+    }
+    if (!seen.insert(key).second) throw BadInput(name + ": key `" + key + "` is given twice");
+    config.set_from_scene(key, key_text(key, v), name);
+  }
+}
+
+Config make_config(const py::object& scene, const py::dict& keys, std::optional<std::string>& scene_path) {
+  Config config;
+  if (py::isinstance<py::dict>(scene)) {
+    std::set<std::string> seen;
+    read_scene_dict(scene.cast<py::dict>(), config, seen);
+  } else if (!scene.is_none()) {
+    scene_path = py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>();
+    config = Config::from_scene_file(*scene_path);
+  }
+  for (auto [k, v] : keys) {
+    if (v.is_none()) continue;  // None: the key's default (or the scene's value)
+    const std::string key = py::str(k);
+    config.set(key, key_text(key, v), "--set");
+  }
+  return config;
+}
+
+py::object to_python(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::null: return py::none();
+    case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer: return py::int_(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float: return py::float_(j.get<double>());
+    case nlohmann::json::value_t::string: return py::str(j.get_ref<const std::string&>());
+    case nlohmann::json::value_t::array: {
+      py::list list(j.size());
+      for (size_t i = 0; i < j.size(); ++i) list[i] = to_python(j[i]);
+      return list;
+    }
+    case nlohmann::json::value_t::object: {
+      py::dict dict;
+      for (const auto& [k, v] : j.items()) dict[py::str(k)] = to_python(v);
+      return dict;
+    }
+    default: throw std::runtime_error("a JSON value of an unexpected type");
+  }
+}
+
+// Runs `command` as `delayspec COMMAND [SCENE] --set KEY=VALUE... --json --quiet [--out OUT]`.
+// Returns (the JSON result, the bulk arrays the JSON leaves to --out files, the exit status:
+// 0, or 3 for failures recorded in a complete result, what the command wrote to stderr).
+py::tuple run(const std::string& command, const py::object& scene, const py::dict& keys,
+              const std::optional<std::string>& out, bool resume) {
+  if (!delayspec::cli::command_table().count(command)) throw BadInput("unknown command `" + command + "`");
+  std::optional<std::string> scene_path;
+  Config config = make_config(scene, keys, scene_path);
+  delayspec::cli::check_output_flags(command, out.has_value(), out.value_or(""), resume);
+  PythonSignals signals(on_main_thread());
+  std::ostringstream json_text, err;
+  nlohmann::json result, arrays = nlohmann::json::object();
+  int status = 0;
+  bool cancelled = false;
+  {
+    py::gil_scoped_release released;
+    const delayspec::CancellationScope scope(&signals);
+    const delayspec::cli::Invocation inv{.command = command,
+                                         .scene = scene_path,
+                                         .json = true,
+                                         .out_dir = out,
+                                         .quiet = true,
+                                         .resume = resume,
+                                         .out = json_text,
+                                         .err = err,
+                                         .arrays = &arrays};
+    try {
+      std::unique_lock<std::timed_mutex> turn;
+      if (out) turn = wait_for_output_turn();
+      status = delayspec::cli::run_command(config, inv);
+      result = nlohmann::json::parse(json_text.str());
+    } catch (const delayspec::Cancelled&) {
+      cancelled = true;
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error("delayspec " + command +
+                               ": internal error (please report): no single JSON result: " + e.what());
+    }
+  }
+  if (cancelled) signals.rethrow();
+  return py::make_tuple(to_python(result), to_python(arrays), status, err.str());
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_delayspec, m) {
+  m.doc() = "delayspec's command layer (use the package `delayspec`, not this module)";
+  m.attr("__version__") = DELAYSPEC_VERSION;
+  py::register_exception<BadInput>(m, "BadInput", PyExc_ValueError);
+  py::register_exception<NumericalFailure>(m, "NumericalFailure", PyExc_RuntimeError);
+  m.def("run", &run, py::arg("command"), py::arg("scene"), py::arg("keys"), py::arg("out"), py::arg("resume"),
+        "Runs a command as `delayspec COMMAND --json`: (result, arrays, status, stderr text).");
+  m.def(
+      "keys_help", [](const std::string& command) { return delayspec::cli::command_keys_help(command); },
+      py::arg("command"), "The keys COMMAND reads, with their defaults (the tail of `delayspec COMMAND --help`).");
+}

@@ -1,0 +1,355 @@
+"""The Python module against the program it fronts: every function's to_dict() equals the JSON
+`delayspec COMMAND --json` prints for the same keys, to the last bit (timings aside), since both
+run the same command code; the numpy views hold the same numbers with the documented dtypes and
+shapes; errors are the CLI's, with its messages; Ctrl-C stops a long run; threads are safe.
+Small N throughout: a few seconds in all."""
+import os
+import pathlib
+import signal
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import delayspec
+from conftest import CLI, SCENES, bitwise, cli_json, run_cli, without_timings
+
+DEFAULT = SCENES / "default.toml"  # impact model, k = 0.2: a stable period-1 orbit
+FLOQUET_KEYS = dict(N=40, nev=4, solver="spectra")
+LYAPUNOV_KEYS = dict(N=20, transient=10, periods=30, exponents=2)
+
+
+def same_as_cli(result, command, scene=None, **keys):
+    assert bitwise(without_timings(result.to_dict())) == bitwise(without_timings(cli_json(command, scene, **keys)))
+
+
+# ---- every function against the CLI's JSON --------------------------------------------------
+
+def test_floquet_equals_cli_json():
+    r = delayspec.floquet(DEFAULT, **FLOQUET_KEYS)
+    same_as_cli(r, "floquet", DEFAULT, **FLOQUET_KEYS)
+
+
+def test_floquet_without_scene_equals_cli_json():
+    r = delayspec.floquet(N=20, k=0.1, orbit="newton")
+    same_as_cli(r, "floquet", N=20, k=0.1, orbit="newton")
+
+
+def test_floquet_dict_scene_equals_the_file():
+    """A dict stands for a scene file: default.toml's keys as a dict give the file's result."""
+    scene = dict(model="impact", zeta=0.01, e=1.26, a=0.7, beta=28, omega=0.802, k=0.2, tau_over_T=1,
+                 x0=-0.0566, v0=1.0101, N=200, nev=6, solver="spectra", analyses=["floquet"])
+    r = delayspec.floquet(scene, N=40, nev=4)
+    same_as_cli(r, "floquet", DEFAULT, N=40, nev=4)
+
+
+def test_dict_scene_tables_flatten_as_in_a_scene_file(tmp_path):
+    """Nested dicts are TOML tables: flattened, and a key given twice is bad input, as in a file."""
+    scene = {"model": "impact", "k": 0.2, "floquet": {"nev": 3, "solver": "spectra"}}
+    r = delayspec.floquet(scene, N=30)
+    toml = tmp_path / "scene.toml"
+    toml.write_text('model = "impact"\nk = 0.2\n[floquet]\nnev = 3\nsolver = "spectra"\n')
+    same_as_cli(r, "floquet", toml, N=30)
+    with pytest.raises(delayspec.BadInput, match="key `nev` is given twice"):
+        delayspec.floquet({"nev": 3, "floquet": {"nev": 4}})
+
+
+def test_lyapunov_equals_cli_json():
+    r = delayspec.lyapunov(**LYAPUNOV_KEYS)
+    same_as_cli(r, "lyapunov", **LYAPUNOV_KEYS)
+
+
+def test_converge_equals_cli_json():
+    keys = dict(Ns=[10, 20, 40], nev=2)
+    r = delayspec.converge(**keys)
+    same_as_cli(r, "converge", **keys)
+    assert r.Ns.dtype == np.int64 and list(r.Ns) == [10, 20, 40]
+    assert r.multipliers_by_N.shape == (3, 2) and r.multipliers_by_N.dtype == np.complex128
+    assert r.errors_by_N.shape == (3, 2)
+    assert r.extrapolated.dtype == np.complex128 and r.extrapolated.shape == (2,)
+
+
+def test_simulate_equals_cli_json_and_files(tmp_path):
+    keys = dict(N=10, t_end=40, sample_every=2)
+    r = delayspec.simulate(out=tmp_path, **keys)
+    cli = cli_json("simulate", **keys)
+    mine = without_timings(r.to_dict())
+    assert mine.pop("files") == [str(tmp_path / f) for f in ("trajectory.csv", "poincare.csv", "impacts.csv")]
+    cli.pop("files")
+    assert bitwise(mine) == bitwise(without_timings(cli))
+    # The trajectory is the one --out writes (17 significant digits: the same doubles).
+    lines = [l for l in (tmp_path / "trajectory.csv").read_text().splitlines() if not l.startswith("#")]
+    assert lines[0] == "t,x,v"
+    written = np.array([[float(x) for x in l.split(",")] for l in lines[1:]])
+    assert r.trajectory.dtype == np.float64 and r.trajectory.shape == (r.samples, 3)
+    np.testing.assert_array_equal(r.trajectory, written)
+    assert r.poincare.shape == (len(cli["poincare"]), 3)
+    np.testing.assert_array_equal(r.poincare, np.array(cli["poincare"]))
+    assert r.impact_times.dtype == np.float64 and r.impact_times.shape == (r.impacts,)
+
+
+def test_sweep_equals_cli_json():
+    keys = dict(N=20, sweep_points=3, transient=10, periods=20, section_points=4)
+    r = delayspec.sweep(SCENES / "fig6_2.toml", **keys)
+    same_as_cli(r, "sweep", SCENES / "fig6_2.toml", **keys)
+    assert r.parameter.shape == (3,) and np.array_equal(r.parameter, [0.0, 0.7, 1.4])
+    assert r.exponents_per_period.shape == (3, 2) and r.exponents_per_period.dtype == np.float64
+    assert r.section_x.shape == (3, 4)
+
+
+def test_chart_equals_cli_json():
+    keys = dict(N=10, chart_x_points=3, chart_y_points=2)
+    r = delayspec.chart(SCENES / "mathieu_chart.toml", **keys)
+    same_as_cli(r, "chart", SCENES / "mathieu_chart.toml", **keys)
+    assert r.spectral_radius.shape == (2, 3) and r.spectral_radius.dtype == np.float64
+    np.testing.assert_array_equal(r.x, [-1.0, 2.0, 5.0])
+    np.testing.assert_array_equal(r.y, [-1.5, 1.5])
+    rows = r["rows"]
+    for row in rows:  # spectral_radius[j, i] is the row at (x[i], y[j])
+        i, j = list(r.x).index(row["x"]), list(r.y).index(row["y"])
+        assert r.spectral_radius[j, i] == row["spectral_radius"]
+
+
+def test_basin_equals_cli_json():
+    keys = dict(N=10, basin_x_points=3, basin_y_points=2, basin_transient=20)
+    r = delayspec.basin(**keys)
+    same_as_cli(r, "basin", **keys)
+    assert r.period.shape == (2, 3) and r.period.dtype == np.int64
+    np.testing.assert_array_equal(r.x, [-3.0, 0.0, 3.0])
+    assert r["x"] == "x0"  # the axis' key; r.x its values
+
+
+def test_continue_equals_cli_json():
+    keys = dict(continue_Ns=[10, 20], N=20)
+    scene = SCENES / "continue_mathieu_delta2.toml"
+    r = delayspec.continue_(scene, **keys)
+    same_as_cli(r, "continue", scene, **keys)
+    assert r.multipliers.dtype == np.complex128 and r.multipliers.shape == (len(r["points"]), 6)
+
+
+# ---- numpy views -----------------------------------------------------------------------------
+
+def test_floquet_arrays_hold_the_json_numbers():
+    r = delayspec.floquet(DEFAULT, **FLOQUET_KEYS)
+    d = r.to_dict()
+    assert r.multipliers.dtype == np.complex128 and r.multipliers.shape == (4,)
+    assert [complex(m["re"], m["im"]) for m in d["multipliers"]] == list(r.multipliers)
+    assert np.all(np.diff(np.abs(r.multipliers)) <= 0)  # by modulus, largest first (CLI contract)
+    assert r.residuals.dtype == np.float64 and list(r.residuals) == d["residuals"]
+    assert isinstance(r.operator_applications, int) and r.operator_applications == d["operator_applications"]
+    assert isinstance(r.seconds, float)
+    assert r.orbit["newton_residuals"].dtype == np.float64
+    assert r.N == 40 and r.model == "impact"
+
+
+def test_lyapunov_arrays():
+    r = delayspec.lyapunov(**LYAPUNOV_KEYS)
+    for field in ("exponents_per_period", "exponents_per_time", "standard_error_per_period"):
+        a = getattr(r, field)
+        assert a.dtype == np.float64 and a.shape == (2,)
+        assert list(a) == r[field]
+
+
+def test_numpy_and_float_key_values_read_as_the_cli_reads_text():
+    """k = 0.1 as a float, numpy scalar or text: the same double as `--set k=0.1`."""
+    a = bitwise(without_timings(delayspec.floquet(N=20, k=0.1).to_dict()))
+    b = bitwise(without_timings(delayspec.floquet(N=np.int64(20), k=np.float64(0.1)).to_dict()))
+    c = bitwise(without_timings(delayspec.floquet(N="20", k="0.1").to_dict()))
+    assert a == b == c
+    # List keys from numpy arrays: Ns = np.array([...]) is Ns = "10,20,40".
+    d = delayspec.converge(Ns=np.array([10, 20, 40]), nev=2).to_dict()
+    e = delayspec.converge(Ns="10,20,40", nev=2).to_dict()
+    assert bitwise(without_timings(d)) == bitwise(without_timings(e))
+
+
+# ---- errors ------------------------------------------------------------------------------------
+
+def cli_error(command, scene=None, **keys):
+    status, out, err = run_cli(command, scene, **keys)
+    return status, out, err
+
+
+@pytest.mark.parametrize("keys", [dict(nevv=3), dict(N=0), dict(solver="lanczos"), dict(tol=-1), dict(nev="x")])
+def test_bad_input_raises_with_the_cli_message(keys):
+    status, out, err = cli_error("floquet", **keys)
+    assert status == 2 and out is None
+    prefix = "delayspec floquet: bad input: "
+    assert err.startswith(prefix)
+    with pytest.raises(delayspec.BadInput) as caught:
+        delayspec.floquet(**keys)
+    assert str(caught.value) == err[len(prefix):].rstrip("\n")
+    assert isinstance(caught.value, ValueError)
+
+
+def test_bad_scene_file_raises_bad_input(tmp_path):
+    scene = tmp_path / "bad.toml"
+    scene.write_text("N = = 3\n")
+    status, _, err = cli_error("floquet", scene)
+    with pytest.raises(delayspec.BadInput) as caught:
+        delayspec.floquet(scene)
+    assert status == 2 and str(caught.value) == err[len("delayspec floquet: bad input: "):].rstrip("\n")
+
+
+def test_bad_value_type_raises_bad_input():
+    with pytest.raises(delayspec.BadInput, match="`k`: a value of Python type object"):
+        delayspec.floquet(k=object())
+
+
+def test_forced_krylov_failure_raises_numerical_failure():
+    """As tests/test_krylov_cli.cpp: one Arnoldi iteration (max_restarts = 0) cannot converge 10
+    Ritz values with ncv = 12 at N = 100."""
+    keys = dict(N=100, nev=10, ncv=12, max_restarts=0, solver="spectra")
+    status, out, err = cli_error("floquet", DEFAULT, **keys)
+    assert status == 3 and out is None
+    with pytest.raises(delayspec.NumericalFailure) as caught:
+        delayspec.floquet(DEFAULT, **keys)
+    assert isinstance(caught.value, RuntimeError)
+    assert "did not converge" in str(caught.value)
+    assert str(caught.value) == err[len("delayspec floquet: numerical failure: "):].rstrip("\n")
+
+
+def test_failed_points_give_the_complete_result_status_3_and_a_warning():
+    """Exit 3 with a complete result in the CLI (failures recorded per point): the same result,
+    status 3, and the CLI's stderr message as a RuntimeWarning."""
+    keys = dict(N=40, chart_x_points=3, chart_y_points=2, solver="spectra", nev=6, ncv=8, max_restarts=0)
+    scene = SCENES / "mathieu_chart.toml"
+    status, cli, err = run_cli("chart", scene, **keys)
+    assert status == 3 and cli is not None
+    with pytest.warns(RuntimeWarning) as warned:
+        r = delayspec.chart(scene, **keys)
+    assert r.status == 3
+    assert str(warned[0].message) == err.strip()
+    assert bitwise(without_timings(r.to_dict())) == bitwise(without_timings(cli))
+    assert all("failure" in row for row in r["rows"])
+
+
+def test_out_for_a_command_that_writes_no_files_is_bad_input(tmp_path):
+    with pytest.raises(delayspec.BadInput, match="writes no files"):
+        delayspec._run("floquet", delayspec.FloquetResult, None, {}, out=tmp_path)
+
+
+# ---- interrupt, threads ------------------------------------------------------------------------
+
+def interrupt_after(seconds):
+    timer = threading.Timer(seconds, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    return timer
+
+
+@pytest.mark.parametrize("command,keys", [
+    ("lyapunov", dict(N=100, transient=0, periods=10_000_000)),               # periods
+    ("floquet", dict(N=100, orbit="simulate", orbit_max_periods=10_000_000,   # orbit periods
+                     orbit_tolerance=1e-300)),
+    ("simulate", dict(N=100, t_end=1e7, sample_every=1_000_000)),              # simulation periods
+    ("sweep", dict(N=100, sweep_key="k", sweep_from=0, sweep_to=1, sweep_points=4, threads=2,
+                   transient=0, periods=10_000_000)),                          # points on 2 threads
+])
+def test_sigint_raises_keyboard_interrupt_promptly(command, keys):
+    """A run of hours, interrupted after 0.3 s: KeyboardInterrupt within a second (the module
+    polls the signal handlers every 50 ms between periods; a period at N = 100 takes < 1 ms)."""
+    function = getattr(delayspec, command)
+    timer = interrupt_after(0.3)
+    start = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            function(**keys)
+    finally:
+        timer.cancel()  # no stray SIGINT into the next test if the call ended otherwise
+        timer.join()
+    elapsed = time.monotonic() - start
+    assert elapsed < 1.5, elapsed
+    # The module still works afterwards.
+    assert delayspec.floquet(N=10).N == 10
+
+
+def test_interrupted_sweep_keeps_finished_points_and_resumes(tmp_path):
+    """Ctrl-C during a sweep with out=DIR leaves what the CLI leaves when killed: the finished
+    points' files (atomic, no temporary left), no complete.json; resume=True computes only the missing points and
+    gives the uninterrupted CLI run's result."""
+    keys = dict(N=20, sweep_key="k", sweep_from=0, sweep_to=1.4, sweep_points=12, transient=0, periods=8000,
+                threads=1, section_points=2)  # ~0.05 s per point
+    out = tmp_path / "sweep"
+
+    def interrupt_after_the_first_point():  # not by time: a loaded machine is slower
+        deadline = time.monotonic() + 60
+        while not list((out / "points").glob("point_*.json")) and time.monotonic() < deadline:
+            time.sleep(0.002)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    watcher = threading.Thread(target=interrupt_after_the_first_point)
+    watcher.start()
+    with pytest.raises(KeyboardInterrupt):
+        delayspec.sweep(out=out, **keys)
+    watcher.join()
+    done = sorted(p.name for p in (out / "points").glob("point_*.json"))
+    assert 0 < len(done) < 12, done
+    assert not (out / "complete.json").exists()
+    assert not [p for p in out.rglob("*") if p.name.startswith(".") and p.name != ".delayspec-lock"]
+    r = delayspec.sweep(out=out, resume=True, **keys)
+    assert r.points_computed_now == 12 - len(done)
+    assert (out / "complete.json").exists()
+    mine, cli = without_timings(r.to_dict()), without_timings(cli_json("sweep", **keys))
+    mine.pop("points_computed_now"), cli.pop("points_computed_now")
+    assert bitwise(mine) == bitwise(cli)
+
+
+def test_threads_calling_floquet_at_once_give_the_sequential_results():
+    """Three threads at once, two of them on ARPACK (whose Fortran state the library serialises)."""
+    cases = [dict(N=150, k=0.2, nev=4, solver="spectra"), dict(N=150, k=0.3, nev=4, solver="arpack"),
+             dict(N=120, k=0.25, nev=3, solver="arpack")]
+    expected = [bitwise(without_timings(cli_json("floquet", **keys))) for keys in cases]
+    results = [None] * len(cases)
+    barrier = threading.Barrier(len(cases))
+
+    def work(i):
+        barrier.wait()
+        for _ in range(3):
+            got = bitwise(without_timings(delayspec.floquet(**cases[i]).to_dict()))
+            if got != expected[i]:
+                results[i] = got
+                return
+        results[i] = expected[i]
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(len(cases))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert results == expected
+
+
+def test_gil_is_released_during_a_run():
+    """A Python thread keeps running while another computes."""
+    ticks = []
+    done = threading.Event()
+
+    def ticker():
+        while not done.is_set():
+            ticks.append(time.monotonic())
+            time.sleep(0.01)
+
+    t = threading.Thread(target=ticker)
+    t.start()
+    start = time.monotonic()
+    delayspec.lyapunov(N=100, transient=0, periods=10000)  # ~0.2 s
+    end = time.monotonic()
+    done.set()
+    t.join()
+    assert end - start > 0.05, "the run is too short to tell"
+    # With the GIL held the ticker could not run at all; a quarter of its 10 ms ticks is margin
+    # for a loaded machine.
+    during = [x for x in ticks if start < x < end]
+    assert len(during) >= (end - start) / 0.01 / 4
+
+
+def test_version_is_the_programs():
+    out = subprocess.run([CLI, "--version"], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == f"delayspec {delayspec.__version__}"
+
+
+def test_docstrings_list_the_keys():
+    for function, key in [(delayspec.floquet, "nev = 6"), (delayspec.lyapunov, "exponents"),
+                          (delayspec.sweep, "sweep_key"), (delayspec.chart, "chart_x")]:
+        assert key in function.__doc__, function.__name__
