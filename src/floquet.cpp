@@ -139,8 +139,7 @@ namespace {
 // Absolute residuals |M v - mu v| / |v| of the Ritz pairs, from applying M to the Ritz
 // vectors (real form) in blocks of at most kChunk columns, a complex pair's two columns always in
 // the same block (bounds the extra memory to 2 kChunk vectors plus the operator's block buffer).
-template <int D>
-std::vector<double> ritz_residuals(const Monodromy<D>& op, const krylov::RitzPairs& pairs) {
+std::vector<double> ritz_residuals(const LinearOperator& op, const krylov::RitzPairs& pairs) {
   constexpr long kChunk = 8;
   const long n = op.rows();
   std::vector<double> residual(pairs.values.size(), 0.0);
@@ -260,8 +259,7 @@ size_t zero_round_off_pairs(FloquetResult& r, const std::vector<double>& absolut
 }
 
 // |M x| / |x|: a lower bound of the operator's norm (within sqrt(n) of it for a random x).
-template <int D>
-double operator_size(const Monodromy<D>& op, const Eigen::VectorXd& x) {
+double operator_size(const LinearOperator& op, const Eigen::VectorXd& x) {
   Eigen::VectorXd y(op.rows());
   op.perform_op(x.data(), y.data());
   return y.norm() / x.norm();
@@ -293,8 +291,7 @@ std::string residual_gate_message(double size, const FloquetResult& r, const std
   return message;
 }
 
-template <int D>
-void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, FloquetResult& result) {
+void krylov_solve(const LinearOperator& op, const FloquetOptions& options, FloquetResult& result) {
   const long n = op.rows();
   krylov::Settings settings;
   settings.nev = options.nev;
@@ -386,8 +383,7 @@ void krylov_solve(const Monodromy<D>& op, const FloquetOptions& options, Floquet
 
 }  // namespace
 
-template <int D>
-FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& requested) {
+FloquetResult floquet_multipliers(const LinearOperator& op, const FloquetOptions& requested) {
   const long n = op.rows();
   validate_floquet_options(requested, n);
   FloquetOptions options = requested;
@@ -424,7 +420,5 @@ FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& 
   return result;
 }
 
-template FloquetResult floquet_multipliers<1>(const Monodromy<1>&, const FloquetOptions&);
-template FloquetResult floquet_multipliers<2>(const Monodromy<2>&, const FloquetOptions&);
 
 }  // namespace delayspec

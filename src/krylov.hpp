@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-#include "delayspec/monodromy.hpp"
+#include "delayspec/linear_operator.hpp"
 
 namespace delayspec::krylov {
 
@@ -38,12 +38,9 @@ struct RitzPairs {
 // Both throw NumericalFailure when the backend does not converge within max_iterations or
 // reports an error; the message names iterations, converged count and residual estimate.
 // start has n entries (the same vector for both backends).
-template <int D>
-RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& settings, const Eigen::VectorXd& start);
-template <int D>
-RitzPairs arpack_ritz_pairs(const Monodromy<D>& op, const Settings& settings, const Eigen::VectorXd& start);
-template <int D>
-RitzPairs block_ritz_pairs(const Monodromy<D>& op, const Settings& settings, const Eigen::VectorXd& start);
+RitzPairs spectra_ritz_pairs(const LinearOperator& op, const Settings& settings, const Eigen::VectorXd& start);
+RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& settings, const Eigen::VectorXd& start);
+RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& settings, const Eigen::VectorXd& start);
 
 // The RitzPairs of the leading Ritz values `theta` (sorted by modulus) with coefficient vectors
 // `y` (Ritz vector = V y) in the orthonormal basis V: representatives (real values, and each

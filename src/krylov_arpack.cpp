@@ -69,8 +69,7 @@ std::string dneupd_error(a_int info) {
 
 }  // namespace
 
-template <int D>
-RitzPairs arpack_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eigen::VectorXd& start) {
+RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const Eigen::VectorXd& start) {
   if (op.rows() > INT_MAX)
     throw BadInput("solver = arpack: dimension n = " + std::to_string(op.rows()) +
                    " exceeds ARPACK's 32-bit integers; use solver = spectra");
@@ -157,7 +156,5 @@ RitzPairs arpack_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eig
   return pairs;
 }
 
-template RitzPairs arpack_ritz_pairs<1>(const Monodromy<1>&, const Settings&, const Eigen::VectorXd&);
-template RitzPairs arpack_ritz_pairs<2>(const Monodromy<2>&, const Settings&, const Eigen::VectorXd&);
 
 }  // namespace delayspec::krylov

@@ -134,8 +134,7 @@ class BlockKrylovSchur {
 
 }  // namespace
 
-template <int D>
-RitzPairs block_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eigen::VectorXd& start) {
+RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Eigen::VectorXd& start) {
   const long n = op.rows();
   const int nev = s.nev;
   // Block size at most a third of the room above nev; basis m >= nev + 2 b + 2 so that a restart
@@ -259,7 +258,5 @@ RitzPairs block_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eige
   }
 }
 
-template RitzPairs block_ritz_pairs<1>(const Monodromy<1>&, const Settings&, const Eigen::VectorXd&);
-template RitzPairs block_ritz_pairs<2>(const Monodromy<2>&, const Settings&, const Eigen::VectorXd&);
 
 }  // namespace delayspec::krylov

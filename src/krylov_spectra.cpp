@@ -31,11 +31,10 @@ namespace {
 // so the Ritz values are mu / scale to the last bit. (Not on the first attempt: for a large n the
 // scaled thresholds are looser than needed, eps n |M x| / |x|, and every ordinary case passes
 // the gate unscaled.)
-template <int D>
 class ScaledMonodromy {
  public:
   using Scalar = double;
-  ScaledMonodromy(const Monodromy<D>& op, double scale) : op_(op), inverse_scale_(1 / scale) {}
+  ScaledMonodromy(const LinearOperator& op, double scale) : op_(op), inverse_scale_(1 / scale) {}
   Eigen::Index rows() const { return op_.rows(); }
   Eigen::Index cols() const { return op_.cols(); }
   // y = M x / scale
@@ -45,7 +44,7 @@ class ScaledMonodromy {
   }
 
  private:
-  const Monodromy<D>& op_;
+  const LinearOperator& op_;
   double inverse_scale_;
 };
 
@@ -57,12 +56,11 @@ class ScaledMonodromy {
 // here: re-read GenEigsSolver / EigsBase for m_fac, m_ritz_val, m_ritz_vec, m_ritz_est, m_nev.
 static_assert(SPECTRA_MAJOR_VERSION == 1 && SPECTRA_MINOR_VERSION == 0 && SPECTRA_PATCH_VERSION == 1,
               "krylov_spectra.cpp reads Spectra 1.0.1's protected members: check them for this version");
-template <int D>
-class SpectraSolver : public Spectra::GenEigsSolver<const ScaledMonodromy<D>> {
-  using Base = Spectra::GenEigsSolver<const ScaledMonodromy<D>>;
+class SpectraSolver : public Spectra::GenEigsSolver<const ScaledMonodromy> {
+  using Base = Spectra::GenEigsSolver<const ScaledMonodromy>;
 
  public:
-  SpectraSolver(const ScaledMonodromy<D>& op, int nev, int ncv) : Base(op, nev, ncv) {}
+  SpectraSolver(const ScaledMonodromy& op, int nev, int ncv) : Base(op, nev, ncv) {}
 
   const Eigen::MatrixXd& basis() const { return this->m_fac.matrix_V(); }
   // The nev wanted Ritz values and their coefficient vectors (ncv x nev), sorted by modulus.
@@ -85,11 +83,10 @@ class SpectraSolver : public Spectra::GenEigsSolver<const ScaledMonodromy<D>> {
 
 }  // namespace
 
-template <int D>
-RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Eigen::VectorXd& start) {
+RitzPairs spectra_ritz_pairs(const LinearOperator& op, const Settings& s, const Eigen::VectorXd& start) {
   const double scale = s.scale;
-  const ScaledMonodromy<D> scaled(op, scale);
-  SpectraSolver<D> solver(scaled, s.nev, s.ncv);
+  const ScaledMonodromy scaled(op, scale);
+  SpectraSolver solver(scaled, s.nev, s.ncv);
   solver.init(start.data());  // Spectra starts from M * start (forces the vector into M's range)
   const Eigen::Index nconv =
       solver.compute(Spectra::SortRule::LargestMagn, s.max_iterations, s.tolerance, Spectra::SortRule::LargestMagn);
@@ -117,7 +114,5 @@ RitzPairs spectra_ritz_pairs(const Monodromy<D>& op, const Settings& s, const Ei
   return pairs;
 }
 
-template RitzPairs spectra_ritz_pairs<1>(const Monodromy<1>&, const Settings&, const Eigen::VectorXd&);
-template RitzPairs spectra_ritz_pairs<2>(const Monodromy<2>&, const Settings&, const Eigen::VectorXd&);
 
 }  // namespace delayspec::krylov

@@ -69,9 +69,13 @@ TEST(MillingCli, BenchRunsTheClassicPathsBesideDelayspec) {
                                                     "reference=finest"}));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
+  ASSERT_FALSE(j["reference_values"].empty());
   int classic = 0;
   for (const auto& row : j["rows"]) {
     EXPECT_EQ(row["status"], "ok") << row.dump();
+    // | |mu| - |ref| | <= |mu - ref| (triangle inequality): the modulus error never exceeds the
+    // complex one (up to the rounding of the two divisions by |ref|).
+    EXPECT_LE(row["abs_error"].get<double>(), row["error"].get<double>() * (1 + 1e-12) + 1e-15) << row.dump();
     if (row["solver"] == "sdm0" || row["solver"] == "fdm1") {
       ++classic;
       EXPECT_EQ(row["dimension"], 2 + row["N"].get<int>());  // x, v and m delayed positions

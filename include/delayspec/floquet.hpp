@@ -105,9 +105,9 @@ struct FloquetResult {
 // fail fast. (Krylov's nev <= n - 2 is not a rule: a larger nev runs the dense path.)
 void validate_floquet_options(const FloquetOptions& options, long n);
 
-// The nev leading multipliers. See the header comment for errors.
-template <int D>
-FloquetResult floquet_multipliers(const Monodromy<D>& op, const FloquetOptions& options);
+// The nev leading multipliers of op (a Monodromy<D> of any d, or any LinearOperator). See the
+// header comment for errors.
+FloquetResult floquet_multipliers(const LinearOperator& op, const FloquetOptions& options);
 
 // Default Krylov subspace dimension for nev wanted values of an n x n operator:
 // min(n, max(2 nev + 1, nev + 10)).
@@ -116,8 +116,5 @@ int default_ncv(int nev, long n);
 // The reproducible start vector of both Krylov backends: entries uniform in [-1, 1) from a
 // SplitMix64 stream seeded with `seed` (platform independent).
 Eigen::VectorXd start_vector(long n, std::uint64_t seed);
-
-extern template FloquetResult floquet_multipliers<1>(const Monodromy<1>&, const FloquetOptions&);
-extern template FloquetResult floquet_multipliers<2>(const Monodromy<2>&, const FloquetOptions&);
 
 }  // namespace delayspec

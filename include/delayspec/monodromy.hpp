@@ -14,25 +14,32 @@
 // Thread safety: the work buffers are owned by the operator (no allocation per application),
 // so one Monodromy must not be applied from two threads at once. Copy it instead.
 //
-// Usable as a Spectra operator: Scalar, rows(), cols(), perform_op(const double*, double*).
+// A LinearOperator (linear_operator.hpp): the eigensolvers take it for any d. The bodies are
+// here, so a model of any d instantiates them; d = 1 and 2 are compiled once in the library.
+#include <algorithm>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "delayspec/cancellation.hpp"
+#include "delayspec/detail/block_kernel.hpp"
+#include "delayspec/errors.hpp"
 #include "delayspec/grid.hpp"
+#include "delayspec/linear_operator.hpp"
 #include "delayspec/step_map.hpp"
 
 namespace delayspec {
 
 template <int D>
-class Monodromy {
+class Monodromy final : public LinearOperator {
  public:
   using Scalar = double;
 
   // maps.size() must equal grid.K (BadInput otherwise).
   Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps);
 
-  Eigen::Index rows() const { return n_; }
+  Eigen::Index rows() const override { return n_; }
   Eigen::Index cols() const { return n_; }
   const HistoryGrid& grid() const { return grid_; }
   const std::vector<StepMap<D>>& step_maps() const { return maps_; }
@@ -40,14 +47,14 @@ class Monodromy {
   // y = M x. Checks sizes (BadInput naming both) then calls the unchecked kernel.
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
   // Y = M X for an n x k block.
-  void apply_block(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const;
+  void apply_block(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const override;
   // Spectra's interface: y = M x, both of length n, unchecked.
-  void perform_op(const double* x, double* y) const;
+  void perform_op(const double* x, double* y) const override;
   // The dense n x n matrix, by applying the operator to the identity (reference only).
-  Eigen::MatrixXd to_dense() const;
+  Eigen::MatrixXd to_dense() const override;
 
   // Number of single-vector applications so far (a block of k counts k).
-  long applications() const { return applications_; }
+  long applications() const override { return applications_; }
   void reset_applications() const { applications_ = 0; }
 
  private:
@@ -61,6 +68,98 @@ class Monodromy {
   mutable long applications_ = 0;
 };
 
+template <int D>
+Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
+    : grid_(grid), maps_(std::move(maps)), n_(grid.dimension(D)) {
+  if (static_cast<long>(maps_.size()) != grid_.K)
+    throw BadInput("Monodromy: " + std::to_string(maps_.size()) +
+                   " step maps given, the grid has K = " + std::to_string(grid_.K) + " steps per map");
+  work_.assign(static_cast<size_t>(grid_.M + 1 + grid_.K) * D, 0.0);
+}
+
+template <int D>
+void Monodromy<D>::perform_op(const double* x, double* y) const {
+  throw_if_cancelled();  // one application = one period: the front end may stop here
+  using V = Vec<D>;
+  const int M = grid_.M, m = grid_.m, K = grid_.K;
+  const double theta = grid_.theta;
+  double* b = work_.data();
+  std::copy(x, x + n_, b);
+  auto block = [b](long j) { return Eigen::Map<V>(b + j * D); };
+  if (theta == 0) {
+    // b[M+l+1] = P b[M+l] + Q b[M+l-m] + R b[M+l-m+1]
+    for (long l = 0; l < K; ++l) {
+      const StepMap<D>& s = maps_[l];
+      block(M + l + 1).noalias() = s.P * block(M + l) + s.Q * block(M + l - m) + s.R * block(M + l - m + 1);
+    }
+  } else {
+    // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the delayed values from grid.delay_tap
+    for (long l = 0; l < K; ++l) {
+      const StepMap<D>& s = maps_[l];
+      const DelayTap<V> tap = grid_.delay_tap<V>(l, block);
+      block(M + l + 1).noalias() = s.P * block(M + l) + s.Q * tap.w0 + s.R * tap.w1;
+    }
+  }
+  std::copy(b + static_cast<long>(K) * D, b + static_cast<long>(K) * D + n_, y);
+  ++applications_;
+}
+
+template <int D>
+void Monodromy<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  if (x.size() != n_)
+    throw BadInput("Monodromy::apply: x has " + std::to_string(x.size()) + " entries, the operator is " +
+                   std::to_string(n_) + " x " + std::to_string(n_));
+  y.resize(n_);
+  perform_op(x.data(), y.data());
+}
+
+template <int D>
+void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const {
+  throw_if_cancelled();
+  const long M = grid_.M, K = grid_.K;
+  const double theta = grid_.theta;
+  const size_t need = static_cast<size_t>(M + 1 + K) * D * k;
+  if (block_work_.size() < need) block_work_.resize(need);
+  double* b = block_work_.data();
+  // Interleave: b[(j D + r) k + v] = X(j D + r, v).
+  for (long v = 0; v < k; ++v)
+    for (long i = 0; i < n_; ++i) b[i * k + v] = X[v * ldx + i];
+  const long stride = static_cast<long>(D) * k;  // one history slot
+  // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the tap of grid.delay_tap on k vectors (block_kernel.hpp)
+  for (long l = 0; l < K; ++l)
+    step_block<D>(maps_[l], b + (M + l) * stride, b + grid_.delayed_slot(l) * stride, k, theta,
+                  b + (M + l + 1) * stride);
+  const double* res = b + K * stride;
+  for (long v = 0; v < k; ++v)
+    for (long i = 0; i < n_; ++i) Y[v * ldy + i] = res[i * k + v];
+  applications_ += k;
+}
+
+template <int D>
+void Monodromy<D>::apply_block(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const {
+  if (X.rows() != n_)
+    throw BadInput("Monodromy::apply_block: X has " + std::to_string(X.rows()) + " rows, the operator is " +
+                   std::to_string(n_) + " x " + std::to_string(n_));
+  Y.resize(n_, X.cols());
+  if (X.cols() == 0) return;
+  apply_block_raw(X.data(), X.rows(), X.cols(), Y.data(), Y.rows());
+}
+
+template <int D>
+Eigen::MatrixXd Monodromy<D>::to_dense() const {
+  Eigen::MatrixXd dense(n_, n_);
+  constexpr long kChunk = 32;
+  Eigen::MatrixXd I = Eigen::MatrixXd::Zero(n_, kChunk);
+  for (long c0 = 0; c0 < n_; c0 += kChunk) {
+    const long k = std::min<long>(kChunk, n_ - c0);
+    I.setZero();
+    for (long v = 0; v < k; ++v) I(c0 + v, v) = 1;
+    apply_block_raw(I.data(), n_, k, dense.data() + c0 * n_, n_);
+  }
+  return dense;
+}
+
+// Compiled once in the library (src/monodromy.cpp) for the built-in dimensions.
 extern template class Monodromy<1>;
 extern template class Monodromy<2>;
 

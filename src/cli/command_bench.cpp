@@ -16,6 +16,8 @@
 // Per row: seconds (the eigen-solve, incl. forming the dense matrix), setup_seconds (orbit and
 // step maps, shared by the solvers of one N), peak_bytes (memory_probe.hpp: what the solve added
 // at its peak), error (relative, leading multiplier), max_error (over the nev), correct_digits,
+// abs_error (relative error of |mu_1|: what a stability boundary |mu_1| = 1 depends on; the
+// phase of mu_1 can be much less accurate, milling: docs/milling.md),
 // deviation_from_dense (max |mu_k - mu_k^dense| / |mu_1^dense| at the same N, when dense ran).
 #include <chrono>
 #include <cmath>
@@ -52,6 +54,7 @@ struct BenchRow {
   long operator_applications = 0;  // of one solve
   int repeats = 0;                 // solves timed (seconds = the fastest)
   double error = NAN, max_error = NAN, correct_digits = NAN, deviation_from_dense = NAN;
+  double abs_error = NAN;  // relative error of |mu_1|
 };
 
 bool is_dense(FloquetSolver s) { return s == FloquetSolver::dense_lapack || s == FloquetSolver::dense_eigen; }
@@ -288,6 +291,7 @@ void score_rows(std::vector<BenchRow>& rows, const BenchReference& reference) {
       r.error = m.errors[0];
       r.max_error = *std::max_element(m.errors.begin(), m.errors.end());
       r.correct_digits = m.correct_digits[0];
+      r.abs_error = std::abs(std::abs(m.matched[0]) / std::abs(reference.values[0]) - 1);
     }
     for (const auto& dense : rows)
       if (dense.N == r.N && dense.status == "ok" && is_dense_row(dense.solver) && &dense != &r && !is_classic(r.solver)) {
@@ -308,13 +312,13 @@ void write_bench_csv(const std::filesystem::path& path, const std::string& metad
   csv.stream() << metadata_header;
   csv.stream() << "# delayspec bench: model " << s.problem.model_name << ", nev " << s.base.nev << ", reference "
                << reference.used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
-               << "error,max_error,correct_digits,deviation_from_dense,abs_mu1\n";
+               << "error,max_error,correct_digits,deviation_from_dense,abs_mu1,abs_error\n";
   csv.stream().precision(10);
   for (const auto& r : rows)
     csv.stream() << r.N << "," << r.n << "," << r.solver << "," << r.status << "," << r.seconds << ","
                  << r.setup_seconds << "," << r.peak_bytes << "," << r.operator_applications << "," << r.error << ","
                  << r.max_error << "," << r.correct_digits << "," << r.deviation_from_dense << ","
-                 << (r.multipliers.empty() ? NAN : std::abs(r.multipliers[0])) << "\n";
+                 << (r.multipliers.empty() ? NAN : std::abs(r.multipliers[0])) << "," << r.abs_error << "\n";
   csv.commit();
 }
 
@@ -324,6 +328,7 @@ nlohmann::json bench_json(const BenchSettings& s, const std::vector<BenchRow>& r
   j["events"] = to_string(s.problem.events);
   j["nev"] = s.base.nev;
   j["reference"] = reference.used;
+  j["reference_values"] = multipliers_json(reference.values);
   if (!reference.note.empty()) j["reference_note"] = reference.note;
   j["dense_memory_limit_mb"] = s.limit_mb;
   j["peak_bytes_method"] = "VmHWM - VmRSS after malloc_trim and a reset of the peak mark (per row)";
@@ -340,6 +345,7 @@ nlohmann::json bench_json(const BenchSettings& s, const std::vector<BenchRow>& r
                           {"max_error", number_or_null(r.max_error)},
                           {"correct_digits", number_or_null(r.correct_digits)},
                           {"deviation_from_dense", number_or_null(r.deviation_from_dense)},
+                          {"abs_error", number_or_null(r.abs_error)},
                           {"operator_applications", r.operator_applications},
                           {"repeats", r.repeats},
                           {"multipliers", multipliers_json(r.multipliers)}};
