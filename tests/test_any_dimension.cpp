@@ -30,10 +30,20 @@ struct ThreeScalarDdes {
   M A(int, double, const V&, const V&) const { return a.asDiagonal(); }
   M B(int, double, const V&, const V&) const { return b.asDiagonal(); }
   V f(int, double, const V& y, const V& y_tau) const { return a.cwiseProduct(y) + b.cwiseProduct(y_tau); }
-  double H(const V&) const { return 1; }
-  V grad_H(const V&) const { return V::Zero(); }
   V initial_state() const { return V(1, 1, 1); }
 };
+
+// The model contract as a concept (model.hpp): switching members only when the model switches.
+static_assert(DelayModel<ThreeScalarDdes>, "no H / grad_H needed without switching");
+static_assert(DelayModel<LinearModel>);
+struct SwitchingWithoutH : ThreeScalarDdes {
+  static constexpr bool has_switching = true;  // then H, grad_H, f_t, f_tt are required
+};
+static_assert(!DelayModel<SwitchingWithoutH>);
+struct TimeSwitchedWithoutSegments : ThreeScalarDdes {
+  static constexpr bool has_time_switches = true;  // then time_segment, next_time_switch are
+};
+static_assert(!DelayModel<TimeSwitchedWithoutSegments>);
 
 constexpr int kN = 60;
 

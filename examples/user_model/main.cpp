@@ -21,8 +21,6 @@ struct FilteredDelayedOscillator {  // the model concept: see delayspec/model.hp
   M A(int, double, const V&, const V&) const { return (M() << 0, 1, 0, -1, -c, 0, 1 / filter, 0, -1 / filter).finished(); }
   M B(int, double, const V&, const V&) const { return (M() << 0, 0, 0, 0, 0, b, 0, 0, 0).finished(); }
   V f(int j, double t, const V& y, const V& y_tau) const { return A(j, t, y, y_tau) * y + B(j, t, y, y_tau) * y_tau; }
-  double H(const V&) const { return 1; }
-  V grad_H(const V&) const { return V::Zero(); }
   V initial_state() const { return V::Zero(); }
 };
 

@@ -16,10 +16,11 @@
 //   Vec f(int j, double t, const Vec& y, const Vec& y_tau) const;
 //   Mat A(int j, double t, const Vec& y, const Vec& y_tau) const;   // df_j / dy
 //   Mat B(int j, double t, const Vec& y, const Vec& y_tau) const;   // df_j / dy_tau
-//   double H(const Vec& y) const;  Vec grad_H(const Vec& y) const;  // switching function
 //   Vec initial_state() const;               // constant initial history y(t), t <= 0
 //
-// Models with switching (has_switching) also provide, for event handling (event_step.hpp):
+// Models with switching (has_switching) also provide the switching function and, for event
+// handling (event_step.hpp), the time derivatives of the field:
+//   double H(const Vec& y) const;  Vec grad_H(const Vec& y) const;
 //   Vec f_t(int j, double t, const Vec& y, const Vec& y_tau) const;   // df_j / dt at fixed y, y_tau
 //   Vec f_tt(int j, double t, const Vec& y, const Vec& y_tau) const;  // d2f_j / dt2 (events = linear)
 // and must have f_1 = f_2 on H = 0 (a continuous vector field: no saltation; design.md 1.5).
@@ -38,6 +39,8 @@
 // switches (time_switch_step.hpp); with events = off it is the plain grid trapezoid, each node
 // evaluated in the branch of its own time (first order across a jump). Such a model has no
 // state switching (has_switching = false): the two kinds are not combined.
+#include <concepts>
+
 #include "delayspec/types.hpp"
 
 namespace delayspec {
@@ -46,6 +49,34 @@ namespace delayspec {
 // has_time_switches do not.
 template <class Model>
 concept TimeSwitchedModel = requires { requires Model::has_time_switches; };
+
+// The contract above as a concept, checked where a stepper is made (stepper.hpp): the members
+// every model has, the switching members (H, grad_H, f_t, f_tt) only when has_switching, the
+// time-switch members only when has_time_switches.
+template <class Model>
+concept DelayModel =
+    requires(const Model& m, const Vec<Model::d>& y, double t, int j) {
+      requires Model::d >= 1;
+      { Model::has_switching } -> std::convertible_to<bool>;
+      { Model::affine_in_state } -> std::convertible_to<bool>;
+      { Model::is_linear } -> std::convertible_to<bool>;
+      { m.tau() } -> std::convertible_to<double>;
+      { m.period() } -> std::convertible_to<double>;
+      { m.f(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
+      { m.A(j, t, y, y) } -> std::convertible_to<Mat<Model::d>>;
+      { m.B(j, t, y, y) } -> std::convertible_to<Mat<Model::d>>;
+      { m.initial_state() } -> std::convertible_to<Vec<Model::d>>;
+    } &&
+    (!Model::has_switching || requires(const Model& m, const Vec<Model::d>& y, double t, int j) {
+      { m.H(y) } -> std::convertible_to<double>;
+      { m.grad_H(y) } -> std::convertible_to<Vec<Model::d>>;
+      { m.f_t(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
+      { m.f_tt(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
+    }) &&
+    (!TimeSwitchedModel<Model> || requires(const Model& m, double t) {
+      { m.time_segment(t) } -> std::convertible_to<int>;
+      { m.next_time_switch(t, t) } -> std::convertible_to<double>;
+    });
 
 // Region of a state: 1 on the strict side H > 0, else 2. Models without switching: 1.
 template <class Model>

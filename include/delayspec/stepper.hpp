@@ -29,6 +29,8 @@ namespace delayspec {
 
 template <class Model>
 class TrapezoidStepper {
+  static_assert(DelayModel<Model>, "Model does not satisfy the model contract (delayspec/model.hpp, DelayModel)");
+
  public:
   static constexpr int D = Model::d;
   using V = Vec<D>;
