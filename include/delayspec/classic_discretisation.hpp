@@ -172,12 +172,20 @@ Eigen::MatrixXd classic_monodromy(const Model& model, int m, ClassicMethod metho
                 K2 = K.block(0, 3 * D, D, D) * (2 / (dt * dt));
         const Eigen::PartialPivLU<M> lhs(M(M::Identity() - K1 * Ai - K2 * dA));
         S = lhs.solve(M(Phi0 + (K0 - K1) * Ai + (K1 - K2) * dA));
-        Da = lhs.solve(restrict_columns(M(K1 * Bi + K2 * dB)));
-        Db = lhs.solve(restrict_columns(M((K0 - K1) * Bi + (K1 - K2) * dB)));
+        if (r > 0) {  // (Eigen's triangular solve is undefined on a matrix with no columns)
+          Da = lhs.solve(restrict_columns(M(K1 * Bi + K2 * dB)));
+          Db = lhs.solve(restrict_columns(M((K0 - K1) * Bi + (K1 - K2) * dB)));
+        }
       }
       // Z_{i+1} = G_i Z_i applied to the rows of Phi: x from x, y_{i-m+1} (block m - 1) and
-      // y_{i-m} (block m); y_i = C x_i; blocks 1 .. m-1 move down by one.
+      // y_{i-m} (block m); y_i = C x_i; blocks 1 .. m-1 move down by one. Without delayed
+      // components (r = 0, B = 0) Z = x and the step is S alone.
       const auto x_rows = Phi.topRows(D);
+      if (r == 0) {
+        next.topRows(D) = S * x_rows;
+        Phi.swap(next);
+        continue;
+      }
       next.topRows(D) = S * x_rows + Da * Phi.middleRows(D + (m - 2) * r, r) + Db * Phi.middleRows(D + (m - 1) * r, r);
       for (int k = 0; k < r; ++k) next.row(D + k) = x_rows.row(delayed[k]);
       next.middleRows(D + r, (m - 1) * r) = Phi.middleRows(D, (m - 1) * r);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "delayspec/detail/remembered_trig.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
 
@@ -59,7 +60,7 @@ class ImpactModel {
 
   V f(int j, double t, const V& y, const V& y_tau) const {
     double contact = j == 1 ? p_.beta * (y[0] - p_.e) : 0.0;
-    return V(y[1], p_.a * p_.omega * p_.omega * std::sin(p_.omega * t) + p_.k * (y_tau[1] - y[1]) - 2 * p_.zeta * y[1] -
+    return V(y[1], p_.a * p_.omega * p_.omega * detail::remembered_sin(p_.omega * t) + p_.k * (y_tau[1] - y[1]) - 2 * p_.zeta * y[1] -
                        y[0] - contact);
   }
   M A(int j, double, const V&, const V&) const {
@@ -75,11 +76,11 @@ class ImpactModel {
   // Explicit time derivatives of f (the forcing), for the event-time sensitivity of a split
   // step (event_step.hpp): df/dt and d2f/dt2 at fixed (y, y_tau).
   V f_t(int, double t, const V&, const V&) const {
-    return V(0, p_.a * p_.omega * p_.omega * p_.omega * std::cos(p_.omega * t));
+    return V(0, p_.a * p_.omega * p_.omega * p_.omega * detail::remembered_cos(p_.omega * t));
   }
   V f_tt(int, double t, const V&, const V&) const {
     const double w2 = p_.omega * p_.omega;
-    return V(0, -p_.a * w2 * w2 * std::sin(p_.omega * t));
+    return V(0, -p_.a * w2 * w2 * detail::remembered_sin(p_.omega * t));
   }
   double H(const V& y) const { return y[0] - p_.e; }
   V grad_H(const V&) const { return V(1, 0); }
