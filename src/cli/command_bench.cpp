@@ -108,8 +108,7 @@ BenchSettings read_bench_settings(Config& config) {
   s.reference_kind =
       parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
   s.repeats = config.get_int_in_range("repeats", 1, 1, 1000);
-  if (std::any_of(s.solver_names.begin(), s.solver_names.end(), is_classic))
-    s.classic_max_N = config.get_int_in_range("classic_max_N", s.classic_max_N, 2, 1'000'000);
+  s.classic_max_N = config.get_int_in_range("classic_max_N", s.classic_max_N, 2, 1'000'000);
   s.limit_mb = config.get_double("dense_memory_limit_mb", 2048);
   require_positive("dense_memory_limit_mb", s.limit_mb);
   config.check_all_used();

@@ -166,7 +166,8 @@ const std::map<std::string, std::string>& key_meanings() {
        "converge: keep doubling N past Ns until every tracked multiplier's relative error estimate is <= this (none: off)"},
       {"converge_max_N", "converge_target: the largest N tried, 1..1e7"},
       {"converge_max_seconds", "converge_target: stop when the next level would end past this many seconds"},
-      {"solvers", "bench: solvers compared (comma list)"},
+      {"solvers", "bench: solvers compared (comma list; also sdm0, fdm1: classic discretisations)"},
+      {"classic_max_N", "bench: the classic discretisations (sdm0, fdm1) run at the listed N up to this one"},
       {"dense_memory_limit_mb", "bench: dense rows needing more memory (3 n^2 doubles) are skipped"},
       {"repeats", "bench: solves timed per row (the fastest is reported), 1..1000"},
       // simulate (command_simulate.cpp)
