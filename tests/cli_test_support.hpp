@@ -36,4 +36,25 @@ inline CliResult run(std::vector<std::string> args) {
   return {status, out.str(), err.str()};
 }
 
+// `head` followed by --set S for each S of `sets`.
+inline std::vector<std::string> with_sets(std::vector<std::string> head, const std::vector<std::string>& sets) {
+  for (const auto& s : sets) {
+    head.push_back("--set");
+    head.push_back(s);
+  }
+  return head;
+}
+
+inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// One bad-input case of a parameterised test: `COMMAND --set KEY=VALUE` must exit 2 with
+// `expected` in its message.
+struct BadKey {
+  const char* command;
+  const char* key;
+  const char* value;
+  const char* expected;
+};
+inline void PrintTo(const BadKey& b, std::ostream* os) { *os << b.command << ":" << b.key << "=" << b.value; }
+
 }  // namespace delayspec::testing

@@ -18,14 +18,9 @@ namespace {
 
 using delayspec::testing::CliResult;
 using delayspec::testing::run;
-
-std::vector<std::string> with_sets(std::vector<std::string> head, const std::vector<std::string>& sets) {
-  for (const auto& s : sets) {
-    head.push_back("--set");
-    head.push_back(s);
-  }
-  return head;
-}
+using delayspec::testing::contains;
+using delayspec::testing::with_sets;
+using delayspec::testing::BadKey;
 
 // Spectral radius of the trapezoid rule's monodromy for x'' + kappa x' + delta x = 0 (b = eps = 0):
 // the delay term vanishes, every step is u0' = C u0 with the Cayley transform
@@ -38,8 +33,6 @@ double trapezoid_radius(double kappa, double delta, int K, double h) {
     radius = std::max(radius, std::pow(std::abs((1.0 + h * lambda / 2.0) / (1.0 - h * lambda / 2.0)), K));
   return radius;
 }
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace
 
@@ -121,14 +114,6 @@ TEST(BasinCli, NeighbourhoodOfStablePeriodOneOrbitIsPeriodOne) {
   EXPECT_EQ(j["counts"]["1"], 4);
 }
 
-struct BadKey {
-  const char* command;
-  const char* key;
-  const char* value;
-  const char* expected;
-};
-
-void PrintTo(const BadKey& b, std::ostream* os) { *os << b.command << ":" << b.key << "=" << b.value; }
 
 class GridBadInput : public ::testing::TestWithParam<BadKey> {};
 

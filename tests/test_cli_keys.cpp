@@ -23,8 +23,7 @@ namespace {
 using delayspec::testing::CliResult;
 using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using delayspec::testing::contains;
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path);

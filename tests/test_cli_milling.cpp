@@ -14,16 +14,9 @@ namespace {
 
 using delayspec::testing::CliResult;
 using delayspec::testing::run;
-
-std::vector<std::string> with_sets(std::vector<std::string> head, const std::vector<std::string>& sets) {
-  for (const auto& s : sets) {
-    head.push_back("--set");
-    head.push_back(s);
-  }
-  return head;
-}
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using delayspec::testing::contains;
+using delayspec::testing::with_sets;
+using delayspec::testing::BadKey;
 
 // At depth 0 the cut vanishes: x'' + 2 zeta w x' + w^2 x = 0 over T = 60 / (teeth Omega), and
 // the trapezoid's multipliers are exactly c^N, c = (1 + h l / 2) / (1 - h l / 2) for the roots l
@@ -83,14 +76,6 @@ TEST(MillingCli, BenchRunsTheClassicPathsBesideDelayspec) {
   }
   EXPECT_EQ(classic, 4);
 }
-
-struct BadKey {
-  const char* command;
-  const char* key;
-  const char* value;
-  const char* expected;
-};
-void PrintTo(const BadKey& b, std::ostream* os) { *os << b.command << ":" << b.key << "=" << b.value; }
 
 class MillingBadInput : public ::testing::TestWithParam<BadKey> {};
 

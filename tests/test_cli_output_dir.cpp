@@ -34,6 +34,7 @@ namespace {
 using delayspec::testing::CliResult;
 using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
+using delayspec::testing::contains;
 
 std::string read(const fs::path& path) {
   std::ifstream in(path);
@@ -41,8 +42,6 @@ std::string read(const fs::path& path) {
   ss << in.rdbuf();
   return ss.str();
 }
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 std::vector<std::string> with(std::vector<std::string> head, const std::vector<std::string>& tail) {
   head.insert(head.end(), tail.begin(), tail.end());

@@ -17,6 +17,7 @@ namespace {
 using delayspec::testing::CliResult;
 using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
+using delayspec::testing::contains;
 
 std::string scene(const std::string& name, const std::string& text) {
   const fs::path path = fs::temp_directory_path() / ("delayspec_test_run_" + name + ".toml");
@@ -27,8 +28,6 @@ std::string scene(const std::string& name, const std::string& text) {
 const char* kLinearScene =
     "title = \"linear test\"\nanalyses = [\"floquet\"]\nmodel = \"linear\"\na = -1\nb = 0.5\n"
     "N = 40\nsolver = \"dense\"\nnev = 3\n";
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace
 
