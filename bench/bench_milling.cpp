@@ -36,7 +36,8 @@ MillingModel benchmark_point(int index) {
 
 // One chart point of delayspec: step maps at the zero orbit, then |mu_1|.
 double delayspec_modulus(const MillingModel& model, int N) {
-  const StroboscopicMap<MillingModel> map(TrapezoidStepper<MillingModel>(model), make_grid(model.tau(), model.period(), N));
+  const StroboscopicMap<MillingModel> map(TrapezoidStepper<MillingModel>(model),
+                                          make_grid(model.tau(), model.period(), N));
   FloquetOptions options;
   options.nev = 1;
   return std::abs(floquet_multipliers(map.monodromy(Eigen::VectorXd::Zero(map.dimension())), options).multipliers[0]);
@@ -67,7 +68,8 @@ void BM_MillingClassic(benchmark::State& state) {
   const int index = static_cast<int>(state.range(0)), m = static_cast<int>(state.range(1));
   const MillingModel model = benchmark_point(index);
   double modulus = 0;
-  for (auto _ : state) benchmark::DoNotOptimize(modulus = std::abs(classic_multipliers(model, m, method, 1).multipliers[0]));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(modulus = std::abs(classic_multipliers(model, m, method, 1).multipliers[0]));
   state.counters["error"] = std::abs(modulus / reference_modulus(index) - 1);
 }
 

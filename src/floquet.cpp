@@ -420,5 +420,4 @@ FloquetResult floquet_multipliers(const LinearOperator& op, const FloquetOptions
   return result;
 }
 
-
 }  // namespace delayspec

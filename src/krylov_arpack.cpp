@@ -156,5 +156,4 @@ RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const E
   return pairs;
 }
 
-
 }  // namespace delayspec::krylov

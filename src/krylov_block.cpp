@@ -258,5 +258,4 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
   }
 }
 
-
 }  // namespace delayspec::krylov

@@ -114,5 +114,4 @@ RitzPairs spectra_ritz_pairs(const LinearOperator& op, const Settings& s, const 
   return pairs;
 }
 
-
 }  // namespace delayspec::krylov

@@ -16,11 +16,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using delayspec::testing::CliResult;
-using delayspec::testing::run;
-using delayspec::testing::contains;
-using delayspec::testing::with_sets;
 using delayspec::testing::BadKey;
+using delayspec::testing::CliResult;
+using delayspec::testing::contains;
+using delayspec::testing::run;
+using delayspec::testing::with_sets;
 
 // Spectral radius of the trapezoid rule's monodromy for x'' + kappa x' + delta x = 0 (b = eps = 0):
 // the delay term vanishes, every step is u0' = C u0 with the Cayley transform
@@ -113,7 +113,6 @@ TEST(BasinCli, NeighbourhoodOfStablePeriodOneOrbitIsPeriodOne) {
   for (const auto& row : j["rows"]) EXPECT_EQ(row["period"], 1) << row.dump();
   EXPECT_EQ(j["counts"]["1"], 4);
 }
-
 
 class GridBadInput : public ::testing::TestWithParam<BadKey> {};
 

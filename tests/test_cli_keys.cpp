@@ -21,9 +21,9 @@ namespace fs = std::filesystem;
 namespace {
 
 using delayspec::testing::CliResult;
+using delayspec::testing::contains;
 using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
-using delayspec::testing::contains;
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path);
@@ -63,7 +63,8 @@ TEST(CommandHelp, RequiredKeysAndCommandSpecificDefaults) {
   EXPECT_TRUE(contains(chart.out, "N = 40 ")) << chart.out;
   // converge's events default depends on the model (impact: on and off side by side).
   CliResult converge = run({"converge", "--help"});
-  EXPECT_TRUE(contains(converge.out, "events = on (linear, mathieu, mackey-glass); on,off (impact, milling)")) << converge.out;
+  EXPECT_TRUE(contains(converge.out, "events = on (linear, mathieu, mackey-glass); on,off (impact, milling)"))
+      << converge.out;
 }
 
 TEST(KeyRegistry, EveryKeyReadHasAMeaningAndEveryMeaningIsRead) {

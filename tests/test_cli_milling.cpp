@@ -12,11 +12,11 @@
 
 namespace {
 
-using delayspec::testing::CliResult;
-using delayspec::testing::run;
-using delayspec::testing::contains;
-using delayspec::testing::with_sets;
 using delayspec::testing::BadKey;
+using delayspec::testing::CliResult;
+using delayspec::testing::contains;
+using delayspec::testing::run;
+using delayspec::testing::with_sets;
 
 // At depth 0 the cut vanishes: x'' + 2 zeta w x' + w^2 x = 0 over T = 60 / (teeth Omega), and
 // the trapezoid's multipliers are exactly c^N, c = (1 + h l / 2) / (1 - h l / 2) for the roots l
@@ -25,9 +25,9 @@ using delayspec::testing::BadKey;
 TEST(MillingCli, DepthZeroIsTheFreeOscillatorsCayleyTransform) {
   const double rpm = 7200, w = 2 * std::numbers::pi * 500, zeta = 0.02;
   const int teeth = 3, N = 60;
-  CliResult r = run(with_sets({"floquet", "--json"}, {"model=milling", "depth=0", "spindle_rpm=7200", "teeth=3",
-                                                      "omega_n=" + std::to_string(w), "zeta=0.02", "N=60", "nev=2",
-                                                      "solver=dense"}));
+  CliResult r = run(
+      with_sets({"floquet", "--json"}, {"model=milling", "depth=0", "spindle_rpm=7200", "teeth=3",
+                                        "omega_n=" + std::to_string(w), "zeta=0.02", "N=60", "nev=2", "solver=dense"}));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["model"], "milling");
@@ -41,10 +41,10 @@ TEST(MillingCli, DepthZeroIsTheFreeOscillatorsCayleyTransform) {
 }
 
 TEST(MillingCli, ChartOverSpindleSpeedAndDepthHasItsPoints) {
-  CliResult r = run(with_sets({"chart", "--json"}, {"model=milling", "radial_immersion=0.05", "N=30", "solver=dense",
-                                                    "chart_x=spindle_rpm", "chart_x_range=5000,25000",
-                                                    "chart_x_points=4", "chart_y=depth", "chart_y_range=0,5e-3",
-                                                    "chart_y_points=3", "threads=1"}));
+  CliResult r =
+      run(with_sets({"chart", "--json"}, {"model=milling", "radial_immersion=0.05", "N=30", "solver=dense",
+                                          "chart_x=spindle_rpm", "chart_x_range=5000,25000", "chart_x_points=4",
+                                          "chart_y=depth", "chart_y_range=0,5e-3", "chart_y_points=3", "threads=1"}));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["points"], 12);
@@ -58,8 +58,8 @@ TEST(MillingCli, ChartOverSpindleSpeedAndDepthHasItsPoints) {
 }
 
 TEST(MillingCli, BenchRunsTheClassicPathsBesideDelayspec) {
-  CliResult r = run(with_sets({"bench", "--json"}, {"model=milling", "Ns=20,40", "solvers=arpack,sdm0,fdm1", "nev=2",
-                                                    "reference=finest"}));
+  CliResult r = run(with_sets({"bench", "--json"},
+                              {"model=milling", "Ns=20,40", "solvers=arpack,sdm0,fdm1", "nev=2", "reference=finest"}));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_FALSE(j["reference_values"].empty());

@@ -32,9 +32,9 @@ namespace fs = std::filesystem;
 namespace {
 
 using delayspec::testing::CliResult;
+using delayspec::testing::contains;
 using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
-using delayspec::testing::contains;
 
 std::string read(const fs::path& path) {
   std::ifstream in(path);

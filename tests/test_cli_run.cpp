@@ -15,9 +15,9 @@ namespace fs = std::filesystem;
 namespace {
 
 using delayspec::testing::CliResult;
+using delayspec::testing::contains;
 using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
-using delayspec::testing::contains;
 
 std::string scene(const std::string& name, const std::string& text) {
   const fs::path path = fs::temp_directory_path() / ("delayspec_test_run_" + name + ".toml");

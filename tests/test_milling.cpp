@@ -53,9 +53,9 @@ double observed_order(double coarse, double middle, double fine) {
 TEST(Milling, OrderTwoAtTheFourPointsWithTheWindowsLocated) {
   for (const MillingPoint& p : kPoints) {
     const MillingModel model = model_at(p);
-    const double order = observed_order(leading_modulus(model, 800, EventMode::on),
-                                        leading_modulus(model, 1600, EventMode::on),
-                                        leading_modulus(model, 3200, EventMode::on));
+    const double order =
+        observed_order(leading_modulus(model, 800, EventMode::on), leading_modulus(model, 1600, EventMode::on),
+                       leading_modulus(model, 3200, EventMode::on));
     EXPECT_NEAR(order, 2.0, 0.1) << "a/D = " << p.immersion << ", " << p.rpm << " rpm, " << p.depth << " m";
   }
 }
@@ -66,9 +66,9 @@ TEST(Milling, OrderTwoAtTheFourPointsWithTheWindowsLocated) {
 TEST(Milling, OrderOneWithTheDiscontinuousWindowNotLocated) {
   for (const MillingPoint& p : kPoints) {
     const MillingModel model = model_at(p);
-    const double order = observed_order(leading_modulus(model, 800, EventMode::off),
-                                        leading_modulus(model, 1600, EventMode::off),
-                                        leading_modulus(model, 3200, EventMode::off));
+    const double order =
+        observed_order(leading_modulus(model, 800, EventMode::off), leading_modulus(model, 1600, EventMode::off),
+                       leading_modulus(model, 3200, EventMode::off));
     if (p.immersion < 1) EXPECT_LT(order, 1.5) << p.rpm << " rpm";
     else EXPECT_NEAR(order, 2.0, 0.1) << p.rpm << " rpm";
   }

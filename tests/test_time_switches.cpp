@@ -91,7 +91,8 @@ constexpr double kRoundingTolerance = 1e-13;
 
 TEST(TimeSwitches, LocatedStepIsTheTrapezoidOnEachPiece) {
   WindowModel model;  // edges 0.3 and 0.45 fall inside steps for N = 7 and 100 (not on nodes)
-  for (int N : {7, 100}) EXPECT_NEAR(ode_period(model, N, EventMode::on), trapezoid_by_hand(model, N), kRoundingTolerance);
+  for (int N : {7, 100})
+    EXPECT_NEAR(ode_period(model, N, EventMode::on), trapezoid_by_hand(model, N), kRoundingTolerance);
 }
 
 TEST(TimeSwitches, WindowShorterThanAStep) {

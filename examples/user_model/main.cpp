@@ -18,7 +18,9 @@ struct FilteredDelayedOscillator {  // the model concept: see delayspec/model.hp
   double c = 0.1, b = -0.2, filter = 0.5, delay = 2.0;
   double tau() const { return delay; }
   double period() const { return delay; }
-  M A(int, double, const V&, const V&) const { return (M() << 0, 1, 0, -1, -c, 0, 1 / filter, 0, -1 / filter).finished(); }
+  M A(int, double, const V&, const V&) const {
+    return (M() << 0, 1, 0, -1, -c, 0, 1 / filter, 0, -1 / filter).finished();
+  }
   M B(int, double, const V&, const V&) const { return (M() << 0, 0, 0, 0, 0, b, 0, 0, 0).finished(); }
   V f(int j, double t, const V& y, const V& y_tau) const { return A(j, t, y, y_tau) * y + B(j, t, y, y_tau) * y_tau; }
   V initial_state() const { return V::Zero(); }

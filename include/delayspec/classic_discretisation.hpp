@@ -136,7 +136,8 @@ Eigen::MatrixXd classic_monodromy(const Model& model, int m, ClassicMethod metho
       bool used = false;
       for (int i = 0; i < m && !used; ++i) {
         const double t = i * dt;
-        used = B_mean[i].col(c).cwiseAbs().maxCoeff() > 0 || B_at(detail::branch_at(model, t), t).col(c).cwiseAbs().maxCoeff() > 0;
+        used = B_mean[i].col(c).cwiseAbs().maxCoeff() > 0 ||
+               B_at(detail::branch_at(model, t), t).col(c).cwiseAbs().maxCoeff() > 0;
       }
       if (used) delayed.push_back(c);
     }

@@ -48,31 +48,33 @@ namespace delayspec {
 // Does Model switch its field at given times (see above)? Models that do not declare
 // has_time_switches do not.
 template <class Model>
-concept TimeSwitchedModel = requires { requires Model::has_time_switches; };
+concept TimeSwitchedModel = requires {
+  requires Model::has_time_switches;
+};
 
 // The contract above as a concept, checked where a stepper is made (stepper.hpp): the members
 // every model has, the switching members (H, grad_H, f_t, f_tt) only when has_switching, the
 // time-switch members only when has_time_switches.
 template <class Model>
-concept DelayModel =
-    requires(const Model& m, const Vec<Model::d>& y, double t, int j) {
-      requires Model::d >= 1;
-      { Model::has_switching } -> std::convertible_to<bool>;
-      { Model::affine_in_state } -> std::convertible_to<bool>;
-      { Model::is_linear } -> std::convertible_to<bool>;
-      { m.tau() } -> std::convertible_to<double>;
-      { m.period() } -> std::convertible_to<double>;
-      { m.f(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
-      { m.A(j, t, y, y) } -> std::convertible_to<Mat<Model::d>>;
-      { m.B(j, t, y, y) } -> std::convertible_to<Mat<Model::d>>;
-      { m.initial_state() } -> std::convertible_to<Vec<Model::d>>;
-    } &&
-    (!Model::has_switching || requires(const Model& m, const Vec<Model::d>& y, double t, int j) {
-      { m.H(y) } -> std::convertible_to<double>;
-      { m.grad_H(y) } -> std::convertible_to<Vec<Model::d>>;
-      { m.f_t(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
-      { m.f_tt(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
-    }) &&
+concept DelayModel = requires(const Model& m, const Vec<Model::d>& y, double t, int j) {
+  requires Model::d >= 1;
+  { Model::has_switching } -> std::convertible_to<bool>;
+  { Model::affine_in_state } -> std::convertible_to<bool>;
+  { Model::is_linear } -> std::convertible_to<bool>;
+  { m.tau() } -> std::convertible_to<double>;
+  { m.period() } -> std::convertible_to<double>;
+  { m.f(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
+  { m.A(j, t, y, y) } -> std::convertible_to<Mat<Model::d>>;
+  { m.B(j, t, y, y) } -> std::convertible_to<Mat<Model::d>>;
+  { m.initial_state() } -> std::convertible_to<Vec<Model::d>>;
+}
+&&(!Model::has_switching ||
+   requires(const Model& m, const Vec<Model::d>& y, double t, int j) {
+     { m.H(y) } -> std::convertible_to<double>;
+     { m.grad_H(y) } -> std::convertible_to<Vec<Model::d>>;
+     { m.f_t(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
+     { m.f_tt(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
+   }) &&
     (!TimeSwitchedModel<Model> || requires(const Model& m, double t) {
       { m.time_segment(t) } -> std::convertible_to<int>;
       { m.next_time_switch(t, t) } -> std::convertible_to<double>;

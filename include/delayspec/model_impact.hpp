@@ -60,8 +60,8 @@ class ImpactModel {
 
   V f(int j, double t, const V& y, const V& y_tau) const {
     double contact = j == 1 ? p_.beta * (y[0] - p_.e) : 0.0;
-    return V(y[1], p_.a * p_.omega * p_.omega * detail::remembered_sin(p_.omega * t) + p_.k * (y_tau[1] - y[1]) - 2 * p_.zeta * y[1] -
-                       y[0] - contact);
+    return V(y[1], p_.a * p_.omega * p_.omega * detail::remembered_sin(p_.omega * t) + p_.k * (y_tau[1] - y[1]) -
+                       2 * p_.zeta * y[1] - y[0] - contact);
   }
   M A(int j, double, const V&, const V&) const {
     M a;

@@ -29,17 +29,17 @@ namespace delayspec {
 enum class MillingDirection { down, up };
 
 struct MillingParameters {
-  double spindle_rpm = 10000;    // Omega
-  double depth = 0.5e-3;         // a_p, axial depth of cut (m)
-  double radial_immersion = 1;   // a/D, in (0, 1]
-  int teeth = 2;                 // N_t
-  double Kt = 6e8;               // tangential cutting coefficient (N/m^2)
-  double Kn = 2e8;               // normal cutting coefficient (N/m^2)
+  double spindle_rpm = 10000;                   // Omega
+  double depth = 0.5e-3;                        // a_p, axial depth of cut (m)
+  double radial_immersion = 1;                  // a/D, in (0, 1]
+  int teeth = 2;                                // N_t
+  double Kt = 6e8;                              // tangential cutting coefficient (N/m^2)
+  double Kn = 2e8;                              // normal cutting coefficient (N/m^2)
   double omega_n = 922 * 2 * std::numbers::pi;  // natural angular frequency (rad/s)
-  double zeta = 0.011;           // relative damping
-  double mass = 0.03993;         // modal mass (kg)
+  double zeta = 0.011;                          // relative damping
+  double mass = 0.03993;                        // modal mass (kg)
   MillingDirection direction = MillingDirection::down;
-  double x0 = 1e-5, v0 = 0;      // constant initial history (m, m/s), for simulations
+  double x0 = 1e-5, v0 = 0;  // constant initial history (m, m/s), for simulations
 };
 
 class MillingModel {

@@ -67,7 +67,9 @@ const std::vector<std::string>& classic_names() {
 bool is_classic(const std::string& name) {
   return std::find(classic_names().begin(), classic_names().end(), name) != classic_names().end();
 }
-ClassicMethod parse_classic(const std::string& name) { return name == "sdm0" ? ClassicMethod::sdm0 : ClassicMethod::fdm1; }
+ClassicMethod parse_classic(const std::string& name) {
+  return name == "sdm0" ? ClassicMethod::sdm0 : ClassicMethod::fdm1;
+}
 // A row of a dense delayspec solver (the `vs dense` comparison and the speed-up line use them).
 bool is_dense_row(const std::string& solver) { return !is_classic(solver) && is_dense(parse_floquet_solver(solver)); }
 
@@ -80,16 +82,16 @@ struct BenchSettings {
   Problem problem;
   OrbitSettings orbit;
   std::vector<int> Ns;
-  std::vector<std::string> solver_names;  // as given (`dense` stays `dense`)
+  std::vector<std::string> solver_names;   // as given (`dense` stays `dense`)
   std::vector<FloquetSolver> solvers;      // delayspec's
   std::vector<ClassicMethod> classics;     // the classic discretisations listed
   std::vector<std::string> classic_names;  // their names, in the order listed
-  FloquetOptions base;  // nev, ncv, tol, ... (the solver is set per row)
+  FloquetOptions base;                     // nev, ncv, tol, ... (the solver is set per row)
   ReferenceKind reference_kind = ReferenceKind::automatic;
   long repeats = 1;
   double limit_mb = 2048;
   long classic_max_N = 640;  // the classic rows stop here (O(N^3) each)
-  Multipliers exact;  // the exact multipliers when the model has them
+  Multipliers exact;         // the exact multipliers when the model has them
 };
 
 BenchSettings read_bench_settings(Config& config) {
@@ -293,7 +295,8 @@ void score_rows(std::vector<BenchRow>& rows, const BenchReference& reference) {
       r.abs_error = std::abs(std::abs(m.matched[0]) / std::abs(reference.values[0]) - 1);
     }
     for (const auto& dense : rows)
-      if (dense.N == r.N && dense.status == "ok" && is_dense_row(dense.solver) && &dense != &r && !is_classic(r.solver)) {
+      if (dense.N == r.N && dense.status == "ok" && is_dense_row(dense.solver) && &dense != &r &&
+          !is_classic(r.solver)) {
         const MatchedErrors m =
             errors_against(r.multipliers, dense.multipliers, std::vector<double>(dense.multipliers.size(), 0));
         double dev = 0;

@@ -288,11 +288,12 @@ int command_converge(Config& config, const Invocation& inv) {
       read_word_list(config, "events", switching_default ? "on,off" : "on", event_mode_names());
   config.set("events", events.front(), "converge");
   Problem problem = read_problem(config, 100);
-  const bool switching =
-      std::visit([](const auto& model) {
+  const bool switching = std::visit(
+      [](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
         return Model::has_switching || TimeSwitchedModel<Model>;
-      }, problem.model);
+      },
+      problem.model);
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   ConvergenceOptions base;
   base.Ns = read_N_list(config, problem, 25, 400);

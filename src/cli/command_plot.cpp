@@ -320,8 +320,7 @@ void plot_exponents(FigureRenderer& renderer, const fs::path& dir) {
          << colours[i % 6] << "' title '{/Symbol l}_" << i + 1 << "'";
   }
   gp << "set title " << gnuplot_string("Lyapunov exponents per period against " + label + " (zero line green)") << "\n";
-  gp << "set xlabel " << gnuplot_label(label)
-     << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
+  gp << "set xlabel " << gnuplot_label(label) << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
   gp << plot.str() << ", \\\n     0 with lines lc rgb '#2ca02c' lw 2 title 'zero'\n";
   renderer.figure("exponents", gp.str());
 }

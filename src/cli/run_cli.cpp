@@ -61,8 +61,7 @@ int run_command(Config& config, const Invocation& inv) {
   // Under mpirun the workers only compute points (ranks.hpp): the lead runs any other command
   // alone and owns --out (its lock and completeness marker).
   if (!is_lead_rank() && !distributes_points(inv.command)) return 0;
-  if (!inv.out_dir || output_use(inv.command).out != OutDirUse::written || !is_lead_rank())
-    return command(config, inv);
+  if (!inv.out_dir || output_use(inv.command).out != OutDirUse::written || !is_lead_rank()) return command(config, inv);
   OutputDirectory directory(*inv.out_dir);  // held until the command returns: one run per DIR
   const int status = command(config, inv);
   directory.finish(inv.command, status);
