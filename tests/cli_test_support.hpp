@@ -8,6 +8,8 @@
 
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 #include "commands.hpp"
 
 namespace delayspec::testing {
@@ -56,5 +58,16 @@ struct BadKey {
   const char* expected;
 };
 inline void PrintTo(const BadKey& b, std::ostream* os) { *os << b.command << ":" << b.key << "=" << b.value; }
+
+// `COMMAND --set base... --set KEY=VALUE` of the case exits 2, `expected` in the message, nothing
+// on stdout.
+inline void expect_bad_input(const BadKey& b, const std::vector<std::string>& base) {
+  std::vector<std::string> sets = base;
+  sets.push_back(std::string(b.key) + "=" + b.value);
+  const CliResult r = run(with_sets({b.command}, sets));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, b.expected)) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
 
 }  // namespace delayspec::testing

@@ -117,12 +117,7 @@ TEST(BasinCli, NeighbourhoodOfStablePeriodOneOrbitIsPeriodOne) {
 class GridBadInput : public ::testing::TestWithParam<BadKey> {};
 
 TEST_P(GridBadInput, ExitsTwoNamingKeyAndValue) {
-  const BadKey b = GetParam();
-  CliResult r =
-      run(with_sets({b.command}, {"model=mathieu", "N=8", "solver=dense", std::string(b.key) + "=" + b.value}));
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_TRUE(contains(r.err, b.expected)) << r.err;
-  EXPECT_TRUE(r.out.empty()) << r.out;
+  delayspec::testing::expect_bad_input(GetParam(), {"model=mathieu", "N=8", "solver=dense"});
 }
 
 // clang-format off

@@ -80,11 +80,7 @@ TEST(MillingCli, BenchRunsTheClassicPathsBesideDelayspec) {
 class MillingBadInput : public ::testing::TestWithParam<BadKey> {};
 
 TEST_P(MillingBadInput, ExitsTwoNamingKeyAndValue) {
-  const BadKey b = GetParam();
-  CliResult r = run(with_sets({b.command}, {"model=milling", "N=10", std::string(b.key) + "=" + b.value}));
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_TRUE(contains(r.err, b.expected)) << r.err;
-  EXPECT_TRUE(r.out.empty()) << r.out;
+  delayspec::testing::expect_bad_input(GetParam(), {"model=milling", "N=10"});
 }
 
 // clang-format off

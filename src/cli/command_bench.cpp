@@ -150,6 +150,20 @@ BenchSettings read_bench_settings(Config& config) {
   return s;
 }
 
+// Repeats: the minimum time is the least disturbed by other processes. A solve that took more
+// than a second is not repeated (its noise is relatively small). solve() returns its seconds.
+template <class Solve>
+void keep_fastest_of_repeats(BenchRow& row, long repeats, Solve&& solve) {
+  for (row.repeats = 1; row.repeats < repeats && row.seconds < 1.0; ++row.repeats)
+    row.seconds = std::min(row.seconds, solve());
+}
+
+void record_failure(BenchRow& row, const NumericalFailure& e, const Invocation& inv) {
+  row.status = "failed";
+  row.message = e.what();
+  inv.err << "bench: N = " << row.N << ", " << row.solver << ": failed: " << e.what() << "\n";
+}
+
 // Every solver at every N: one row each (ok, skipped for memory, or failed numerically).
 std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
   const std::vector<FloquetSolver>& solvers = s.solvers;
@@ -173,13 +187,11 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
           row.n = r.dimension;
           row.multipliers = r.multipliers;
           row.seconds = r.seconds;
-          for (row.repeats = 1; row.repeats < repeats && row.seconds < 1.0; ++row.repeats)
-            row.seconds = std::min(row.seconds, classic_multipliers(model, N, s.classics[c], base.nev).seconds);
+          keep_fastest_of_repeats(row, repeats,
+                                  [&] { return classic_multipliers(model, N, s.classics[c], base.nev).seconds; });
         });
       } catch (const NumericalFailure& e) {
-        row.status = "failed";
-        row.message = e.what();
-        inv.err << "bench: N = " << N << ", " << row.solver << ": failed: " << e.what() << "\n";
+        record_failure(row, e, inv);
       }
       rows.push_back(row);
       progress.add();
@@ -212,14 +224,9 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
             row.seconds = r.seconds;
             row.operator_applications = r.operator_applications;
             if (!r.note.empty()) row.message = r.note;
-            // Repeats: the minimum time is the least disturbed by other processes. A solve that
-            // took more than a second is not repeated (its noise is relatively small).
-            for (row.repeats = 1; row.repeats < repeats && row.seconds < 1.0; ++row.repeats)
-              row.seconds = std::min(row.seconds, floquet_multipliers(op, o).seconds);
+            keep_fastest_of_repeats(row, repeats, [&] { return floquet_multipliers(op, o).seconds; });
           } catch (const NumericalFailure& e) {
-            row.status = "failed";
-            row.message = e.what();
-            inv.err << "bench: N = " << N << ", " << row.solver << ": failed: " << e.what() << "\n";
+            record_failure(row, e, inv);
           }
         }
         rows.push_back(row);
