@@ -121,9 +121,12 @@ Toolchain toolchain() {
                    (env && *env ? " or correct DELAYSPEC_CXX" : ""));
   const std::filesystem::path library = running_library();
   const std::filesystem::path libdir = library.parent_path();
-  std::error_code ec;
-  const bool installed = std::filesystem::equivalent(libdir, DELAYSPEC_PLUGIN_INSTALL_LIBDIR, ec);
-  const auto includes = split(installed ? DELAYSPEC_PLUGIN_INSTALL_INCLUDES : DELAYSPEC_PLUGIN_BUILD_INCLUDES);
+  // Installed (wherever the prefix is now): the headers beside the library, version.hpp among
+  // them; the build tree keeps that one among its generated files.
+  const std::filesystem::path installed = libdir / DELAYSPEC_PLUGIN_INSTALLED_INCLUDE;
+  const auto includes = std::filesystem::exists(installed / "delayspec" / "version.hpp")
+                            ? std::vector<std::string>{installed.lexically_normal().string(), DELAYSPEC_PLUGIN_EIGEN_INCLUDE}
+                            : split(DELAYSPEC_PLUGIN_BUILD_INCLUDES);
   // -O3 as the library's own Release build, so that the model runs as fast as a built-in one;
   // -fno-math-errno as the library (CMakeLists.txt: repeated sin/cos are evaluated once).
   tc.flags = {"-std=c++20", "-O3", "-DNDEBUG", "-fno-math-errno", "-fPIC", "-shared", "-fvisibility=hidden",
