@@ -24,6 +24,7 @@ namespace {
 // GiNaC's operator precedences (add.h, mul.h; public as sum.precedence(), not as constants).
 constexpr unsigned kSumPrecedence = 40;
 constexpr unsigned kProductPrecedence = 50;
+constexpr unsigned kPowerPrecedence = 60;
 
 std::string text_at(const GiNaC::ex& e, unsigned level) {
   std::ostringstream out;
@@ -56,8 +57,9 @@ void print_sum(const GiNaC::add& sum, const print_sorted_csrc& c, unsigned level
 }
 
 // Whether the sum's first term, in the order of the terms' texts without a leading minus, has
-// a minus: GiNaC stores k (z - y) as k (z - y) or as -k (y - z) depending on the run, and the
-// product is printed with the sum's sign so that this first term is positive.
+// a minus. GiNaC stores k (z - y) as k (z - y) or as -k (y - z), and (x - e)^3 as (x - e)^3 or
+// -(e - x)^3, depending on the run: a sum is printed as a factor with the sign that makes this
+// first term positive, the sign moved to the product's coefficient.
 bool leads_with_minus(const GiNaC::ex& sum) {
   std::string first;
   bool minus = false;
@@ -73,25 +75,47 @@ bool leads_with_minus(const GiNaC::ex& sum) {
   return minus;
 }
 
-// A factor of a product in that sign convention: a sum, or a sum to an integer power, with its
-// sign turned if it leads with a minus; `negate` flips when the factor's sign did.
-GiNaC::ex sign_normal_factor(const GiNaC::ex& factor, bool& negate) {
-  if (GiNaC::is_a<GiNaC::add>(factor) && leads_with_minus(factor)) {
-    negate = !negate;
-    return -factor;
-  }
-  if (GiNaC::is_a<GiNaC::power>(factor) && GiNaC::is_a<GiNaC::add>(factor.op(0)) &&
-      GiNaC::is_a<GiNaC::numeric>(factor.op(1)) && GiNaC::ex_to<GiNaC::numeric>(factor.op(1)).is_integer() &&
-      leads_with_minus(factor.op(0))) {
-    if (GiNaC::ex_to<GiNaC::numeric>(factor.op(1)).is_odd()) negate = !negate;
-    return GiNaC::pow(-factor.op(0), factor.op(1));
-  }
-  return factor;
+// base^n for an integer n >= 1, base already printed as a factor: a product for small n (the
+// compiler turns pow with a large exponent into a library call), else pow.
+constexpr long kMaxPowerAsProduct = 8;
+std::string integer_power_text(const std::string& base, const GiNaC::numeric& n) {
+  if (n == 1) return base;
+  if (n > kMaxPowerAsProduct) return "pow(" + base + ", " + text_at(n, 0) + ")";
+  std::string text = base;
+  for (long i = 1; i < n.to_long(); ++i) text += "*" + base;
+  return "(" + text + ")";
 }
 
-bool negative_integer_power(const GiNaC::ex& e) {
-  return GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
-         GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer() && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_negative();
+// One factor of a product: its text, whether it belongs to the denominator (a negative integer
+// power, printed with the positive exponent), whether its sign was turned (leads_with_minus).
+struct Factor {
+  std::string text;
+  bool denominator = false;
+  bool negated = false;
+};
+
+Factor factor_of(const GiNaC::ex& f) {
+  Factor factor;
+  GiNaC::ex base = f;
+  GiNaC::numeric n = 1;
+  if (GiNaC::is_a<GiNaC::power>(f) && GiNaC::is_a<GiNaC::numeric>(f.op(1)) &&
+      GiNaC::ex_to<GiNaC::numeric>(f.op(1)).is_integer()) {
+    base = f.op(0);
+    n = GiNaC::ex_to<GiNaC::numeric>(f.op(1));
+  } else if (!GiNaC::is_a<GiNaC::add>(f)) {
+    factor.text = text_at(f, kProductPrecedence);
+    return factor;
+  }
+  std::string base_text;
+  if (GiNaC::is_a<GiNaC::add>(base) && leads_with_minus(base)) {
+    base_text = text_at(-base, kPowerPrecedence);  // -1 * sum is the sum of the negated terms
+    factor.negated = n.is_odd();
+  } else {
+    base_text = text_at(base, kPowerPrecedence);
+  }
+  factor.denominator = n.is_negative();
+  factor.text = integer_power_text(base_text, n.is_negative() ? -n : n);
+  return factor;
 }
 
 std::string joined(std::vector<std::string> factors) {
@@ -101,26 +125,16 @@ std::string joined(std::vector<std::string> factors) {
   return text;
 }
 
-// A product: numerator / denominator (the factors with a negative integer exponent), each the
-// numeric coefficient first and then the other factors (sign-normal, above) sorted by text:
-// 2 pi / omega prints 2.0*pi_/p[4], computed as the built-in models compute it.
-void print_product(const GiNaC::mul& product, const print_sorted_csrc& c, unsigned level) {
-  GiNaC::numeric coefficient = 1;
-  bool negate = false;
+// coefficient * factors as numerator / denominator, each the coefficient first and then the
+// factors sorted by text: 2 pi / omega prints 2.0*pi_/p[4], computed as the built-in models do.
+void print_factors(GiNaC::numeric coefficient, const std::vector<GiNaC::ex>& factors, const print_sorted_csrc& c,
+                   unsigned level) {
   std::vector<std::string> numerator, denominator;
-  for (size_t i = 0; i < product.nops(); ++i) {
-    if (GiNaC::is_a<GiNaC::numeric>(product.op(i))) {
-      coefficient *= GiNaC::ex_to<GiNaC::numeric>(product.op(i));
-      continue;
-    }
-    const GiNaC::ex factor = sign_normal_factor(product.op(i), negate);
-    if (negative_integer_power(factor)) {
-      denominator.push_back(text_at(GiNaC::pow(factor.op(0), -factor.op(1)), kProductPrecedence));
-    } else {
-      numerator.push_back(text_at(factor, kProductPrecedence));
-    }
+  for (const auto& f : factors) {
+    const Factor factor = factor_of(f);
+    if (factor.negated) coefficient = -coefficient;
+    (factor.denominator ? denominator : numerator).push_back(factor.text);
   }
-  if (negate) coefficient = -coefficient;
   std::string text = joined(numerator);
   if (text.empty()) {
     text = text_at(coefficient, kProductPrecedence);
@@ -138,10 +152,40 @@ void print_product(const GiNaC::mul& product, const print_sorted_csrc& c, unsign
   }
 }
 
+void print_product(const GiNaC::mul& product, const print_sorted_csrc& c, unsigned level) {
+  GiNaC::numeric coefficient = 1;
+  std::vector<GiNaC::ex> factors;
+  for (size_t i = 0; i < product.nops(); ++i) {
+    if (GiNaC::is_a<GiNaC::numeric>(product.op(i))) {
+      coefficient *= GiNaC::ex_to<GiNaC::numeric>(product.op(i));
+    } else {
+      factors.push_back(product.op(i));
+    }
+  }
+  print_factors(coefficient, factors, c, level);
+}
+
+// A power: an integer power as a product of one factor (above); sqrt for the exponent 1/2;
+// else pow.
+void print_power(const GiNaC::power& power, const print_sorted_csrc& c, unsigned level) {
+  const GiNaC::ex base = power.op(0), exponent = power.op(1);
+  if (GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_integer()) {
+    print_factors(1, {GiNaC::ex(power)}, c, level);
+  } else if (exponent == GiNaC::numeric(1, 2)) {
+    c.s << "sqrt(" << text_at(base, 0) << ")";
+  } else if (exponent == GiNaC::numeric(-1, 2)) {
+    c.s << (level >= kProductPrecedence ? "(1.0/sqrt(" : "1.0/sqrt(") << text_at(base, 0)
+        << (level >= kProductPrecedence ? "))" : ")");
+  } else {
+    c.s << "pow(" << text_at(base, 0) << ", " << text_at(exponent, 0) << ")";
+  }
+}
+
 void register_printers() {
   static const bool registered = [] {
     GiNaC::set_print_func<GiNaC::add, print_sorted_csrc>(print_sum);
     GiNaC::set_print_func<GiNaC::mul, print_sorted_csrc>(print_product);
+    GiNaC::set_print_func<GiNaC::power, print_sorted_csrc>(print_power);
     return true;
   }();
   (void)registered;
