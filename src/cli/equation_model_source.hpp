@@ -1,0 +1,37 @@
+#pragma once
+// The [equations] table of a scene (docs/models.md), checked, differentiated (GiNaC) and printed
+// as the C++ source of a model struct, which the plugin loader compiles and loads.
+//
+// Nothing of the scene reaches the code as text: user names become generated names (y[i],
+// z[i], p[k], t), numbers their exact values, and every expression is printed by GiNaC from its
+// parsed form (equation_expression.hpp).
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+namespace delayspec::cli {
+
+// The [equations] table of a scene, checked, differentiated (GiNaC) and printed as C++.
+struct EquationModelSource {
+  std::vector<std::string> state;          // state names in order; d = state.size()
+  std::vector<std::string> parameters;     // parameter names, sorted (the table's order)
+  std::vector<double> parameter_defaults;  // their values in the table, same order
+  bool switches_in_state = false;          // `switch` given and depends on the state
+  bool switches_in_time = false;           // `switch` given and depends on t only
+  std::string code;                        // C++ text of `struct EquationModel {...};`
+};
+
+// Throws BadInput naming the item (e.g. "`equations.rhs[2]`: ...") for every input error that
+// is not about the compiler. reserved_keys: every key the engine reads (N, nev, seed, ...): a
+// parameter may not take one of these names. NOT thread-safe (GiNaC is not): call under a mutex.
+//
+// The code (after <array>, <cmath> and "delayspec/types.hpp") defines struct EquationModel with
+// d, parameter_count, the model flags, `std::array<double, parameter_count> p` (values in the
+// order of `parameters`), tau_, period_, history_ (set by the loader), the static period_of(p),
+// delay_of(p), history_of(p), and f, A, B, f_t, f_tt for j = 1 (rhs_switched, switch > 0) and
+// j = 2 (rhs), H and grad_H with a state switch, time_segment and next_time_switch with a time
+// switch: a delayspec::DelayModel (model.hpp).
+EquationModelSource generate_equation_model(const toml::table& equations, const std::vector<std::string>& reserved_keys);
+
+}  // namespace delayspec::cli
