@@ -20,6 +20,7 @@
 #include "delayspec/floquet.hpp"
 #include "delayspec/version.hpp"
 #include "delayspec_test_paths.hpp"
+#include "equation_model.hpp"
 #include "equation_model_source.hpp"
 #include "equation_plugin.hpp"
 #include "problem.hpp"
@@ -31,10 +32,14 @@ namespace {
 
 const std::string kScene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/equations_impact.toml";
 
+// The program's own model cache, removed when the program ends.
+struct CacheDirectory {
+  std::filesystem::path path;
+  ~CacheDirectory() { std::filesystem::remove_all(path); }
+};
 std::string cache_dir() {
-  static const std::string dir =
-      (std::filesystem::temp_directory_path() / ("delayspec-bench-equations-" + std::to_string(::getpid()))).string();
-  return dir;
+  static const CacheDirectory dir{std::filesystem::temp_directory_path() / ("delayspec-bench-equations-" + std::to_string(::getpid()))};
+  return dir.path.string();
 }
 
 // The problem as equations (range 1) or as the built-in model (range 0), at N.

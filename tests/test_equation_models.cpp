@@ -15,6 +15,8 @@
 #include <complex>
 #include <filesystem>
 
+#include <unistd.h>
+
 #include "config.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/lambert_w.hpp"
@@ -58,10 +60,14 @@ history = { x = 1 }
 )scene";
 
 // The test's own cache, so that the first test of a run compiles and the rest reuse it.
+// The program's own model cache, removed when the program ends.
+struct CacheDirectory {
+  std::filesystem::path path;
+  ~CacheDirectory() { std::filesystem::remove_all(path); }
+};
 std::string cache_dir() {
-  static const std::string dir =
-      (std::filesystem::temp_directory_path() / ("delayspec-equation-models-" + std::to_string(::getpid()))).string();
-  return dir;
+  static const CacheDirectory dir{std::filesystem::temp_directory_path() / ("delayspec-equation-models-" + std::to_string(::getpid()))};
+  return dir.path.string();
 }
 
 Problem problem_from(const std::string& scene, const std::vector<std::pair<std::string, std::string>>& sets) {
