@@ -198,11 +198,16 @@ int run_compiler(const Toolchain& tc, const std::filesystem::path& source, const
   std::vector<std::string> ordered = {tc.compiler, source.string(), "-o", object.string()};
   ordered.insert(ordered.end(), tc.flags.begin(), tc.flags.end());
   std::vector<char*> argv;
-  for (auto& a : ordered) argv.push_back(a.data());
+  std::string command;  // the log's first line: how the object was made
+  for (auto& a : ordered) {
+    argv.push_back(a.data());
+    command += a + " ";
+  }
   argv.push_back(nullptr);
+  std::ofstream(log, std::ios::trunc) << command << "\n";
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_APPEND, 0600);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
   pid_t pid = 0;
   const int spawned = posix_spawn(&pid, tc.compiler.c_str(), &actions, nullptr, argv.data(), environ);
@@ -276,8 +281,10 @@ EquationPlugin load_equation_plugin(const std::string& model_code, const std::fi
   const int status = run_compiler(tc, cpp, tmp, log);
   if (status != 0) {
     std::filesystem::remove(tmp, ec);
+    const std::string output = read_file(log);  // the command line, then the compiler's output
     throw BadInput("equations: the model did not compile (" + tc.compiler + ", exit " + std::to_string(status) +
-                   "; full output in " + log.string() + "):" + first_lines(read_file(log), 8));
+                   "; the command and its output are in " + log.string() + "):" +
+                   first_lines(output.substr(output.find('\n') + 1), 8));
   }
   std::filesystem::rename(tmp, object);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
