@@ -189,7 +189,9 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"continue_pwsdde_k", "continue"},
                                                        {"milling_lobes", "chart"},
                                                        {"milling_lobes_full", "chart"},
-                                                       {"milling_point", "converge"}};
+                                                       {"milling_point", "converge"},
+                                                       {"equations_impact", "floquet"},
+                                                       {"equations_two_oscillators", "floquet"}};
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
     if (entry.path().extension() != ".toml") continue;
