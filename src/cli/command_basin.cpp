@@ -93,26 +93,23 @@ int command_basin(Config& config, const Invocation& inv) {
     point.set(y.name, format_number(y.value(i / x.points)), "basin");
     const Problem p = read_problem(point, 50);
     try {
-      with_map(p, [&](const auto& model, const auto& map) {
-        using Model = std::decay_t<decltype(model)>;
-        Eigen::VectorXd U = map.constant_history(model.initial_state());
-        for (long j = 0; j < transient; ++j) U = map.apply(U);
-        // Section sequence U_0 .. U_{2 P}: enough to test every p <= P on P + 1 pairs.
-        std::vector<Eigen::VectorXd> section(static_cast<size_t>(2 * max_period + 1));
-        section[0] = U;
-        for (long j = 1; j <= 2 * max_period; ++j) section[j] = map.apply(section[j - 1]);
-        Classification c;
-        c.max_section_x = -INFINITY;
-        for (const auto& S : section) {
-          if (!S.allFinite()) {
-            failure[i] = "trajectory not finite";
-            return;
-          }
-          c.max_section_x = std::max(c.max_section_x, S[S.size() - Model::d]);  // u_0's first component
-        }
+      // Section sequence U_0 .. U_{2 P}: enough to test every p <= P on P + 1 pairs.
+      const std::vector<Eigen::VectorXd> section =
+          p.analyses->section_sequence(p.map_settings(), transient, 2 * max_period + 1);
+      const int d = p.state_dimension();
+      Classification c;
+      c.max_section_x = -INFINITY;
+      bool finite = true;
+      for (const auto& S : section) {
+        finite = finite && S.allFinite();
+        if (finite) c.max_section_x = std::max(c.max_section_x, S[S.size() - d]);  // u_0's first component
+      }
+      if (finite) {
         c.period = section_period(section, max_period, tolerance);
         result[i] = c;
-      });
+      } else {
+        failure[i] = "trajectory not finite";
+      }
     } catch (const NumericalFailure& e) {
       failure[i] = e.what();  // reported with the point, not fatal to the basin
     }

@@ -127,7 +127,9 @@ BenchSettings read_bench_settings(Config& config) {
     // Checked now, before any work: the classic paths need a linear model with tau = T.
     const std::string key = "`solvers = " + s.classic_names.front() + "`: ";
     try {
-      with_map(s.problem, [&](const auto& model, const auto&) { classic_monodromy(model, 2, s.classics.front()); });
+      with_map(
+          s.problem, [&](const auto& model, const auto&) { classic_monodromy(model, 2, s.classics.front()); },
+          "the classic discretisations");
     } catch (const BadInput& e) {
       throw BadInput(key + e.what());
     }
@@ -189,7 +191,7 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
           row.seconds = r.seconds;
           keep_fastest_of_repeats(row, repeats,
                                   [&] { return classic_multipliers(model, N, s.classics[c], base.nev).seconds; });
-        });
+        }, "the classic discretisations");
       } catch (const NumericalFailure& e) {
         record_failure(row, e, inv);
       }
@@ -197,7 +199,7 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
       progress.add();
     }
     if (solvers.empty()) continue;
-    with_monodromy(s.problem, s.problem.events, s.orbit, N, [&](const auto& op, const PeriodicOrbit&, double setup) {
+    with_monodromy(s.problem, s.problem.events, s.orbit, N, [&](const LinearOperator& op, const LinearisedOrbit&, double setup) {
       for (FloquetSolver solver : solvers) {
         BenchRow row;
         row.N = N;

@@ -71,13 +71,8 @@ int command_chart(Config& config, const Invocation& inv) {
     const Problem p = read_problem(point, 40);
     const FloquetOptions options = read_floquet_options(point, 1);
     try {
-      with_map(p, [&](const auto& model, const auto& map) {
-        using Model = std::decay_t<decltype(model)>;
-        OrbitLinearisation<Model::d> at_orbit;
-        find_orbit(model, map, orbit_settings, &at_orbit);
-        const FloquetResult r = floquet_multipliers(Monodromy<Model::d>(map.grid(), std::move(at_orbit.maps)), options);
-        radius[i] = std::abs(r.multipliers.at(0));
-      });
+      const LinearisedOrbit at_orbit = p.analyses->linearised_orbit(p.map_settings(), orbit_settings);
+      radius[i] = std::abs(floquet_multipliers(*at_orbit.monodromy, options).multipliers.at(0));
     } catch (const NumericalFailure& e) {
       failure[i] = e.what();  // e.g. no periodic orbit at this point: reported, not fatal
     }

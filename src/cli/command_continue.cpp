@@ -47,7 +47,7 @@ struct ModelWithKey {
   Model operator()(double p) const {
     Config c = base;
     c.set(key, format_number(p), "continue");
-    return std::get<Model>(read_problem(c, 100).model);
+    return std::get<Model>(*read_problem(c, 100).model);
   }
 };
 
@@ -75,13 +75,16 @@ ContinuationResult branch_at(const Config& config, const ContinueSettings& setti
                              const OrbitSettings& orbit_settings, ContinuationOptions options, int N,
                              Progress& progress) {
   const Level level = level_at(config, settings.key, options.from, N, options, progress);
-  return with_map(level.problem, [&](const auto& model, const auto& map) {
-    using Model = std::decay_t<decltype(model)>;
-    const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
-    const Eigen::VectorXd guess =
-        PeriodicOrbitProblem<std::decay_t<decltype(map)>>(map).sequence_from_history(orbit.history);
-    return continue_orbit<Model>(ModelWithKey<Model>{level.config, settings.key}, guess, options);
-  });
+  return with_map(
+      level.problem,
+      [&](const auto& model, const auto& map) {
+        using Model = std::decay_t<decltype(model)>;
+        const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
+        const Eigen::VectorXd guess =
+            PeriodicOrbitProblem<std::decay_t<decltype(map)>>(map).sequence_from_history(orbit.history);
+        return continue_orbit<Model>(ModelWithKey<Model>{level.config, settings.key}, guess, options);
+      },
+      "`continue`");
 }
 
 // The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
@@ -93,7 +96,7 @@ ContinuationResult switched_at(const Config& config, const ContinueSettings& set
         using Model = std::decay_t<decltype(model)>;
         return continue_period_doubled<Model>(ModelWithKey<Model>{level.config, settings.key}, pd, options);
       },
-      level.problem.model);
+      *level.problem.model);
 }
 
 json measures_json(const OrbitMeasures& m) {
@@ -137,10 +140,10 @@ int command_continue(Config& config, const Invocation& inv) {
   // it as used (a key no model reads is then reported as unknown).
   config.set(settings.key, format_number(options.from), "continue_from");
   const Problem problem = read_problem(config, 100);
+  if (!problem.model) throw BadInput("`continue` takes the built-in models only, not model = equations");
   config.check_all_used();
   const std::vector<int> Ns = settings.Ns.empty() ? std::vector<int>{problem.N} : settings.Ns;
-  const bool switching =
-      std::visit([](const auto& m) { return std::decay_t<decltype(m)>::has_switching; }, problem.model);
+  const bool switching = problem.analyses->switches_in_state();
 
   Progress progress(inv.err, "continue", 0, inv.quiet);
   std::vector<ContinuationResult> levels;

@@ -236,10 +236,14 @@ class ConvergeLevels {
     const auto start = std::chrono::steady_clock::now();
     bool orbit_found = false;
     Eigen::VectorXd sequence;
+    Problem level = problem_;
+    level.N = N;
+    const long K = level.grid().K;
     try {
       with_monodromy(
           problem_, events_, orbit_, N,
-          [&](const auto& op, const PeriodicOrbit&, double) {
+          [&](const LinearOperator& op, const LinearisedOrbit& at_orbit, double) {
+            sequence = at_orbit.sequence;
             orbit_found = true;
             FloquetOptions fo = solver_;
             fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
@@ -249,9 +253,9 @@ class ConvergeLevels {
             const double radius = f.multipliers.empty() ? 0.0 : std::abs(f.multipliers.front());
             for (size_t k = 0; k < f.multipliers.size(); ++k)
               r.accuracy.push_back(multiplier_accuracy(f.multipliers[k], k < f.residuals.size() ? f.residuals[k] : NAN,
-                                                       op.rows(), op.grid().K, radius));
+                                                       op.rows(), K, radius));
           },
-          {guess, &sequence});
+          {guess, true});
       if (sequence.size() > 0) sequences_[N] = std::move(sequence);
       if (guess)
         r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);
@@ -283,17 +287,17 @@ int command_converge(Config& config, const Invocation& inv) {
   // events may be a list here (side by side); the problem reads the first of them.
   // Models that switch (the impact wall, milling's cutting windows): located and not, side by side.
   const std::string model_name = config.get_string("model", "impact");
-  const bool switching_default = model_name == "impact" || model_name == "milling";
+  bool switching_default = model_name == "impact" || model_name == "milling";
+  if (model_name == "equations") {  // known once the equations are read
+    Config first = config;
+    first.set("events", "on", "converge");
+    switching_default = read_problem(first, 100).switching();
+  }
   const std::vector<std::string> events =
       read_word_list(config, "events", switching_default ? "on,off" : "on", event_mode_names());
   config.set("events", events.front(), "converge");
   Problem problem = read_problem(config, 100);
-  const bool switching = std::visit(
-      [](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        return Model::has_switching || TimeSwitchedModel<Model>;
-      },
-      problem.model);
+  const bool switching = problem.switching();
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   ConvergenceOptions base;
   base.Ns = read_N_list(config, problem, 25, 400);

@@ -26,16 +26,14 @@ int command_floquet(Config& config, const Invocation& inv) {
   PeriodicOrbit orbit;
   ContactSummary contacts;
   double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
-  with_map(problem, [&](const auto& model, const auto& map) {
-    using Model = std::decay_t<decltype(model)>;
+  {
     const auto orbit_start = std::chrono::steady_clock::now();
-    OrbitLinearisation<Model::d> at_orbit;  // the monodromy and states at the orbit
-    orbit = find_orbit(model, map, orbit_settings, &at_orbit);
+    LinearisedOrbit at_orbit = problem.analyses->linearised_orbit(problem.map_settings(), orbit_settings);
     orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
-    contacts = orbit_contacts(model, std::move(at_orbit.states));
-    const Monodromy<Model::d> monodromy(map.grid(), std::move(at_orbit.maps));
-    result = floquet_multipliers(monodromy, options);
-  });
+    orbit = std::move(at_orbit.orbit);
+    contacts = at_orbit.contacts;
+    result = floquet_multipliers(*at_orbit.monodromy, options);
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (inv.json) {

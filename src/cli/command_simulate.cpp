@@ -18,6 +18,7 @@
 
 #include "atomic_file.hpp"
 #include "commands.hpp"
+#include "delayspec/builtin_analyses.hpp"
 #include "delayspec/simulation.hpp"
 #include "metadata.hpp"
 #include "problem.hpp"
@@ -26,28 +27,29 @@ namespace delayspec::cli {
 
 namespace {
 
-template <int D>
-std::string columns() {
-  return D == 2 ? "t,x,v" : "t,x";
+// "t,x,v": the time and the state's names.
+std::string columns(const Problem& problem) {
+  std::string c = "t";
+  for (const auto& name : problem.state_names) c += "," + name;
+  return c;
 }
 
-template <int D>
-void write_points(std::ostream& s, const std::vector<double>& t, const std::vector<Vec<D>>& y) {
+void write_points(std::ostream& s, const std::string& columns, const std::vector<double>& t,
+                  const std::vector<Eigen::VectorXd>& y) {
   s << std::setprecision(std::numeric_limits<double>::max_digits10);
-  s << columns<D>() << "\n";
+  s << columns << "\n";
   for (size_t i = 0; i < t.size(); ++i) {
     s << t[i];
-    for (int c = 0; c < D; ++c) s << "," << y[i][c];
+    for (double c : y[i]) s << "," << c;
     s << "\n";
   }
 }
 
-template <int D>
-nlohmann::json points_json(const std::vector<double>& t, const std::vector<Vec<D>>& y) {
+nlohmann::json points_json(const std::vector<double>& t, const std::vector<Eigen::VectorXd>& y) {
   nlohmann::json a = nlohmann::json::array();
   for (size_t i = 0; i < t.size(); ++i) {
     nlohmann::json row = {t[i]};
-    for (int c = 0; c < D; ++c) row.push_back(y[i][c]);
+    for (double c : y[i]) row.push_back(c);
     a.push_back(row);
   }
   return a;
@@ -84,87 +86,77 @@ int command_simulate(Config& config, const Invocation& inv) {
 
   nlohmann::json json;
   std::ostringstream text;
-  std::visit(
-      [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        constexpr int D = Model::d;
-        const StepOptions step = step_options(problem);
-        Model before_model = model;
-        if constexpr (std::is_same_v<Model, ImpactModel>) {
-          if (control_on_at > 0) {
-            ImpactParameters p = model.parameters();
-            p.k = 0;
-            before_model = ImpactModel(p);
-            options.switch_time = control_on_at;
-          }
-        }
-        const TrapezoidStepper<Model> before(before_model, step_options(before_problem)), after(model, step);
-        Eigen::VectorXd U(grid.dimension(D));
-        for (int j = 0; j <= grid.M; ++j) U.template segment<D>(static_cast<long>(j) * D) = model.initial_state();
-        const SimulationRecord<D> rec = simulate(before, after, grid, U, options);
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-        std::vector<std::string> files;
-        if (inv.out_dir) {
-          const std::filesystem::path dir(*inv.out_dir);
-          const std::string header = metadata_comment_lines(make_metadata(
-              "simulate", inv.scene, config,
-              {{"N", problem.N}, {"events", to_string(problem.events)}, {"jacobian", to_string(problem.jacobian)}},
-              seconds));
-          AtomicFile traj(dir / "trajectory.csv");
-          traj.stream() << header;
-          write_points<D>(traj.stream(), rec.t, rec.y);
-          traj.commit();
-          AtomicFile poincare(dir / "poincare.csv");
-          poincare.stream() << header;
-          write_points<D>(poincare.stream(), rec.poincare_t, rec.poincare_y);
-          poincare.commit();
-          AtomicFile impacts(dir / "impacts.csv");
-          impacts.stream() << header << std::setprecision(std::numeric_limits<double>::max_digits10) << "t,count\n";
-          for (size_t i = 0; i < rec.impact_times.size(); ++i)
-            impacts.stream() << rec.impact_times[i] << "," << i + 1 << "\n";
-          impacts.commit();
-          files = {traj.path().string(), poincare.path().string(), impacts.path().string()};
-        }
-        if (inv.arrays) (*inv.arrays)["trajectory"] = points_json<D>(rec.t, rec.y);
-        if (inv.json) {
-          json["model"] = problem.model_name;
-          json["N"] = problem.N;
-          json["h"] = grid.h;
-          json["events"] = to_string(problem.events);
-          json["contact_substeps"] = problem.contact_substeps;
-          json["t_start"] = options.t_start;
-          json["t_end"] = options.t_end;
-          json["steps"] = rec.steps;
-          json["control_on_at"] = control_on_at;
-          json["events_before_control"] = to_string(before_problem.events);
-          json["impacts"] = rec.impact_times.size();
-          json["impact_times"] = rec.impact_times;
-          json["poincare"] = points_json<D>(rec.poincare_t, rec.poincare_y);
-          json["columns"] = columns<D>();
-          json["samples"] = rec.t.size();
-          if constexpr (Model::has_switching) json["max_H"] = rec.max_H;
-          json["seconds"] = seconds;
-          json["files"] = files;
-        } else {
-          text << "delayspec simulate: model " << problem.model_name << ", " << grid.describe() << ", events "
-               << to_string(problem.events) << "\n";
-          text << "window [" << options.t_start << ", " << options.t_end << "], " << rec.steps << " steps";
-          if (control_on_at > 0)
-            text << ", control (k) on from t = " << control_on_at << " (events " << to_string(before_problem.events)
-                 << " before)";
-          text << "\n";
-          if constexpr (Model::has_switching)
-            text << "impacts (entries into H > 0): " << rec.impact_times.size()
-                 << "; max H at grid points: " << rec.max_H << "\n";
-          text << "Poincare points (t = m T): " << rec.poincare_t.size();
-          if (!rec.poincare_y.empty()) text << ", last " << rec.poincare_y.back().transpose();
-          text << "\n";
-          for (const auto& f : files) text << "wrote " << f << "\n";
-          text << "time: " << seconds << " s\n";
-        }
-      },
-      problem.model);
+  // The model before control_on_at: the impact model with k = 0 (checked above: impact only).
+  std::shared_ptr<const ModelAnalyses> before_model;
+  if (control_on_at > 0) {
+    ImpactParameters p = std::get<ImpactModel>(*problem.model).parameters();
+    p.k = 0;
+    before_model = builtin_analyses(ImpactModel(p));
+    options.switch_time = control_on_at;
+  }
+  const bool switching = problem.analyses->switches_in_state();
+  const SimulationRecord<Eigen::Dynamic> rec =
+      problem.analyses->simulate(before_problem.map_settings(), problem.map_settings(), options, before_model.get());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::vector<std::string> files;
+  if (inv.out_dir) {
+    const std::filesystem::path dir(*inv.out_dir);
+    const std::string header = metadata_comment_lines(make_metadata(
+        "simulate", inv.scene, config,
+        {{"N", problem.N}, {"events", to_string(problem.events)}, {"jacobian", to_string(problem.jacobian)}},
+        seconds));
+    AtomicFile traj(dir / "trajectory.csv");
+    traj.stream() << header;
+    write_points(traj.stream(), columns(problem), rec.t, rec.y);
+    traj.commit();
+    AtomicFile poincare(dir / "poincare.csv");
+    poincare.stream() << header;
+    write_points(poincare.stream(), columns(problem), rec.poincare_t, rec.poincare_y);
+    poincare.commit();
+    AtomicFile impacts(dir / "impacts.csv");
+    impacts.stream() << header << std::setprecision(std::numeric_limits<double>::max_digits10) << "t,count\n";
+    for (size_t i = 0; i < rec.impact_times.size(); ++i)
+      impacts.stream() << rec.impact_times[i] << "," << i + 1 << "\n";
+    impacts.commit();
+    files = {traj.path().string(), poincare.path().string(), impacts.path().string()};
+  }
+  if (inv.arrays) (*inv.arrays)["trajectory"] = points_json(rec.t, rec.y);
+  if (inv.json) {
+    json["model"] = problem.model_name;
+    json["N"] = problem.N;
+    json["h"] = grid.h;
+    json["events"] = to_string(problem.events);
+    json["contact_substeps"] = problem.contact_substeps;
+    json["t_start"] = options.t_start;
+    json["t_end"] = options.t_end;
+    json["steps"] = rec.steps;
+    json["control_on_at"] = control_on_at;
+    json["events_before_control"] = to_string(before_problem.events);
+    json["impacts"] = rec.impact_times.size();
+    json["impact_times"] = rec.impact_times;
+    json["poincare"] = points_json(rec.poincare_t, rec.poincare_y);
+    json["columns"] = columns(problem);
+    json["samples"] = rec.t.size();
+    if (switching) json["max_H"] = rec.max_H;
+    json["seconds"] = seconds;
+    json["files"] = files;
+  } else {
+    text << "delayspec simulate: model " << problem.model_name << ", " << grid.describe() << ", events "
+         << to_string(problem.events) << "\n";
+    text << "window [" << options.t_start << ", " << options.t_end << "], " << rec.steps << " steps";
+    if (control_on_at > 0)
+      text << ", control (k) on from t = " << control_on_at << " (events " << to_string(before_problem.events)
+           << " before)";
+    text << "\n";
+    if (switching)
+      text << "impacts (entries into H > 0): " << rec.impact_times.size()
+           << "; max H at grid points: " << rec.max_H << "\n";
+    text << "Poincare points (t = m T): " << rec.poincare_t.size();
+    if (!rec.poincare_y.empty()) text << ", last " << rec.poincare_y.back().transpose();
+    text << "\n";
+    for (const auto& f : files) text << "wrote " << f << "\n";
+    text << "time: " << seconds << " s\n";
+  }
   if (inv.json) inv.out << json.dump(2) << "\n";
   else inv.out << text.str();
   return 0;

@@ -46,6 +46,13 @@ void flatten(const toml::table& table, Config& config, const std::string& path, 
   for (const auto& [k, node] : table) {
     const std::string key(k.str());
     if (const toml::table* sub = node.as_table()) {
+      if (key == "equations") {  // a model's equations: kept whole, as TOML text (equation_model.hpp)
+        if (!seen.insert(key).second) throw BadInput(path + ": key `" + key + "` is given twice");
+        std::ostringstream text;
+        text << *sub;
+        config.set_from_scene(key, text.str(), path);
+        continue;
+      }
       flatten(*sub, config, path, seen);
       continue;
     }

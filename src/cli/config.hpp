@@ -8,7 +8,9 @@
 // result metadata (key_registry.hpp, metadata.hpp).
 //
 // Scene files: top-level `key = value` pairs; tables ([model], [floquet], ...) may group keys
-// for readability and are flattened (a key may appear only once in the whole file).
+// for readability and are flattened (a key may appear only once in the whole file). The one
+// exception is [equations] (model = equations, equation_model.hpp): kept whole, as the TOML text
+// of the table under the key `equations`.
 #include <map>
 #include <optional>
 #include <set>

@@ -62,7 +62,7 @@ std::vector<std::string> read_word_list(Config& config, const std::string& key, 
 }
 
 std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count) {
-  if (const auto* linear = std::get_if<LinearModel>(&problem.model)) {
+  if (const auto* linear = problem.model ? std::get_if<LinearModel>(&*problem.model) : nullptr) {
     const LinearParameters& p = linear->parameters();
     if (p.b == 0) return {};  // no delay term: Lambert W form does not apply
     return linear_dde_multipliers(p.a, p.b, p.tau, p.period, count);

@@ -7,7 +7,6 @@
 
 #include "config.hpp"
 #include "delayspec/periodic_orbit.hpp"
-#include "delayspec/stroboscopic_map.hpp"
 #include "orbit_settings.hpp"
 #include "problem.hpp"
 
@@ -25,49 +24,19 @@ std::vector<std::string> read_word_list(Config& config, const std::string& key, 
 // The exact leading multipliers when the model has them (linear: Lambert W), else empty.
 std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count);
 
-// How with_monodromy finds the orbit, beyond the orbit settings.
-struct LevelOrbit {
-  // in: when set, Newton (orbit_by_newton) from this sequence (another level's orbit, any K:
-  // prolonged) instead of the configured method.
-  const Eigen::VectorXd* newton_guess = nullptr;
-  // out: when set, the orbit's states over one map (nonlinear models; left empty for linear ones).
-  Eigen::VectorXd* sequence = nullptr;
-};
-
-// Builds the problem at resolution N with the given events mode, finds its periodic orbit and
-// calls fn(monodromy, orbit, setup_seconds). fn is generic in the Monodromy<D> type.
+// Builds the problem at resolution N with the given events mode, finds its periodic orbit (as
+// `request` says: from another level's orbit by Newton, and whether to keep the sequence) and
+// calls fn(monodromy, linearised_orbit, setup_seconds).
 template <class Fn>
 void with_monodromy(const Problem& problem, EventMode events, const OrbitSettings& orbit_settings, int N, Fn&& fn,
-                    const LevelOrbit& level_orbit = {}) {
+                    const OrbitRequest& request = {}) {
   const auto start = std::chrono::steady_clock::now();
   Problem p = problem;
   p.events = events;
   p.N = N;
-  with_map(p, [&](const auto& model, const auto& map) {
-    using Model = std::decay_t<decltype(model)>;
-    const long K = map.grid().K;
-    PeriodicOrbit orbit;
-    OrbitLinearisation<Model::d> at_orbit;  // step maps and states of one map at the orbit
-    if constexpr (!Model::is_linear) {
-      if (level_orbit.newton_guess) {
-        const Eigen::VectorXd guess = prolong_periodic_sequence(*level_orbit.newton_guess, Model::d, K);
-        orbit = orbit_by_newton(map, guess, orbit_settings.newton);
-        map.apply(orbit.history, &at_orbit.maps, &at_orbit.states);
-      } else {
-        orbit = find_orbit(model, map, orbit_settings, &at_orbit);
-      }
-      if (level_orbit.sequence) {  // the states u_0 .. u_{K-1}
-        Eigen::VectorXd& x = *level_orbit.sequence;
-        x.resize(static_cast<long>(Model::d) * K);
-        for (long l = 0; l < K; ++l) x.template segment<Model::d>(Model::d * l) = at_orbit.states[l];
-      }
-    } else {
-      orbit = find_orbit(model, map, orbit_settings, &at_orbit);
-    }
-    const Monodromy<Model::d> monodromy(map.grid(), std::move(at_orbit.maps));
-    const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    fn(monodromy, orbit, setup);
-  });
+  const LinearisedOrbit at_orbit = p.analyses->linearised_orbit(p.map_settings(), orbit_settings, request);
+  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fn(static_cast<const LinearOperator&>(*at_orbit.monodromy), at_orbit, setup);
 }
 
 }  // namespace delayspec::cli

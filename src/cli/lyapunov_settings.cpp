@@ -27,9 +27,7 @@ LyapunovOptions read_lyapunov_options(Config& config, int default_exponents) {
 }
 
 LyapunovResult run_lyapunov(const Problem& problem, const LyapunovOptions& options) {
-  return with_map(problem, [&](const auto& model, const auto& map) {
-    return lyapunov_exponents(map, map.constant_history(model.initial_state()), options);
-  });
+  return problem.analyses->lyapunov(problem.map_settings(), options);
 }
 
 }  // namespace delayspec::cli

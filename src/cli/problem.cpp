@@ -2,6 +2,7 @@
 
 #include <climits>
 
+#include "delayspec/builtin_analyses.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec::cli {
@@ -87,13 +88,11 @@ StepOptions step_options(const Problem& problem) {
   return options;
 }
 
-HistoryGrid Problem::grid() const {
-  return std::visit([&](const auto& mod) { return make_grid(mod.tau(), mod.period(), N, orbit_period); }, model);
-}
+HistoryGrid Problem::grid() const { return analyses->grid(map_settings()); }
 
-int Problem::state_dimension() const {
-  return std::visit([](const auto& mod) { return std::decay_t<decltype(mod)>::d; }, model);
-}
+int Problem::state_dimension() const { return analyses->state_dimension(); }
+
+MapSettings Problem::map_settings() const { return {N, orbit_period, step_options(*this)}; }
 
 std::string to_string(EventMode mode) {
   switch (mode) {
@@ -122,14 +121,30 @@ const std::vector<std::string>& model_names() {
   return names;
 }
 
+const std::vector<std::string>& model_choices() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all = model_names();
+    all.push_back("equations");
+    return all;
+  }();
+  return names;
+}
+
 Problem read_problem(Config& config, int default_N) {
   Problem problem;
-  problem.model_name = config.get_choice("model", model_names().front(), model_names());
+  problem.model_name = config.get_choice("model", model_names().front(), model_choices());
   if (problem.model_name == "impact") problem.model = read_impact(config);
   if (problem.model_name == "linear") problem.model = read_linear(config);
   if (problem.model_name == "mathieu") problem.model = read_mathieu(config);
   if (problem.model_name == "mackey-glass") problem.model = read_mackey_glass(config);
   if (problem.model_name == "milling") problem.model = read_milling(config);
+  if (problem.model) {
+    problem.analyses = std::visit([](const auto& model) { return builtin_analyses(model); }, *problem.model);
+    problem.state_names = problem.state_dimension() == 2 ? std::vector<std::string>{"x", "v"}
+                                                         : std::vector<std::string>{"x"};
+  } else {
+    throw BadInput("`model = equations`: not wired yet");
+  }
   // N up to 1e9 (the history alone is then 16 GB at d = 2); orbit_period and contact_substeps
   // multiply the work per step or per period, 1000 is far beyond any use.
   problem.N = static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000));

@@ -1,0 +1,26 @@
+#pragma once
+// The analyses of the built-in models (model_analyses.hpp), compiled once in the library
+// (src/analyses_<model>.cpp): builtin_analyses(model) wraps a model in them.
+#include <memory>
+
+#include "delayspec/model_analyses.hpp"
+#include "delayspec/model_impact.hpp"
+#include "delayspec/model_linear.hpp"
+#include "delayspec/model_mackey_glass.hpp"
+#include "delayspec/model_mathieu.hpp"
+#include "delayspec/model_milling.hpp"
+
+namespace delayspec {
+
+extern template class ModelAnalysesFor<ImpactModel>;
+extern template class ModelAnalysesFor<LinearModel>;
+extern template class ModelAnalysesFor<MathieuModel>;
+extern template class ModelAnalysesFor<MackeyGlassModel>;
+extern template class ModelAnalysesFor<MillingModel>;
+
+template <class Model>
+std::shared_ptr<const ModelAnalyses> builtin_analyses(const Model& model) {
+  return std::make_shared<const ModelAnalysesFor<Model>>(model);
+}
+
+}  // namespace delayspec

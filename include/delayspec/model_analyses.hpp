@@ -1,0 +1,171 @@
+#pragma once
+// ModelAnalyses: what the front ends (the CLI and the Python module) ask of a model, behind one
+// interface whatever the model and its state dimension d: its periodic orbit linearised (the
+// monodromy as a LinearOperator, for floquet, chart, converge and bench), Lyapunov exponents
+// (lyapunov, sweep), the stroboscopic sequence (basin) and a simulation (simulate).
+//
+// ModelAnalysesFor<Model> implements it from the templates of the engine, compiled for Model's
+// d. It is instantiated once per built-in model in the library (builtin_analyses.hpp) and, for a
+// model written as equations in a scene, inside the object compiled from those equations at run
+// time (docs/models.md): the per-step work is always compiled for the model, never interpreted,
+// and one virtual call per analysis is all the front ends add.
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "delayspec/grid.hpp"
+#include "delayspec/linear_operator.hpp"
+#include "delayspec/lyapunov.hpp"
+#include "delayspec/model.hpp"
+#include "delayspec/monodromy.hpp"
+#include "delayspec/orbit_search.hpp"
+#include "delayspec/simulation.hpp"
+#include "delayspec/step_options.hpp"
+#include "delayspec/stepper.hpp"
+#include "delayspec/stroboscopic_map.hpp"
+
+namespace delayspec {
+
+// The discretisation: N steps per delay, the map over orbit_period forcing periods, the step.
+struct MapSettings {
+  int N = 100;
+  int orbit_period = 1;
+  StepOptions step;
+};
+
+// What linearised_orbit() does beyond the orbit settings.
+struct OrbitRequest {
+  // When set: Newton (orbit_by_newton) from this periodic sequence (another resolution's orbit,
+  // any K: prolonged) instead of the configured method. Nonlinear models only.
+  const Eigen::VectorXd* newton_guess = nullptr;
+  // Fill LinearisedOrbit::sequence with the orbit's states u_0 .. u_{K-1} (nonlinear models).
+  bool sequence = false;
+};
+
+// A periodic orbit and the map's linearisation along it.
+struct LinearisedOrbit {
+  PeriodicOrbit orbit;
+  ContactSummary contacts;                     // the orbit against H = 0 (no switching: zero)
+  std::unique_ptr<LinearOperator> monodromy;   // Monodromy<d> of one map at the orbit
+  Eigen::VectorXd sequence;                    // u_0 .. u_{K-1} when requested (empty for linear models)
+};
+
+class ModelAnalyses {
+ public:
+  virtual ~ModelAnalyses() = default;
+
+  virtual int state_dimension() const = 0;    // d
+  virtual bool switches_in_state() const = 0;  // H(y) with events (has_switching)
+  virtual bool switches_in_time() const = 0;   // cutting windows (has_time_switches)
+  virtual bool is_linear() const = 0;          // the monodromy does not depend on the orbit
+  virtual double tau() const = 0;
+  virtual double period() const = 0;
+  HistoryGrid grid(const MapSettings& s) const { return make_grid(tau(), period(), s.N, s.orbit_period); }
+
+  // The periodic orbit (orbit_search.hpp; the zero orbit of a linear model) and its monodromy.
+  virtual LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
+                                           const OrbitRequest& request = {}) const = 0;
+  // Lyapunov exponents from the constant initial history.
+  virtual LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const = 0;
+  // The histories U_0 .. U_{count-1} of successive maps after `transient` maps, from the constant
+  // initial history (the stroboscopic section of a trajectory).
+  virtual std::vector<Eigen::VectorXd> section_sequence(const MapSettings& map, long transient,
+                                                        long count) const = 0;
+  // simulate() from the constant initial history: `before` (a model of the same type, e.g. the
+  // impact model with its control off; nullptr: this one) with the step settings of
+  // `before_map` runs the steps starting before options.switch_time, this model with `map` the
+  // others. Both settings must give the same grid.
+  virtual SimulationRecord<Eigen::Dynamic> simulate(const MapSettings& before_map, const MapSettings& map,
+                                                    const SimulationOptions& options,
+                                                    const ModelAnalyses* before = nullptr) const = 0;
+
+ protected:
+  ModelAnalyses() = default;
+  ModelAnalyses(const ModelAnalyses&) = default;
+  ModelAnalyses& operator=(const ModelAnalyses&) = default;
+};
+
+template <class Model>
+class ModelAnalysesFor final : public ModelAnalyses {
+ public:
+  static constexpr int D = Model::d;
+  explicit ModelAnalysesFor(Model model) : model_(std::move(model)) {}
+  const Model& model() const { return model_; }
+
+  int state_dimension() const override { return D; }
+  bool switches_in_state() const override { return Model::has_switching; }
+  bool switches_in_time() const override { return TimeSwitchedModel<Model>; }
+  bool is_linear() const override { return Model::is_linear; }
+  double tau() const override { return model_.tau(); }
+  double period() const override { return model_.period(); }
+
+  LinearisedOrbit linearised_orbit(const MapSettings& s, const OrbitSettings& settings,
+                                   const OrbitRequest& request) const override {
+    const StroboscopicMap<Model> map = make_map(s);
+    const long K = map.grid().K;
+    LinearisedOrbit out;
+    OrbitLinearisation<D> at_orbit;  // step maps and states of one map at the orbit
+    if (request.newton_guess && !Model::is_linear) {
+      const Eigen::VectorXd guess = prolong_periodic_sequence(*request.newton_guess, D, K);
+      out.orbit = orbit_by_newton(map, guess, settings.newton);
+      map.apply(out.orbit.history, &at_orbit.maps, &at_orbit.states);
+    } else {
+      out.orbit = find_orbit(model_, map, settings, &at_orbit);
+    }
+    if (request.sequence && !Model::is_linear) {
+      out.sequence.resize(static_cast<long>(D) * K);
+      for (long l = 0; l < K; ++l) out.sequence.template segment<D>(D * l) = at_orbit.states[l];
+    }
+    out.contacts = orbit_contacts(model_, std::move(at_orbit.states));
+    out.monodromy = std::make_unique<Monodromy<D>>(map.grid(), std::move(at_orbit.maps));
+    return out;
+  }
+
+  LyapunovResult lyapunov(const MapSettings& s, const LyapunovOptions& options) const override {
+    const StroboscopicMap<Model> map = make_map(s);
+    return lyapunov_exponents(map, map.constant_history(model_.initial_state()), options);
+  }
+
+  std::vector<Eigen::VectorXd> section_sequence(const MapSettings& s, long transient, long count) const override {
+    const StroboscopicMap<Model> map = make_map(s);
+    Eigen::VectorXd U = map.constant_history(model_.initial_state());
+    for (long j = 0; j < transient; ++j) U = map.apply(U);
+    std::vector<Eigen::VectorXd> section;
+    section.reserve(static_cast<size_t>(count));
+    for (long j = 0; j < count; ++j) {
+      if (j > 0) U = map.apply(U);
+      section.push_back(U);
+    }
+    return section;
+  }
+
+  SimulationRecord<Eigen::Dynamic> simulate(const MapSettings& before_map, const MapSettings& s,
+                                            const SimulationOptions& options,
+                                            const ModelAnalyses* before) const override {
+    const auto* before_model = before ? dynamic_cast<const ModelAnalysesFor*>(before) : this;
+    if (!before_model) throw std::logic_error("simulate: the model before the switch is of another type");
+    const TrapezoidStepper<Model> first(before_model->model_, before_map.step), second(model_, s.step);
+    const HistoryGrid grid = this->grid(s);
+    Eigen::VectorXd U(grid.dimension(D));
+    for (int j = 0; j <= grid.M; ++j) U.template segment<D>(static_cast<long>(j) * D) = model_.initial_state();
+    SimulationRecord<D> rec = delayspec::simulate(first, second, grid, U, options);
+    SimulationRecord<Eigen::Dynamic> out;
+    out.t = std::move(rec.t);
+    out.y.assign(rec.y.begin(), rec.y.end());
+    out.poincare_t = std::move(rec.poincare_t);
+    out.poincare_y.assign(rec.poincare_y.begin(), rec.poincare_y.end());
+    out.impact_times = std::move(rec.impact_times);
+    out.steps = rec.steps;
+    out.max_H = rec.max_H;
+    return out;
+  }
+
+ private:
+  StroboscopicMap<Model> make_map(const MapSettings& s) const {
+    return StroboscopicMap<Model>(TrapezoidStepper<Model>(model_, s.step), grid(s));
+  }
+  Model model_;
+};
+
+}  // namespace delayspec

@@ -1,0 +1,92 @@
+#pragma once
+// How a periodic orbit is found (OrbitSettings), the one function that finds it (or takes the
+// zero orbit of a linear model), and the orbit's contacts with the switching surface.
+//
+// orbit = auto (default): nested iteration (orbit_shooting.hpp): levels N, N/8, ... down to the
+//   last one >= orbit_coarse_N; at the coarsest, orbit_guess_periods maps simulated from the
+//   constant initial history and sparse-LU Newton; every finer level by Newton-Krylov shooting
+//   from the coarser orbit. With N < 8 orbit_coarse_N there is one level: sparse-LU Newton at N.
+//   Finds unstable orbits too.
+// orbit = shooting: the same levels, Newton-Krylov shooting at the coarsest level too.
+// orbit = simulate: iterate the map from the constant initial history until it settles.
+// orbit = newton: simulate orbit_guess_periods maps from the constant initial history, then
+//   Newton on the discrete periodic problem at N (orbit_newton.hpp, sparse LU).
+#include <string>
+
+#include "delayspec/errors.hpp"
+#include "delayspec/orbit_contacts.hpp"
+#include "delayspec/orbit_newton.hpp"
+#include "delayspec/orbit_shooting.hpp"
+#include "delayspec/orbit_simulation.hpp"
+
+namespace delayspec {
+
+struct OrbitSettings {
+  std::string method = "auto";  // auto | shooting | simulate | newton
+  OrbitBySimulationOptions simulation;
+  OrbitByNewtonOptions newton;
+  OrbitByShootingOptions shooting;
+  long guess_periods = 100;  // newton, auto, shooting: maps simulated before the guess is taken
+  int coarse_N = 64;         // auto, shooting: the coarsest level is the last N / 8^i >= coarse_N
+};
+
+// The periodic orbit of `map` for the model's constant initial history; for a linear model the
+// zero orbit (its monodromy does not depend on the orbit). `at_orbit`, when given, receives the
+// step maps and states of one map at the orbit's history (the monodromy and the trajectory at
+// the orbit), from the orbit search's own last evaluation where it has one.
+template <class Model, class Map>
+PeriodicOrbit find_orbit(const Model& model, const Map& map, const OrbitSettings& settings,
+                         OrbitLinearisation<Model::d>* at_orbit = nullptr) {
+  auto linearise = [&](PeriodicOrbit orbit) {
+    if (at_orbit) map.apply(orbit.history, &at_orbit->maps, &at_orbit->states);
+    return orbit;
+  };
+  if constexpr (Model::is_linear) {
+    PeriodicOrbit zero;
+    zero.history = Eigen::VectorXd::Zero(map.dimension());
+    zero.residual = 0;
+    zero.method = "zero";
+    return linearise(std::move(zero));
+  } else {
+    if (settings.method == "auto" || settings.method == "shooting") {
+      NestedShootingOptions o;
+      o.shooting = settings.shooting;
+      o.newton = settings.newton;
+      o.coarse_method = settings.method == "auto" ? CoarseOrbitMethod::newton : CoarseOrbitMethod::shooting;
+      o.guess_periods = settings.guess_periods;
+      o.coarse_N = settings.coarse_N;
+      return orbit_by_nested_shooting(map, model.initial_state(), o, at_orbit);
+    }
+    Eigen::VectorXd U = map.constant_history(model.initial_state());
+    if (settings.method == "simulate") {
+      try {
+        return linearise(orbit_by_simulation(map, U, settings.simulation));
+      } catch (const NumericalFailure& e) {
+        // The usual cause: the run from the initial history lands on another attractor (the
+        // impact model's defaults from rest are chaotic). Say what to do.
+        throw NumericalFailure(std::string(e.what()) +
+                               ". To reach a periodic orbit: `--set orbit=auto` or `--set orbit=newton` (Newton on "
+                               "the periodic problem, finds unstable orbits too), an initial history near the orbit "
+                               "(x0, v0 for impact), or a scene that has one, e.g. data/scenes/default.toml");
+      }
+    }
+    for (long i = 1; i <= settings.guess_periods; ++i) {
+      U = map.apply(U);
+      if (!U.allFinite())
+        throw NumericalFailure("orbit = newton: the simulated guess diverged after " + std::to_string(i) + " periods");
+    }
+    PeriodicOrbitProblem<Map> problem(map);
+    PeriodicOrbit orbit = orbit_by_newton(map, problem.sequence_from_history(U), settings.newton);
+    orbit.maps = settings.guess_periods;
+    return linearise(std::move(orbit));
+  }
+}
+
+// Contacts of the orbit with H = 0, from the states of one map at the orbit (u_0 .. u_K).
+template <class Model>
+ContactSummary orbit_contacts(const Model& model, std::vector<Vec<Model::d>> states) {
+  states.pop_back();  // u_K = u_0 on a periodic orbit
+  return contact_summary(model, states);
+}
+
+}  // namespace delayspec

@@ -1,0 +1,47 @@
+#pragma once
+// A model compiled at run time. The C++ struct printed from a scene's equations
+// (equation_model_source.hpp: only code GiNaC printed from parsed expressions) is wrapped in a
+// translation unit that instantiates the analyses for it (ModelAnalysesFor<EquationModel>,
+// model_analyses.hpp), compiled with the compiler that built delayspec against its headers into
+// a shared object that links this same libdelayspec, and loaded with dlopen. Nothing is
+// interpreted per step: the model's steps are compiled code with the model's d fixed.
+//
+// Cache: DIR/eq-HASH.so beside its source DIR/eq-HASH.cpp. HASH covers the source, delayspec's
+// version and revision, the compiler (path, size, time) and the library it links (path, size,
+// time). A hit needs both files and the stored source equal to this one, so not even a hash
+// collision loads another model. Concurrent first runs (threads, MPI ranks, processes) take an
+// flock on DIR/eq-HASH.lock: one compiles, into temporary files renamed into place (atomic), the
+// others wait and load its object. A loaded object is never unloaded (its code runs the
+// analyses it made).
+#include <filesystem>
+#include <string>
+
+#include "delayspec/model_analyses.hpp"
+
+namespace delayspec::cli {
+
+struct EquationPlugin {
+  // The analyses of the model at the given parameter values (in the order of the source's
+  // parameters), delay, period and constant initial history (d values). The caller owns it.
+  ModelAnalyses* (*analyses)(const double* parameters, double tau, double period, const double* history) = nullptr;
+  double (*period)(const double* parameters) = nullptr;           // the `period` expression
+  double (*delay)(const double* parameters) = nullptr;            // the `delay` expression
+  void (*history)(const double* parameters, double* state) = nullptr;  // the `history` expressions
+  std::filesystem::path object;                                    // the loaded shared object
+};
+
+// Loads the model whose printed struct is `model_code`, compiling it into `cache_dir` first
+// unless a cached object exists. The compiler is the one that built delayspec, or the program
+// the environment variable DELAYSPEC_CXX names. BadInput (exit 2) when there is no compiler
+// (naming the Debian package), when the code does not compile (with the compiler's first lines)
+// and when the cache cannot be written or the object not loaded. Reports on stderr when it
+// compiles, and how long that took.
+EquationPlugin load_equation_plugin(const std::string& model_code, const std::filesystem::path& cache_dir);
+
+// Compilations this process has run (tests: a cache hit compiles nothing).
+long equation_plugin_compilations();
+
+// $XDG_CACHE_HOME/delayspec, else $HOME/.cache/delayspec (the key `model_cache` overrides it).
+std::filesystem::path default_model_cache();
+
+}  // namespace delayspec::cli
