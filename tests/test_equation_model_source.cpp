@@ -276,6 +276,9 @@ std::vector<BadTable> bad_tables() {
   add("GiNaC's constant", impact_rhs2("Pi*x"), {"`equations.rhs[2]`", "unknown name `Pi`", "did you mean `pi`?"});
   // GiNaC's evaluation
   add("complex", impact_rhs2("sqrt(-1)*x"), {"`equations.rhs[2]`", "complex"});
+  add("complex power", impact_rhs2("(-8)^(1/3)*x"), {"`equations.rhs[2]`", "complex"});
+  add("complex log", impact_rhs2("log(-2)"), {"`equations.rhs[2]`", "complex"});
+  add("complex asin", impact_rhs2("x + asin(2)"), {"`equations.rhs[2]`", "complex"});
   add("log of zero", impact_rhs2("log(0)"), {"`equations.rhs[2]`", "cannot be evaluated"});
   add("division by zero", impact_rhs2("x/(e - e)"), {"`equations.rhs[2]`", "cannot be evaluated"});
   // switches
