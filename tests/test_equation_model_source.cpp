@@ -112,6 +112,30 @@ TEST(EquationModelSource, FlagsFollowTheSecondDerivatives) {
   }
 }
 
+TEST(EquationModelSource, NamesOfGiNaCFunctionsAreOrdinaryNames) {
+  // GiNaC's parser knows beta, zeta, psi, tgamma, H, ... as functions and I, Pi as constants; a
+  // scene's names reach it only as generated keys, so these are plain parameters.
+  toml::table table{{"state", toml::array{"H", "G"}},
+                    {"parameters", toml::table{{"beta", 2}, {"zeta", 3}, {"psi", 5}, {"tgamma", 7}, {"Li", 11}, {"lst", 13}}},
+                    {"period", "beta*zeta"},
+                    {"rhs", toml::array{"psi*H + tgamma*G_tau", "Li*G - lst*H_tau"}}};
+  const SymbolicEquationModel m = analyse_equations(table, kEngineKeys);
+  EXPECT_TRUE((m.period - m.p[1] * m.p[5]).is_zero()) << m.period;  // sorted: Li beta lst psi tgamma zeta
+  EXPECT_TRUE((m.fields[0].f[0] - (m.p[3] * m.y[0] + m.p[4] * m.z[1])).is_zero()) << m.fields[0].f[0];
+  EXPECT_TRUE((m.fields[0].f[1] - (m.p[0] * m.y[1] - m.p[2] * m.z[0])).is_zero()) << m.fields[0].f[1];
+}
+
+TEST(EquationModelSource, NumbersArePrintedExactly) {
+  // 0.1 is 1/10: printed as the ratio of two exact doubles, so the division gives the double
+  // nearest to 0.1 (what the literal 0.1 gives); a 20-digit decimal is not a ratio of doubles
+  // and is printed as 17 significant digits.
+  toml::table table = scalar_table("0.1*x + 0.12345678901234567891*x_tau - 3");
+  const std::string code = generate_equation_model(table, kEngineKeys).code;
+  EXPECT_TRUE(contains(code, "(1.0/10.0)*y[0]")) << code;
+  EXPECT_TRUE(contains(code, "0.12345678901234568*z[0]")) << code;
+  EXPECT_TRUE(contains(code, " - 3.0")) << code;
+}
+
 TEST(EquationModelSource, AStateSwitchIsNeverLinearAndATimeSwitchMayBe) {
   const SymbolicEquationModel impact = analyse_equations(impact_table(), kEngineKeys);
   EXPECT_TRUE(impact.affine_in_state);
@@ -267,6 +291,7 @@ std::vector<BadTable> bad_tables() {
   add("two arguments", impact_rhs2("sin(x, v)"), {"`equations.rhs[2]`", "`,`", "position 6", "one argument"});
   add("function without argument", impact_rhs2("sin*x"), {"`equations.rhs[2]`", "`sin` without an argument"});
   add("number out of range", impact_rhs2("1e999*x"), {"`equations.rhs[2]`", "out of range"});
+  add("product out of range", impact_rhs2("1e300*1e300*x"), {"`equations.rhs[2]`", "beyond the range of a double"});
   // names in expressions
   add("unknown name", impact_rhs2("a*omgea^2*sin(omega*t)"), {"`equations.rhs[2]`", "unknown name `omgea`", "position 3", "did you mean `omega`?"});
   add("unknown delayed", impact_rhs2("k*(w_tau - v)"), {"`equations.rhs[2]`", "unknown name `w_tau`", "did you mean `v_tau`?"});

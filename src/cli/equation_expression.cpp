@@ -1,6 +1,7 @@
 #include "equation_expression.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <optional>
 #include <vector>
@@ -275,6 +276,8 @@ class ExpressionReader {
         complex = !GiNaC::is_a<GiNaC::numeric>(number) || !GiNaC::ex_to<GiNaC::numeric>(number).is_real();
       }
       if (complex) fail_whole("has a complex value (e.g. sqrt or log of a negative number, asin(2))");
+      if (GiNaC::is_a<GiNaC::numeric>(*it) && !std::isfinite(GiNaC::ex_to<GiNaC::numeric>(*it).to_double()))
+        fail_whole("has a number beyond the range of a double");
     }
     return value;
   }
