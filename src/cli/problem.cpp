@@ -4,6 +4,7 @@
 
 #include "delayspec/builtin_analyses.hpp"
 #include "delayspec/errors.hpp"
+#include "equation_model.hpp"
 
 namespace delayspec::cli {
 
@@ -143,7 +144,9 @@ Problem read_problem(Config& config, int default_N) {
     problem.state_names = problem.state_dimension() == 2 ? std::vector<std::string>{"x", "v"}
                                                          : std::vector<std::string>{"x"};
   } else {
-    throw BadInput("`model = equations`: not wired yet");
+    EquationModel equations = read_equation_model(config);
+    problem.analyses = std::move(equations.analyses);
+    problem.state_names = std::move(equations.state);
   }
   // N up to 1e9 (the history alone is then 16 GB at d = 2); orbit_period and contact_substeps
   // multiply the work per step or per period, 1000 is far beyond any use.

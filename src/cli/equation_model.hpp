@@ -1,0 +1,31 @@
+#pragma once
+// model = equations: a model written in the scene's [equations] table (docs/models.md). The
+// table is checked, differentiated and printed as C++ by GiNaC (equation_model_source.hpp), then
+// compiled at run time and loaded (equation_plugin.hpp). Its parameters are keys like those of
+// any model (`--set k=0.3`, sweep_key, chart_x), read here with the table's values as defaults,
+// so a new parameter value never recompiles. The delay is the `delay` expression, or
+// tau_over_T times the period when that key is given.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+#include "delayspec/model_analyses.hpp"
+
+namespace delayspec::cli {
+
+struct EquationModel {
+  std::vector<std::string> state;       // the state's names (output columns)
+  std::vector<std::string> parameters;  // the parameters' names (keys)
+  std::shared_ptr<const ModelAnalyses> analyses;
+};
+
+// Reads the [equations] table (kept whole by Config as the key `equations`), the parameter keys,
+// tau_over_T and model_cache. BadInput for every input error, naming the item.
+EquationModel read_equation_model(Config& config);
+
+// The keys an equation parameter may not be named after: those the engine reads whatever the
+// model (N, nev, seed, ...), and model, equations, tau_over_T and model_cache.
+std::vector<std::string> engine_keys();
+
+}  // namespace delayspec::cli
