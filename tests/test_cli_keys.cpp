@@ -190,7 +190,8 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"milling_lobes", "chart"},
                                                        {"milling_lobes_full", "chart"},
                                                        {"milling_point", "converge"},
-                                                       {"equations_impact", "floquet"}};
+                                                       {"equations_impact", "floquet"},
+                                                       {"equations_two_oscillators", "floquet"}};
   const fs::path cache = fresh_dir("keys_scenes_model_cache");  // equation models compile here
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
