@@ -128,9 +128,9 @@ Toolchain toolchain() {
   const auto includes = std::filesystem::exists(installed / "delayspec" / "version.hpp")
                             ? std::vector<std::string>{installed.lexically_normal().string(), DELAYSPEC_PLUGIN_EIGEN_INCLUDE}
                             : split(DELAYSPEC_PLUGIN_BUILD_INCLUDES);
-  // -O3 as the library's own Release build, so that the model runs as fast as a built-in one;
-  // -fno-math-errno as the library (CMakeLists.txt: repeated sin/cos are evaluated once).
-  tc.flags = {"-std=c++20", "-O3", "-DNDEBUG", "-fno-math-errno", "-fPIC", "-shared", "-fvisibility=hidden",
+  // The optimisation and sanitizer flags of this build come with DELAYSPEC_PLUGIN_FLAGS
+  // (CMakeLists.txt); -fno-math-errno as the library (repeated sin/cos are evaluated once).
+  tc.flags = {"-std=c++20", "-DNDEBUG", "-fno-math-errno", "-fPIC", "-shared", "-fvisibility=hidden",
               "-fvisibility-inlines-hidden", "-w"};
   for (const auto& f : split_words(DELAYSPEC_PLUGIN_FLAGS)) tc.flags.push_back(f);
   for (const auto& dir : includes) tc.flags.push_back("-I" + dir);
