@@ -137,9 +137,19 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
   const size_t need = static_cast<size_t>(M + 1 + K) * D * k;
   if (block_work_.size() < need) block_work_.resize(need);
   double* b = block_work_.data();
-  interleave(X, ldx, n_, k, b);  // b[(j D + r) k + v] = X(j D + r, v)
+  // b[(j D + r) k + v] = X(j D + r, v); K steps; the result (slots K .. K + M) back into Y
+  if constexpr (kHasAvx2Kernel) {
+    if (path_ == KernelPath::avx2) {
+      detail::transpose_avx2(X, ldx, k, n_, b, k);
+      run_steps(b, k);
+      detail::transpose_avx2(b + K * D * k, k, n_, k, Y, ldy);
+      applications_ += k;
+      return;
+    }
+  }
+  interleave(X, ldx, n_, k, b);
   run_steps(b, k);
-  deinterleave(b + K * D * k, n_, k, Y, ldy);  // the result: slots K .. K + M
+  deinterleave(b + K * D * k, n_, k, Y, ldy);
   applications_ += k;
 }
 
