@@ -20,6 +20,7 @@
 #include "delayspec/floquet.hpp"
 #include "delayspec/version.hpp"
 #include "delayspec_test_paths.hpp"
+#include "equation_model.hpp"
 #include "equation_model_source.hpp"
 #include "equation_plugin.hpp"
 #include "problem.hpp"
@@ -31,26 +32,28 @@ namespace {
 
 const std::string kScene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/equations_impact.toml";
 
+// The program's own model cache, removed when the program ends.
+struct CacheDirectory {
+  std::filesystem::path path;
+  ~CacheDirectory() { std::filesystem::remove_all(path); }
+};
 std::string cache_dir() {
-  static const std::string dir =
-      (std::filesystem::temp_directory_path() / ("delayspec-bench-equations-" + std::to_string(::getpid()))).string();
-  return dir;
+  static const CacheDirectory dir{std::filesystem::temp_directory_path() / ("delayspec-bench-equations-" + std::to_string(::getpid()))};
+  return dir.path.string();
 }
 
-// The problem as equations (range 1) or as the built-in model (range 0), at N.
+// The problem as equations or as the built-in model with the scene's values, at N.
 cli::Problem impact(bool equations, int N) {
-  cli::Config config = cli::Config::from_scene_file(kScene);
-  config.set("model_cache", cache_dir(), "bench");
+  cli::Config config = equations ? cli::Config::from_scene_file(kScene) : cli::Config();
+  if (equations) {
+    config.set("model_cache", cache_dir(), "bench");
+  } else {  // equations_impact.toml's values: the built-in defaults but k and the history
+    config.set("model", "impact", "bench");
+    config.set("x0", "-0.0566", "bench");
+    config.set("v0", "1.0101", "bench");
+  }
   config.set("N", std::to_string(N), "bench");
   config.set("k", "0.55", "bench");
-  if (!equations) {
-    cli::Config builtin;
-    for (const char* key : {"zeta", "e", "a", "beta", "omega", "k"})
-      builtin.set(key, config.get_string(key, ""), "bench");
-    builtin.set("model", "impact", "bench");
-    builtin.set("N", std::to_string(N), "bench");
-    return cli::read_problem(builtin);
-  }
   return cli::read_problem(config);
 }
 

@@ -117,26 +117,56 @@ std::string key_text(const std::string& key, py::handle value) {
                  " (give a number, a string, a boolean or a list of them)");
 }
 
-// A dict standing for a scene file, read as config.cpp reads one: nested dicts are tables, flattened
-// (a key may appear once in all), and a key another command reads is no error.
-void read_scene_dict(const py::dict& table, Config& config, std::set<std::string>& seen) {
-  const std::string name = "the scene dict";
-  for (auto [k, v] : table) {
-    const std::string key = py::str(k);
-    if (py::isinstance<py::dict>(v)) {
-      read_scene_dict(v.cast<py::dict>(), config, seen);
-      continue;
-    }
-    if (!seen.insert(key).second) throw BadInput(name + ": key `" + key + "` is given twice");
-    config.set_from_scene(key, key_text(key, v), name);
+// A Python value of a scene dict -> the TOML node a scene file would hold: booleans, integers,
+// floats, strings, sequences as arrays, dicts as tables (numpy scalars and arrays as the Python
+// values they hold). Config then reads the table as it reads a file (one rule for both).
+template <class X>
+void add(toml::table& table, const std::string& key, X&& x) {
+  table.insert_or_assign(key, std::forward<X>(x));
+}
+template <class X>
+void add(toml::array& array, const std::string&, X&& x) {
+  array.push_back(std::forward<X>(x));
+}
+
+// Adds `value` to `into` (a table: under `key`; an array: at its end).
+template <class Container>
+void add_scene_value(Container& into, const std::string& key, py::handle value) {
+  if (py::isinstance<py::dict>(value)) {
+    toml::table table;
+    for (auto [k, v] : value.cast<py::dict>()) add_scene_value(table, py::str(k), v);
+    return add(into, key, std::move(table));
   }
+  if (py::isinstance<py::bool_>(value)) return add(into, key, value.cast<bool>());
+  if (py::isinstance<py::str>(value)) return add(into, key, value.cast<std::string>());
+  if (py::hasattr(value, "__array__") && py::hasattr(value, "ndim"))
+    return add_scene_value(into, key, value.attr(value.attr("ndim").cast<int>() == 0 ? "item" : "tolist")());
+  PyObject* p = value.ptr();
+  if (PyLong_Check(p)) {
+    const long long v = PyLong_AsLongLong(p);
+    if (v == -1 && PyErr_Occurred()) {  // beyond 64 bits: its digits, which the key's reader refuses by name
+      PyErr_Clear();
+      return add(into, key, std::string(py::str(value)));
+    }
+    return add(into, key, static_cast<int64_t>(v));
+  }
+  if (PyFloat_Check(p)) return add(into, key, value.cast<double>());
+  if (py::isinstance<py::sequence>(value)) {
+    toml::array array;
+    for (py::handle element : value) add_scene_value(array, key, element);
+    return add(into, key, std::move(array));
+  }
+  throw BadInput("`" + key + "`: a value of Python type " +
+                 py::str(py::type::handle_of(value).attr("__name__")).cast<std::string>() +
+                 " (give a number, a string, a boolean or a list of them)");
 }
 
 Config make_config(const py::object& scene, const py::dict& keys, std::optional<std::string>& scene_path) {
   Config config;
   if (py::isinstance<py::dict>(scene)) {
-    std::set<std::string> seen;
-    read_scene_dict(scene.cast<py::dict>(), config, seen);
+    toml::table table;
+    for (auto [k, v] : scene.cast<py::dict>()) add_scene_value(table, py::str(k), v);
+    config = Config::from_scene_table(table, "the scene dict");
   } else if (!scene.is_none()) {
     scene_path = py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>();
     config = Config::from_scene_file(*scene_path);

@@ -189,19 +189,24 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"continue_pwsdde_k", "continue"},
                                                        {"milling_lobes", "chart"},
                                                        {"milling_lobes_full", "chart"},
-                                                       {"milling_point", "converge"}};
+                                                       {"milling_point", "converge"},
+                                                       {"equations_impact", "floquet"},
+                                                       {"equations_two_oscillators", "floquet"}};
+  const fs::path cache = fresh_dir("keys_scenes_model_cache");  // equation models compile here
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
     if (entry.path().extension() != ".toml") continue;
     ++scenes;
     const std::string name = entry.path().stem().string();
     delayspec::cli::Config config = delayspec::cli::Config::from_scene_file(entry.path().string());
+    if (config.has("equations")) config.set("model_cache", cache.string(), "test");
     delayspec::cli::RunPlan plan;
     ASSERT_NO_THROW(plan = delayspec::cli::plan_run(config)) << name;
     ASSERT_TRUE(expected.count(name)) << "new scene " << name << ": add its analysis here";
     EXPECT_EQ(plan.analyses, std::vector<std::string>{expected.at(name)}) << name;
   }
   EXPECT_EQ(scenes, static_cast<int>(expected.size()));
+  fs::remove_all(cache);
 }
 
 TEST(Scenes, Fig63RunsWithRunAtReducedSize) {

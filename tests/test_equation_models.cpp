@@ -15,6 +15,8 @@
 #include <complex>
 #include <filesystem>
 
+#include <unistd.h>
+
 #include "config.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/lambert_w.hpp"
@@ -58,10 +60,14 @@ history = { x = 1 }
 )scene";
 
 // The test's own cache, so that the first test of a run compiles and the rest reuse it.
+// The program's own model cache, removed when the program ends.
+struct CacheDirectory {
+  std::filesystem::path path;
+  ~CacheDirectory() { std::filesystem::remove_all(path); }
+};
 std::string cache_dir() {
-  static const std::string dir =
-      (std::filesystem::temp_directory_path() / ("delayspec-equation-models-" + std::to_string(::getpid()))).string();
-  return dir;
+  static const CacheDirectory dir{std::filesystem::temp_directory_path() / ("delayspec-equation-models-" + std::to_string(::getpid()))};
+  return dir.path.string();
 }
 
 Problem problem_from(const std::string& scene, const std::vector<std::pair<std::string, std::string>>& sets) {
@@ -199,6 +205,38 @@ TEST(EquationModels, ThreeDimensionalCoupledSystemHasOrderTwoAgainstLambertW) {
     for (auto mu : linear_dde_multipliers(a[i], b[i], 1, 1, 6)) exact.push_back(mu);
   const std::vector<double> e = errors_against(scene, exact, 4);
   EXPECT_NEAR(observed_order(e), 2.0, 0.05) << e[0] << " " << e[1] << " " << e[2];
+}
+
+TEST(EquationModels, TimeWindowHasOrderTwoLocatedAndOneNotAgainstTheExactMultiplier) {
+  // x' = a1 x inside the window sin(2 pi t) > c, x' = a2 x outside: a scalar linear ODE over one
+  // period T = 1, so the multiplier is exp(a1 w + a2 (1 - w)) exactly, w the window's length
+  // (pi - 2 asin c) / (2 pi). The window's ends are irrational: never on a grid node. The delay
+  // term is absent (the delayed state is only carried), so mu_1 is the only non-zero multiplier.
+  const char* scene = R"scene(model = "equations"
+[equations]
+state = ["x"]
+parameters = { a1 = -2, a2 = 0.5, c = 0.3 }
+period = "1"
+delay = "1"
+rhs = ["a2*x"]
+switch = "sin(2*pi*t) - c"
+rhs_switched = ["a1*x"]
+history = { x = 1 }
+)scene";
+  const double w = (M_PI - 2 * std::asin(0.3)) / (2 * M_PI);
+  const std::vector<std::complex<double>> exact = {std::exp(-2 * w + 0.5 * (1 - w))};
+  EXPECT_TRUE(problem_from(scene, {}).analyses->switches_in_time());
+  const std::vector<double> located = errors_against(scene, exact, 1);
+  // The time-switched step is the trapezoid on each piece: second order (design.md 1.5b).
+  EXPECT_NEAR(observed_order(located), 2.0, 0.1) << located[0] << " " << located[1] << " " << located[2];
+  std::vector<double> plain;
+  for (int N : {50, 100, 200}) {
+    const auto mu = spectrum(problem_from(scene, {{"N", std::to_string(N)}, {"events", "off"}}), 1).multipliers;
+    plain.push_back(std::abs(mu[0] - exact[0]));
+  }
+  // Each node in the branch of its own time: the jump costs O(h) (design.md 1.5b).
+  EXPECT_LT(observed_order(plain), 1.5) << plain[0] << " " << plain[1] << " " << plain[2];
+  EXPECT_GT(plain[2], 10 * located[2]);
 }
 
 TEST(EquationModels, AParameterChangeReachesTheModelWithoutRecompiling) {

@@ -194,6 +194,13 @@ Config Config::from_scene_file(const std::string& path) { return parse_scene(pat
 
 Config Config::from_scene_text(const std::string& text, const std::string& name) { return parse_scene(name, &text); }
 
+Config Config::from_scene_table(const toml::table& table, const std::string& name) {
+  Config config;
+  std::set<std::string> seen;
+  flatten(table, config, name, seen);
+  return config;
+}
+
 void Config::set_from_assignment(const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos) throw BadInput("`--set " + assignment + "`: expected KEY=VALUE");

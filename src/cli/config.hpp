@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include <toml++/toml.h>
+
 namespace delayspec::cli {
 
 class Config {
@@ -25,6 +27,8 @@ class Config {
   static Config from_scene_file(const std::string& path);
   // Parses TOML text; `name` stands for the file in messages. BadInput when it cannot be parsed.
   static Config from_scene_text(const std::string& text, const std::string& name);
+  // A scene already parsed (the Python module's dict scenes): flattened as a file's.
+  static Config from_scene_table(const toml::table& table, const std::string& name);
 
   // Applies "KEY=VALUE" (BadInput when there is no '=' or the key is empty).
   void set_from_assignment(const std::string& assignment);

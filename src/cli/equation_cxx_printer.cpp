@@ -1,9 +1,13 @@
 #include "equation_cxx_printer.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 #include <vector>
+
+#include "delayspec/errors.hpp"
 
 namespace delayspec::cli {
 
@@ -137,11 +141,11 @@ void print_factors(GiNaC::numeric coefficient, const std::vector<GiNaC::ex>& fac
   }
   std::string text = joined(numerator);
   if (text.empty()) {
-    text = text_at(coefficient, kProductPrecedence);
+    text = text_at(coefficient, 0);
   } else if (coefficient == -1) {
     text = "-" + text;
   } else if (coefficient != 1) {
-    text = text_at(coefficient, kProductPrecedence) + "*" + text;
+    text = text_at(coefficient, 0) + "*" + text;
   }
   if (!denominator.empty())
     text += denominator.size() == 1 ? "/" + denominator[0] : "/(" + joined(denominator) + ")";
@@ -181,11 +185,37 @@ void print_power(const GiNaC::power& power, const print_sorted_csrc& c, unsigned
   }
 }
 
+// A number (always rational here: the expressions' numbers are exact): p.0 or (p.0/q.0) when p
+// and q are doubles exactly (|p|, q <= 2^53: the division is then correctly rounded), else the
+// double nearest to p/q (CLN's conversion) with 17 significant digits, which reads back as
+// that double. A sign is written in front, never in parentheses (leads_with_minus reads it).
+void print_number(const GiNaC::numeric& number, const print_sorted_csrc& c, unsigned) {
+  const GiNaC::numeric exact_limit = GiNaC::numeric(2).power(53);
+  const GiNaC::numeric p = GiNaC::abs(number.numer()), q = number.denom();
+  const std::string sign = number.is_negative() ? "-" : "";
+  if (number.is_rational() && p <= exact_limit && q <= exact_limit) {
+    if (q == 1) {
+      c.s << sign << p.to_long() << ".0";
+    } else {
+      c.s << sign << "(" << p.to_long() << ".0/" << q.to_long() << ".0)";
+    }
+    return;
+  }
+  const double value = number.to_double();
+  if (!std::isfinite(value) || !number.is_real())
+    throw BadInput("a constant of the model, " + format_number(value) + ", is not a finite real double");
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  const std::string digits = text;
+  c.s << digits << (digits.find_first_of(".e") == std::string::npos ? ".0" : "");
+}
+
 void register_printers() {
   static const bool registered = [] {
     GiNaC::set_print_func<GiNaC::add, print_sorted_csrc>(print_sum);
     GiNaC::set_print_func<GiNaC::mul, print_sorted_csrc>(print_product);
     GiNaC::set_print_func<GiNaC::power, print_sorted_csrc>(print_power);
+    GiNaC::set_print_func<GiNaC::numeric, print_sorted_csrc>(print_number);
     return true;
   }();
   (void)registered;

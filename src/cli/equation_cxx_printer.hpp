@@ -5,9 +5,10 @@
 // symbol serial numbers and on addresses (they differ between runs and between two readings of
 // one scene in one process): its printed text, and the rounding of the sum, would change from
 // run to run, and so would the plugin's cache key. This printer is GiNaC's C source printing for
-// doubles (print_csrc_double: numbers as ratios of doubles or with 17 significant digits, which
-// read back as the same double; powers, functions) with sums and products printed with their
-// operands sorted by their text.
+// doubles (print_csrc_double, which prints the functions) with its own printing of numbers
+// (exactly: ratios of exact doubles, or 17 significant digits), sums and products (operands
+// sorted by their text, a sum as a factor with a fixed sign) and powers (integer powers as
+// products, sqrt, pow).
 #include <string>
 
 #include <ginac/ginac.h>

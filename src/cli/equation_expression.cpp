@@ -1,6 +1,7 @@
 #include "equation_expression.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <optional>
 #include <vector>
@@ -31,6 +32,10 @@ constexpr long kMaxExponent = 400;
 bool is_letter(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+
+bool has_symbol(const GiNaC::ex& e) {
+  return std::any_of(e.preorder_begin(), e.preorder_end(), [](const GiNaC::ex& x) { return GiNaC::is_a<GiNaC::symbol>(x); });
+}
 
 std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
 
@@ -257,9 +262,22 @@ class ExpressionReader {
     } catch (const std::exception& e) {  // GiNaC's evaluation: 1/0, log(0), tan(pi/2) (pole_error)
       fail_whole("cannot be evaluated: " + first_line(e.what()));
     }
+    // Complex constants: I (sqrt(-1)) or a constant function or power that GiNaC keeps
+    // unevaluated but whose value is complex (log(-2), asin(2), (-8)^(1/3)): C++ would compute NaN.
     for (auto it = value.preorder_begin(); it != value.preorder_end(); ++it) {
-      if (GiNaC::is_a<GiNaC::numeric>(*it) && !GiNaC::ex_to<GiNaC::numeric>(*it).is_real())
-        fail_whole("has a complex value (e.g. sqrt or log of a negative constant)");
+      bool complex = GiNaC::is_a<GiNaC::numeric>(*it) && !GiNaC::ex_to<GiNaC::numeric>(*it).is_real();
+      if ((GiNaC::is_a<GiNaC::function>(*it) || GiNaC::is_a<GiNaC::power>(*it)) && !has_symbol(*it)) {
+        GiNaC::ex number;
+        try {
+          number = GiNaC::evalf(*it);
+        } catch (const std::exception& e) {
+          fail_whole("cannot be evaluated: " + first_line(e.what()));
+        }
+        complex = !GiNaC::is_a<GiNaC::numeric>(number) || !GiNaC::ex_to<GiNaC::numeric>(number).is_real();
+      }
+      if (complex) fail_whole("has a complex value (e.g. sqrt or log of a negative number, asin(2))");
+      if (GiNaC::is_a<GiNaC::numeric>(*it) && !std::isfinite(GiNaC::ex_to<GiNaC::numeric>(*it).to_double()))
+        fail_whole("has a number beyond the range of a double");
     }
     return value;
   }

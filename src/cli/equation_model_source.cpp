@@ -49,8 +49,14 @@ class ModelPrinter {
          << "  double period() const { return period_; }\n"
          << "  Vector initial_state() const { return history_; }\n"
          << "  // The functions of the expressions, as <cmath>'s (the printed expressions call them unqualified).\n";
+    // sin and cos through the per-thread memo of the built-in models (detail/remembered_trig.hpp,
+    // the same values bit for bit): a forcing term sin(w t) is evaluated at one t by f, f_t,
+    // f_tt, the event test and the next step's left node. Measured on the impact equations,
+    // lyapunov N = 1000, 1e4 periods (bench_equations): 1.43 s with std::sin, 1.24 s with the
+    // memo, against 1.07 s for the built-in model.
     for (const auto& f : equation_functions())
-      out_ << "  static double " << f << "(double x) { return std::" << f << "(x); }\n";
+      out_ << "  static double " << f << "(double x) { return "
+           << (f == "sin" || f == "cos" ? "delayspec::detail::remembered_" : "std::") << f << "(x); }\n";
     out_ << "  static double pow(double x, double y) { return std::pow(x, y); }\n"
          << "  static constexpr double " << pi_.get_name() << " = " << "3.141592653589793238462643383279502884;\n";
     out_ << "  static double period_of([[maybe_unused]] const double* p) { return " << cxx(m_.period) << "; }\n"

@@ -93,7 +93,7 @@ const KeyReaders& key_readers() {
 const std::map<std::string, std::string>& key_meanings() {
   static const std::map<std::string, std::string> meanings = {
       // the problem (problem.cpp)
-      {"model", "the system: impact, linear, mathieu, mackey-glass, milling"},
+      {"model", "the system: impact, linear, mathieu, mackey-glass, milling, equations (the scene's [equations])"},
       {"N", "steps per delay (h = tau / N), integer >= 1"},
       {"orbit_period", "forcing periods per stroboscopic map (period-p orbits; forced models only)"},
       {"events", "impact events: on (located), linear (first-order estimate), off"},

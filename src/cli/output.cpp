@@ -96,8 +96,9 @@ void print_orbit(std::ostream& out, const PeriodicOrbit& orbit, const ContactSum
           << l.seconds << ";";
     out << "\n";
   }
-  out << "  contacts per map: " << contacts.contacts << " (" << contacts.nodes_in_contact
-      << " grid nodes in contact, max H = " << contacts.max_H << ")\n";
+  if (!std::isnan(contacts.max_H))  // NaN: the model has no switching surface
+    out << "  contacts per map: " << contacts.contacts << " (" << contacts.nodes_in_contact
+        << " grid nodes in contact, max H = " << contacts.max_H << ")\n";
 }
 
 }  // namespace delayspec::cli

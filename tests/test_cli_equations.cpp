@@ -1,0 +1,164 @@
+// model = equations through the command line: every command the issue names runs an equation
+// model from a scene file (floquet, lyapunov, simulate, sweep, chart, basin, converge, bench,
+// run); the numbers equal the built-in linear model's (the same discrete problem); the commands
+// that only built-in models support refuse it with exit 2; bad equations exit 2 naming the item.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_test_support.hpp"
+
+namespace {
+
+using delayspec::testing::CliResult;
+using delayspec::testing::contains;
+using delayspec::testing::fresh_dir;
+using delayspec::testing::run;
+using delayspec::testing::with_sets;
+
+// x' = a x + b x(t - tau), the built-in linear model (a = -1, b = 0.5, tau = T = 1), with its
+// initial history a parameter so that basin has two axes.
+const char* kScene = R"scene(model = "equations"
+[equations]
+state = ["x"]
+parameters = { a = -1, b = 0.5, x0 = 1 }
+period = "1"
+delay = "1"
+rhs = ["a*x + b*x_tau"]
+history = { x = "x0" }
+)scene";
+
+class EquationsCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fresh_dir("equations_cli");
+    std::filesystem::create_directories(dir_);
+    scene_ = (dir_ / "linear.toml").string();
+    std::ofstream(scene_) << kScene;
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+  // COMMAND on the scene with the test's own model cache and `sets`.
+  static CliResult command(const std::string& name, std::vector<std::string> sets, const std::string& scene = scene_) {
+    sets.push_back("model_cache=" + (dir_ / "cache").string());
+    return run(with_sets({name, scene, "--json"}, sets));
+  }
+  static std::filesystem::path dir_;
+  static std::string scene_;
+};
+std::filesystem::path EquationsCli::dir_;
+std::string EquationsCli::scene_;
+
+TEST_F(EquationsCli, FloquetEqualsTheBuiltInLinearModel) {
+  const CliResult eq = command("floquet", {"N=50", "nev=3", "solver=dense"});
+  ASSERT_EQ(eq.status, 0) << eq.err;
+  const CliResult builtin = run(with_sets({"floquet", "--json"}, {"model=linear", "N=50", "nev=3", "solver=dense"}));
+  ASSERT_EQ(builtin.status, 0) << builtin.err;
+  const auto a = nlohmann::json::parse(eq.out), b = nlohmann::json::parse(builtin.out);
+  EXPECT_EQ(a["model"], "equations");
+  EXPECT_EQ(a["dimension"], b["dimension"]);
+  for (size_t k = 0; k < 3; ++k)
+    for (const char* part : {"re", "im"}) {
+      // The same discrete problem, the same LAPACK call: a few ulp of the compiled coefficients.
+      const double x = a["multipliers"][k][part], y = b["multipliers"][k][part];
+      EXPECT_NEAR(x, y, 1e-13) << k << part;
+    }
+}
+
+TEST_F(EquationsCli, EveryAnalysisCommandRunsIt) {
+  struct Case {
+    const char* command;
+    std::vector<std::string> sets;
+    const char* field;  // a field of the command's JSON that carries its result
+  };
+  const std::vector<Case> cases = {
+      {"lyapunov", {"N=20", "periods=20", "exponents=1"}, "exponents_per_period"},
+      {"simulate", {"N=20", "t_end=2"}, "samples"},
+      {"sweep", {"N=20", "periods=10", "exponents=1", "sweep_key=b", "sweep_from=0", "sweep_to=0.5", "sweep_points=3"},
+       "points"},
+      {"chart",
+       {"N=20", "chart_x=a", "chart_x_range=-2,-1", "chart_x_points=2", "chart_y=b", "chart_y_range=0,0.5",
+        "chart_y_points=2"},
+       "rows"},
+      {"basin",
+       {"N=20", "basin_x=x0", "basin_x_range=0,1", "basin_x_points=2", "basin_y=b", "basin_y_range=0,0.5",
+        "basin_y_points=2", "basin_transient=5", "basin_max_period=2"},
+       "rows"},
+      {"converge", {"Ns=20,40,80", "nev=2"}, "rows"},
+      {"bench", {"Ns=20,40", "nev=2", "solvers=arpack,dense-lapack"}, "rows"},
+  };
+  for (const auto& c : cases) {
+    const CliResult r = command(c.command, c.sets);
+    ASSERT_EQ(r.status, 0) << c.command << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(j.contains(c.field)) << c.command << ": " << r.out.substr(0, 400);
+  }
+  // The chart's points carry the spectral radius of x' = a x + b x_tau: below 1 for b < -a.
+  const auto chart = nlohmann::json::parse(command("chart", cases[3].sets).out);
+  for (const auto& row : chart["rows"]) EXPECT_LT(row["spectral_radius"].get<double>(), 1) << row.dump();
+}
+
+TEST_F(EquationsCli, RunComputesTheScenesAnalyses) {
+  const std::string scene = (dir_ / "run.toml").string();
+  std::ofstream(scene) << "analyses = [\"floquet\", \"lyapunov\"]\nN = 20\nperiods = 10\n" << kScene;
+  const std::filesystem::path out = dir_ / "run-out";
+  const CliResult r =
+      run({"run", scene, "--out", out.string(), "--quiet", "--set", "model_cache=" + (dir_ / "cache").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(out / "floquet.json"));
+  EXPECT_TRUE(std::filesystem::exists(out / "lyapunov.json"));
+}
+
+TEST_F(EquationsCli, ContinuationRefusesItWithExitTwo) {
+  const CliResult r = command("continue", {"continue_key=b", "continue_from=0", "continue_to=0.4", "N=20"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "built-in models only")) << r.err;
+}
+
+TEST_F(EquationsCli, BadEquationsExitTwoNamingTheItem) {
+  struct Case {
+    std::string from, to, expected;
+  };
+  const std::vector<Case> cases = {
+      {"rhs = [\"a*x + b*x_tau\"]", "rhs = [\"a*x + b*x_tua\"]", "x_tau"},       // unknown symbol: did you mean
+      {"rhs = [\"a*x + b*x_tau\"]", "rhs = [\"a*x + (b*x_tau\"]", "equations.rhs"},  // parse error
+      {"rhs = [\"a*x + b*x_tau\"]", "rhs = [\"a*x\", \"x\"]", "equations.rhs"},  // wrong length
+      {"x0 = 1 }", "x0 = 1, nev = 2 }", "nev"},                                   // an engine key
+  };
+  for (const auto& c : cases) {
+    std::string text = kScene;
+    const auto at = text.find(c.from);
+    ASSERT_NE(at, std::string::npos) << c.from;
+    text.replace(at, c.from.size(), c.to);
+    const std::string scene = (dir_ / "bad.toml").string();
+    std::ofstream(scene) << text;
+    const CliResult r = command("floquet", {"N=20"}, scene);
+    EXPECT_EQ(r.status, 2) << c.to << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, c.expected)) << c.to << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+TEST_F(EquationsCli, NoCompilerExitsTwoNamingThePackage) {
+  // A model no other test compiles (another history), so that this process must compile it.
+  std::string text = kScene;
+  text.replace(text.find("x0 = 1 }"), 8, "x0 = 1, unused_in_other_tests = 3 }");
+  const std::string scene = (dir_ / "nocompiler.toml").string();
+  std::ofstream(scene) << text;
+  ::setenv("DELAYSPEC_CXX", "/nonexistent/c++", 1);
+  const CliResult r = command("floquet", {"N=20"}, scene);
+  ::unsetenv("DELAYSPEC_CXX");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "Debian package g++")) << r.err;
+}
+
+TEST_F(EquationsCli, MissingTableIsBadInput) {
+  const CliResult r = run({"floquet", "--set", "model=equations"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "[equations]")) << r.err;
+}
+
+}  // namespace
