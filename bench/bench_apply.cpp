@@ -1,12 +1,16 @@
 // Monodromy::apply_block against its roofline on this machine (design.md 1.4).
 //
-//  BM_ApplyBlock/N/k   apply_block of the delayed Mathieu monodromy (d = 2, tau = T, K = N steps)
-//                      to k vectors. Counters: ns per step per vector, and the achieved rates
-//                      under the traffic model below.
+//  BM_ApplyBlock/N/k/path   apply_block of the delayed Mathieu monodromy (d = 2, tau = T, K = N
+//                      steps) to k vectors, on kernel path 0 = main's kernel before issue 17
+//                      (kernels_before.hpp), 1 = baseline (portable build), 2 = dispatched (AVX2 +
+//                      FMA where the CPU has it; kernel_dispatch.hpp). Counters: ns per step per
+//                      vector, and the achieved rates under the traffic model below.
+//  BM_PerformOp/N/path single-vector perform_op on the same operator and paths: ns per step.
 //  BM_Triad/n          STREAM-like triad a = b + s c over n doubles per array: memory bandwidth
 //                      (24 bytes per element moved, write-allocate not counted, as in STREAM).
-//  BM_PeakFma          the kernel's own arithmetic, out += p a + q b + r c, on L1-resident
-//                      vectors of length 32: the attainable flop rate with these compiler flags.
+//  BM_PeakFma/isa      the kernel's own arithmetic, out += p a + q b + r c, on L1-resident
+//                      vectors of length 32: the attainable flop rate with the default flags
+//                      (isa 0) and with AVX2 + FMA (isa 1, what the dispatched path may use).
 //
 // Traffic model of one apply_block (n = d (N + 1), K steps, k vectors), in doubles:
 //   interleave X into the buffer (read + write n k), each step reads the delayed slot and writes
@@ -16,8 +20,10 @@
 // working-set size (buffer (N + 1 + K) d k doubles + step maps).
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
 #include <vector>
 
+#include "kernels_before.hpp"
 #include "delayspec/model_mathieu.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
@@ -25,7 +31,12 @@ namespace {
 
 using namespace delayspec;
 
-Monodromy<2> mathieu_monodromy(int N) {
+enum Variant { kBefore = 0, kBaseline = 1, kDispatched = 2 };
+
+// The operator on the kernel path of `variant` (DELAYSPEC_KERNEL is read at construction).
+Monodromy<2> mathieu_monodromy(int N, long variant = kDispatched) {
+  if (variant == kBaseline) setenv("DELAYSPEC_KERNEL", "baseline", 1);
+  else unsetenv("DELAYSPEC_KERNEL");
   const MathieuModel model({.kappa = 0.1, .delta = 1, .eps = 1, .b = 0.2});
   TrapezoidStepper<MathieuModel> stepper(model);
   StroboscopicMap<MathieuModel> map(stepper, make_grid(model.tau(), model.period(), N));
@@ -34,12 +45,15 @@ Monodromy<2> mathieu_monodromy(int N) {
 
 void BM_ApplyBlock(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
-  const long k = state.range(1);
-  const Monodromy<2> op = mathieu_monodromy(N);
+  const long k = state.range(1), variant = state.range(2);
+  const Monodromy<2> op = mathieu_monodromy(N, variant);
+  state.SetLabel(variant == kBefore ? "before" : kernel_path_name(op.kernel_path()));
   const long n = op.rows(), K = op.grid().K, d = 2;
   Eigen::MatrixXd X = Eigen::MatrixXd::Random(n, k), Y(n, k);
+  std::vector<double> work;
   for (auto _ : state) {
-    op.apply_block(X, Y);
+    if (variant == kBefore) before::apply_block(op, X.data(), k, Y.data(), work);
+    else op.apply_block(X, Y);
     benchmark::DoNotOptimize(Y.data());
     benchmark::ClobberMemory();
   }
@@ -52,7 +66,26 @@ void BM_ApplyBlock(benchmark::State& state) {
   state.counters["GFlops"] = benchmark::Counter(iters * flops * 1e-9, benchmark::Counter::kIsRate);
   state.counters["working_set_KiB"] = (8.0 * ((N + 1 + K) * d * k + 9.0 * d * d * K / 3.0)) / 1024.0;
 }
-BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 4, 8, 16, 32}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 4, 8, 16, 32}, {0, 1, 2}})->Unit(benchmark::kMicrosecond);
+
+void BM_PerformOp(benchmark::State& state) {
+  const int N = static_cast<int>(state.range(0));
+  const long variant = state.range(1);
+  const Monodromy<2> op = mathieu_monodromy(N, variant);
+  state.SetLabel(variant == kBefore ? "before" : kernel_path_name(op.kernel_path()));
+  const long n = op.rows(), K = op.grid().K;
+  Eigen::VectorXd x = Eigen::VectorXd::Random(n), y(n);
+  std::vector<double> work;
+  for (auto _ : state) {
+    if (variant == kBefore) before::perform_op(op, x.data(), y.data(), work);
+    else op.perform_op(x.data(), y.data());
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["ns_per_step"] = benchmark::Counter(static_cast<double>(state.iterations()) * K * 1e-9,
+                                                     benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_PerformOp)->ArgsProduct({{1000, 4000}, {0, 1, 2}})->Unit(benchmark::kMicrosecond);
 
 void BM_Triad(benchmark::State& state) {
   const long n = state.range(0);
@@ -70,23 +103,40 @@ void BM_Triad(benchmark::State& state) {
 // 3 arrays of: 16 KiB (L1), 256 KiB (L2), 4 MiB (L3), 64 MiB (memory).
 BENCHMARK(BM_Triad)->Arg(2048)->Arg(32768)->Arg(524288)->Arg(8388608)->Unit(benchmark::kMicrosecond);
 
+// 1000 passes of o = 0.5 o + p a + q b + r c over 32 doubles; the same source compiled twice.
+#define DELAYSPEC_PEAK_FMA_BODY                                                     \
+  for (int rep = 0; rep < 1000; ++rep) {                                            \
+    for (long v = 0; v < 32; ++v) o[v] = 0.5 * o[v] + p * a[v] + q * b[v] + r * c[v]; \
+    benchmark::DoNotOptimize(o);                                                    \
+  }
+void peak_fma_default(double* o, const double* a, const double* b, const double* c, double p, double q, double r) {
+  DELAYSPEC_PEAK_FMA_BODY
+}
+__attribute__((target("avx2,fma"))) void peak_fma_avx2(double* o, const double* a, const double* b, const double* c,
+                                                       double p, double q, double r) {
+  DELAYSPEC_PEAK_FMA_BODY
+}
+
 void BM_PeakFma(benchmark::State& state) {
   constexpr long k = 32;
   alignas(64) double o[k] = {}, a[k], b[k], c[k];
   for (long v = 0; v < k; ++v) a[v] = 1e-3 * v, b[v] = 2e-3 * v, c[v] = 3e-3 * v;
   const double p = 0.999, q = 1e-3, r = -1e-3;
+  const bool avx2 = state.range(0) == 1;
+  if (avx2 && !(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) {
+    state.SkipWithError("this CPU has no AVX2 + FMA");
+    return;
+  }
   long reps = 0;
   for (auto _ : state) {
-    for (int rep = 0; rep < 1000; ++rep) {
-      for (long v = 0; v < k; ++v) o[v] = 0.5 * o[v] + p * a[v] + q * b[v] + r * c[v];
-      benchmark::DoNotOptimize(o);
-    }
+    if (avx2) peak_fma_avx2(o, a, b, c, p, q, r);
+    else peak_fma_default(o, a, b, c, p, q, r);
     reps += 1000;
   }
   // 3 FMAs + 1 multiply per element: count 7 flops (the kernel's 3 FMA = 6 flops plus the scaling)
   state.counters["GFlops"] = benchmark::Counter(static_cast<double>(reps) * k * 7 * 1e-9, benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_PeakFma);
+BENCHMARK(BM_PeakFma)->Arg(0)->Arg(1);
 
 }  // namespace
 

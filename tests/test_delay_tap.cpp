@@ -2,7 +2,8 @@
 // step's time", against the formulas it replaced at its five call sites (stroboscopic_map.hpp,
 // simulation.hpp, lyapunov.hpp, orbit_newton.hpp, monodromy.cpp), written out literally here,
 // on an aligned and a fractional delay. The replacement must not change one bit: the same
-// operations in the same order, so every comparison is exact (EXPECT_EQ, no tolerance).
+// operations in the same order, so every comparison is exact (EXPECT_EQ, no tolerance), except
+// the monodromy's (same_to_rounding below says why).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -25,6 +26,15 @@ HistoryGrid fractional_grid() { return make_grid(1.0, std::sqrt(2.0), 12); }
 
 bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return a.size() == b.size() && (a.array() == b.array()).all();
+}
+
+// The monodromy is the exception to "not one bit": since issue 17 (item 5) it runs its own
+// kernels (block_kernel.hpp), which apply the same tap but add Q w0 + R w1 before P u0 (u0 is
+// the recurrence, kept off the front of the sum), so it agrees with the old loop to rounding: a
+// few eps per step over the K = 12-17 steps of these grids, maps of norm ~1, far below 1e-13 relative.
+// tests/test_kernel_dispatch.cpp checks every kernel path against delay_tap the same way.
+bool same_to_rounding(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() && (a - b).norm() <= 1e-13 * b.norm();
 }
 
 // The loop StroboscopicMap::apply ran before delay_tap, verbatim but for the names.
@@ -117,7 +127,7 @@ TEST(DelayTap, StroboscopicMapAndMonodromyReproduceTheOldLoopsBitForBit) {
     Eigen::VectorXd y;
     map.monodromy(U).apply(x, y);
     if (g.theta != 0) {
-      EXPECT_TRUE(same_bits(y, old_monodromy_apply<1>(g, maps, x))) << "theta = " << g.theta;
+      EXPECT_TRUE(same_to_rounding(y, old_monodromy_apply<1>(g, maps, x))) << "theta = " << g.theta;
     }
   }
   // d = 2: Mathieu (forced, the time enters the step; tau = T, aligned) and the impact
@@ -141,5 +151,5 @@ TEST(DelayTap, StroboscopicMapAndMonodromyReproduceTheOldLoopsBitForBit) {
   const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(Uf.size(), -1, 1);
   Eigen::VectorXd y;
   fractional.monodromy(Uf).apply(x, y);
-  EXPECT_TRUE(same_bits(y, old_monodromy_apply<2>(fractional.grid(), maps, x)));
+  EXPECT_TRUE(same_to_rounding(y, old_monodromy_apply<2>(fractional.grid(), maps, x)));
 }

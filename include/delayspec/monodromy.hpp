@@ -11,6 +11,10 @@
 // vectors at once with the k values of each component contiguous, so the inner loop is a
 // vectorisable axpy of length k.
 //
+// Kernels: perform_op and apply_block run the K steps through block_kernel.hpp; blocks of k > 1
+// on the path chosen at construction (kernel_dispatch.hpp: AVX2 + FMA for D = 1, 2 where the CPU
+// has it, else the portable build; DELAYSPEC_KERNEL=baseline forces the latter). A copy keeps it.
+//
 // Thread safety: the work buffers are owned by the operator (no allocation per application),
 // so one Monodromy must not be applied from two threads at once. Copy it instead.
 //
@@ -24,6 +28,7 @@
 
 #include "delayspec/cancellation.hpp"
 #include "delayspec/detail/block_kernel.hpp"
+#include "delayspec/detail/kernel_dispatch.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/grid.hpp"
 #include "delayspec/linear_operator.hpp"
@@ -57,8 +62,17 @@ class Monodromy final : public LinearOperator {
   long applications() const override { return applications_; }
   void reset_applications() const { applications_ = 0; }
 
+  // The kernel path this operator runs (kernel_dispatch.hpp).
+  KernelPath kernel_path() const { return path_; }
+
+  // An AVX2 path is compiled in the library for these dimensions only.
+  static constexpr bool kHasAvx2Kernel = D == 1 || D == 2;
+
  private:
   void apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const;
+  // The K steps of one map on the work buffer b of k vectors (k = 1: the plain history), on
+  // this operator's kernel path.
+  void run_steps(double* b, long k) const;
 
   HistoryGrid grid_;
   std::vector<StepMap<D>> maps_;
@@ -66,11 +80,12 @@ class Monodromy final : public LinearOperator {
   mutable std::vector<double> work_;        // (M + 1 + K) d, single vector
   mutable std::vector<double> block_work_;  // (M + 1 + K) d k, interleaved
   mutable long applications_ = 0;
+  KernelPath path_ = KernelPath::baseline;
 };
 
 template <int D>
 Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
-    : grid_(grid), maps_(std::move(maps)), n_(grid.dimension(D)) {
+    : grid_(grid), maps_(std::move(maps)), n_(grid.dimension(D)), path_(choose_kernel_path(kHasAvx2Kernel)) {
   if (static_cast<long>(maps_.size()) != grid_.K)
     throw BadInput("Monodromy: " + std::to_string(maps_.size()) +
                    " step maps given, the grid has K = " + std::to_string(grid_.K) + " steps per map");
@@ -80,28 +95,30 @@ Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
 template <int D>
 void Monodromy<D>::perform_op(const double* x, double* y) const {
   throw_if_cancelled();  // one application = one period: the front end may stop here
-  using V = Vec<D>;
-  const int M = grid_.M, m = grid_.m, K = grid_.K;
-  const double theta = grid_.theta;
+  const long K = grid_.K;
   double* b = work_.data();
   std::copy(x, x + n_, b);
-  auto block = [b](long j) { return Eigen::Map<V>(b + j * D); };
-  if (theta == 0) {
-    // b[M+l+1] = P b[M+l] + Q b[M+l-m] + R b[M+l-m+1]
-    for (long l = 0; l < K; ++l) {
-      const StepMap<D>& s = maps_[l];
-      block(M + l + 1).noalias() = s.P * block(M + l) + s.Q * block(M + l - m) + s.R * block(M + l - m + 1);
-    }
-  } else {
-    // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the delayed values from grid.delay_tap
-    for (long l = 0; l < K; ++l) {
-      const StepMap<D>& s = maps_[l];
-      const DelayTap<V> tap = grid_.delay_tap<V>(l, block);
-      block(M + l + 1).noalias() = s.P * block(M + l) + s.Q * tap.w0 + s.R * tap.w1;
+  run_steps(b, 1);
+  std::copy(b + K * D, b + K * D + n_, y);
+  ++applications_;
+}
+
+template <int D>
+void Monodromy<D>::run_steps(double* b, long k) const {
+  // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the tap of grid.delay_tap (block_kernel.hpp)
+  const long M = grid_.M, K = grid_.K, j0 = grid_.delayed_slot(0);
+  const double theta = grid_.theta;
+  if (k == 1) {
+    single_steps<D>(maps_.data(), K, M, j0, theta, b);  // every path: latency-bound (block_kernel_avx2.cpp)
+    return;
+  }
+  if constexpr (kHasAvx2Kernel) {
+    if (path_ == KernelPath::avx2) {
+      detail::block_steps_avx2(maps_.data(), K, M, j0, theta, b, k);
+      return;
     }
   }
-  std::copy(b + static_cast<long>(K) * D, b + static_cast<long>(K) * D + n_, y);
-  ++applications_;
+  block_steps<D>(maps_.data(), K, M, j0, theta, b, k);
 }
 
 template <int D>
@@ -117,21 +134,22 @@ template <int D>
 void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const {
   throw_if_cancelled();
   const long M = grid_.M, K = grid_.K;
-  const double theta = grid_.theta;
   const size_t need = static_cast<size_t>(M + 1 + K) * D * k;
   if (block_work_.size() < need) block_work_.resize(need);
   double* b = block_work_.data();
-  // Interleave: b[(j D + r) k + v] = X(j D + r, v).
-  for (long v = 0; v < k; ++v)
-    for (long i = 0; i < n_; ++i) b[i * k + v] = X[v * ldx + i];
-  const long stride = static_cast<long>(D) * k;  // one history slot
-  // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the tap of grid.delay_tap on k vectors (block_kernel.hpp)
-  for (long l = 0; l < K; ++l)
-    step_block<D>(maps_[l], b + (M + l) * stride, b + grid_.delayed_slot(l) * stride, k, theta,
-                  b + (M + l + 1) * stride);
-  const double* res = b + K * stride;
-  for (long v = 0; v < k; ++v)
-    for (long i = 0; i < n_; ++i) Y[v * ldy + i] = res[i * k + v];
+  // b[(j D + r) k + v] = X(j D + r, v); K steps; the result (slots K .. K + M) back into Y
+  if constexpr (kHasAvx2Kernel) {
+    if (path_ == KernelPath::avx2) {
+      detail::transpose_avx2(X, ldx, k, n_, b, k);
+      run_steps(b, k);
+      detail::transpose_avx2(b + K * D * k, k, n_, k, Y, ldy);
+      applications_ += k;
+      return;
+    }
+  }
+  interleave(X, ldx, n_, k, b);
+  run_steps(b, k);
+  deinterleave(b + K * D * k, n_, k, Y, ldy);
   applications_ += k;
 }
 

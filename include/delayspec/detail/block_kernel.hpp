@@ -1,61 +1,130 @@
 #pragma once
-// The one kernel that applies a step map to k tangent vectors at once (design.md 1.3-1.4),
-// shared by Monodromy::apply_block (stored step maps) and the Lyapunov propagation (step maps
-// used as soon as the stepper produces them).
+// The kernels that apply step maps to tangent vectors (design.md 1.3-1.4): step_block (one step,
+// k vectors) shared by Monodromy::apply_block and the Lyapunov propagation; block_steps (the K
+// steps of one map, k vectors) and single_steps (the K steps, one vector: perform_op).
 //
-// Layout: a history slot holds D components of k vectors, component-major with the k values
-// of a component contiguous ("interleaved"): slot[r * k + v] = component r of vector v. A slot
-// is D k doubles. With the delayed slot j = (current slot) - m (HistoryGrid::delayed_slot), the
-// step computes HistoryGrid::delay_tap's formula (grid.hpp) on k vectors at once:
+// Math. With the delayed slot j = (current slot) - m (HistoryGrid::delayed_slot), one step is
+// HistoryGrid::delay_tap's formula (grid.hpp):
 //
 //   out = P u0 + Q w0 + R w1,   w0 = (1 - theta) b[j] + theta b[j - 1],
 //                               w1 = (1 - theta) b[j + 1] + theta b[j]
 //
-// (theta = 0: w0 = b[j], w1 = b[j + 1]). Cost per step: 3 D^2 k FMAs, reads 3-4 slots, writes
-// one; the inner loop is an axpy of length k and vectorises. No allocation, no checks.
-#include <algorithm>
-
+// (theta = 0: w0 = b[j], w1 = b[j + 1]; b[j - 1] is then not read: it may not exist).
+//
+// Layout of k vectors: a history slot holds D components of k vectors, component-major with
+// the k values of a component contiguous ("interleaved"): slot[r * k + v] = component r of
+// vector v. A slot is D k doubles. One vector (k = 1) is the plain history, slot j at b + j D.
+//
+// Cost per step per vector: 3 D^2 FMAs (plus 2 D for the interpolation), reads the current and
+// 2-3 delayed slots, writes one. step_block makes ONE pass over the k vectors with D
+// accumulators held in registers (the loop over v vectorises; the P, Q, R coefficients are
+// loop-invariant scalars). single_steps keeps u0 in registers across steps: one vector is a
+// recurrence (u0 of step l + 1 is the output of step l), so its speed is the latency of
+// P u0 + (Q w0 + R w1), with the delayed part computed off that critical path.
+//
+// Target: an instantiation tag. The portable kernels use PortableTarget; a translation unit
+// compiled for another instruction set (src/block_kernel_avx2.cpp) instantiates the same
+// templates with its own tag of internal linkage, so the two machine codes get distinct
+// symbols and the linker can never merge one into the other (kernel_dispatch.hpp).
+// No allocation, no checks: the callers check sizes.
 #include "delayspec/step_map.hpp"
 
 namespace delayspec {
 
+namespace detail {
+struct PortableTarget {};
+}  // namespace detail
+
 // u0: the current slot; d0: the delayed slot j (its neighbours j - 1 and j + 1 are d0 -+ D k);
 // out: the new slot (must not alias the inputs).
-template <int D>
-inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, long k, double theta, double* out) {
-  constexpr long kChunk = 64;  // vectors per pass when the delayed values need interpolating
+template <int D, class Target = detail::PortableTarget>
+inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, long k, double theta,
+                       double* __restrict out) {
   const long stride = static_cast<long>(D) * k;
-  const double c0 = 1 - theta;
-  const double* d1 = d0 + stride;
-  double w[2 * D * kChunk];
-  for (long v0 = 0; v0 < k; v0 += kChunk) {
-    const long kk = std::min<long>(kChunk, k - v0);
-    const double* w0 = d0 + v0;
-    const double* w1 = d1 + v0;
-    long ws = k;  // row stride of w0/w1
-    if (theta != 0) {
-      const double* dm = d0 - stride;  // b[j - 1]
-      for (int r = 0; r < D; ++r)
-        for (long v = 0; v < kk; ++v) {
-          w[r * kChunk + v] = c0 * d0[r * k + v0 + v] + theta * dm[r * k + v0 + v];
-          w[(D + r) * kChunk + v] = c0 * d1[r * k + v0 + v] + theta * d0[r * k + v0 + v];
-        }
-      w0 = w;
-      w1 = w + D * kChunk;
-      ws = kChunk;
-    }
-    // out_r = sum_c P_rc u0_c + Q_rc w0_c + R_rc w1_c, vectorised over the kk vectors
-    for (int r = 0; r < D; ++r) {
-      double* o = out + r * k + v0;
-      for (long v = 0; v < kk; ++v) o[v] = 0;
-      for (int c = 0; c < D; ++c) {
-        const double p = s.P(r, c), q = s.Q(r, c), rr = s.R(r, c);
-        const double* a = u0 + c * k + v0;
-        const double* e0 = w0 + c * ws;
-        const double* e1 = w1 + c * ws;
-        for (long v = 0; v < kk; ++v) o[v] += p * a[v] + q * e0[v] + rr * e1[v];
+  const double* d1 = d0 + stride;  // b[j + 1]
+  // s.P, s.Q, s.R: loop-invariant (out is __restrict), broadcast once per step
+  if (theta == 0) {
+    // out_r = sum_c P_rc u0_c + Q_rc b[j]_c + R_rc b[j+1]_c, one pass over the k vectors
+    for (long v = 0; v < k; ++v)
+      for (int r = 0; r < D; ++r) {
+        double acc = 0;
+        for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * d0[c * k + v] + s.R.coeff(r, c) * d1[c * k + v];
+        out[r * k + v] = acc;
       }
+    return;
+  }
+  const double c0 = 1 - theta;
+  const double* dm = d0 - stride;  // b[j - 1]
+  for (long v = 0; v < k; ++v) {
+    double w0[D], w1[D];
+    for (int c = 0; c < D; ++c) {
+      w0[c] = c0 * d0[c * k + v] + theta * dm[c * k + v];
+      w1[c] = c0 * d1[c * k + v] + theta * d0[c * k + v];
     }
+    for (int r = 0; r < D; ++r) {
+      double acc = 0;
+      for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * w0[c] + s.R.coeff(r, c) * w1[c];
+      out[r * k + v] = acc;
+    }
+  }
+}
+
+// Interleave an n x k column-major block X (leading dimension ldx) into slots: b[i k + v] = X(i, v),
+// and back. Row tiles of about 16 KiB of b stay in L1 while the k columns pass over them (a
+// column-by-column pass over all n rows would evict each line of b k times).
+inline long interleave_tile_rows(long k) { return k >= 256 ? 8 : 2048 / k; }
+
+inline void interleave(const double* X, long ldx, long n, long k, double* __restrict b) {
+  const long rows = interleave_tile_rows(k);
+  for (long i0 = 0; i0 < n; i0 += rows) {
+    const long i1 = i0 + rows < n ? i0 + rows : n;
+    for (long v = 0; v < k; ++v)
+      for (long i = i0; i < i1; ++i) b[i * k + v] = X[v * ldx + i];
+  }
+}
+
+inline void deinterleave(const double* b, long n, long k, double* __restrict Y, long ldy) {
+  const long rows = interleave_tile_rows(k);
+  for (long i0 = 0; i0 < n; i0 += rows) {
+    const long i1 = i0 + rows < n ? i0 + rows : n;
+    for (long v = 0; v < k; ++v)
+      for (long i = i0; i < i1; ++i) Y[v * ldy + i] = b[i * k + v];
+  }
+}
+
+// The K steps of one map on k interleaved vectors: b[M + l + 1] from b[M + l] and the delayed
+// slots around j = first_delayed + l (HistoryGrid::delayed_slot(l) = delayed_slot(0) + l).
+template <int D, class Target = detail::PortableTarget>
+inline void block_steps(const StepMap<D>* maps, long K, long M, long first_delayed, double theta, double* b, long k) {
+  const long stride = static_cast<long>(D) * k;
+  for (long l = 0; l < K; ++l)
+    step_block<D, Target>(maps[l], b + (M + l) * stride, b + (first_delayed + l) * stride, k, theta,
+                          b + (M + l + 1) * stride);
+}
+
+// The same K steps on one vector (slot j at b + j D), u0 carried in registers.
+template <int D>
+inline void single_steps(const StepMap<D>* maps, long K, long M, long first_delayed, double theta, double* b) {
+  const double c0 = 1 - theta;
+  double u[D];
+  for (int c = 0; c < D; ++c) u[c] = b[M * D + c];
+  for (long l = 0; l < K; ++l) {
+    const StepMap<D>& s = maps[l];
+    const double* d0 = b + (first_delayed + l) * D;
+    double w0[D], w1[D];
+    for (int c = 0; c < D; ++c) {
+      w0[c] = theta == 0 ? d0[c] : c0 * d0[c] + theta * d0[c - D];
+      w1[c] = theta == 0 ? d0[D + c] : c0 * d0[D + c] + theta * d0[c];
+    }
+    double out[D];
+    for (int r = 0; r < D; ++r) {
+      double acc = 0;  // Q w0 + R w1: independent of u, off the critical path
+      for (int c = 0; c < D; ++c) acc += s.Q.coeff(r, c) * w0[c] + s.R.coeff(r, c) * w1[c];
+      for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u[c];  // the recurrence: D dependent FMAs
+      out[r] = acc;
+    }
+    double* next = b + (M + l + 1) * D;
+    for (int r = 0; r < D; ++r) next[r] = u[r] = out[r];
   }
 }
 

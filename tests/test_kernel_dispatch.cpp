@@ -1,0 +1,186 @@
+// Every kernel path of the monodromy (kernel_dispatch.hpp) against a reference written here from
+// grid.delay_tap (one vector at a time, Eigen fixed-size products: the formula as stated, no
+// kernel code) and against to_dense(), for d = 1, 2 (AVX2 path in the library) and d = 3 (a
+// dimension instantiated outside the library: portable path only), aligned and fractional
+// delays, k = 1, 3, 8, 32 vectors (not only multiples of the vector width). The portable path is
+// forced by DELAYSPEC_KERNEL=baseline, as a user would.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <optional>
+#include <random>
+#include <string>
+
+#include "delayspec/errors.hpp"
+#include "delayspec/monodromy.hpp"
+
+using namespace delayspec;
+
+namespace {
+
+// Sets DELAYSPEC_KERNEL for the scope (unset when value is empty); restores the old value.
+class KernelEnv {
+ public:
+  explicit KernelEnv(const std::string& value) {
+    if (const char* old = std::getenv("DELAYSPEC_KERNEL")) old_ = old;
+    if (value.empty()) unsetenv("DELAYSPEC_KERNEL");
+    else setenv("DELAYSPEC_KERNEL", value.c_str(), 1);
+  }
+  ~KernelEnv() {
+    if (old_) setenv("DELAYSPEC_KERNEL", old_->c_str(), 1);
+    else unsetenv("DELAYSPEC_KERNEL");
+  }
+  KernelEnv(const KernelEnv&) = delete;
+  KernelEnv& operator=(const KernelEnv&) = delete;
+
+ private:
+  std::optional<std::string> old_;
+};
+
+bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+
+// Step maps shaped like a trapezoid step's, h = 1 / N: P = I + h A, Q = R = h B / 2 with random
+// A, B. The product of K of them stays O(1) in norm, so relative errors are meaningful.
+template <int D>
+std::vector<StepMap<D>> random_maps(long K, int N, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  const double h = 1.0 / N;
+  std::vector<StepMap<D>> maps(static_cast<size_t>(K));
+  for (StepMap<D>& s : maps)
+    for (int r = 0; r < D; ++r)
+      for (int c = 0; c < D; ++c) {
+        s.P(r, c) = (r == c ? 1 : 0) + h * g(rng);
+        s.Q(r, c) = 0.5 * h * g(rng);
+        s.R(r, c) = 0.5 * h * g(rng);
+      }
+  return maps;
+}
+
+Eigen::MatrixXd random_block(long n, long k, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  Eigen::MatrixXd X(n, k);
+  for (long j = 0; j < k; ++j)
+    for (long i = 0; i < n; ++i) X(i, j) = g(rng);
+  return X;
+}
+
+// y = M x by the definition: b[M+l+1] = P b[M+l] + Q w0 + R w1 with (w0, w1) = grid.delay_tap.
+template <int D>
+Eigen::VectorXd reference_apply(const HistoryGrid& grid, const std::vector<StepMap<D>>& maps, const Eigen::VectorXd& x) {
+  using V = Vec<D>;
+  std::vector<V> b(static_cast<size_t>(grid.M + 1 + grid.K));
+  for (long j = 0; j <= grid.M; ++j) b[j] = x.segment<D>(j * D);
+  auto slot = [&b](long i) -> const V& { return b[i]; };
+  for (long l = 0; l < grid.K; ++l) {
+    const DelayTap<V> tap = grid.delay_tap<V>(l, slot);
+    const StepMap<D>& s = maps[l];
+    b[grid.M + l + 1] = s.P * b[grid.M + l] + s.Q * tap.w0 + s.R * tap.w1;
+  }
+  Eigen::VectorXd y(x.size());
+  for (long j = 0; j <= grid.M; ++j) y.segment<D>(j * D) = b[grid.K + j];
+  return y;
+}
+
+// The tolerance. Every path sums the same 3 D terms per component per step in its own order,
+// with or without FMA (one rounding instead of two): each step perturbs its output by a few
+// eps relative to the terms, and K <= ~100 steps of maps of norm 1 + O(h) accumulate at most
+// c K eps ~ 100 * 2.2e-16 * a few = ~1e-14 of the result's norm. 1e-13 leaves a factor 10; a wrong
+// coefficient, slot or interpolation weight is an O(h) = O(1e-2) error.
+constexpr double kTol = 1e-13;
+
+// apply_block on k = 1, 3, 8, 32 columns and apply on one vector, against the reference and
+// against to_dense() of an operator on the baseline path.
+template <int D>
+void expect_path_matches(const Monodromy<D>& op, const Eigen::MatrixXd& dense_baseline) {
+  const HistoryGrid& grid = op.grid();
+  for (long k : {1L, 3L, 8L, 32L}) {
+    SCOPED_TRACE("d = " + std::to_string(D) + ", k = " + std::to_string(k) + ", path " +
+                 kernel_path_name(op.kernel_path()) + ", theta = " + std::to_string(grid.theta));
+    const Eigen::MatrixXd X = random_block(op.rows(), k, 100 + static_cast<unsigned>(k));
+    Eigen::MatrixXd Y;
+    op.apply_block(X, Y);
+    Eigen::MatrixXd reference(op.rows(), k);
+    for (long v = 0; v < k; ++v) reference.col(v) = reference_apply<D>(grid, op.step_maps(), X.col(v));
+    EXPECT_LE((Y - reference).norm(), kTol * reference.norm());
+    const Eigen::MatrixXd by_dense = dense_baseline * X;
+    EXPECT_LE((Y - by_dense).norm(), kTol * by_dense.norm());
+    Eigen::VectorXd y;
+    op.apply(X.col(0), y);
+    EXPECT_LE((y - reference.col(0)).norm(), kTol * reference.col(0).norm());
+  }
+  // The operator's own dense matrix (built by its own path, 32 columns at a time) agrees too.
+  EXPECT_LE((op.to_dense() - dense_baseline).norm(), kTol * dense_baseline.norm());
+}
+
+// The baseline path (forced) and the dispatched path on one grid, d = D.
+template <int D>
+void check_all_paths(const HistoryGrid& grid) {
+  const auto maps = random_maps<D>(grid.K, grid.N, 7 + D);
+  std::optional<Monodromy<D>> baseline, dispatched;
+  {
+    KernelEnv env("baseline");
+    baseline.emplace(grid, maps);
+  }
+  {
+    KernelEnv env("");  // unset: the run-time choice
+    dispatched.emplace(grid, maps);
+  }
+  ASSERT_EQ(baseline->kernel_path(), KernelPath::baseline);
+  // The dispatched path is AVX2 exactly when the library has one for D and the CPU runs it, so
+  // on an AVX2 machine this test does compare two different machine codes.
+  const bool avx2 = Monodromy<D>::kHasAvx2Kernel && cpu_has_avx2_fma();
+  ASSERT_EQ(dispatched->kernel_path(), avx2 ? KernelPath::avx2 : KernelPath::baseline);
+
+  // The reference itself against the definition on a unit vector: column 0 of the dense matrix.
+  const Eigen::MatrixXd dense = baseline->to_dense();
+  Eigen::VectorXd e0 = Eigen::VectorXd::Zero(baseline->rows());
+  e0(0) = 1;
+  ASSERT_LE((reference_apply<D>(grid, maps, e0) - dense.col(0)).norm(), kTol * dense.col(0).norm());
+
+  expect_path_matches(*baseline, dense);
+  expect_path_matches(*dispatched, dense);
+}
+
+HistoryGrid aligned_grid() {
+  HistoryGrid g = make_grid(1.0, 1.0, 40);  // tau = T: K = M = 40, theta = 0
+  EXPECT_TRUE(g.aligned());
+  return g;
+}
+HistoryGrid fractional_grid() {
+  HistoryGrid g = make_grid(1.0, 1.37, 29);  // tau / T not a ratio of small integers: theta in (0, 1)
+  EXPECT_FALSE(g.aligned());
+  EXPECT_GT(g.theta, 0.0);
+  return g;
+}
+
+}  // namespace
+
+TEST(KernelDispatch, ScalarAlignedDelay) { check_all_paths<1>(aligned_grid()); }
+TEST(KernelDispatch, ScalarFractionalDelay) { check_all_paths<1>(fractional_grid()); }
+TEST(KernelDispatch, TwoDimensionalAlignedDelay) { check_all_paths<2>(aligned_grid()); }
+TEST(KernelDispatch, TwoDimensionalFractionalDelay) { check_all_paths<2>(fractional_grid()); }
+// d = 3 is compiled here, outside the library, like an equation model: the portable path.
+TEST(KernelDispatch, DimensionOutsideTheLibraryRunsThePortablePath) {
+  check_all_paths<3>(aligned_grid());
+  check_all_paths<3>(fractional_grid());
+}
+
+TEST(KernelDispatch, AutoIsTheDefaultChoice) {
+  KernelEnv env("auto");
+  const HistoryGrid grid = aligned_grid();
+  const Monodromy<2> op(grid, random_maps<2>(grid.K, grid.N, 3));
+  EXPECT_EQ(op.kernel_path(), cpu_has_avx2_fma() ? KernelPath::avx2 : KernelPath::baseline);
+}
+
+TEST(KernelDispatch, UnknownKernelNameIsBadInputNamingIt) {
+  KernelEnv env("avx512");
+  const HistoryGrid grid = aligned_grid();
+  try {
+    Monodromy<2> op(grid, random_maps<2>(grid.K, grid.N, 3));
+    FAIL() << "no exception";
+  } catch (const BadInput& e) {
+    EXPECT_NE(std::string(e.what()).find("DELAYSPEC_KERNEL = 'avx512'"), std::string::npos) << e.what();
+  }
+}
