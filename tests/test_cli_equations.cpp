@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_test_support.hpp"
+#include "delayspec_test_paths.hpp"
 
 namespace {
 
@@ -43,7 +44,7 @@ class EquationsCli : public ::testing::Test {
   static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
   // COMMAND on the scene with the test's own model cache and `sets`.
   static CliResult command(const std::string& name, std::vector<std::string> sets, const std::string& scene = scene_) {
-    sets.push_back("model_cache=" + (dir_ / "cache").string());
+    sets.push_back(std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE);
     return run(with_sets({name, scene, "--json"}, sets));
   }
   static std::filesystem::path dir_;
@@ -106,7 +107,7 @@ TEST_F(EquationsCli, RunComputesTheScenesAnalyses) {
   std::ofstream(scene) << "analyses = [\"floquet\", \"lyapunov\"]\nN = 20\nperiods = 10\n" << kScene;
   const std::filesystem::path out = dir_ / "run-out";
   const CliResult r =
-      run({"run", scene, "--out", out.string(), "--quiet", "--set", "model_cache=" + (dir_ / "cache").string()});
+      run({"run", scene, "--out", out.string(), "--quiet", "--set", std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(std::filesystem::exists(out / "floquet.json"));
   EXPECT_TRUE(std::filesystem::exists(out / "lyapunov.json"));

@@ -192,7 +192,7 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"milling_point", "converge"},
                                                        {"equations_impact", "floquet"},
                                                        {"equations_two_oscillators", "floquet"}};
-  const fs::path cache = fresh_dir("keys_scenes_model_cache");  // equation models compile here
+  const fs::path cache = DELAYSPEC_TEST_MODEL_CACHE;  // equation models compile here
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
     if (entry.path().extension() != ".toml") continue;
@@ -206,7 +206,6 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
     EXPECT_EQ(plan.analyses, std::vector<std::string>{expected.at(name)}) << name;
   }
   EXPECT_EQ(scenes, static_cast<int>(expected.size()));
-  fs::remove_all(cache);
 }
 
 TEST(Scenes, Fig63RunsWithRunAtReducedSize) {

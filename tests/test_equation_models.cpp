@@ -15,9 +15,8 @@
 #include <complex>
 #include <filesystem>
 
-#include <unistd.h>
-
 #include "config.hpp"
+#include "delayspec_test_paths.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/lambert_w.hpp"
 #include "equation_plugin.hpp"
@@ -59,16 +58,8 @@ rhs = ["a*x + b*x_tau"]
 history = { x = 1 }
 )scene";
 
-// The test's own cache, so that the first test of a run compiles and the rest reuse it.
-// The program's own model cache, removed when the program ends.
-struct CacheDirectory {
-  std::filesystem::path path;
-  ~CacheDirectory() { std::filesystem::remove_all(path); }
-};
-std::string cache_dir() {
-  static const CacheDirectory dir{std::filesystem::temp_directory_path() / ("delayspec-equation-models-" + std::to_string(::getpid()))};
-  return dir.path.string();
-}
+// The build tree's test cache: each model compiles once for all test processes.
+std::string cache_dir() { return DELAYSPEC_TEST_MODEL_CACHE; }
 
 Problem problem_from(const std::string& scene, const std::vector<std::pair<std::string, std::string>>& sets) {
   Config config = Config::from_scene_text(scene, "test.toml");
