@@ -13,8 +13,10 @@
 
 #include "delayspec/errors.hpp"
 #include "delayspec/monodromy.hpp"
+#include "test_support.hpp"
 
 using namespace delayspec;
+using delayspec::testing::random_matrix;
 
 namespace {
 
@@ -57,15 +59,6 @@ std::vector<StepMap<D>> random_maps(long K, int N, unsigned seed) {
   return maps;
 }
 
-Eigen::MatrixXd random_block(long n, long k, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g;
-  Eigen::MatrixXd X(n, k);
-  for (long j = 0; j < k; ++j)
-    for (long i = 0; i < n; ++i) X(i, j) = g(rng);
-  return X;
-}
-
 // y = M x by the definition: b[M+l+1] = P b[M+l] + Q w0 + R w1 with (w0, w1) = grid.delay_tap.
 template <int D>
 Eigen::VectorXd reference_apply(const HistoryGrid& grid, const std::vector<StepMap<D>>& maps, const Eigen::VectorXd& x) {
@@ -98,7 +91,7 @@ void expect_path_matches(const Monodromy<D>& op, const Eigen::MatrixXd& dense_ba
   for (long k : {1L, 3L, 8L, 32L}) {
     SCOPED_TRACE("d = " + std::to_string(D) + ", k = " + std::to_string(k) + ", path " +
                  kernel_path_name(op.kernel_path()) + ", theta = " + std::to_string(grid.theta));
-    const Eigen::MatrixXd X = random_block(op.rows(), k, 100 + static_cast<unsigned>(k));
+    const Eigen::MatrixXd X = random_matrix(op.rows(), k, 100 + static_cast<unsigned>(k));
     Eigen::MatrixXd Y;
     op.apply_block(X, Y);
     Eigen::MatrixXd reference(op.rows(), k);

@@ -11,19 +11,12 @@
 #include "delayspec/monodromy.hpp"
 #include "delayspec/orbit_simulation.hpp"
 #include "delayspec/stroboscopic_map.hpp"
+#include "test_support.hpp"
 
 using namespace delayspec;
+using delayspec::testing::random_matrix;
 
 namespace {
-
-Eigen::MatrixXd random_matrix(long rows, long cols, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g;
-  Eigen::MatrixXd X(rows, cols);
-  for (long j = 0; j < cols; ++j)
-    for (long i = 0; i < rows; ++i) X(i, j) = g(rng);
-  return X;
-}
 
 // apply / apply_block against to_dense() times the same vectors. Both compute the same sums
 // of K products in a different order; for a contracting or mildly expanding product the

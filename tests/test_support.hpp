@@ -1,6 +1,7 @@
 #pragma once
 // Small helpers shared by the tests.
 #include <complex>
+#include <random>
 #include <vector>
 
 #include "delayspec/floquet.hpp"
@@ -19,6 +20,16 @@ std::vector<std::complex<double>> dense_multipliers(const Model& model, int N, i
   options.nev = nev;
   options.solver = FloquetSolver::dense_lapack;
   return floquet_multipliers(op, options).multipliers;
+}
+
+// A rows x cols matrix of standard normal entries, reproducible from `seed`.
+inline Eigen::MatrixXd random_matrix(long rows, long cols, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  Eigen::MatrixXd X(rows, cols);
+  for (long j = 0; j < cols; ++j)
+    for (long i = 0; i < rows; ++i) X(i, j) = g(rng);
+  return X;
 }
 
 // Distance from `target` to the nearest entry of `values`.
