@@ -104,10 +104,10 @@ void BM_Triad(benchmark::State& state) {
 BENCHMARK(BM_Triad)->Arg(2048)->Arg(32768)->Arg(524288)->Arg(8388608)->Unit(benchmark::kMicrosecond);
 
 // 1000 passes of o = 0.5 o + p a + q b + r c over 32 doubles; the same source compiled twice.
-#define DELAYSPEC_PEAK_FMA_BODY                                                     \
-  for (int rep = 0; rep < 1000; ++rep) {                                            \
+#define DELAYSPEC_PEAK_FMA_BODY                                                       \
+  for (int rep = 0; rep < 1000; ++rep) {                                              \
     for (long v = 0; v < 32; ++v) o[v] = 0.5 * o[v] + p * a[v] + q * b[v] + r * c[v]; \
-    benchmark::DoNotOptimize(o);                                                    \
+    benchmark::DoNotOptimize(o);                                                      \
   }
 void peak_fma_default(double* o, const double* a, const double* b, const double* c, double p, double q, double r) {
   DELAYSPEC_PEAK_FMA_BODY

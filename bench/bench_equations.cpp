@@ -38,7 +38,8 @@ struct CacheDirectory {
   ~CacheDirectory() { std::filesystem::remove_all(path); }
 };
 std::string cache_dir() {
-  static const CacheDirectory dir{std::filesystem::temp_directory_path() / ("delayspec-bench-equations-" + std::to_string(::getpid()))};
+  static const CacheDirectory dir{std::filesystem::temp_directory_path() /
+                                  ("delayspec-bench-equations-" + std::to_string(::getpid()))};
   return dir.path.string();
 }
 
@@ -86,9 +87,8 @@ static void BM_Lyapunov(benchmark::State& state) {
   double lambda1 = 0;
   for (auto _ : state) lambda1 = p.analyses->lyapunov(p.map_settings(), o).per_period[0];
   state.counters["lambda1"] = lambda1;
-  state.counters["ns_per_step"] = benchmark::Counter(static_cast<double>(o.periods) * N,
-                                                     benchmark::Counter::kIsIterationInvariantRate |
-                                                         benchmark::Counter::kInvert);
+  state.counters["ns_per_step"] = benchmark::Counter(
+      static_cast<double>(o.periods) * N, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.SetLabel(state.range(0) == 1 ? "equations" : "built-in");
 }
 BENCHMARK(BM_Lyapunov)->Args({0, 1000, 10000})->Args({1, 1000, 10000})->Iterations(1)->Unit(benchmark::kSecond);

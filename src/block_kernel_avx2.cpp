@@ -1,8 +1,8 @@
 // The AVX2 + FMA path of the step-map kernels (kernel_dispatch.hpp): the same template as the
 // portable path (block_kernel.hpp's block_steps), compiled in this file only with -mavx2 -mfma
-// (CMakeLists.txt), and the interleave copies as 4 x 4 register transposes (transpose_avx2). Only the block kernel: one vector (single_steps) is a recurrence bound by the
-// latency of P u0, and there FMA is slower, not faster (bench_apply, docs/benchmarks.md: 2.8 ns
-// against 2.2 ns per step), so perform_op runs the portable code on every path.
+// (CMakeLists.txt), and the interleave copies as 4 x 4 register transposes (transpose_avx2). Only the block kernel: one
+// vector (single_steps) is a recurrence bound by the latency of P u0, and there FMA is slower, not faster (bench_apply,
+// docs/benchmarks.md: 2.8 ns against 2.2 ns per step), so perform_op runs the portable code on every path.
 //
 // Why a tag of internal linkage: a template instantiated here and, with the same arguments, in a
 // portable file would be one weak symbol with two machine codes, and the linker would keep either
@@ -48,7 +48,7 @@ void transpose_avx2(const double* src, long lds, long rows, long cols, double* _
         const __m256d s2 = _mm256_loadu_pd(src + (r + 2) * lds + c), s3 = _mm256_loadu_pd(src + (r + 3) * lds + c);
         const __m256d a0 = _mm256_unpacklo_pd(s0, s1), a1 = _mm256_unpackhi_pd(s0, s1);  // (s0 s1)[0], [1]; [2], [3]
         const __m256d a2 = _mm256_unpacklo_pd(s2, s3), a3 = _mm256_unpackhi_pd(s2, s3);
-        _mm256_storeu_pd(dst + c * ldd + r, _mm256_permute2f128_pd(a0, a2, 0x20));        // column c of src
+        _mm256_storeu_pd(dst + c * ldd + r, _mm256_permute2f128_pd(a0, a2, 0x20));  // column c of src
         _mm256_storeu_pd(dst + (c + 1) * ldd + r, _mm256_permute2f128_pd(a1, a3, 0x20));
         _mm256_storeu_pd(dst + (c + 2) * ldd + r, _mm256_permute2f128_pd(a0, a2, 0x31));
         _mm256_storeu_pd(dst + (c + 3) * ldd + r, _mm256_permute2f128_pd(a1, a3, 0x31));

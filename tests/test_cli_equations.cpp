@@ -78,7 +78,8 @@ TEST_F(EquationsCli, EveryAnalysisCommandRunsIt) {
   const std::vector<Case> cases = {
       {"lyapunov", {"N=20", "periods=20", "exponents=1"}, "exponents_per_period"},
       {"simulate", {"N=20", "t_end=2"}, "samples"},
-      {"sweep", {"N=20", "periods=10", "exponents=1", "sweep_key=b", "sweep_from=0", "sweep_to=0.5", "sweep_points=3"},
+      {"sweep",
+       {"N=20", "periods=10", "exponents=1", "sweep_key=b", "sweep_from=0", "sweep_to=0.5", "sweep_points=3"},
        "points"},
       {"chart",
        {"N=20", "chart_x=a", "chart_x_range=-2,-1", "chart_x_points=2", "chart_y=b", "chart_y_range=0,0.5",
@@ -106,8 +107,8 @@ TEST_F(EquationsCli, RunComputesTheScenesAnalyses) {
   const std::string scene = (dir_ / "run.toml").string();
   std::ofstream(scene) << "analyses = [\"floquet\", \"lyapunov\"]\nN = 20\nperiods = 10\n" << kScene;
   const std::filesystem::path out = dir_ / "run-out";
-  const CliResult r =
-      run({"run", scene, "--out", out.string(), "--quiet", "--set", std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE});
+  const CliResult r = run({"run", scene, "--out", out.string(), "--quiet", "--set",
+                           std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(std::filesystem::exists(out / "floquet.json"));
   EXPECT_TRUE(std::filesystem::exists(out / "lyapunov.json"));
@@ -124,10 +125,10 @@ TEST_F(EquationsCli, BadEquationsExitTwoNamingTheItem) {
     std::string from, to, expected;
   };
   const std::vector<Case> cases = {
-      {"rhs = [\"a*x + b*x_tau\"]", "rhs = [\"a*x + b*x_tua\"]", "x_tau"},       // unknown symbol: did you mean
+      {"rhs = [\"a*x + b*x_tau\"]", "rhs = [\"a*x + b*x_tua\"]", "x_tau"},           // unknown symbol: did you mean
       {"rhs = [\"a*x + b*x_tau\"]", "rhs = [\"a*x + (b*x_tau\"]", "equations.rhs"},  // parse error
-      {"rhs = [\"a*x + b*x_tau\"]", "rhs = [\"a*x\", \"x\"]", "equations.rhs"},  // wrong length
-      {"x0 = 1 }", "x0 = 1, nev = 2 }", "nev"},                                   // an engine key
+      {"rhs = [\"a*x + b*x_tau\"]", "rhs = [\"a*x\", \"x\"]", "equations.rhs"},      // wrong length
+      {"x0 = 1 }", "x0 = 1, nev = 2 }", "nev"},                                      // an engine key
   };
   for (const auto& c : cases) {
     std::string text = kScene;

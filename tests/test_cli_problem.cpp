@@ -34,10 +34,13 @@ TEST(Problem, DimensionsAgreeWithTheMapWithMapBuilds) {
   for (const std::string model : {"impact", "linear", "mathieu", "mackey-glass"}) {
     for (int N : {16, 50}) {
       const Problem p = problem_of(model, N, model == "impact" || model == "mathieu" ? 2 : 1);
-      const auto [n, K, d] = delayspec::cli::with_map(p, [](const auto& model_, const auto& map) {
-        (void)model_;
-        return std::tuple<long, int, int>(map.dimension(), map.grid().K, std::decay_t<decltype(model_)>::d);
-      }, "test");
+      const auto [n, K, d] = delayspec::cli::with_map(
+          p,
+          [](const auto& model_, const auto& map) {
+            (void)model_;
+            return std::tuple<long, int, int>(map.dimension(), map.grid().K, std::decay_t<decltype(model_)>::d);
+          },
+          "test");
       EXPECT_EQ(p.dimension(), n) << model << " N = " << N;
       EXPECT_EQ(p.grid().K, K) << model << " N = " << N;
       EXPECT_EQ(p.state_dimension(), d) << model;

@@ -75,11 +75,11 @@ TEST(EquationModelSource, ImpactSceneIsAStateSwitchWithContinuousFields) {
   EXPECT_EQ(s.parameter_defaults, (std::vector<double>{0.7, 28, 1.26, 0.55, 0.802, 0.01}));
   EXPECT_TRUE(s.switches_in_state);
   EXPECT_FALSE(s.switches_in_time);
-  for (const char* line : {"static constexpr int d = 2;", "static constexpr int parameter_count = 6;",
-                           "static constexpr bool has_switching = true;",
-                           "static constexpr bool has_time_switches = false;",
-                           "static constexpr bool affine_in_state = true;", "static constexpr bool is_linear = false;",
-                           "double H(", "Vector grad_H(", "Vector f_t(", "Vector f_tt(", "Matrix A(", "Matrix B("})
+  for (const char* line :
+       {"static constexpr int d = 2;", "static constexpr int parameter_count = 6;",
+        "static constexpr bool has_switching = true;", "static constexpr bool has_time_switches = false;",
+        "static constexpr bool affine_in_state = true;", "static constexpr bool is_linear = false;", "double H(",
+        "Vector grad_H(", "Vector f_t(", "Vector f_tt(", "Matrix A(", "Matrix B("})
     EXPECT_TRUE(contains(s.code, line)) << line << "\n" << s.code;
   EXPECT_FALSE(contains(s.code, "time_segment"));
 }
@@ -99,13 +99,12 @@ TEST(EquationModelSource, FlagsFollowTheSecondDerivatives) {
     bool affine_in_state, is_linear;
   };
   for (const Case& c : {Case{"a*x + b*x_tau", true, true},                  // linear
-                        Case{"a*x + b*x_tau + sin(pi*t)", true, true},       // forcing g(t) allowed
-                        Case{"a*x*cos(t) + b*x_tau", true, true},            // time-periodic coefficients
-                        Case{"b*x_tau/(1 + x_tau^10) + a*x", true, false},   // Mackey-Glass: nonlinear in z only
-                        Case{"x*x_tau", true, false},                        // affine in y for fixed z, not jointly
-                        Case{"a*x^2 + b*x_tau", false, false},
-                        Case{"sin(x)", false, false},
-                        Case{"(x + 1)^2 - x^2 - 2*x", true, true}}) {        // cancels to 1
+                        Case{"a*x + b*x_tau + sin(pi*t)", true, true},      // forcing g(t) allowed
+                        Case{"a*x*cos(t) + b*x_tau", true, true},           // time-periodic coefficients
+                        Case{"b*x_tau/(1 + x_tau^10) + a*x", true, false},  // Mackey-Glass: nonlinear in z only
+                        Case{"x*x_tau", true, false},                       // affine in y for fixed z, not jointly
+                        Case{"a*x^2 + b*x_tau", false, false}, Case{"sin(x)", false, false},
+                        Case{"(x + 1)^2 - x^2 - 2*x", true, true}}) {  // cancels to 1
     const SymbolicEquationModel m = analyse_equations(scalar_table(c.rhs), kEngineKeys);
     EXPECT_EQ(m.affine_in_state, c.affine_in_state) << c.rhs;
     EXPECT_EQ(m.is_linear, c.is_linear) << c.rhs;
@@ -115,10 +114,11 @@ TEST(EquationModelSource, FlagsFollowTheSecondDerivatives) {
 TEST(EquationModelSource, NamesOfGiNaCFunctionsAreOrdinaryNames) {
   // GiNaC's parser knows beta, zeta, psi, tgamma, H, ... as functions and I, Pi as constants; a
   // scene's names reach it only as generated keys, so these are plain parameters.
-  toml::table table{{"state", toml::array{"H", "G"}},
-                    {"parameters", toml::table{{"beta", 2}, {"zeta", 3}, {"psi", 5}, {"tgamma", 7}, {"Li", 11}, {"lst", 13}}},
-                    {"period", "beta*zeta"},
-                    {"rhs", toml::array{"psi*H + tgamma*G_tau", "Li*G - lst*H_tau"}}};
+  toml::table table{
+      {"state", toml::array{"H", "G"}},
+      {"parameters", toml::table{{"beta", 2}, {"zeta", 3}, {"psi", 5}, {"tgamma", 7}, {"Li", 11}, {"lst", 13}}},
+      {"period", "beta*zeta"},
+      {"rhs", toml::array{"psi*H + tgamma*G_tau", "Li*G - lst*H_tau"}}};
   const SymbolicEquationModel m = analyse_equations(table, kEngineKeys);
   EXPECT_TRUE((m.period - m.p[1] * m.p[5]).is_zero()) << m.period;  // sorted: Li beta lst psi tgamma zeta
   EXPECT_TRUE((m.fields[0].f[0] - (m.p[3] * m.y[0] + m.p[4] * m.z[1])).is_zero()) << m.fields[0].f[0];
@@ -142,7 +142,7 @@ TEST(EquationModelSource, AStateSwitchIsNeverLinearAndATimeSwitchMayBe) {
   EXPECT_FALSE(impact.is_linear);  // the monodromy depends on the orbit through the contacts
 
   toml::table window = scalar_table("a*x + b*x_tau");
-  window.insert_or_assign("switch", "sin(pi*t)");          // on for half the period
+  window.insert_or_assign("switch", "sin(pi*t)");               // on for half the period
   window.insert_or_assign("rhs_switched", toml::array{"a*x"});  // discontinuous in t: allowed
   const EquationModelSource s = generate_equation_model(window, kEngineKeys);
   EXPECT_TRUE(s.switches_in_time);
@@ -182,11 +182,11 @@ TEST(EquationModelSource, ExpressionsFollowTheUsualPrecedenceAndNumbersAreExact)
     const char* period;
     GiNaC::ex value;
   };
-  for (const Case& c : {Case{"2^3*2", 16}, Case{"2*3^2", 18}, Case{"-2^2", -4}, Case{"2-3-4", -5},
-                        Case{"8/4/2", 1}, Case{"(2+3)*4", 20}, Case{"-(1+2)*3", -9}, Case{"1.5e2", 150},
-                        Case{".5", GiNaC::numeric(1, 2)}, Case{"1e-3", GiNaC::numeric(1, 1000)},
-                        Case{"0.1+0.2", GiNaC::numeric(3, 10)}, Case{"007", 7}, Case{"2^(-1)+3", GiNaC::numeric(7, 2)},
-                        Case{"2*pi", 2 * GiNaC::Pi}, Case{"a*b", GiNaC::numeric(-1, 2)}}) {
+  for (const Case& c :
+       {Case{"2^3*2", 16}, Case{"2*3^2", 18}, Case{"-2^2", -4}, Case{"2-3-4", -5}, Case{"8/4/2", 1},
+        Case{"(2+3)*4", 20}, Case{"-(1+2)*3", -9}, Case{"1.5e2", 150}, Case{".5", GiNaC::numeric(1, 2)},
+        Case{"1e-3", GiNaC::numeric(1, 1000)}, Case{"0.1+0.2", GiNaC::numeric(3, 10)}, Case{"007", 7},
+        Case{"2^(-1)+3", GiNaC::numeric(7, 2)}, Case{"2*pi", 2 * GiNaC::Pi}, Case{"a*b", GiNaC::numeric(-1, 2)}}) {
     toml::table table = scalar_table("x");
     table.insert_or_assign("period", c.period);
     SymbolicEquationModel m = analyse_equations(table, kEngineKeys);
@@ -226,9 +226,7 @@ toml::table impact_state(const std::string& name) {
   toml::table t = impact_with("state", toml::array{"x", name});
   return t;
 }
-toml::table impact_rhs2(const std::string& expression) {
-  return impact_with("rhs", toml::array{"v", expression});
-}
+toml::table impact_rhs2(const std::string& expression) { return impact_with("rhs", toml::array{"v", expression}); }
 
 std::vector<BadTable> bad_tables() {
   std::vector<BadTable> cases;
@@ -254,7 +252,8 @@ std::vector<BadTable> bad_tables() {
   add("function name", impact_state("exp"), {"`equations.state[2]`", "`exp`", "function"});
   add("_tau suffix", impact_state("x_tau"), {"`equations.state[2]`", "`x_tau`", "_tau"});
   add("duplicate state", impact_state("x"), {"`equations.state[2]`", "`x` is named twice"});
-  add("parameter is an engine key", impact_parameter("N", 3), {"`equations.parameters.N`", "collides with an engine key"});
+  add("parameter is an engine key", impact_parameter("N", 3),
+      {"`equations.parameters.N`", "collides with an engine key"});
   add("parameter is an engine key nev", impact_parameter("nev", 3), {"`equations.parameters.nev`", "engine key"});
   add("parameter is a state", impact_parameter("x", 3), {"`equations.parameters.x`", "also a state"});
   add("parameter keyword", impact_parameter("class", 3), {"`equations.parameters.class`", "C++ keyword"});
@@ -267,17 +266,20 @@ std::vector<BadTable> bad_tables() {
   add("period of t", impact_with("period", "2*pi/omega + t"), {"`equations.period`", "`t` is the time", "position 14"});
   add("delay of a state", impact_with("delay", "x"), {"`equations.delay`", "`x` is a state"});
   add("delay of a delayed state", impact_with("delay", "v_tau"), {"`equations.delay`", "`v_tau` is a delayed state"});
-  add("history key", impact_with("history", toml::table{{"V", 1}}), {"`equations.history.V`", "not a state", "did you mean `v`?"});
+  add("history key", impact_with("history", toml::table{{"V", 1}}),
+      {"`equations.history.V`", "not a state", "did you mean `v`?"});
   add("history of t", impact_with("history", toml::table{{"x", "t"}}), {"`equations.history.x`", "`t` is the time"});
   add("history not a table", impact_with("history", toml::array{1, 2}), {"`equations.history`", "table"});
   add("expression not text", impact_with("delay", true), {"`equations.delay`", "expression"});
   // the fields
   add("rhs too long", impact_with("rhs", toml::array{"v", "x", "x"}), {"`equations.rhs`", "has 3 entries", "d = 2"});
   add("rhs too short", impact_with("rhs", toml::array{"v"}), {"`equations.rhs`", "has 1 entries", "d = 2"});
-  add("rhs_switched length", impact_with("rhs_switched", toml::array{"v"}), {"`equations.rhs_switched`", "has 1 entries"});
+  add("rhs_switched length", impact_with("rhs_switched", toml::array{"v"}),
+      {"`equations.rhs_switched`", "has 1 entries"});
   add("no rhs", impact_without("rhs"), {"`equations.rhs` is required"});
   // parse errors: item, expression, position
-  add("bad character", impact_rhs2("v $ x"), {"`equations.rhs[2]`", "unexpected character `$`", "position 3", "\"v $ x\""});
+  add("bad character", impact_rhs2("v $ x"),
+      {"`equations.rhs[2]`", "unexpected character `$`", "position 3", "\"v $ x\""});
   add("operator for operand", impact_rhs2("v +* x"), {"`equations.rhs[2]`", "found `*`", "position 4"});
   add("missing operator", impact_rhs2("2x"), {"`equations.rhs[2]`", "missing operator before `x`", "position 2"});
   add("unclosed", impact_rhs2("(v + x"), {"`equations.rhs[2]`", "`(` is not closed", "position 1"});
@@ -293,10 +295,14 @@ std::vector<BadTable> bad_tables() {
   add("number out of range", impact_rhs2("1e999*x"), {"`equations.rhs[2]`", "out of range"});
   add("product out of range", impact_rhs2("1e300*1e300*x"), {"`equations.rhs[2]`", "beyond the range of a double"});
   // names in expressions
-  add("unknown name", impact_rhs2("a*omgea^2*sin(omega*t)"), {"`equations.rhs[2]`", "unknown name `omgea`", "position 3", "did you mean `omega`?"});
-  add("unknown delayed", impact_rhs2("k*(w_tau - v)"), {"`equations.rhs[2]`", "unknown name `w_tau`", "did you mean `v_tau`?"});
-  add("function not allowed", impact_rhs2("abs(x)"), {"`equations.rhs[2]`", "function `abs` is not allowed", "position 1", "sin, cos"});
-  add("Heaviside", impact_rhs2("beta*Heaviside(x - e)"), {"`equations.rhs[2]`", "function `Heaviside` is not allowed", "position 6"});
+  add("unknown name", impact_rhs2("a*omgea^2*sin(omega*t)"),
+      {"`equations.rhs[2]`", "unknown name `omgea`", "position 3", "did you mean `omega`?"});
+  add("unknown delayed", impact_rhs2("k*(w_tau - v)"),
+      {"`equations.rhs[2]`", "unknown name `w_tau`", "did you mean `v_tau`?"});
+  add("function not allowed", impact_rhs2("abs(x)"),
+      {"`equations.rhs[2]`", "function `abs` is not allowed", "position 1", "sin, cos"});
+  add("Heaviside", impact_rhs2("beta*Heaviside(x - e)"),
+      {"`equations.rhs[2]`", "function `Heaviside` is not allowed", "position 6"});
   add("parameter called", impact_rhs2("zeta(x)"), {"`equations.rhs[2]`", "`zeta` is not a function"});
   add("GiNaC's constant", impact_rhs2("Pi*x"), {"`equations.rhs[2]`", "unknown name `Pi`", "did you mean `pi`?"});
   // GiNaC's evaluation
@@ -307,13 +313,17 @@ std::vector<BadTable> bad_tables() {
   add("log of zero", impact_rhs2("log(0)"), {"`equations.rhs[2]`", "cannot be evaluated"});
   add("division by zero", impact_rhs2("x/(e - e)"), {"`equations.rhs[2]`", "cannot be evaluated"});
   // switches
-  add("switch without field", impact_without("rhs_switched"), {"`equations.rhs_switched` is required with `equations.switch`"});
-  add("field without switch", impact_without("switch"), {"`equations.rhs_switched` is given without `equations.switch`"});
-  add("switch of t and the state", impact_with("switch", "x - e*sin(t)"), {"`equations.switch`", "both t and the state"});
+  add("switch without field", impact_without("rhs_switched"),
+      {"`equations.rhs_switched` is required with `equations.switch`"});
+  add("field without switch", impact_without("switch"),
+      {"`equations.rhs_switched` is given without `equations.switch`"});
+  add("switch of t and the state", impact_with("switch", "x - e*sin(t)"),
+      {"`equations.switch`", "both t and the state"});
   add("switch of a delayed state", impact_with("switch", "x_tau - e"), {"`equations.switch`", "delayed states"});
   add("switch not affine", impact_with("switch", "x^2 - e"), {"`equations.switch`", "affine"});
   add("constant switch", impact_with("switch", "e - 1"), {"`equations.switch`", "neither t nor the state"});
-  add("discontinuous", impact_with("rhs_switched", toml::array{"v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x - beta*x"}),
+  add("discontinuous",
+      impact_with("rhs_switched", toml::array{"v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x - beta*x"}),
       {"`equations.rhs_switched[2]` differs from `equations.rhs[2]` on switch = 0", "difference", "beta", "e"});
   add("discontinuous first component", impact_with("rhs_switched", toml::array{"v + 1", "a*omega^2*sin(omega*t) - x"}),
       {"`equations.rhs_switched[1]` differs from `equations.rhs[1]`"});
@@ -335,7 +345,8 @@ TEST(EquationModelSource, ContinuityIsCheckedOnTheSwitchSurface) {
   EXPECT_EQ(error_of(impact_with("switch", "e - x")), "");  // the sides swap, continuity holds
   toml::table in_v = impact_table();
   in_v.insert_or_assign("switch", "v/omega - e + 0*x");
-  in_v.insert_or_assign("rhs_switched", toml::array{"v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x - beta*(v - e*omega)^2"});
+  in_v.insert_or_assign(
+      "rhs_switched", toml::array{"v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x - beta*(v - e*omega)^2"});
   EXPECT_EQ(error_of(in_v), "");
   toml::table expanded = impact_table();
   expanded.insert_or_assign(
@@ -372,8 +383,8 @@ TEST(EquationModelSource, NoFieldSmugglesCodeIntoTheSource) {
       "\xef\xbd\x98",  // a full-width x
   };
   // The words of the payloads that must not appear in the code whatever happens.
-  const std::vector<std::string> forbidden = {"system", "rm -rf", "include", "evil", "cstdlib", "R\"", "??", "/*",
-                                              "__x", "main"};
+  const std::vector<std::string> forbidden = {"system", "rm -rf", "include", "evil", "cstdlib",
+                                              "R\"",    "??",     "/*",      "__x",  "main"};
   auto check = [&](const std::string& field, const std::string& payload, const toml::table& table) {
     try {
       const std::string code = generate_equation_model(table, kEngineKeys).code;
@@ -402,8 +413,8 @@ TEST(EquationModelSource, NoFieldSmugglesCodeIntoTheSource) {
   // A harmless but unusual parameter name is accepted and appears nowhere in the code.
   toml::table harmless = impact_parameter("system", 1.0);
   harmless.insert_or_assign("rhs", toml::array{"v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x*system"});
-  harmless.insert_or_assign("rhs_switched",
-                            toml::array{"v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x*system - beta*(x - e)"});
+  harmless.insert_or_assign(
+      "rhs_switched", toml::array{"v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x*system - beta*(x - e)"});
   EXPECT_FALSE(contains(generate_equation_model(harmless, kEngineKeys).code, "system"));
 }
 
@@ -411,7 +422,8 @@ TEST(EquationModelSource, NoUserNameAppearsInTheCode) {
   const std::string code = generate_equation_model(scene_equations("equations_impact.toml"), kEngineKeys).code;
   for (const char* name : {"omega", "zeta", "beta", "v_tau", "x_tau"}) EXPECT_FALSE(contains(code, name)) << name;
   const std::string four = generate_equation_model(scene_equations("equations_two_oscillators.toml"), kEngineKeys).code;
-  for (const auto& name : generate_equation_model(scene_equations("equations_two_oscillators.toml"), kEngineKeys).parameters)
+  for (const auto& name :
+       generate_equation_model(scene_equations("equations_two_oscillators.toml"), kEngineKeys).parameters)
     if (name.size() > 2) {  // one- and two-letter names (F, g, w2) are parts of the code's words
       EXPECT_FALSE(contains(four, name)) << name;
     }
@@ -455,9 +467,10 @@ void expect_derivatives_match_differences(const SymbolicEquationModel& m, const 
     }
   }
   for (size_t a = 0; a < m.grad_H.size(); ++a)
-    expect_close(m.grad_H[a],
-                 (value(m.switch_function, shifted(m.y[a], h)) - value(m.switch_function, shifted(m.y[a], -h))) / (2 * h),
-                 "grad H " + std::to_string(a));
+    expect_close(
+        m.grad_H[a],
+        (value(m.switch_function, shifted(m.y[a], h)) - value(m.switch_function, shifted(m.y[a], -h))) / (2 * h),
+        "grad H " + std::to_string(a));
   GiNaC::Digits = saved_digits;
 }
 

@@ -145,7 +145,8 @@ double observed_order(const std::vector<double>& errors) {
 }
 
 // The error of the leading `count` multipliers (nearest exact one each) at N = 50, 100, 200.
-std::vector<double> errors_against(const std::string& scene, const std::vector<std::complex<double>>& exact, int count) {
+std::vector<double> errors_against(const std::string& scene, const std::vector<std::complex<double>>& exact,
+                                   int count) {
   std::vector<double> errors;
   for (int N : {50, 100, 200}) {
     const Problem p = problem_from(scene, {{"N", std::to_string(N)}});
@@ -186,8 +187,10 @@ TEST(EquationModels, ThreeDimensionalCoupledSystemHasOrderTwoAgainstLambertW) {
              "_tau";
     rhs += std::string(i ? ", " : "") + "\"" + row.substr(3) + "\"";
   }
-  const std::string scene = "model = \"equations\"\n[equations]\nstate = [\"x\", \"y\", \"z\"]\nparameters = {}\n"
-                            "period = \"1\"\ndelay = \"1\"\nrhs = [" + rhs + "]\nhistory = { x = 1 }\n";
+  const std::string scene =
+      "model = \"equations\"\n[equations]\nstate = [\"x\", \"y\", \"z\"]\nparameters = {}\n"
+      "period = \"1\"\ndelay = \"1\"\nrhs = [" +
+      rhs + "]\nhistory = { x = 1 }\n";
   const Problem p = problem_from(scene, {});
   EXPECT_EQ(p.state_dimension(), 3);
   EXPECT_TRUE(p.analyses->is_linear());

@@ -48,9 +48,8 @@ const char* kLinearCode = R"(struct EquationModel {
 class EquationPluginTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    cache_ = std::filesystem::temp_directory_path() /
-             ("delayspec-plugin-test-" + std::to_string(::getpid()) + "-" +
-              ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    cache_ = std::filesystem::temp_directory_path() / ("delayspec-plugin-test-" + std::to_string(::getpid()) + "-" +
+                                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::remove_all(cache_);
   }
   void TearDown() override { std::filesystem::remove_all(cache_); }

@@ -61,7 +61,8 @@ std::vector<StepMap<D>> random_maps(long K, int N, unsigned seed) {
 
 // y = M x by the definition: b[M+l+1] = P b[M+l] + Q w0 + R w1 with (w0, w1) = grid.delay_tap.
 template <int D>
-Eigen::VectorXd reference_apply(const HistoryGrid& grid, const std::vector<StepMap<D>>& maps, const Eigen::VectorXd& x) {
+Eigen::VectorXd reference_apply(const HistoryGrid& grid, const std::vector<StepMap<D>>& maps,
+                                const Eigen::VectorXd& x) {
   using V = Vec<D>;
   std::vector<V> b(static_cast<size_t>(grid.M + 1 + grid.K));
   for (long j = 0; j <= grid.M; ++j) b[j] = x.segment<D>(j * D);

@@ -46,16 +46,16 @@ struct OrbitRequest {
 // A periodic orbit and the map's linearisation along it.
 struct LinearisedOrbit {
   PeriodicOrbit orbit;
-  ContactSummary contacts;                     // the orbit against H = 0 (no switching: zero)
-  std::unique_ptr<LinearOperator> monodromy;   // Monodromy<d> of one map at the orbit
-  Eigen::VectorXd sequence;                    // u_0 .. u_{K-1} when requested (empty for linear models)
+  ContactSummary contacts;                    // the orbit against H = 0 (no switching: zero)
+  std::unique_ptr<LinearOperator> monodromy;  // Monodromy<d> of one map at the orbit
+  Eigen::VectorXd sequence;                   // u_0 .. u_{K-1} when requested (empty for linear models)
 };
 
 class ModelAnalyses {
  public:
   virtual ~ModelAnalyses() = default;
 
-  virtual int state_dimension() const = 0;    // d
+  virtual int state_dimension() const = 0;     // d
   virtual bool switches_in_state() const = 0;  // H(y) with events (has_switching)
   virtual bool switches_in_time() const = 0;   // cutting windows (has_time_switches)
   virtual bool is_linear() const = 0;          // the monodromy does not depend on the orbit
@@ -70,8 +70,7 @@ class ModelAnalyses {
   virtual LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const = 0;
   // The histories U_0 .. U_{count-1} of successive maps after `transient` maps, from the constant
   // initial history (the stroboscopic section of a trajectory).
-  virtual std::vector<Eigen::VectorXd> section_sequence(const MapSettings& map, long transient,
-                                                        long count) const = 0;
+  virtual std::vector<Eigen::VectorXd> section_sequence(const MapSettings& map, long transient, long count) const = 0;
   // simulate() from the constant initial history: `before` (a model of the same type, e.g. the
   // impact model with its control off; nullptr: this one) with the step settings of
   // `before_map` runs the steps starting before options.switch_time, this model with `map` the

@@ -182,16 +182,19 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
       row.N = N;
       row.solver = s.classic_names[c];
       try {
-        with_map(s.problem, [&](const auto& model, const auto&) {
-          const MemoryProbe probe;
-          const ClassicResult r = classic_multipliers(model, N, s.classics[c], base.nev);
-          row.peak_bytes = probe.peak_bytes();
-          row.n = r.dimension;
-          row.multipliers = r.multipliers;
-          row.seconds = r.seconds;
-          keep_fastest_of_repeats(row, repeats,
-                                  [&] { return classic_multipliers(model, N, s.classics[c], base.nev).seconds; });
-        }, "the classic discretisations");
+        with_map(
+            s.problem,
+            [&](const auto& model, const auto&) {
+              const MemoryProbe probe;
+              const ClassicResult r = classic_multipliers(model, N, s.classics[c], base.nev);
+              row.peak_bytes = probe.peak_bytes();
+              row.n = r.dimension;
+              row.multipliers = r.multipliers;
+              row.seconds = r.seconds;
+              keep_fastest_of_repeats(row, repeats,
+                                      [&] { return classic_multipliers(model, N, s.classics[c], base.nev).seconds; });
+            },
+            "the classic discretisations");
       } catch (const NumericalFailure& e) {
         record_failure(row, e, inv);
       }
@@ -199,42 +202,43 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
       progress.add();
     }
     if (solvers.empty()) continue;
-    with_monodromy(s.problem, s.problem.events, s.orbit, N, [&](const LinearOperator& op, const LinearisedOrbit&, double setup) {
-      for (FloquetSolver solver : solvers) {
-        BenchRow row;
-        row.N = N;
-        row.n = op.rows();
-        row.solver = to_string(solver);
-        row.setup_seconds = setup;
-        const double need_mb = dense_bytes_estimate(row.n) / (1024.0 * 1024.0);
-        if (is_dense(solver) && need_mb > limit_mb) {
-          char buf[200];
-          std::snprintf(buf, sizeof buf,
-                        "dense needs about %.0f MB (3 n^2 doubles, n = %ld) > dense_memory_limit_mb = %g", need_mb,
-                        row.n, limit_mb);
-          row.status = "skipped";
-          row.message = buf;
-          inv.err << "bench: N = " << N << ", " << row.solver << ": skipped: " << buf << "\n";
-        } else {
-          FloquetOptions o = base;
-          o.solver = solver;
-          try {
-            const MemoryProbe probe;
-            const FloquetResult r = floquet_multipliers(op, o);
-            row.peak_bytes = probe.peak_bytes();
-            row.multipliers = r.multipliers;
-            row.seconds = r.seconds;
-            row.operator_applications = r.operator_applications;
-            if (!r.note.empty()) row.message = r.note;
-            keep_fastest_of_repeats(row, repeats, [&] { return floquet_multipliers(op, o).seconds; });
-          } catch (const NumericalFailure& e) {
-            record_failure(row, e, inv);
+    with_monodromy(
+        s.problem, s.problem.events, s.orbit, N, [&](const LinearOperator& op, const LinearisedOrbit&, double setup) {
+          for (FloquetSolver solver : solvers) {
+            BenchRow row;
+            row.N = N;
+            row.n = op.rows();
+            row.solver = to_string(solver);
+            row.setup_seconds = setup;
+            const double need_mb = dense_bytes_estimate(row.n) / (1024.0 * 1024.0);
+            if (is_dense(solver) && need_mb > limit_mb) {
+              char buf[200];
+              std::snprintf(buf, sizeof buf,
+                            "dense needs about %.0f MB (3 n^2 doubles, n = %ld) > dense_memory_limit_mb = %g", need_mb,
+                            row.n, limit_mb);
+              row.status = "skipped";
+              row.message = buf;
+              inv.err << "bench: N = " << N << ", " << row.solver << ": skipped: " << buf << "\n";
+            } else {
+              FloquetOptions o = base;
+              o.solver = solver;
+              try {
+                const MemoryProbe probe;
+                const FloquetResult r = floquet_multipliers(op, o);
+                row.peak_bytes = probe.peak_bytes();
+                row.multipliers = r.multipliers;
+                row.seconds = r.seconds;
+                row.operator_applications = r.operator_applications;
+                if (!r.note.empty()) row.message = r.note;
+                keep_fastest_of_repeats(row, repeats, [&] { return floquet_multipliers(op, o).seconds; });
+              } catch (const NumericalFailure& e) {
+                record_failure(row, e, inv);
+              }
+            }
+            rows.push_back(row);
+            progress.add();
           }
-        }
-        rows.push_back(row);
-        progress.add();
-      }
-    });
+        });
   }
   progress.finish();
   return rows;

@@ -240,22 +240,21 @@ class ConvergeLevels {
     level.N = N;
     const long K = level.grid().K;
     try {
-      with_monodromy(
-          problem_, events_, orbit_, N,
-          [&](const LinearOperator& op, const LinearisedOrbit& at_orbit, double) {
-            sequence = at_orbit.sequence;
-            orbit_found = true;
-            FloquetOptions fo = solver_;
-            fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
-            const FloquetResult f = floquet_multipliers(op, fo);
-            r.multipliers = f.multipliers;
-            r.operator_applications = f.operator_applications;
-            const double radius = f.multipliers.empty() ? 0.0 : std::abs(f.multipliers.front());
-            for (size_t k = 0; k < f.multipliers.size(); ++k)
-              r.accuracy.push_back(multiplier_accuracy(f.multipliers[k], k < f.residuals.size() ? f.residuals[k] : NAN,
-                                                       op.rows(), K, radius));
-          },
-          {guess, true});
+      with_monodromy(problem_, events_, orbit_, N,
+                     [&](const LinearOperator& op, const LinearisedOrbit& at_orbit, double) {
+                       sequence = at_orbit.sequence;
+                       orbit_found = true;
+                       FloquetOptions fo = solver_;
+                       fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
+                       const FloquetResult f = floquet_multipliers(op, fo);
+                       r.multipliers = f.multipliers;
+                       r.operator_applications = f.operator_applications;
+                       const double radius = f.multipliers.empty() ? 0.0 : std::abs(f.multipliers.front());
+                       for (size_t k = 0; k < f.multipliers.size(); ++k)
+                         r.accuracy.push_back(multiplier_accuracy(
+                             f.multipliers[k], k < f.residuals.size() ? f.residuals[k] : NAN, op.rows(), K, radius));
+                     },
+                     {guess, true});
       if (sequence.size() > 0) sequences_[N] = std::move(sequence);
       if (guess)
         r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);

@@ -103,8 +103,7 @@ int command_simulate(Config& config, const Invocation& inv) {
     const std::filesystem::path dir(*inv.out_dir);
     const std::string header = metadata_comment_lines(make_metadata(
         "simulate", inv.scene, config,
-        {{"N", problem.N}, {"events", to_string(problem.events)}, {"jacobian", to_string(problem.jacobian)}},
-        seconds));
+        {{"N", problem.N}, {"events", to_string(problem.events)}, {"jacobian", to_string(problem.jacobian)}}, seconds));
     AtomicFile traj(dir / "trajectory.csv");
     traj.stream() << header;
     write_points(traj.stream(), columns(problem), rec.t, rec.y);
@@ -149,8 +148,8 @@ int command_simulate(Config& config, const Invocation& inv) {
            << " before)";
     text << "\n";
     if (switching)
-      text << "impacts (entries into H > 0): " << rec.impact_times.size()
-           << "; max H at grid points: " << rec.max_H << "\n";
+      text << "impacts (entries into H > 0): " << rec.impact_times.size() << "; max H at grid points: " << rec.max_H
+           << "\n";
     text << "Poincare points (t = m T): " << rec.poincare_t.size();
     if (!rec.poincare_y.empty()) text << ", last " << rec.poincare_y.back().transpose();
     text << "\n";

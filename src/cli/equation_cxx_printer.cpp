@@ -46,12 +46,9 @@ void print_sum(const GiNaC::add& sum, const print_sorted_csrc& c, unsigned level
   std::sort(terms.begin(), terms.end());
   std::string text;
   for (const auto& term : terms) {
-    if (text.empty())
-      text = term;
-    else if (term[0] == '-')
-      text += " - " + term.substr(1);
-    else
-      text += " + " + term;
+    if (text.empty()) text = term;
+    else if (term[0] == '-') text += " - " + term.substr(1);
+    else text += " + " + term;
   }
   if (level >= kSumPrecedence) {
     c.s << "(" << text << ")";
@@ -147,8 +144,7 @@ void print_factors(GiNaC::numeric coefficient, const std::vector<GiNaC::ex>& fac
   } else if (coefficient != 1) {
     text = text_at(coefficient, 0) + "*" + text;
   }
-  if (!denominator.empty())
-    text += denominator.size() == 1 ? "/" + denominator[0] : "/(" + joined(denominator) + ")";
+  if (!denominator.empty()) text += denominator.size() == 1 ? "/" + denominator[0] : "/(" + joined(denominator) + ")";
   if (level >= kProductPrecedence) {  // the base of a power
     c.s << "(" << text << ")";
   } else {

@@ -34,7 +34,8 @@ bool is_digit(char c) { return c >= '0' && c <= '9'; }
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
 
 bool has_symbol(const GiNaC::ex& e) {
-  return std::any_of(e.preorder_begin(), e.preorder_end(), [](const GiNaC::ex& x) { return GiNaC::is_a<GiNaC::symbol>(x); });
+  return std::any_of(e.preorder_begin(), e.preorder_end(),
+                     [](const GiNaC::ex& x) { return GiNaC::is_a<GiNaC::symbol>(x); });
 }
 
 std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
@@ -96,7 +97,9 @@ class ExpressionReader {
         tokens_.push_back({TokenKind::op, std::string(1, c), position});
         ++i;
       } else if (c == '(' || c == ')' || c == ',') {
-        tokens_.push_back({c == '(' ? TokenKind::open : c == ')' ? TokenKind::close : TokenKind::comma,
+        tokens_.push_back({c == '('   ? TokenKind::open
+                           : c == ')' ? TokenKind::close
+                                      : TokenKind::comma,
                            std::string(1, c), position});
         ++i;
       } else {
@@ -131,7 +134,8 @@ class ExpressionReader {
       fail(token.position, "`" + token.text + "` is not a function", "write * for a product");
     std::string allowed;
     for (const auto& f : functions) allowed += (allowed.empty() ? "" : ", ") + f;
-    fail(token.position, "function `" + printable(token.text) + "` is not allowed", "allowed: " + allowed + "; ^ for powers");
+    fail(token.position, "function `" + printable(token.text) + "` is not allowed",
+         "allowed: " + allowed + "; ^ for powers");
   }
 
   // operand := number | name | function '(' expression ')' | '(' expression ')'
@@ -175,8 +179,7 @@ class ExpressionReader {
             break;
           }
           case TokenKind::close:
-          case TokenKind::comma:
-            fail(token.position, "expected a number, a name or ( but found `" + token.text + "`");
+          case TokenKind::comma: fail(token.position, "expected a number, a name or ( but found `" + token.text + "`");
         }
       } else {
         switch (token.kind) {
@@ -191,12 +194,10 @@ class ExpressionReader {
             open.pop_back();
             last_operator.pop_back();
             break;
-          case TokenKind::comma:
-            fail(token.position, "`,`", "the functions take one argument");
+          case TokenKind::comma: fail(token.position, "`,`", "the functions take one argument");
           case TokenKind::number:
           case TokenKind::name:
-          case TokenKind::open:
-            fail(token.position, "missing operator before `" + printable(token.text) + "`");
+          case TokenKind::open: fail(token.position, "missing operator before `" + printable(token.text) + "`");
         }
       }
     }
@@ -288,8 +289,7 @@ class ExpressionReader {
       GiNaC::prototype_table t;
       const auto& functions = equation_functions();
       for (const auto& [prototype, reader] : GiNaC::get_default_reader())
-        if (prototype.second == 1 &&
-            std::find(functions.begin(), functions.end(), prototype.first) != functions.end())
+        if (prototype.second == 1 && std::find(functions.begin(), functions.end(), prototype.first) != functions.end())
           t.insert({prototype, reader});
       return t;
     }();

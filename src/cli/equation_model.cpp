@@ -44,7 +44,8 @@ const LoadedEquations& load(const std::string& table_text, const std::filesystem
 
 double positive_value(const std::string& item, double value) {
   if (!std::isfinite(value) || !(value > 0))
-    throw BadInput("`" + item + "` evaluates to " + format_number(value) + " at these parameters: must be > 0 and finite");
+    throw BadInput("`" + item + "` evaluates to " + format_number(value) +
+                   " at these parameters: must be > 0 and finite");
   return value;
 }
 

@@ -58,7 +58,8 @@ class ModelPrinter {
       out_ << "  static double " << f << "(double x) { return "
            << (f == "sin" || f == "cos" ? "delayspec::detail::remembered_" : "std::") << f << "(x); }\n";
     out_ << "  static double pow(double x, double y) { return std::pow(x, y); }\n"
-         << "  static constexpr double " << pi_.get_name() << " = " << "3.141592653589793238462643383279502884;\n";
+         << "  static constexpr double " << pi_.get_name() << " = "
+         << "3.141592653589793238462643383279502884;\n";
     out_ << "  static double period_of([[maybe_unused]] const double* p) { return " << cxx(m_.period) << "; }\n"
          << "  static double delay_of([[maybe_unused]] const double* p) { return " << cxx(m_.delay) << "; }\n"
          << "  static Vector history_of([[maybe_unused]] const double* p) {\n"
@@ -66,8 +67,10 @@ class ModelPrinter {
     for (int i = 0; i < m_.d(); ++i) out_ << "    r[" << i << "] = " << cxx(m_.history[i]) << ";\n";
     out_ << "    return r;\n  }\n";
     print_field_vector("f", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f; });
-    print_field_matrix("A", [](const SymbolicField& f) -> const auto& { return f.A; });
-    print_field_matrix("B", [](const SymbolicField& f) -> const auto& { return f.B; });
+    print_field_matrix(
+        "A", [](const SymbolicField& f) -> const auto& { return f.A; });
+    print_field_matrix(
+        "B", [](const SymbolicField& f) -> const auto& { return f.B; });
     print_field_vector("f_t", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f_t; });
     print_field_vector("f_tt", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f_tt; });
     if (state_switch) print_state_switch();
@@ -151,8 +154,7 @@ class ModelPrinter {
   // searched in order for a change of segment, which is then bisected to adjacent doubles; the
   // first double of the new segment is returned (> t0, as time_switch_step.hpp requires).
   void print_time_switch() {
-    out_ << "  double switch_value_([[maybe_unused]] double t) const { return " << cxx(m_.switch_function)
-         << "; }\n"
+    out_ << "  double switch_value_([[maybe_unused]] double t) const { return " << cxx(m_.switch_function) << "; }\n"
          << "  int time_segment(double t) const { return switch_value_(t) > 0 ? 1 : 2; }\n"
          << "  double next_time_switch(double t0, double t1) const {\n"
          << "    constexpr int samples = " << kTimeSwitchSamples << ";\n"
@@ -183,7 +185,8 @@ class ModelPrinter {
 
 }  // namespace
 
-EquationModelSource generate_equation_model(const toml::table& equations, const std::vector<std::string>& reserved_keys) {
+EquationModelSource generate_equation_model(const toml::table& equations,
+                                            const std::vector<std::string>& reserved_keys) {
   const SymbolicEquationModel model = analyse_equations(equations, reserved_keys);
   EquationModelSource source;
   source.state = model.state;

@@ -32,6 +32,7 @@ struct EquationModelSource {
 // delay_of(p), history_of(p), and f, A, B, f_t, f_tt for j = 1 (rhs_switched, switch > 0) and
 // j = 2 (rhs), H and grad_H with a state switch, time_segment and next_time_switch with a time
 // switch: a delayspec::DelayModel (model.hpp).
-EquationModelSource generate_equation_model(const toml::table& equations, const std::vector<std::string>& reserved_keys);
+EquationModelSource generate_equation_model(const toml::table& equations,
+                                            const std::vector<std::string>& reserved_keys);
 
 }  // namespace delayspec::cli

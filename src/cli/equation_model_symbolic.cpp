@@ -16,8 +16,8 @@ namespace delayspec::cli {
 namespace {
 
 const std::vector<std::string>& table_entries() {
-  static const std::vector<std::string> entries = {"state",  "parameters",   "period", "delay",
-                                                   "rhs",    "switch",       "rhs_switched", "history"};
+  static const std::vector<std::string> entries = {"state", "parameters", "period",       "delay",
+                                                   "rhs",   "switch",     "rhs_switched", "history"};
   return entries;
 }
 
@@ -166,8 +166,8 @@ class EquationsReader {
   std::vector<GiNaC::ex> read_field(const std::string& entry) const {
     const toml::array& array = required_array(table_, entry);
     if (array.size() != m_.state.size())
-      throw BadInput("`" + item_of(entry) + "`: has " + std::to_string(array.size()) + " entries, the state has d = " +
-                     std::to_string(m_.state.size()));
+      throw BadInput("`" + item_of(entry) + "`: has " + std::to_string(array.size()) +
+                     " entries, the state has d = " + std::to_string(m_.state.size()));
     std::vector<GiNaC::ex> field;
     for (size_t i = 0; i < array.size(); ++i) field.push_back(expression(array[i], item_of(entry, i), fields_));
     return field;
@@ -177,7 +177,8 @@ class EquationsReader {
     rhs_ = read_field("rhs");
     const toml::node* h = table_.get("switch");
     const bool switched = table_.contains("rhs_switched");
-    if (h && !switched) throw BadInput("`equations.rhs_switched` is required with `equations.switch` (the field where switch > 0)");
+    if (h && !switched)
+      throw BadInput("`equations.rhs_switched` is required with `equations.switch` (the field where switch > 0)");
     if (!h && switched) throw BadInput("`equations.rhs_switched` is given without `equations.switch`");
     if (!h) return;
     m_.switch_function = expression(*h, item_of("switch"), fields_);
@@ -196,7 +197,8 @@ class EquationsReader {
     const GiNaC::ex& h = m_.switch_function;
     const std::string item = "`equations.switch`: ";
     const bool of_t = h.has(m_.t), of_y = depends_on(h, m_.y);
-    if (depends_on(h, m_.z)) throw BadInput(item + "may not use delayed states (a switch is of t or of the state y(t))");
+    if (depends_on(h, m_.z))
+      throw BadInput(item + "may not use delayed states (a switch is of t or of the state y(t))");
     if (of_t && of_y)
       throw BadInput(item + "depends on both t and the state: a switch is a time window (t only) or a state switch");
     if (!of_t && !of_y) throw BadInput(item + "depends on neither t nor the state: the field would never switch");
@@ -208,9 +210,10 @@ class EquationsReader {
     for (const auto& ya : m_.y) {
       m_.grad_H.push_back(h.diff(ya));  // printed: not normal(), whose form may vary between runs
       if (depends_on(m_.grad_H.back().normal(), m_.y))
-        throw BadInput(item + "a state switch must be affine in the state (event location assumes a constant "
-                              "gradient of the switch): d/d" + text_of(m_.display(ya)) + " = " +
-                       text_of(m_.display(m_.grad_H.back())));
+        throw BadInput(item +
+                       "a state switch must be affine in the state (event location assumes a constant "
+                       "gradient of the switch): d/d" +
+                       text_of(m_.display(ya)) + " = " + text_of(m_.display(m_.grad_H.back())));
     }
     if (std::all_of(m_.grad_H.begin(), m_.grad_H.end(), [](const GiNaC::ex& c) { return c.normal().is_zero(); }))
       throw BadInput(item + "depends on neither t nor the state: the field would never switch");
@@ -271,8 +274,8 @@ class EquationsReader {
     m_.fields.push_back(differentiate_field(rhs_, "rhs"));
     std::vector<GiNaC::symbol> state_and_delayed = m_.y;
     state_and_delayed.insert(state_and_delayed.end(), m_.z.begin(), m_.z.end());
-    m_.affine_in_state = std::all_of(m_.fields.begin(), m_.fields.end(),
-                                     [&](const SymbolicField& f) { return affine_in(f, m_.y); });
+    m_.affine_in_state =
+        std::all_of(m_.fields.begin(), m_.fields.end(), [&](const SymbolicField& f) { return affine_in(f, m_.y); });
     m_.is_linear = m_.switch_kind != SwitchKind::state &&
                    std::all_of(m_.fields.begin(), m_.fields.end(),
                                [&](const SymbolicField& f) { return affine_in(f, state_and_delayed); });

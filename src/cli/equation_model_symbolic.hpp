@@ -17,27 +17,27 @@ enum class SwitchKind { none, time, state };
 
 // One vector field f_j and what the engine needs of it, by GiNaC's diff.
 struct SymbolicField {
-  std::vector<GiNaC::ex> f;                    // f_j, d components
-  std::vector<std::vector<GiNaC::ex>> A, B;    // A[i][a] = d f_i / d y_a, B[i][a] = d f_i / d z_a
-  std::vector<GiNaC::ex> f_t, f_tt;            // d f / dt, d2 f / dt2 at fixed y, z
+  std::vector<GiNaC::ex> f;                  // f_j, d components
+  std::vector<std::vector<GiNaC::ex>> A, B;  // A[i][a] = d f_i / d y_a, B[i][a] = d f_i / d z_a
+  std::vector<GiNaC::ex> f_t, f_tt;          // d f / dt, d2 f / dt2 at fixed y, z
 };
 
 struct SymbolicEquationModel {
-  std::vector<std::string> state;              // user names, in order
-  std::vector<std::string> parameters;         // user names, in the table's (sorted) order
+  std::vector<std::string> state;       // user names, in order
+  std::vector<std::string> parameters;  // user names, in the table's (sorted) order
   std::vector<double> parameter_defaults;
   GiNaC::symbol t{"t"};
-  std::vector<GiNaC::symbol> y, z, p;          // printed y[i], z[i], p[k]
-  GiNaC::ex period, delay;                     // in p and Pi only
-  std::vector<GiNaC::ex> history;              // d entries, in p and Pi only
+  std::vector<GiNaC::symbol> y, z, p;  // printed y[i], z[i], p[k]
+  GiNaC::ex period, delay;             // in p and Pi only
+  std::vector<GiNaC::ex> history;      // d entries, in p and Pi only
   SwitchKind switch_kind = SwitchKind::none;
-  GiNaC::ex switch_function;                   // H (0 without a switch): of t only, or affine in y
-  std::vector<GiNaC::ex> grad_H;               // state switch only: d H / d y_a (constant in y)
+  GiNaC::ex switch_function;      // H (0 without a switch): of t only, or affine in y
+  std::vector<GiNaC::ex> grad_H;  // state switch only: d H / d y_a (constant in y)
   // fields[0] is f_1 (rhs_switched, H > 0) and fields[1] f_2 (rhs) with a switch; without a
   // switch the one field rhs.
   std::vector<SymbolicField> fields;
-  bool affine_in_state = false;                // every d2 f_j / dy_a dy_b == 0
-  bool is_linear = false;                      // no state switch, every f_j affine in (y, z) jointly
+  bool affine_in_state = false;  // every d2 f_j / dy_a dy_b == 0
+  bool is_linear = false;        // no state switch, every f_j affine in (y, z) jointly
 
   int d() const { return static_cast<int>(state.size()); }
   // e with the user's names for the generated symbols, for messages.

@@ -14,20 +14,20 @@ namespace {
 // C++20 keywords, alternative tokens and identifiers with special meaning ([lex.key], [lex.digraph],
 // [lex.name]: final, override, import, module).
 constexpr std::array<std::string_view, 97> kCppWords = {
-    "alignas",   "alignof",     "and",          "and_eq",    "asm",       "auto",      "bitand",
-    "bitor",     "bool",        "break",        "case",      "catch",     "char",      "char8_t",
-    "char16_t",  "char32_t",    "class",        "compl",     "concept",   "const",     "consteval",
-    "constexpr", "constinit",   "const_cast",   "continue",  "co_await",  "co_return", "co_yield",
-    "decltype",  "default",     "delete",       "do",        "double",    "dynamic_cast", "else",
-    "enum",      "explicit",    "export",       "extern",    "false",     "float",     "for",
-    "friend",    "goto",        "if",           "inline",    "int",       "long",      "mutable",
-    "namespace", "new",         "noexcept",     "not",       "not_eq",    "nullptr",   "operator",
-    "or",        "or_eq",       "private",      "protected", "public",    "register",  "reinterpret_cast",
-    "requires",  "return",      "short",        "signed",    "sizeof",    "static",    "static_assert",
-    "static_cast", "struct",    "switch",       "template",  "this",      "thread_local", "throw",
-    "true",      "try",         "typedef",      "typeid",    "typename",  "union",     "unsigned",
-    "using",     "virtual",     "void",         "volatile",  "wchar_t",   "while",     "xor",
-    "xor_eq",    "final",       "override",     "import",    "module",    "_Pragma"};
+    "alignas",     "alignof",   "and",        "and_eq",    "asm",      "auto",         "bitand",
+    "bitor",       "bool",      "break",      "case",      "catch",    "char",         "char8_t",
+    "char16_t",    "char32_t",  "class",      "compl",     "concept",  "const",        "consteval",
+    "constexpr",   "constinit", "const_cast", "continue",  "co_await", "co_return",    "co_yield",
+    "decltype",    "default",   "delete",     "do",        "double",   "dynamic_cast", "else",
+    "enum",        "explicit",  "export",     "extern",    "false",    "float",        "for",
+    "friend",      "goto",      "if",         "inline",    "int",      "long",         "mutable",
+    "namespace",   "new",       "noexcept",   "not",       "not_eq",   "nullptr",      "operator",
+    "or",          "or_eq",     "private",    "protected", "public",   "register",     "reinterpret_cast",
+    "requires",    "return",    "short",      "signed",    "sizeof",   "static",       "static_assert",
+    "static_cast", "struct",    "switch",     "template",  "this",     "thread_local", "throw",
+    "true",        "try",       "typedef",    "typeid",    "typename", "union",        "unsigned",
+    "using",       "virtual",   "void",       "volatile",  "wchar_t",  "while",        "xor",
+    "xor_eq",      "final",     "override",   "import",    "module",   "_Pragma"};
 
 // GiNaC's parser reads these as constants whatever its symbol table says (I is the imaginary unit).
 constexpr std::array<std::string_view, 4> kGinacLiterals = {"I", "Pi", "Euler", "Catalan"};
@@ -68,8 +68,7 @@ std::string printable(const std::string& text) {
 
 void check_equation_name(const std::string& item, const std::string& name) {
   const std::string head = "`" + item + "`: `" + printable(name) + "` ";
-  if (!is_plain_identifier(name))
-    throw BadInput(head + "is not a plain name (a letter, then letters, digits or _)");
+  if (!is_plain_identifier(name)) throw BadInput(head + "is not a plain name (a letter, then letters, digits or _)");
   if (name.find("__") != std::string::npos) throw BadInput(head + "is a reserved C++ name (contains __)");
   if (among(kCppWords, name)) throw BadInput(head + "is a C++ keyword");
   if (name == "t" || name == "pi") throw BadInput(head + "is reserved: the expressions' time or pi");

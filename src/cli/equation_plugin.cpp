@@ -125,13 +125,20 @@ Toolchain toolchain() {
   // Installed (wherever the prefix is now): the headers beside the library, version.hpp among
   // them; the build tree keeps that one among its generated files.
   const std::filesystem::path installed = libdir / DELAYSPEC_PLUGIN_INSTALLED_INCLUDE;
-  const auto includes = std::filesystem::exists(installed / "delayspec" / "version.hpp")
-                            ? std::vector<std::string>{installed.lexically_normal().string(), DELAYSPEC_PLUGIN_EIGEN_INCLUDE}
-                            : split(DELAYSPEC_PLUGIN_BUILD_INCLUDES);
+  const auto includes =
+      std::filesystem::exists(installed / "delayspec" / "version.hpp")
+          ? std::vector<std::string>{installed.lexically_normal().string(), DELAYSPEC_PLUGIN_EIGEN_INCLUDE}
+          : split(DELAYSPEC_PLUGIN_BUILD_INCLUDES);
   // The optimisation and sanitizer flags of this build come with DELAYSPEC_PLUGIN_FLAGS
   // (CMakeLists.txt); -fno-math-errno as the library (repeated sin/cos are evaluated once).
-  tc.flags = {"-std=c++20", "-DNDEBUG", "-fno-math-errno", "-fPIC", "-shared", "-fvisibility=hidden",
-              "-fvisibility-inlines-hidden", "-w"};
+  tc.flags = {"-std=c++20",
+              "-DNDEBUG",
+              "-fno-math-errno",
+              "-fPIC",
+              "-shared",
+              "-fvisibility=hidden",
+              "-fvisibility-inlines-hidden",
+              "-w"};
   for (const auto& f : split_words(DELAYSPEC_PLUGIN_FLAGS)) tc.flags.push_back(f);
   for (const auto& dir : includes) tc.flags.push_back("-I" + dir);
   tc.flags.push_back("-L" + libdir.string());
@@ -240,8 +247,8 @@ EquationPlugin open_plugin(const std::filesystem::path& object) {
   const std::string version = symbol<const char* (*)()>(handle, "delayspec_equation_version", object)();
   const std::string expected = std::string(DELAYSPEC_VERSION) + " " + DELAYSPEC_REVISION;
   if (version != expected)
-    throw BadInput("equations: the compiled model " + object.string() + " is of delayspec " + version +
-                   ", this is " + expected + ": delete it");
+    throw BadInput("equations: the compiled model " + object.string() + " is of delayspec " + version + ", this is " +
+                   expected + ": delete it");
   EquationPlugin plugin;
   plugin.analyses = symbol<decltype(plugin.analyses)>(handle, "delayspec_equation_analyses", object);
   plugin.period = symbol<decltype(plugin.period)>(handle, "delayspec_equation_period", object);
@@ -256,8 +263,10 @@ EquationPlugin open_plugin(const std::filesystem::path& object) {
 long equation_plugin_compilations() { return compilations.load(); }
 
 std::filesystem::path default_model_cache() {
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg == '/') return std::filesystem::path(xdg) / "delayspec";
-  if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".cache" / "delayspec";
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg == '/')
+    return std::filesystem::path(xdg) / "delayspec";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return std::filesystem::path(home) / ".cache" / "delayspec";
   return std::filesystem::temp_directory_path() / "delayspec-cache";
 }
 
@@ -283,8 +292,8 @@ EquationPlugin load_equation_plugin(const std::string& model_code, const std::fi
     std::filesystem::remove(tmp, ec);
     const std::string output = read_file(log);  // the command line, then the compiler's output
     throw BadInput("equations: the model did not compile (" + tc.compiler + ", exit " + std::to_string(status) +
-                   "; the command and its output are in " + log.string() + "):" +
-                   first_lines(output.substr(output.find('\n') + 1), 8));
+                   "; the command and its output are in " + log.string() +
+                   "):" + first_lines(output.substr(output.find('\n') + 1), 8));
   }
   std::filesystem::rename(tmp, object);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

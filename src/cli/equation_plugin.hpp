@@ -24,10 +24,10 @@ struct EquationPlugin {
   // The analyses of the model at the given parameter values (in the order of the source's
   // parameters), delay, period and constant initial history (d values). The caller owns it.
   ModelAnalyses* (*analyses)(const double* parameters, double tau, double period, const double* history) = nullptr;
-  double (*period)(const double* parameters) = nullptr;           // the `period` expression
-  double (*delay)(const double* parameters) = nullptr;            // the `delay` expression
+  double (*period)(const double* parameters) = nullptr;                // the `period` expression
+  double (*delay)(const double* parameters) = nullptr;                 // the `delay` expression
   void (*history)(const double* parameters, double* state) = nullptr;  // the `history` expressions
-  std::filesystem::path object;                                    // the loaded shared object
+  std::filesystem::path object;                                        // the loaded shared object
 };
 
 // Loads the model whose printed struct is `model_code`, compiling it into `cache_dir` first

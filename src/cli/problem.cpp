@@ -141,8 +141,8 @@ Problem read_problem(Config& config, int default_N) {
   if (problem.model_name == "milling") problem.model = read_milling(config);
   if (problem.model) {
     problem.analyses = std::visit([](const auto& model) { return builtin_analyses(model); }, *problem.model);
-    problem.state_names = problem.state_dimension() == 2 ? std::vector<std::string>{"x", "v"}
-                                                         : std::vector<std::string>{"x"};
+    problem.state_names =
+        problem.state_dimension() == 2 ? std::vector<std::string>{"x", "v"} : std::vector<std::string>{"x"};
   } else {
     EquationModel equations = read_equation_model(config);
     problem.analyses = std::move(equations.analyses);

@@ -48,7 +48,8 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
     for (long v = 0; v < k; ++v)
       for (int r = 0; r < D; ++r) {
         double acc = 0;
-        for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * d0[c * k + v] + s.R.coeff(r, c) * d1[c * k + v];
+        for (int c = 0; c < D; ++c)
+          acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * d0[c * k + v] + s.R.coeff(r, c) * d1[c * k + v];
         out[r * k + v] = acc;
       }
     return;
@@ -63,7 +64,8 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
     }
     for (int r = 0; r < D; ++r) {
       double acc = 0;
-      for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * w0[c] + s.R.coeff(r, c) * w1[c];
+      for (int c = 0; c < D; ++c)
+        acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * w0[c] + s.R.coeff(r, c) * w1[c];
       out[r * k + v] = acc;
     }
   }
