@@ -85,8 +85,9 @@ std::filesystem::path running_library() {
   return std::filesystem::canonical(info.dli_fname);
 }
 
-// The compiler, the flags and the headers to compile against: those of the build tree when this
-// process runs the build tree's library, else the installed ones.
+// The compiler, the flags and the headers to compile against: the installed headers when they sit
+// beside the library this process runs (an installed delayspec, wherever its prefix), else the
+// build tree's.
 struct Toolchain {
   std::string compiler;
   std::vector<std::string> flags;  // everything but the source and the output
