@@ -145,10 +145,9 @@ class ModelAnalysesFor final : public ModelAnalyses {
     const auto* before_model = before ? dynamic_cast<const ModelAnalysesFor*>(before) : this;
     if (!before_model) throw std::logic_error("simulate: the model before the switch is of another type");
     const TrapezoidStepper<Model> first(before_model->model_, before_map.step), second(model_, s.step);
-    const HistoryGrid grid = this->grid(s);
-    Eigen::VectorXd U(grid.dimension(D));
-    for (int j = 0; j <= grid.M; ++j) U.template segment<D>(static_cast<long>(j) * D) = model_.initial_state();
-    SimulationRecord<D> rec = delayspec::simulate(first, second, grid, U, options);
+    const StroboscopicMap<Model> map = make_map(s);  // its grid and constant history
+    SimulationRecord<D> rec = delayspec::simulate(first, second, map.grid(),
+                                                  map.constant_history(model_.initial_state()), options);
     SimulationRecord<Eigen::Dynamic> out;
     out.t = std::move(rec.t);
     out.y.assign(rec.y.begin(), rec.y.end());
