@@ -189,7 +189,8 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   StepMap<D> step_map;
   // One stroboscopic period, trajectory and block fused; afterwards the trajectory history is
   // back in slots 0..M and the (unnormalised) block in slots K..K+M.
-  auto advance = [&](bool record) {
+  // KC: k as a compile-time constant for the common few vectors (step_block), else 0.
+  auto advance_with = [&]<int KC>(bool record) {
     // A decaying trajectory would go subnormal and run ~2x slower (flush_subnormals.hpp)
     const detail::FlushSubnormals flush_subnormals;
     auto slot = [&traj](long i) -> const V& { return traj[i]; };
@@ -197,12 +198,20 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
       const DelayTap<V> tap = grid.delay_tap<V>(l, slot);
       traj[M + l + 1] = stepper.step(tap.t, grid.h, traj[M + l], tap.w0, tap.w1, step_map);
       // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same tap)
-      step_block<D>(step_map, block.data() + (M + l) * stride, block.data() + grid.delayed_slot(l) * stride, k,
-                    grid.theta, block.data() + (M + l + 1) * stride);
+      step_block<D, detail::PortableTarget, KC>(step_map, block.data() + (M + l) * stride,
+                                                block.data() + grid.delayed_slot(l) * stride, k, grid.theta,
+                                                block.data() + (M + l + 1) * stride);
       if (record && (l + 1) % spp == 0 && section_count < options.section_points)
         result.section.row(section_count++) = traj[M + l + 1].transpose();
     }
     std::copy(traj.begin() + K, traj.end(), traj.begin());  // history at the end -> slots 0..M
+  };
+  auto advance = [&](bool record) {
+    switch (k) {
+      case 1: return advance_with.template operator()<1>(record);
+      case 2: return advance_with.template operator()<2>(record);
+      default: return advance_with.template operator()<0>(record);
+    }
   };
   auto check_interval = [&](int interval) {
     if (interval <= 1) return;

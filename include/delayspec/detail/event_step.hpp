@@ -111,12 +111,24 @@ class EventStepSolver {
       if (count == 0) {
         // Most steps have no event: the trial piece over the whole step, with the derivative of
         // its end at fixed ends (da = db = 0), is then the step and its map.
-        const Piece whole = piece_with_fixed_ends(0, h_, u0, dz, j, m);
-        exit = find_exit(0, u0, whole.z, j, false);
-        if (!exit.event) {
-          z = whole.z;
-          dz = whole.X;
-          break;
+        if (m == 1) {  // one sub-step: the plain trapezoid step in region j, its map directly
+          const SubStepResult<D> r = stepper_.sub_step(t_, h_, u0, w0_, w1_, j, j);
+          exit = find_exit(0, u0, r.z1, j, false);
+          if (!exit.event) {
+            if (events) events->count = 0;
+            map.P = r.dz0;
+            map.Q = r.dw0;
+            map.R = r.dw1;
+            return r.z1;
+          }
+        } else {
+          const Piece whole = piece_with_fixed_ends(0, h_, u0, dz, j, m);
+          exit = find_exit(0, u0, whole.z, j, false);
+          if (!exit.event) {
+            z = whole.z;
+            dz = whole.X;
+            break;
+          }
         }
       } else {
         if (a < h_) exit = find_exit(a, z, piece_end(a, h_, z, j, m), j, true);
@@ -355,6 +367,15 @@ class EventStepSolver {
     const double c1 = d0, c2 = -3 * ga - 2 * d0 + 3 * gL - d1, c3 = 2 * ga + d0 - 2 * gL + d1;
     const double margin = std::abs(d1 - d0) + threshold(za);
     const double into = j == 1 ? 1 : -1;
+    // Most steps are far from H = 0: skip the roots (a sqrt and two divisions, measured a third
+    // of the event test) when the whole cubic is beyond the margin. p(tau) = chord(tau) +
+    // tau (1 - tau) [(1 - tau) (d0 - D) - tau (d1 - D)], D = gL - ga, so |p - chord| <=
+    // max(|d0 - D|, |d1 - D|) / 4 on [0, 1] and into p >= into min(ga, gL) - that bound there;
+    // if this exceeds the margin, no extremum is within it and the test below would answer no.
+    // The slack (1e-12 of the data) is far above the test's own rounding (~10 eps of it).
+    const double chord_deviation = 0.25 * std::max(std::abs(d0 - (gL - ga)), std::abs(d1 - (gL - ga)));
+    const double slack = 1e-12 * (std::abs(ga) + std::abs(gL) + std::abs(d0) + std::abs(d1));
+    if (std::min(into * ga, into * gL) - chord_deviation > margin + slack) return false;
     // p'(tau) = c1 + 2 c2 tau + 3 c3 tau^2
     const double qa = 3 * c3, qb = 2 * c2, qc = c1;
     double roots[2];
