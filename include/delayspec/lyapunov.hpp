@@ -201,7 +201,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
       step_block<D, detail::PortableTarget, KC>(step_map, block.data() + (M + l) * stride,
                                                 block.data() + grid.delayed_slot(l) * stride, k, grid.theta,
                                                 block.data() + (M + l + 1) * stride);
-      if (record && (l + 1) % spp == 0 && section_count < options.section_points)
+      if (record && section_count < options.section_points && (l + 1) % spp == 0)  // (no division unless recording)
         result.section.row(section_count++) = traj[M + l + 1].transpose();
     }
     std::copy(traj.begin() + K, traj.end(), traj.begin());  // history at the end -> slots 0..M
