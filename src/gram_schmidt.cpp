@@ -1,5 +1,5 @@
-// Gram-Schmidt kernels streaming a tall basis once (gram_schmidt.hpp).
-#include "gram_schmidt.hpp"
+// Gram-Schmidt kernels streaming a tall basis once (detail/gram_schmidt.hpp).
+#include "delayspec/detail/gram_schmidt.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -7,7 +7,7 @@
 #include <thread>
 #include <vector>
 
-namespace delayspec::krylov {
+namespace delayspec::detail {
 
 namespace {
 
@@ -205,4 +205,4 @@ ProjectedProducts subtract_in_basis(const double* Q, long n, long j, const doubl
   return total;
 }
 
-}  // namespace delayspec::krylov
+}  // namespace delayspec::detail

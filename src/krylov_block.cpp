@@ -1,7 +1,7 @@
 // Krylov-Schur backend of floquet_multipliers() (solver = block, block_size = b vectors per
 // product). b = 1 (the default, auto's choice at large n): one vector per product and classical
 // Gram-Schmidt with delayed reorthogonalisation (expand_single), two passes over the basis per
-// product in threaded row chunks (gram_schmidt.hpp). b > 1: the operator applied to b vectors at
+// product in threaded row chunks (detail/gram_schmidt.hpp). b > 1: the operator applied to b vectors at
 // once (Monodromy::apply_block), the basis orthogonalised with BLAS-3.
 //
 // Relation kept throughout (V orthonormal, p multiplied columns, the last b columns not yet):
@@ -36,10 +36,10 @@
 
 #include <Eigen/Dense>
 
+#include "delayspec/detail/gram_schmidt.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "blas.hpp"
-#include "gram_schmidt.hpp"
 #include "krylov.hpp"
 
 extern "C" void dgees_(const char* jobvs, const char* sort, int (*select)(const double*, const double*), const int* n,
@@ -47,6 +47,11 @@ extern "C" void dgees_(const char* jobvs, const char* sort, int (*select)(const 
                        double* work, const int* lwork, int* bwork, int* info);
 
 namespace delayspec::krylov {
+
+using detail::basis_coefficients;
+using detail::gram_schmidt_threads;
+using detail::ProjectedProducts;
+using detail::subtract_in_basis;
 
 namespace {
 

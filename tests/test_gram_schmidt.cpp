@@ -1,4 +1,4 @@
-// The Gram-Schmidt kernels of the Krylov-Schur backend (src/gram_schmidt.hpp) against Eigen's
+// The Gram-Schmidt kernels of the Krylov-Schur backend (detail/gram_schmidt.hpp) against Eigen's
 // products, for every column remainder of the four-column sweeps, a partial last chunk of rows,
 // and 1, 2 and 3 threads (which must give the same bits: sums are added in chunk order).
 #include <gtest/gtest.h>
@@ -9,10 +9,10 @@
 
 #include <Eigen/Dense>
 
-#include "../src/gram_schmidt.hpp"
+#include "delayspec/detail/gram_schmidt.hpp"
 #include "test_support.hpp"
 
-namespace delayspec::krylov {
+namespace delayspec::detail {
 namespace {
 
 // Three whole chunks and a partial one.
@@ -93,4 +93,4 @@ TEST(GramSchmidt, ThreadsOnlyForLongVectors) {
 }
 
 }  // namespace
-}  // namespace delayspec::krylov
+}  // namespace delayspec::detail
