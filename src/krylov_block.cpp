@@ -151,6 +151,10 @@ class BlockKrylovSchur {
       t.resize(q_cols);
       basis_coefficients(V_.data(), n_, q_cols, u, w.data(), s.data(), t.data(), threads_);
       const ProjectedProducts p = subtract_in_basis(V_.data(), n_, q_cols, s.data(), t.data(), u, w.data(), threads_);
+      // A non-finite product would pass for a lost direction below: say what it is, at once.
+      if (!std::isfinite(p.xx + p.yy))
+        throw NumericalFailure("Krylov (block): the operator returned a non-finite vector (product " +
+                               std::to_string(j) + " of the basis)");
       const double r = std::sqrt(p.xx);
       const Eigen::RowVectorXd row = H_.row(j - 1).head(q_cols);
       H_.topLeftCorner(q_cols, q_cols) += s * row;
