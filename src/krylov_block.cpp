@@ -171,8 +171,7 @@ class BlockKrylovSchur {
       c[q_cols] = g - hs[q_cols];
       c /= r;
       H_.col(j - 1).head(j) = c;
-      V_.col(j - 1) /= r;
-      V_.col(j) = (w - g * V_.col(j - 1)) / r;
+      detail::divide_and_split(n_, r, g, V_.col(j - 1).data(), w.data(), V_.col(j).data(), threads_);
       H_.row(j).head(j).setZero();
       H_(j, j - 1) = 1;
       // |M q|^2 = |c|^2 + |z|^2, |z|^2 = (|w|^2 - g^2) / r^2

@@ -32,4 +32,8 @@ struct ProjectedProducts {
 ProjectedProducts subtract_in_basis(const double* Q, long n, long j, const double* s, const double* t, double* x,
                                     double* y, int threads);
 
+// q = u / r in place of u, and z = (w - g q) / r: the end of an Arnoldi step with delayed
+// reorthogonalisation (the new basis vector and the next candidate), on the same threads.
+void divide_and_split(long n, double r, double g, double* u, const double* w, double* z, int threads);
+
 }  // namespace delayspec::detail
