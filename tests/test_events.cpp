@@ -211,7 +211,7 @@ TEST(EventStep, ExcursionTestShortcutGivesTheAnswerOfTheRoots) {
   std::uniform_real_distribution<double> u(-1, 1);
   int answers[2] = {0, 0}, near_boundary = 0;
   for (int i = 0; i < 400000; ++i) {
-    const double scale = std::pow(10.0, 4 * u(rng));   // slopes from 1e-4 to 1e4
+    const double scale = std::pow(10.0, 4 * u(rng));  // slopes from 1e-4 to 1e4
     const double d0 = scale * u(rng), d1 = scale * u(rng);
     const double into = u(rng) > 0 ? 1 : -1;
     const double margin = std::abs(d1 - d0) + 1e-14 * std::abs(u(rng));

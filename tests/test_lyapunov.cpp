@@ -476,7 +476,7 @@ TEST(FlushSubnormals, FlushesWhileAliveAndRestoresTheCallersMode) {
   {
     const ds::detail::FlushSubnormals flush;
 #if defined(__SSE__) || defined(__x86_64__) || defined(__aarch64__)
-    EXPECT_EQ(tiny * small, 0.0);  // result flushed
+    EXPECT_EQ(tiny * small, 0.0);     // result flushed
     EXPECT_EQ(subnormal * 2.0, 0.0);  // input treated as zero (DAZ; FZ on AArch64)
 #endif
     EXPECT_EQ(small * small, 0x1p-100);  // normal numbers untouched

@@ -47,8 +47,8 @@ class TrapezoidStepper {
   // Throws NumericalFailure if the implicit equation cannot be solved. Always inlined, as the
   // solve inside it: for D <= 2 the whole step is ~100 flops, and a call returning the result
   // through memory cost the scalar Lyapunov step 4 of its 8 ns (bench_lyapunov).
-  [[gnu::always_inline]] inline SubStepResult<D> sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region,
-                            int right_region) const {
+  [[gnu::always_inline]] inline SubStepResult<D> sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1,
+                                                          int left_region, int right_region) const {
     const double t1 = t0 + dt;
     SubStepResult<D> r;
     detail::SmallSolve<D> lu;
