@@ -1,10 +1,11 @@
 // What a delayspec process loads. GiNaC, CLN and GMP (the symbolic front end of model =
-// equations) cost every process that links them 1.5 ms before main (docs/benchmarks.md,
-// "Start-up"): they sit in the module libdelayspec_equations, which the program loads only for an
-// [equations] table (src/cli/equations_module_loader.hpp). Checked on the built program with the
-// dynamic loader's own trace (LD_DEBUG=files lists every object it maps, at start and by
-// dlopen), so a new link dependency or an eager load fails here; the equations run shows that
-// the trace does see the module when it is loaded.
+// equations) and OpenMPI cost every process that links them 1.5 and 1.3 ms before main
+// (docs/benchmarks.md, "Start-up"): they sit in the modules libdelayspec_equations and
+// libdelayspec_mpi, which the program loads only for an [equations] table and under an MPI
+// launcher (src/cli/module_loader.hpp; tests/mpi_test.py checks the MPI side). Checked on the
+// built program with the dynamic loader's own trace (LD_DEBUG=files lists every object it maps,
+// at start and by dlopen), so a new link dependency or an eager load fails here; the equations
+// run shows that the trace does see the module when it is loaded.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,6 +21,7 @@
 #include "delayspec/version.hpp"
 #include "delayspec_test_paths.hpp"
 #include "equations_module_loader.hpp"
+#include "module_loader.hpp"
 #include "running_library.hpp"
 
 namespace {
@@ -45,26 +47,27 @@ Process run_traced(const std::string& prefix, const std::string& program, const 
 
 bool mentions(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-// The symbolic libraries and the module that carries them.
-void expect_no_symbolic_libraries(const Process& p) {
+// The symbolic and MPI libraries and the modules that carry them.
+void expect_no_module_libraries(const Process& p) {
   // The trace works: it names libdelayspec, which every command loads.
   ASSERT_TRUE(mentions(p.trace, "file=libdelayspec.so")) << p.trace.substr(0, 2000);
-  for (const char* library : {"libginac", "libcln", "libgmp", "libdelayspec_equations"})
+  for (const char* library : {"libginac", "libcln", "libgmp", "libdelayspec_equations", "libmpi", "libopen-rte",
+                              "libopen-pal", "libhwloc", "libevent", "libdelayspec_mpi"})
     EXPECT_FALSE(mentions(p.trace, library)) << library << " loaded:\n" << p.trace.substr(0, 4000);
 }
 
 const std::string cache = std::string("--set model_cache=") + DELAYSPEC_TEST_MODEL_CACHE;
 
-TEST(StartupLibraries, VersionLoadsNoSymbolicLibrary) {
+TEST(StartupLibraries, VersionLoadsNeitherGiNaCNorMPI) {
   const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, "--version");
   EXPECT_EQ(p.status, 0) << p.trace;
-  expect_no_symbolic_libraries(p);
+  expect_no_module_libraries(p);
 }
 
-TEST(StartupLibraries, BuiltInModelLoadsNoSymbolicLibrary) {
+TEST(StartupLibraries, BuiltInModelLoadsNeitherGiNaCNorMPI) {
   const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, "floquet --set model=impact --set N=20 --json");
   EXPECT_EQ(p.status, 0) << p.trace;
-  expect_no_symbolic_libraries(p);
+  expect_no_module_libraries(p);
 }
 
 TEST(StartupLibraries, EquationsSceneLoadsTheModuleAndGiNaC) {
@@ -103,9 +106,14 @@ TEST(StartupLibraries, MissingModuleExits2NamingTheFile) {
   fs::remove_all(dir);
 }
 
+const delayspec::cli::EquationsModule& load(const fs::path& file) {
+  return delayspec::cli::load_module<delayspec::cli::EquationsModule>(
+      file, delayspec::cli::equations_module_symbol, delayspec::cli::equations_module_description());
+}
+
 TEST(EquationsModuleLoader, RefusesAMissingFileAndAnObjectWithoutTheEntryPoint) {
   try {
-    delayspec::cli::load_equations_module("/nonexistent/libdelayspec_equations.so");
+    load("/nonexistent/libdelayspec_equations.so");
     ADD_FAILURE() << "no BadInput";
   } catch (const delayspec::BadInput& e) {
     EXPECT_TRUE(mentions(e.what(), "/nonexistent/libdelayspec_equations.so")) << e.what();
@@ -114,7 +122,7 @@ TEST(EquationsModuleLoader, RefusesAMissingFileAndAnObjectWithoutTheEntryPoint) 
   // libdelayspec is a shared object, but not the module.
   const fs::path library = delayspec::cli::running_library();
   try {
-    delayspec::cli::load_equations_module(library);
+    load(library);
     ADD_FAILURE() << "no BadInput";
   } catch (const delayspec::BadInput& e) {
     EXPECT_TRUE(mentions(e.what(), library.string())) << e.what();

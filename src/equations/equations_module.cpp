@@ -13,8 +13,8 @@ const delayspec::cli::EquationsModule module_table{DELAYSPEC_VERSION " " DELAYSP
 
 }  // namespace
 
-// The declaration checks the entry's type against the one the loader casts to.
+// The declaration checks the entry's type against the one load_module casts to.
 extern "C" __attribute__((visibility("default"))) const delayspec::cli::EquationsModule* delayspec_equations_module();
-static_assert(std::is_same_v<decltype(&delayspec_equations_module), delayspec::cli::EquationsModuleEntry>);
+static_assert(std::is_same_v<decltype(&delayspec_equations_module), const delayspec::cli::EquationsModule* (*)()>);
 
 const delayspec::cli::EquationsModule* delayspec_equations_module() { return &module_table; }
