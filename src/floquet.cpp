@@ -10,6 +10,7 @@
 
 #include "delayspec/dense_spectrum.hpp"
 #include "delayspec/errors.hpp"
+#include "blas.hpp"
 #include "krylov.hpp"
 
 namespace delayspec {
@@ -21,12 +22,14 @@ FloquetSolver parse_floquet_solver(const std::string& name) {
   if (name == "block") return FloquetSolver::block;
   if (name == "dense" || name == "dense-lapack") return FloquetSolver::dense_lapack;
   if (name == "dense-eigen") return FloquetSolver::dense_eigen;
-  throw BadInput("`solver = " + name + "`: must be one of auto, spectra, arpack, dense, dense-eigen, dense-lapack");
+  throw BadInput("`solver = " + name +
+                 "`: must be one of auto, spectra, arpack, block, dense, dense-eigen, dense-lapack");
 }
 
 FloquetSolver choose_floquet_solver(long n) {
   if (n <= 100) return FloquetSolver::dense_lapack;
-  return n < 2000 ? FloquetSolver::spectra : FloquetSolver::arpack;
+  if (n < 2000) return FloquetSolver::spectra;
+  return n < 200000 ? FloquetSolver::arpack : FloquetSolver::block;
 }
 
 std::string to_string(FloquetSolver solver) {
@@ -107,7 +110,9 @@ RitzPairs ritz_pairs_in_basis(const std::vector<std::complex<double>>& theta, co
     C.col(pairs.column[i]) = coefficients[i].real();
     if (pairs.values[i].imag() != 0) C.col(pairs.column[i] + 1) = coefficients[i].imag();
   }
-  pairs.vectors.noalias() = V * C;  // Ritz vectors x = V y, real form
+  pairs.vectors.resize(V.rows(), columns);  // Ritz vectors x = V y, real form (BLAS: V is tall)
+  gemm('N', 'N', V.rows(), columns, V.cols(), 1.0, V.data(), V.outerStride(), C.data(), C.rows(), 0.0,
+       pairs.vectors.data(), V.rows());
   return pairs;
 }
 
@@ -136,50 +141,30 @@ std::string short_number(double value) {
 
 namespace {
 
-// Absolute residuals |M v - mu v| / |v| of the Ritz pairs, from applying M to the Ritz
-// vectors (real form) in blocks of at most kChunk columns, a complex pair's two columns always in
-// the same block (bounds the extra memory to 2 kChunk vectors plus the operator's block buffer).
+// Absolute residuals |M v - mu v| / |v| of the Ritz pairs, from applying M to the Ritz vectors
+// (real form) one at a time. Not apply_block: at large n its interleaved buffer holds the whole
+// extended history of every vector of the block (256 MB for 8 vectors at N = 10^6), first touched
+// here, while perform_op's buffer is already warm from the Krylov iterations (measured at
+// N = 10^6, 31 columns: 0.36 s in blocks of 8 against ~0.1 s one at a time).
 std::vector<double> ritz_residuals(const LinearOperator& op, const krylov::RitzPairs& pairs) {
-  constexpr long kChunk = 8;
   const long n = op.rows();
   std::vector<double> residual(pairs.values.size(), 0.0);
-  Eigen::MatrixXd X, Y;
-  size_t first = 0;
-  while (first < pairs.values.size()) {
-    // pairs [first, last) whose columns fit in one block
-    size_t last = first;
-    long k = 0;
-    while (last < pairs.values.size()) {
-      const long w = pairs.values[last].imag() == 0 ? 1 : 2;
-      if (k + w > kChunk) break;
-      k += w;
-      ++last;
+  Eigen::VectorXd Ma(n), Mb(n);
+  for (size_t i = 0; i < pairs.values.size(); ++i) {
+    const std::complex<double> mu = pairs.values[i];
+    const auto a = pairs.vectors.col(pairs.column[i]);
+    op.perform_op(a.data(), Ma.data());
+    if (mu.imag() == 0) {
+      // |M a - mu a| / |a|
+      residual[i] = (Ma - mu.real() * a).norm() / a.norm();
+      continue;
     }
-    X.resize(n, k);
-    for (size_t i = first, c = 0; i < last; ++i) {
-      X.col(c++) = pairs.vectors.col(pairs.column[i]);
-      if (pairs.values[i].imag() != 0) X.col(c++) = pairs.vectors.col(pairs.column[i] + 1);
-    }
-    op.apply_block(X, Y);  // Y = M X
-    for (size_t i = first, c = 0; i < last; ++i) {
-      const std::complex<double> mu = pairs.values[i];
-      const auto a = X.col(c);
-      const auto Ma = Y.col(c);
-      if (mu.imag() == 0) {
-        // |M a - mu a| / (|mu| |a|)
-        residual[i] = (Ma - mu.real() * a).norm() / a.norm();
-        c += 1;
-      } else {
-        // v = a + i b, mu = al + i be:  M v - mu v = (M a - al a + be b) + i (M b - al b - be a)
-        const auto b = X.col(c + 1);
-        const auto Mb = Y.col(c + 1);
-        const double al = mu.real(), be = mu.imag();
-        const double re = (Ma - al * a + be * b).squaredNorm(), im = (Mb - al * b - be * a).squaredNorm();
-        residual[i] = std::sqrt(re + im) / std::sqrt(a.squaredNorm() + b.squaredNorm());
-        c += 2;
-      }
-    }
-    first = last;
+    // v = a + i b, mu = al + i be:  M v - mu v = (M a - al a + be b) + i (M b - al b - be a)
+    const auto b = pairs.vectors.col(pairs.column[i] + 1);
+    op.perform_op(b.data(), Mb.data());
+    const double al = mu.real(), be = mu.imag();
+    const double re = (Ma - al * a + be * b).squaredNorm(), im = (Mb - al * b - be * a).squaredNorm();
+    residual[i] = std::sqrt(re + im) / std::sqrt(a.squaredNorm() + b.squaredNorm());
   }
   return residual;
 }

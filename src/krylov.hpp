@@ -19,7 +19,7 @@ struct Settings {
   double tolerance = 0;
   int max_iterations = 0;
   double scale = 1;    // Spectra only: the solver works on M / scale (a power of two), see krylov_spectra.cpp
-  int block_size = 8;  // block only: vectors per block (krylov_block.cpp)
+  int block_size = 1;  // block only: vectors per block (krylov_block.cpp)
 };
 
 // Converged Ritz pairs, each real eigenvalue and each complex-conjugate pair once.

@@ -1,24 +1,31 @@
-// Block Krylov-Schur backend of floquet_multipliers() (solver = block): the operator applied to b
-// vectors at once (Monodromy::apply_block), the basis orthogonalised with BLAS-3.
+// Krylov-Schur backend of floquet_multipliers() (solver = block, block_size = b vectors per
+// product). b = 1 (the default, auto's choice at large n): one vector per product and classical
+// Gram-Schmidt with delayed reorthogonalisation (expand_single), two passes over the basis per
+// product in threaded row chunks (gram_schmidt.hpp). b > 1: the operator applied to b vectors at
+// once (Monodromy::apply_block), the basis orthogonalised with BLAS-3.
 //
 // Relation kept throughout (V orthonormal, p multiplied columns, the last b columns not yet):
 //     M V(:, 0:p) = V(:, 0:p + b) H(0:p + b, 0:p).
-// Expansion: W = M V(:, p:p+b); block classical Gram-Schmidt twice against V(:, 0:p+b) (two dgemm
-// each: c = V^T W, W -= V c), then the block itself orthonormalised by Cholesky QR twice (two more
-// passes over W); H gets c and the triangular factor. When a new direction is numerically absent
-// (|R_ii| <= 1e-12 |M v_i|: the Krylov space is invariant in it, e.g. a rank-deficient or strongly
-// unstable monodromy whose other multipliers are below round-off) the block is orthonormalised
-// column by column and that column replaced by a random vector orthogonal to the basis, with a
-// zero coefficient: the relation holds to rounding and the search goes on in a fresh direction.
+// Expansion (b > 1): W = M V(:, p:p+b); block classical Gram-Schmidt twice against V(:, 0:p+b) (two
+// dgemm each: c = V^T W, W -= V c), then the block itself orthonormalised by Cholesky QR twice (two
+// more passes over W); H gets c and the triangular factor. When a new direction is numerically
+// absent (|R_ii| <= 1e-12 |M v_i|: the Krylov space is invariant in it, e.g. a rank-deficient or
+// strongly unstable monodromy whose other multipliers are below round-off) the block is
+// orthonormalised column by column and that column replaced by a random vector orthogonal to the
+// basis, with a zero coefficient: the relation holds to rounding and the search goes on in a fresh
+// direction (expand_single does the same for its one vector).
 // Rayleigh-Ritz: Ritz values theta of H_p = H(0:p, 0:p), Ritz vectors V y, residual estimates
 // |H(p:p+b, 0:p) y| (|y| = 1); a pair has converged when estimate <= tol max(|theta|, eps^(2/3)),
 // the criterion Spectra and ARPACK use. Restart (Krylov-Schur, Stewart 2001): the real Schur form
-// of H_p with the k largest-modulus values first (LAPACK dgees with a selection), V <- V Z_k,
-// H_k <- T_k, the coupling row block <- H(p:p+b, 0:p) Z_k; the last block stays the not yet
-// multiplied one. k = (nev + m) / 2 keeps the wanted values and a margin.
+// of H_p with the k largest-modulus values first (LAPACK dgees with a selection), V <- V Z_k (in
+// place, by row chunks), H_k <- T_k, the coupling row block <- H(p:p+b, 0:p) Z_k; the last block
+// stays the not yet multiplied one. k = (nev + m) / 2 keeps the wanted values and a margin.
 //
-// Cost per expansion: one apply_block of b vectors plus 8 n p b flops of dgemm (compute bound, not
-// the memory-bound dgemv of one vector at a time); per restart 2 n p k flops.
+// Cost per product at large n, where reading the n x m basis is what costs (an application of the
+// monodromy at N = 10^6 takes ~2 ms, one read of a 41-column basis ~20 ms): b = 1 reads the j
+// basis columns twice (CGS2 as ARPACK does it: four times); b > 1 makes 8 n p b flops of dgemm
+// per expansion of b vectors but needs 1.7-5x the products for the same accuracy
+// (docs/benchmarks.md). Per restart 2 n p k flops.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -31,28 +38,17 @@
 
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
+#include "blas.hpp"
+#include "gram_schmidt.hpp"
 #include "krylov.hpp"
 
-extern "C" {
-void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const double* alpha,
-            const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
-            const int* ldc);
-void dgees_(const char* jobvs, const char* sort, int (*select)(const double*, const double*), const int* n, double* a,
-            const int* lda, int* sdim, double* wr, double* wi, double* vs, const int* ldvs, double* work,
-            const int* lwork, int* bwork, int* info);
-}
+extern "C" void dgees_(const char* jobvs, const char* sort, int (*select)(const double*, const double*), const int* n,
+                       double* a, const int* lda, int* sdim, double* wr, double* wi, double* vs, const int* ldvs,
+                       double* work, const int* lwork, int* bwork, int* info);
 
 namespace delayspec::krylov {
 
 namespace {
-
-// C = alpha op(A) op(B) + beta C (column-major, BLAS dgemm).
-void gemm(char ta, char tb, long m, long n, long k, double alpha, const double* A, long lda, const double* B, long ldb,
-          double beta, double* C, long ldc) {
-  const int im = static_cast<int>(m), in = static_cast<int>(n), ik = static_cast<int>(k);
-  const int ilda = static_cast<int>(lda), ildb = static_cast<int>(ldb), ildc = static_cast<int>(ldc);
-  dgemm_(&ta, &tb, &im, &in, &ik, &alpha, A, &ilda, B, &ildb, &beta, C, &ildc);
-}
 
 // dgees' selection: |lambda| >= threshold (the wanted, largest-modulus values).
 thread_local double select_threshold = 0;
@@ -126,10 +122,105 @@ class BlockKrylovSchur {
     }
   }
 
+  // Expansion with one vector per product (b = 1): Arnoldi with classical Gram-Schmidt and delayed
+  // reorthogonalisation (DCGS2; Bielich, Langou, Thomas, Swirydowicz, Yamazaki, Boman 2022), two
+  // reads of the basis per product where CGS2 takes four. On entry columns 0..j-1 exist; Q =
+  // V(:, 0:j-1) is orthonormal, u = V(:, j-1) has been projected against Q once (not twice, not
+  // normalised) and enters the relation through its row, M Q = Q H(0:j-1, 0:j-1) + u H(j-1, 0:j-1).
+  // One step, with w = M u:
+  //   pass 1 (reads Q):  s = Q^T u,  t = Q^T w
+  //   pass 2 (reads Q):  u <- u - Q s,  w <- w - Q t;  r = |u|, q = u / r, g = q^T w
+  // u = Q s + r q turns the relation into M Q = [Q q] H' with H(0:j-1, :) += s row, H(j-1, :) = r row,
+  // and M q = (M u - M Q s) / r = (w_in - [Q q] H' s) / r, whose coefficients on [Q q] are
+  // c = ([t; g] - H' s) / r and whose remainder z = (w - q g) / r (w projected once) is the next u.
+  // Rounding: s = O(eps) |u| after the first projection, so the delayed second one corrects H' by
+  // O(eps) and c loses O(eps |s| / r) <= O(eps) |M| as long as r > 1e-12 |M q_prev| (below that the
+  // direction is lost and replaced, as in column_qr).
+  void expand_single(const LinearOperator& op, long& j, long m) {
+    Eigen::VectorXd w(n_), s, t, hs;
+    while (j <= m) {
+      const long q_cols = j - 1;
+      double* u = V_.col(j - 1).data();
+      op.perform_op(u, w.data());
+      s.resize(q_cols);
+      t.resize(q_cols);
+      basis_coefficients(V_.data(), n_, q_cols, u, w.data(), s.data(), t.data(), threads_);
+      const ProjectedProducts p = subtract_in_basis(V_.data(), n_, q_cols, s.data(), t.data(), u, w.data(), threads_);
+      const double r = std::sqrt(p.xx);
+      const Eigen::RowVectorXd row = H_.row(j - 1).head(q_cols);
+      H_.topLeftCorner(q_cols, q_cols) += s * row;
+      if (!(r > 1e-12 * source_norm_)) {  // u was rounding noise: M's space is invariant so far
+        H_.row(j - 1).head(q_cols).setZero();
+        replace_lost_column(j - 1);
+        continue;
+      }
+      H_.row(j - 1).head(q_cols) = r * row;
+      const double g = p.xy / r;
+      hs = H_.topLeftCorner(j, q_cols) * s;
+      Eigen::VectorXd c(j);
+      c.head(q_cols) = t - hs.head(q_cols);
+      c[q_cols] = g - hs[q_cols];
+      c /= r;
+      H_.col(j - 1).head(j) = c;
+      V_.col(j - 1) /= r;
+      V_.col(j) = (w - g * V_.col(j - 1)) / r;
+      H_.row(j).head(j).setZero();
+      H_(j, j - 1) = 1;
+      // |M q|^2 = |c|^2 + |z|^2, |z|^2 = (|w|^2 - g^2) / r^2
+      source_norm_ = std::sqrt(c.squaredNorm() + std::max(0.0, p.yy - g * g) / (r * r));
+      ++j;
+    }
+    finish_single(m);
+  }
+
+  // The last column V(:, m) gets its second projection and is normalised: the relation
+  // M V(:, 0:m) = V(:, 0:m + 1) H(0:m + 1, 0:m) with V orthonormal, as the block expansion leaves it.
+  void finish_single(long m) {
+    double* u = V_.col(m).data();
+    Eigen::VectorXd s(m);
+    basis_coefficients(V_.data(), n_, m, u, nullptr, s.data(), nullptr, threads_);
+    const ProjectedProducts p = subtract_in_basis(V_.data(), n_, m, s.data(), nullptr, u, nullptr, threads_);
+    const double r = std::sqrt(p.xx);
+    const Eigen::RowVectorXd row = H_.row(m).head(m);
+    H_.topLeftCorner(m, m) += s * row;
+    if (!(r > 1e-12 * source_norm_)) {  // invariant subspace: no coupling, any orthonormal successor
+      H_.row(m).head(m).setZero();
+      replace_lost_column(m);
+      return;
+    }
+    H_.row(m).head(m) = r * row;
+    V_.col(m) /= r;
+  }
+
+  // V(:, i) <- a random unit vector orthogonal to V(:, 0:i) (CGS2); the caller zeroes its row.
+  void replace_lost_column(long i) {
+    V_.col(i) = start_vector(n_, 0x5eedULL + seed_++);
+    Eigen::VectorXd s(i);
+    for (int twice = 0; twice < 2; ++twice) {
+      basis_coefficients(V_.data(), n_, i, V_.col(i).data(), nullptr, s.data(), nullptr, threads_);
+      subtract_in_basis(V_.data(), n_, i, s.data(), nullptr, V_.col(i).data(), nullptr, threads_);
+    }
+    V_.col(i).normalize();
+    source_norm_ = 1;
+  }
+
+  // V(:, 0:k) <- V(:, 0:p) Z in place, a chunk of rows at a time: no second n x k matrix.
+  void rotate_basis(long p, const Eigen::MatrixXd& Z, long k) {
+    constexpr long kRows = 4096;
+    Eigen::MatrixXd rows(kRows, k);
+    for (long a = 0; a < n_; a += kRows) {
+      const long h = std::min(kRows, n_ - a);
+      gemm('N', 'N', h, k, p, 1.0, V_.data() + a, n_, Z.data(), p, 0.0, rows.data(), kRows);
+      V_.block(a, 0, h, k) = rows.topRows(h);
+    }
+  }
+
   long n_;
   int b_, m_;
   Eigen::MatrixXd V_, H_;
   std::uint64_t seed_ = 0;
+  int threads_ = gram_schmidt_threads(n_);
+  double source_norm_ = 1;  // |M q| of the vector the current u was projected from (|start| at first)
 };
 
 }  // namespace
@@ -158,6 +249,7 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
   const double eps23 = std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);
   for (int iteration = 1;; ++iteration) {
     // Expand while a whole block fits: M V(:, j-b:j) -> new block.
+    if (b == 1) k.expand_single(op, j, m);
     while (j + b <= m + b) {
       X = V.middleCols(j - b, b);
       op.apply_block(X, Y);
@@ -246,14 +338,12 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
       throw NumericalFailure("Krylov (block): no restart keeps between nev = " + std::to_string(nev) + " and " +
                              std::to_string(m - b) + " Ritz values (dgees info " + std::to_string(info) + ", " +
                              std::to_string(sdim) + " selected); try another solver");
-    Eigen::MatrixXd kept(n, sdim);
-    gemm('N', 'N', n, sdim, p, 1.0, V.data(), n, Z.data(), p, 0.0, kept.data(), n);  // V Z_k
-    const Eigen::MatrixXd residual_block = V.middleCols(p, b);
-    V.leftCols(sdim) = kept;
-    V.middleCols(sdim, b) = residual_block;
+    k.rotate_basis(p, Z, sdim);                  // V(:, 0:sdim) <- V Z_k
+    V.middleCols(sdim, b) = V.middleCols(p, b);  // disjoint: sdim + b <= m = p
     H.setZero();
     H.topLeftCorner(sdim, sdim) = T.topLeftCorner(sdim, sdim);
     H.block(sdim, 0, b, sdim) = coupling * Z.leftCols(sdim);
+    k.source_norm_ = 1;
     j = sdim + b;
   }
 }

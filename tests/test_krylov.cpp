@@ -7,6 +7,7 @@
 
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
+#include "delayspec/lambert_w.hpp"
 #include "delayspec/model_impact.hpp"
 #include "delayspec/model_linear.hpp"
 #include "delayspec/model_mathieu.hpp"
@@ -171,6 +172,39 @@ TEST(KrylovBlock, BlockSizesAgreeWithDenseAndArpack) {
   check(mathieu, 20);
   check(impact, 20);
   check(impact, 7);
+}
+
+// One-vector Krylov-Schur (block_size = 1, the default) at n = 3 x 10^5, where its Gram-Schmidt
+// passes split the rows between threads (gram_schmidt_threads: two from 2^17 rows on a machine
+// with two cores): the same multipliers as ARPACK (1e-10 |mu_1|, as
+// expect_backends_agree) and, to the trapezoid rule's O(h^2) error (h = 3.3e-6: 1e-9 with a wide
+// margin; measured 2.6e-12 to 2.7e-11), the exact multipliers exp(lambda T) of the DDE from
+// Lambert W.
+TEST(KrylovBlock, OneVectorAtLargeDimensionAgreesWithArpackAndLambertW) {
+  const int N = 300000;
+  const auto op = zero_orbit_monodromy(LinearModel({.a = -1, .b = -2, .tau = 1, .period = 1}), N);
+  const FloquetResult arpack = solve(op, FloquetSolver::arpack, 6);
+  const FloquetResult block = solve(op, FloquetSolver::block, 6);
+  const auto exact = linear_dde_multipliers(-1, -2, 1, 1, 6);
+  const double scale = std::abs(arpack.multipliers[0]);
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_LE(std::abs(block.multipliers[k] - arpack.multipliers[k]), 1e-10 * scale) << k;
+    EXPECT_LE(std::abs(block.multipliers[k] - exact[k]), 1e-9 * scale) << k << ": " << exact[k];
+    EXPECT_LE(block.residuals[k], 1e-9) << k;
+  }
+}
+
+// solver = auto's rule (floquet.hpp, from docs/benchmarks.md "Choosing the eigensolver") at each
+// boundary, and what a floquet run reports as the solver it used.
+TEST(Krylov, AutoPicksByDimension) {
+  EXPECT_EQ(choose_floquet_solver(100), FloquetSolver::dense_lapack);
+  EXPECT_EQ(choose_floquet_solver(101), FloquetSolver::spectra);
+  EXPECT_EQ(choose_floquet_solver(1999), FloquetSolver::spectra);
+  EXPECT_EQ(choose_floquet_solver(2000), FloquetSolver::arpack);
+  EXPECT_EQ(choose_floquet_solver(199999), FloquetSolver::arpack);
+  EXPECT_EQ(choose_floquet_solver(200000), FloquetSolver::block);
+  const auto op = zero_orbit_monodromy(LinearModel({.a = -1, .b = -2, .tau = 1, .period = 1}), 200000);
+  EXPECT_EQ(solve(op, FloquetSolver::automatic, 2).solver, "block");
 }
 
 TEST(Krylov, ForcedNonConvergenceThrowsForBothBackends) {

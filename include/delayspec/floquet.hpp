@@ -3,9 +3,11 @@
 // One entry point, several backends on the same matrix-free operator:
 //   spectra: Spectra 1.0 GenEigsSolver (implicitly restarted Arnoldi) with the Monodromy as op;
 //   arpack:  ARPACK-ng dnaupd/dneupd reverse communication calling the same perform_op;
-//   block:   block Krylov-Schur on apply_block (krylov_block.cpp: BLAS-3 CGS2 + Cholesky QR2 with
-//            deflation, restarts by LAPACK dgees with the wanted values first), block_size vectors;
-//            measured slower than ARPACK here (docs/benchmarks.md), so auto does not pick it;
+//   block:   Krylov-Schur (krylov_block.cpp; restarts by LAPACK dgees with the wanted values
+//            first). block_size = 1 (default): one vector per product, Gram-Schmidt with delayed
+//            reorthogonalisation (DCGS2), two threaded passes over the basis per product: auto's
+//            choice at large n. block_size = b > 1: apply_block on b vectors, BLAS-3 CGS2 +
+//            Cholesky QR2 with deflation; measured slower (more products for the same accuracy);
 //   dense_eigen / dense_lapack: form the n x n matrix, all eigenvalues (reference, O(n^3)).
 //
 // Both Krylov backends start from the same vector (start_vector(n, seed), reproducible),
@@ -55,14 +57,18 @@ namespace delayspec {
 
 enum class FloquetSolver { automatic, spectra, arpack, block, dense_eigen, dense_lapack };
 
-// "auto", "spectra", "arpack", "dense" (= dense_lapack), "dense-eigen", "dense-lapack"; BadInput otherwise.
+// "auto", "spectra", "arpack", "block", "dense" (= dense_lapack), "dense-eigen", "dense-lapack"; BadInput
+// otherwise.
 FloquetSolver parse_floquet_solver(const std::string& name);
 std::string to_string(FloquetSolver solver);
 
 // solver = auto: the backend measured fastest for the operator's size (docs/benchmarks.md,
 // "Choosing the eigensolver"): dense LAPACK for n <= 100 (all eigenvalues, no Krylov constraint,
-// as fast as Krylov there), Spectra for n < 2000, ARPACK from n = 2000 on (its BLAS dgemv
-// orthogonalisation: 1.2x Spectra at n = 8000, 3x at n = 128000, 2.9x at n = 2e6, nev = 20).
+// as fast as Krylov there), Spectra for n < 2000, ARPACK from n = 2000 (its BLAS dgemv
+// orthogonalisation: 1.2x Spectra at n = 8000, 3x at n = 128000, nev = 20), and from
+// n = 200000 the one-vector Krylov-Schur (block, block_size = 1), whose Gram-Schmidt reads the
+// basis twice per product instead of four times, on all cores: 1.4x ARPACK at n = 250000, 1.8x
+// at n = 2e6; equal at n = 128000, where the basis still fits the cache.
 FloquetSolver choose_floquet_solver(long n);
 
 struct FloquetOptions {
@@ -73,7 +79,7 @@ struct FloquetOptions {
   double tolerance = 1e-12;       // relative Ritz residual at which a pair counts as converged
   int max_iterations = 300;       // Arnoldi iterations (1 + implicit restarts), ARPACK's MXITER
   std::uint64_t seed = 1;         // start vector = start_vector(n, seed) for both backends
-  int block_size = 8;             // solver = block: vectors per block (1..64)
+  int block_size = 1;             // solver = block: vectors per block (1..64); 1 = one-vector Krylov-Schur
   Eigen::VectorXd start;          // when non-empty: the start vector instead (n finite entries, not all 0)
   bool keep_vectors = false;      // fill FloquetResult::subspace (Krylov only)
   double residual_bound = 1e-8;   // the residual gate (header comment): max(residual_bound, 100 tolerance)

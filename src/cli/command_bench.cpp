@@ -2,7 +2,7 @@
 // N, in one run: time, peak memory, operator applications and error against a reference
 // (CLI contract `bench`). Library parts: floquet.hpp, convergence.hpp.
 //
-// Keys: Ns (comma list) or N_min/N_max (doubling); solvers (comma list of spectra, arpack,
+// Keys: Ns (comma list) or N_min/N_max (doubling); solvers (comma list of spectra, arpack, block,
 // dense-lapack, dense-eigen; default all but dense-eigen; and the classic dense discretisations
 // sdm0, fdm1 of linear models with tau = T, classic_discretisation.hpp: their N is m, the steps
 // per period, and their seconds include forming the product; classic_max_N, default 640: they
@@ -105,7 +105,7 @@ BenchSettings read_bench_settings(Config& config) {
   s.orbit = read_orbit_settings(config);
   s.Ns = read_N_list(config, s.problem, 100, 400);
   s.solver_names = read_word_list(config, "solvers", "spectra,arpack,dense-lapack",
-                                  {"spectra", "arpack", "dense", "dense-lapack", "dense-eigen", "sdm0", "fdm1"});
+                                  {"spectra", "arpack", "block", "dense", "dense-lapack", "dense-eigen", "sdm0", "fdm1"});
   s.base = read_floquet_options(config, 10);
   s.reference_kind =
       parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
