@@ -1,5 +1,5 @@
-// Gram-Schmidt kernels streaming a tall basis once (gram_schmidt.hpp).
-#include "gram_schmidt.hpp"
+// Gram-Schmidt kernels streaming a tall basis once (detail/gram_schmidt.hpp).
+#include "delayspec/detail/gram_schmidt.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -7,7 +7,7 @@
 #include <thread>
 #include <vector>
 
-namespace delayspec::krylov {
+namespace delayspec::detail {
 
 namespace {
 
@@ -205,4 +205,15 @@ ProjectedProducts subtract_in_basis(const double* Q, long n, long j, const doubl
   return total;
 }
 
-}  // namespace delayspec::krylov
+void divide_and_split(long n, double r, double g, double* u, const double* w, double* z, int threads) {
+  const double inverse = 1 / r;
+  for_chunk_ranges(chunk_count(n), threads, [&](long first, long last) {
+    const long a = first * kGramSchmidtRows, b = std::min(n, last * kGramSchmidtRows);
+    for (long i = a; i < b; ++i) {
+      u[i] *= inverse;
+      z[i] = (w[i] - g * u[i]) * inverse;
+    }
+  });
+}
+
+}  // namespace delayspec::detail

@@ -1,7 +1,7 @@
 // Krylov-Schur backend of floquet_multipliers() (solver = block, block_size = b vectors per
 // product). b = 1 (the default, auto's choice at large n): one vector per product and classical
 // Gram-Schmidt with delayed reorthogonalisation (expand_single), two passes over the basis per
-// product in threaded row chunks (gram_schmidt.hpp). b > 1: the operator applied to b vectors at
+// product in threaded row chunks (detail/gram_schmidt.hpp). b > 1: the operator applied to b vectors at
 // once (Monodromy::apply_block), the basis orthogonalised with BLAS-3.
 //
 // Relation kept throughout (V orthonormal, p multiplied columns, the last b columns not yet):
@@ -36,10 +36,10 @@
 
 #include <Eigen/Dense>
 
+#include "delayspec/detail/gram_schmidt.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "blas.hpp"
-#include "gram_schmidt.hpp"
 #include "krylov.hpp"
 
 extern "C" void dgees_(const char* jobvs, const char* sort, int (*select)(const double*, const double*), const int* n,
@@ -47,6 +47,11 @@ extern "C" void dgees_(const char* jobvs, const char* sort, int (*select)(const 
                        double* work, const int* lwork, int* bwork, int* info);
 
 namespace delayspec::krylov {
+
+using detail::basis_coefficients;
+using detail::gram_schmidt_threads;
+using detail::ProjectedProducts;
+using detail::subtract_in_basis;
 
 namespace {
 
@@ -146,6 +151,10 @@ class BlockKrylovSchur {
       t.resize(q_cols);
       basis_coefficients(V_.data(), n_, q_cols, u, w.data(), s.data(), t.data(), threads_);
       const ProjectedProducts p = subtract_in_basis(V_.data(), n_, q_cols, s.data(), t.data(), u, w.data(), threads_);
+      // A non-finite product would pass for a lost direction below: say what it is, at once.
+      if (!std::isfinite(p.xx + p.yy))
+        throw NumericalFailure("Krylov (block): the operator returned a non-finite vector (product " +
+                               std::to_string(j) + " of the basis)");
       const double r = std::sqrt(p.xx);
       const Eigen::RowVectorXd row = H_.row(j - 1).head(q_cols);
       H_.topLeftCorner(q_cols, q_cols) += s * row;
@@ -162,8 +171,7 @@ class BlockKrylovSchur {
       c[q_cols] = g - hs[q_cols];
       c /= r;
       H_.col(j - 1).head(j) = c;
-      V_.col(j - 1) /= r;
-      V_.col(j) = (w - g * V_.col(j - 1)) / r;
+      detail::divide_and_split(n_, r, g, V_.col(j - 1).data(), w.data(), V_.col(j).data(), threads_);
       H_.row(j).head(j).setZero();
       H_(j, j - 1) = 1;
       // |M q|^2 = |c|^2 + |z|^2, |z|^2 = (|w|^2 - g^2) / r^2

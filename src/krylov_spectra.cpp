@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "delayspec/errors.hpp"
@@ -88,8 +89,17 @@ RitzPairs spectra_ritz_pairs(const LinearOperator& op, const Settings& s, const 
   const ScaledMonodromy scaled(op, scale);
   SpectraSolver solver(scaled, s.nev, s.ncv);
   solver.init(start.data());  // Spectra starts from M * start (forces the vector into M's range)
-  const Eigen::Index nconv =
-      solver.compute(Spectra::SortRule::LargestMagn, s.max_iterations, s.tolerance, Spectra::SortRule::LargestMagn);
+  Eigen::Index nconv = 0;
+  try {
+    nconv =
+        solver.compute(Spectra::SortRule::LargestMagn, s.max_iterations, s.tolerance, Spectra::SortRule::LargestMagn);
+  } catch (const NumericalFailure&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    // Spectra's own failures (its Schur or eigen decompositions of the Rayleigh quotient, e.g. on
+    // a non-finite operator) are numerical, not a bug of the caller: exit 3 with its reason.
+    throw NumericalFailure(std::string("Krylov (spectra): ") + e.what());
+  }
   RitzPairs pairs;
   pairs.converged = static_cast<int>(nconv);
   pairs.iterations = static_cast<int>(solver.num_iterations());

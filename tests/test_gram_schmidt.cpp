@@ -1,4 +1,4 @@
-// The Gram-Schmidt kernels of the Krylov-Schur backend (src/gram_schmidt.hpp) against Eigen's
+// The Gram-Schmidt kernels of the Krylov-Schur backend (detail/gram_schmidt.hpp) against Eigen's
 // products, for every column remainder of the four-column sweeps, a partial last chunk of rows,
 // and 1, 2 and 3 threads (which must give the same bits: sums are added in chunk order).
 #include <gtest/gtest.h>
@@ -9,10 +9,10 @@
 
 #include <Eigen/Dense>
 
-#include "../src/gram_schmidt.hpp"
+#include "delayspec/detail/gram_schmidt.hpp"
 #include "test_support.hpp"
 
-namespace delayspec::krylov {
+namespace delayspec::detail {
 namespace {
 
 // Three whole chunks and a partial one.
@@ -85,6 +85,21 @@ TEST(GramSchmidt, SubtractionAndProductsMatchEigen) {
   }
 }
 
+TEST(GramSchmidt, DivideAndSplitMatchesItsFormula) {
+  const Eigen::VectorXd u0 = testing::random_matrix(kRows, 1, 8), w = testing::random_matrix(kRows, 1, 9);
+  const double r = 0.37, g = -1.9;
+  const Eigen::VectorXd q_ref = u0 / r, z_ref = (w - g * q_ref) / r;
+  for (int threads : {1, 2, 3}) {
+    Eigen::VectorXd u = u0, z(kRows);
+    divide_and_split(kRows, r, g, u.data(), w.data(), z.data(), threads);
+    // a product by 1 / r against a division: a few ulps of each entry
+    EXPECT_LE((u - q_ref).cwiseAbs().maxCoeff(), 4e-16 * q_ref.cwiseAbs().maxCoeff()) << threads;
+    EXPECT_LE((z - z_ref).cwiseAbs().maxCoeff(),
+              1e-15 * (w.cwiseAbs().maxCoeff() + std::abs(g) * q_ref.cwiseAbs().maxCoeff()) / r)
+        << threads;
+  }
+}
+
 TEST(GramSchmidt, ThreadsOnlyForLongVectors) {
   EXPECT_EQ(gram_schmidt_threads(1000), 1);
   EXPECT_EQ(gram_schmidt_threads((1L << 17) - 1), 1);
@@ -93,4 +108,4 @@ TEST(GramSchmidt, ThreadsOnlyForLongVectors) {
 }
 
 }  // namespace
-}  // namespace delayspec::krylov
+}  // namespace delayspec::detail

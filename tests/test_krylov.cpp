@@ -207,6 +207,42 @@ TEST(Krylov, AutoPicksByDimension) {
   EXPECT_EQ(solve(op, FloquetSolver::automatic, 2).solver, "block");
 }
 
+// An operator that returns NaN from its fifth product on (an overflowing model, a bug): every
+// backend reports a numerical failure (exit 3) instead of returning NaN multipliers. Spectra
+// threw a plain std::runtime_error from its Schur decomposition here before its failures were
+// wrapped (krylov_spectra.cpp).
+TEST(Krylov, NonFiniteOperatorIsANumericalFailureForEveryBackend) {
+  class TurnsNaN : public LinearOperator {
+   public:
+    Eigen::Index rows() const override { return 300; }
+    void perform_op(const double* x, double* y) const override {
+      const double poison = ++count_ >= 5 ? std::nan("") : 1.0;
+      for (long i = 0; i < 300; ++i) y[i] = poison * x[i] / (1.0 + i);
+    }
+    void apply_block(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const override {
+      Y.resize(X.rows(), X.cols());
+      for (long c = 0; c < X.cols(); ++c) perform_op(X.col(c).data(), Y.col(c).data());
+    }
+    Eigen::MatrixXd to_dense() const override { return Eigen::MatrixXd::Identity(300, 300); }
+    long applications() const override { return count_; }
+
+   private:
+    mutable long count_ = 0;
+  };
+  for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
+    for (int b : {1, 4}) {
+      if (b > 1 && solver != FloquetSolver::block) continue;
+      SCOPED_TRACE(to_string(solver) + " block size " + std::to_string(b));
+      TurnsNaN op;
+      FloquetOptions o;
+      o.nev = 6;
+      o.solver = solver;
+      o.block_size = b;
+      EXPECT_THROW(floquet_multipliers(op, o), NumericalFailure);
+    }
+  }
+}
+
 TEST(Krylov, ForcedNonConvergenceThrowsForBothBackends) {
   // One Arnoldi iteration with the smallest subspace cannot resolve 10 multipliers to 1e-12.
   auto op = impact_orbit_monodromy(200);

@@ -16,12 +16,15 @@
 // leading singular values of M. Multipliers near +1 (a fold) make A nearly singular and GMRES slow:
 // reported as not converged, never hidden.
 //
-// Cost per iteration: one application of A plus 4 n j flops for CGS2 (memory bound: two passes over
-// the j basis vectors). Memory: (m + 1) n doubles for the basis, owned by the call.
+// Cost per iteration: one application of A plus 4 n j flops for CGS2 (memory bound: four passes
+// over the j basis vectors, split between threads at large n). Memory: (m + 1) n doubles for the
+// basis, owned by the call.
 #include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "delayspec/detail/gram_schmidt.hpp"
 
 namespace delayspec {
 
@@ -54,7 +57,8 @@ GmresResult gmres(const Apply& apply, const Eigen::VectorXd& b, const GmresOptio
   const int m = static_cast<int>(std::min<Eigen::Index>(opt.restart, n));
   Eigen::MatrixXd V(n, m + 1);
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + 1, m);
-  Eigen::VectorXd cs(m), sn(m), g(m + 1), w(n), r = b, h(m + 1);
+  Eigen::VectorXd cs(m), sn(m), g(m + 1), w(n), r = b, h(m + 1), h2(m + 1);
+  const int threads = detail::gram_schmidt_threads(n);
   double rnorm = bnorm;
   while (res.iterations < opt.max_iterations) {
     // r = b - A x (true residual at the cycle's start)
@@ -65,14 +69,15 @@ GmresResult gmres(const Apply& apply, const Eigen::VectorXd& b, const GmresOptio
     for (; j < m && res.iterations < opt.max_iterations; ++j) {
       apply(Eigen::Ref<const Eigen::VectorXd>(V.col(j)), w);  // w = A v_j
       ++res.iterations;
-      // CGS2: h = V^T w; w -= V h, twice (the second pass removes what rounding left).
-      auto basis = V.leftCols(j + 1);
-      h.head(j + 1) = basis.transpose() * w;
-      w.noalias() -= basis * h.head(j + 1);
-      const Eigen::VectorXd h2 = basis.transpose() * w;
-      w.noalias() -= basis * h2;
-      h.head(j + 1) += h2;
-      h[j + 1] = w.norm();
+      // CGS2: h = V^T w; w -= V h, twice (the second pass removes what rounding left). Each
+      // product is one threaded pass over the j + 1 basis vectors (detail/gram_schmidt.hpp).
+      detail::basis_coefficients(V.data(), n, j + 1, w.data(), nullptr, h.data(), nullptr, threads);
+      detail::subtract_in_basis(V.data(), n, j + 1, h.data(), nullptr, w.data(), nullptr, threads);
+      detail::basis_coefficients(V.data(), n, j + 1, w.data(), nullptr, h2.data(), nullptr, threads);
+      const detail::ProjectedProducts left =
+          detail::subtract_in_basis(V.data(), n, j + 1, h2.data(), nullptr, w.data(), nullptr, threads);
+      h.head(j + 1) += h2.head(j + 1);
+      h[j + 1] = std::sqrt(left.xx);
       // Apply the earlier rotations to the new column, then make one that zeroes h[j + 1].
       for (int i = 0; i < j; ++i) {
         const double t = cs[i] * h[i] + sn[i] * h[i + 1];

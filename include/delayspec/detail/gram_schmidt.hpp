@@ -1,7 +1,7 @@
 #pragma once
 // Classical Gram-Schmidt against a tall orthonormal basis Q (n x j, column-major, leading
 // dimension n: the first j columns of an Eigen::MatrixXd), for the Krylov-Schur backend
-// (krylov_block.cpp). Internal: not installed.
+// (src/krylov_block.cpp) and GMRES (gmres.hpp). Compiled in the library (src/gram_schmidt.cpp).
 //
 // At large n the Krylov solve is bound by reading Q (2 x 10^6 rows x 41 columns = 656 MB), not by
 // the operator (one application of the monodromy at N = 10^6 is ~2 ms, one read of Q ~30 ms). So
@@ -12,7 +12,7 @@
 // cache while the j columns stream past), four columns at a time (x and y are loaded once per
 // four columns). Sums are formed per chunk and added in chunk order, so the result does not
 // depend on `threads`: the chunks are split between threads, not the sums.
-namespace delayspec::krylov {
+namespace delayspec::detail {
 
 inline constexpr long kGramSchmidtRows = 8192;
 
@@ -32,4 +32,8 @@ struct ProjectedProducts {
 ProjectedProducts subtract_in_basis(const double* Q, long n, long j, const double* s, const double* t, double* x,
                                     double* y, int threads);
 
-}  // namespace delayspec::krylov
+// q = u / r in place of u, and z = (w - g q) / r: the end of an Arnoldi step with delayed
+// reorthogonalisation (the new basis vector and the next candidate), on the same threads.
+void divide_and_split(long n, double r, double g, double* u, const double* w, double* z, int threads);
+
+}  // namespace delayspec::detail
