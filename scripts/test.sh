@@ -18,11 +18,21 @@ cmake -S "$here/examples/user_model" -B "$prefix/example" -G Ninja -DCMAKE_BUILD
 cmake --build "$prefix/example" >/dev/null
 "$prefix/example/user_model"
 "$prefix/install/bin/delayspec" --version
+# The modules loaded on first use are found beside the installed library: an equations scene
+# (libdelayspec_equations) and, with MPI, a run under mpirun (libdelayspec_mpi).
+"$prefix/install/bin/delayspec" floquet "$here/data/scenes/equations_impact.toml" --set N=20 --set nev=2 \
+  --set model_cache="$prefix/cache" --quiet >/dev/null
+if grep -q '^DELAYSPEC_MPI:BOOL=ON' "$here/build/CMakeCache.txt"; then
+  mpiexec=$(sed -n "s/^MPIEXEC_EXECUTABLE:FILEPATH=//p" "$here/build/CMakeCache.txt")
+  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "$mpiexec" --oversubscribe -n 2 \
+    "$prefix/install/bin/delayspec" chart --set model=mathieu --set N=20 --set solver=dense \
+    --set chart_x_points=3 --set chart_y_points=2 --set threads=1 --quiet >/dev/null
+fi
 # The installed Python package (when built) imports from the prefix's site directory.
 if grep -q '^DELAYSPEC_PYTHON:BOOL=ON' "$here/build/CMakeCache.txt"; then
   site=$(sed -n 's/^DELAYSPEC_PYTHON_INSTALL_DIR:STRING=//p' "$here/build/CMakeCache.txt")
   (cd "$prefix" && PYTHONPATH="$prefix/install/$site" /usr/bin/python3 -c \
-    "import delayspec; assert delayspec.__file__.startswith('$prefix/install/'); print('python:', delayspec.floquet(N=20).multipliers[0])")
+    "import delayspec; assert delayspec.__file__.startswith('$prefix/install/'); print('python:', delayspec.floquet(N=20).multipliers[0]); print('python, equations:', delayspec.floquet('$here/data/scenes/equations_impact.toml', N=20, nev=2, model_cache='$prefix/cache').multipliers[0])")
 fi
 if [ "${DELAYSPEC_NO_SANITIZE:-0}" != 1 ]; then
   "$here/scripts/build.sh" "$here/build-sanitize" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDELAYSPEC_SANITIZE=ON \

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """MPI test: `mpirun -n R delayspec sweep|chart|basin|run` writes the files a run of one process
 with threads = 1 writes, value for value; a run killed on one rank is completed by --resume;
-bad input stops every rank with exit 2 and one message.
+bad input stops every rank with exit 2 and one message; so does a missing MPI module, which a
+run without mpirun does not need.
 
     mpi_test.py --delayspec BUILD/delayspec --mpirun /usr/bin/mpirun
 
@@ -21,6 +22,7 @@ rank R raises SIGKILL after its K-th point, as a node failure or `scancel` would
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -204,6 +206,25 @@ def main():
             statuses = sorted(line for line in r.stderr.splitlines() if line.startswith("rank "))
             check(statuses == [f"rank {i} exit 2" for i in range(3)], f"{what}: rank statuses {statuses}\n{r.stderr}")
             check(r.stderr.count("bad input") == 1, f"{what}: the message is not printed once:\n{r.stderr}")
+
+        # 4. The MPI module (libdelayspec_mpi.so beside libdelayspec) is loaded only under a
+        # launcher: the program and its library copied without it run alone, and under mpirun
+        # every rank exits 2 with one message naming the file.
+        copy = scratch / "without_mpi_module"
+        copy.mkdir()
+        libraries = list(Path(program).parent.glob("libdelayspec.so*"))
+        check(len(libraries) >= 1, f"no libdelayspec.so* beside {program}")
+        for library in libraries:
+            shutil.copyfile(library.resolve(), copy / library.name)
+        shutil.copy(program, copy / "delayspec")
+        alone = ["env", f"LD_LIBRARY_PATH={copy}", str(copy / "delayspec"), *CHART, "--quiet", "--json"]
+        r = run(alone)
+        check(r.returncode == 0, f"the copy without the MPI module, alone: exit {r.returncode}: {r.stderr}")
+        r = run(mpirun(2, "sh", "-c", EACH_RANK_STATUS, *alone))
+        statuses = sorted(line for line in r.stderr.splitlines() if line.startswith("rank "))
+        check(statuses == [f"rank {i} exit 2" for i in range(2)], f"no MPI module: rank statuses {statuses}\n{r.stderr}")
+        missing = f"the module {copy / 'libdelayspec_mpi.so'} (delayspec's MPI transport): it is missing"
+        check(r.stderr.count(missing) == 1, f"no MPI module: the message is not printed once:\n{r.stderr}")
 
     if FAILURES:
         print(f"mpi_test: {len(FAILURES)} failure(s)")

@@ -7,6 +7,7 @@ import os
 import pathlib
 import signal
 import subprocess
+import sys
 import threading
 import time
 
@@ -70,6 +71,30 @@ def test_equations_scene_dict_equals_the_file_and_the_built_in_model(tmp_path):
     same_as_cli(r, "floquet", SCENES / "equations_impact.toml", **keys)
     builtin = delayspec.floquet(DEFAULT, N=40, nev=4, solver="dense", k=0.55)
     assert np.allclose(r.multipliers, builtin.multipliers, rtol=1e-12, atol=0)
+
+
+def test_symbolic_libraries_load_only_for_equations(tmp_path):
+    """GiNaC (the symbolic front end, libdelayspec_equations beside libdelayspec) is loaded on the
+    first [equations] table, not by `import delayspec` nor a built-in model: each library mapped
+    costs every process start-up (docs/benchmarks.md, "Start-up"). In a fresh interpreter, since
+    this one may have run an equations model already."""
+    code = f"""
+import delayspec
+
+def mapped():
+    return open("/proc/self/maps").read()
+
+delayspec.floquet(N=20, nev=2)
+before = mapped()
+assert "libdelayspec.so" in before, "libdelayspec not in the maps: the check would see nothing"
+for library in ("libginac", "libcln", "libgmp", "libdelayspec_equations"):
+    assert library not in before, library + " mapped before any [equations] table"
+delayspec.floquet({str(SCENES / "equations_impact.toml")!r}, N=20, nev=2, model_cache={str(tmp_path)!r})
+after = mapped()
+assert "libdelayspec_equations.so" in after and "libginac" in after
+"""
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
 
 
 def test_lyapunov_equals_cli_json():

@@ -19,6 +19,8 @@
 
 #include <toml++/toml.h>
 
+#include "closest_key.hpp"
+
 namespace delayspec::cli {
 
 class Config {
@@ -118,8 +120,5 @@ struct KeysCollected {
   std::set<std::string> keys;
 };
 
-// The closest candidate to `key` (edit distance, case-insensitive; keys of 1-2 characters only
-// by case, 3-4 characters at most 1 edit, longer at most 2), or "" if none.
-std::string closest_key(const std::string& key, const std::vector<std::string>& candidates);
 
 }  // namespace delayspec::cli

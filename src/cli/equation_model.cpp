@@ -7,8 +7,8 @@
 #include <toml++/toml.h>
 
 #include "delayspec/errors.hpp"
-#include "equation_model_source.hpp"
 #include "equation_plugin.hpp"
+#include "equations_module_loader.hpp"
 #include "key_registry.hpp"
 #include "problem.hpp"
 
@@ -37,7 +37,7 @@ const LoadedEquations& load(const std::string& table_text, const std::filesystem
     throw BadInput("`equations`: " + std::string(e.description()));
   }
   auto entry = std::make_unique<LoadedEquations>();
-  entry->source = generate_equation_model(table, engine_keys());
+  entry->source = equations_module().generate(table, engine_keys());
   entry->plugin = load_equation_plugin(entry->source.code, cache_dir);
   return *(loaded[key] = std::move(entry));
 }

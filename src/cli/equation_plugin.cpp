@@ -21,9 +21,9 @@
 #include <vector>
 
 #include "delayspec/errors.hpp"
-#include "delayspec/grid.hpp"
 #include "delayspec/version.hpp"
 #include "equation_toolchain.hpp"
+#include "running_library.hpp"
 
 extern char** environ;
 
@@ -74,15 +74,6 @@ std::vector<std::string> split_words(const std::string& text) {
   std::istringstream s(text);
   for (std::string word; s >> word;) out.push_back(word);
   return out;
-}
-
-// The libdelayspec this process runs: the object the model links against, so that both share one
-// copy of the library.
-std::filesystem::path running_library() {
-  Dl_info info{};
-  if (!dladdr(reinterpret_cast<const void*>(&make_grid), &info) || !info.dli_fname)
-    throw BadInput("equations: cannot locate the delayspec library of this process (dladdr)");
-  return std::filesystem::canonical(info.dli_fname);
 }
 
 // The compiler, the flags and the headers to compile against: the installed headers when they sit

@@ -18,9 +18,10 @@
 // So every rank takes part in the same sequence of broadcasts and ends with the lead's status.
 namespace delayspec::cli {
 
-// main(): initialises MPI (thread level MPI_THREAD_SERIALIZED) if this process was started by
-// an MPI launcher (OpenMPI, MPICH/Hydra, PMIx or PMI environment); otherwise, and in builds
-// without DELAYSPEC_MPI, a run of one rank.
+// main(): if this process was started by an MPI launcher (OpenMPI, MPICH/Hydra, PMIx or PMI
+// environment), loads the MPI module (libdelayspec_mpi, src/mpi/mpi_module.hpp: exit 2 naming
+// the file when it is missing) and initialises MPI (thread level MPI_THREAD_SERIALIZED);
+// otherwise, and in builds without DELAYSPEC_MPI, a run of one rank.
 void start_ranks(int* argc, char*** argv);
 
 int this_rank();   // 0 without MPI
@@ -35,6 +36,11 @@ int finish_ranks(int status, bool stopped = false);
 // compute threads. Returns, on the lead, the sum of the workers' threads (0 on a worker).
 // Throws RankStop on a worker when the lead finished its command instead of starting the loop.
 long enter_point_loop(int threads);
+
+// The MPI module (src/mpi/mpi_module.hpp; builds with DELAYSPEC_MPI), which start_ranks loads
+// under a launcher: there whenever rank_count() > 1.
+struct MpiModule;
+const MpiModule& mpi_module();
 
 // Control flow of the worker ranks, deliberately not std::exception (run_cli's handlers do not
 // catch it): caught in main.cpp, and in command_run between analyses.

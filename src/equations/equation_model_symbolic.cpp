@@ -6,7 +6,7 @@
 #include <set>
 #include <sstream>
 
-#include "config.hpp"
+#include "closest_key.hpp"
 #include "delayspec/errors.hpp"
 #include "equation_expression.hpp"
 #include "equation_names.hpp"

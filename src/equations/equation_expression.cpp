@@ -8,7 +8,7 @@
 
 #include <ginac/parser.h>
 
-#include "config.hpp"
+#include "closest_key.hpp"
 #include "delayspec/errors.hpp"
 #include "equation_names.hpp"
 

@@ -1,0 +1,150 @@
+// What a delayspec process loads. GiNaC, CLN and GMP (the symbolic front end of model =
+// equations) and OpenMPI cost every process that links them 1.5 and 1.3 ms before main
+// (docs/benchmarks.md, "Start-up"): they sit in the modules libdelayspec_equations and
+// libdelayspec_mpi, which the program loads only for an [equations] table and under an MPI
+// launcher (src/cli/module_loader.hpp; tests/mpi_test.py checks the MPI side). Checked on the
+// built program with the dynamic loader's own trace (LD_DEBUG=files lists every object it maps,
+// at start and by dlopen), so a new link dependency or an eager load fails here; the equations
+// run shows that the trace does see the module when it is loaded.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "delayspec/errors.hpp"
+#include "delayspec/version.hpp"
+#include "delayspec_test_paths.hpp"
+#include "equations_module_loader.hpp"
+#include "module_loader.hpp"
+#include "running_library.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Process {
+  int status;
+  std::string trace;  // the loader's trace and the program's stderr (stdout discarded)
+};
+
+// `prefix PROGRAM args` through the shell; stderr kept, stdout dropped.
+Process run_traced(const std::string& prefix, const std::string& program, const std::string& args) {
+  const std::string command = prefix + " '" + program + "' " + args + " 2>&1 >/dev/null";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return {-1, ""};
+  std::string text;
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) text.append(buffer, n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, text};
+}
+
+bool mentions(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// The symbolic and MPI libraries and the modules that carry them.
+void expect_no_module_libraries(const Process& p) {
+  // The trace works: it names libdelayspec, which every command loads.
+  ASSERT_TRUE(mentions(p.trace, "file=libdelayspec.so")) << p.trace.substr(0, 2000);
+  for (const char* library : {"libginac", "libcln", "libgmp", "libdelayspec_equations", "libmpi", "libopen-rte",
+                              "libopen-pal", "libhwloc", "libevent", "libdelayspec_mpi"})
+    EXPECT_FALSE(mentions(p.trace, library)) << library << " loaded:\n" << p.trace.substr(0, 4000);
+}
+
+const std::string cache = std::string("--set model_cache=") + DELAYSPEC_TEST_MODEL_CACHE;
+
+TEST(StartupLibraries, VersionLoadsNeitherGiNaCNorMPI) {
+  const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, "--version");
+  EXPECT_EQ(p.status, 0) << p.trace;
+  expect_no_module_libraries(p);
+}
+
+TEST(StartupLibraries, BuiltInModelLoadsNeitherGiNaCNorMPI) {
+  const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, "floquet --set model=impact --set N=20 --json");
+  EXPECT_EQ(p.status, 0) << p.trace;
+  expect_no_module_libraries(p);
+}
+
+TEST(StartupLibraries, EquationsSceneLoadsTheModuleAndGiNaC) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/equations_impact.toml";
+  const Process p =
+      run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, "floquet '" + scene + "' --set N=20 --json " + cache);
+  EXPECT_EQ(p.status, 0) << p.trace;
+  EXPECT_TRUE(mentions(p.trace, "libdelayspec_equations.so")) << p.trace.substr(0, 4000);
+  EXPECT_TRUE(mentions(p.trace, "libginac")) << p.trace.substr(0, 4000);
+}
+
+// The program and its library copied to a directory without the module (LD_LIBRARY_PATH comes
+// before the build tree's RUNPATH, so this libdelayspec is the one that runs): exit 2, naming
+// the file it looked for, before any computation.
+TEST(StartupLibraries, MissingModuleExits2NamingTheFile) {
+  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_no_module_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // libdelayspec under each of its names (the soname the program asks for among them).
+  const fs::path library = delayspec::cli::running_library();
+  for (const fs::directory_entry& entry : fs::directory_iterator(library.parent_path()))
+    if (entry.path().filename().string().rfind("libdelayspec.so", 0) == 0)
+      fs::copy_file(library, dir / entry.path().filename());
+  fs::copy_file(DELAYSPEC_CLI_PATH, dir / "delayspec");
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/equations_impact.toml";
+  const Process p = run_traced("LD_LIBRARY_PATH='" + dir.string() + "'", (dir / "delayspec").string(),
+                               "floquet '" + scene + "' --set N=20 " + cache);
+  EXPECT_EQ(p.status, 2) << p.trace;
+  EXPECT_TRUE(mentions(p.trace, (dir / "libdelayspec_equations.so").string() + " (delayspec's symbolic front end)"))
+      << p.trace;
+  EXPECT_TRUE(mentions(p.trace, "it is missing")) << p.trace;
+  // The same copy runs a built-in model: only model = equations needs the module.
+  const Process builtin = run_traced("LD_LIBRARY_PATH='" + dir.string() + "'", (dir / "delayspec").string(),
+                                     "floquet --set model=linear --set N=20");
+  EXPECT_EQ(builtin.status, 0) << builtin.trace;
+  fs::remove_all(dir);
+}
+
+const delayspec::cli::EquationsModule& load(const fs::path& file) {
+  return delayspec::cli::load_module<delayspec::cli::EquationsModule>(
+      file, delayspec::cli::equations_module_symbol, delayspec::cli::equations_module_description());
+}
+
+TEST(EquationsModuleLoader, RefusesAMissingFileAndAnObjectWithoutTheEntryPoint) {
+  try {
+    load("/nonexistent/libdelayspec_equations.so");
+    ADD_FAILURE() << "no BadInput";
+  } catch (const delayspec::BadInput& e) {
+    EXPECT_TRUE(mentions(e.what(), "/nonexistent/libdelayspec_equations.so")) << e.what();
+    EXPECT_TRUE(mentions(e.what(), "it is missing")) << e.what();
+  }
+  // libdelayspec is a shared object, but not the module.
+  const fs::path library = delayspec::cli::running_library();
+  try {
+    load(library);
+    ADD_FAILURE() << "no BadInput";
+  } catch (const delayspec::BadInput& e) {
+    EXPECT_TRUE(mentions(e.what(), library.string())) << e.what();
+    EXPECT_TRUE(mentions(e.what(), "lacks `delayspec_equations_module`")) << e.what();
+  }
+}
+
+TEST(EquationsModuleLoader, TheModuleBesideTheLibraryIsThisBuildsAndReadsATable) {
+  const delayspec::cli::EquationsModule& module = delayspec::cli::equations_module();
+  EXPECT_EQ(std::string(module.version), std::string(DELAYSPEC_VERSION) + " " + DELAYSPEC_REVISION);
+  const toml::table table = toml::parse(R"(state = ["x"]
+parameters = { a = -1 }
+period = "1"
+delay = "1"
+rhs = ["a*x + x_tau"]
+history = { x = "1" }
+)");
+  const delayspec::cli::EquationModelSource source = module.generate(table, {"N"});
+  EXPECT_EQ(source.state, std::vector<std::string>{"x"});
+  EXPECT_EQ(source.parameters, std::vector<std::string>{"a"});
+  EXPECT_EQ(source.parameter_defaults, std::vector<double>{-1});
+  EXPECT_TRUE(mentions(source.code, "struct EquationModel"));
+}
+
+}  // namespace
