@@ -11,6 +11,8 @@
 
 #include "delayspec/lyapunov.hpp"
 #include "delayspec/model_impact.hpp"
+#include "delayspec/model_linear.hpp"
+#include "delayspec/model_mathieu.hpp"
 
 namespace ds = delayspec;
 
@@ -100,5 +102,44 @@ static void BM_ApplyBlockPeriod(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ApplyBlockPeriod)->Args({2002, 2})->Args({2002, 8})->Args({402, 2})->Unit(benchmark::kMicrosecond);
+
+// The cost of one fused Lyapunov step (trapezoid step, its step map, the k = 2 tangent vectors;
+// the QR time excluded) for a scalar model against d = 2 models (issue 17 item 2): the CLI runs
+// `lyapunov --set model=linear|mathieu|impact --set N=1000` of docs/benchmarks.md, 300 periods.
+//   step_ns: (run time - QR time) / steps;  qr_ns: QR time / steps
+template <class Model>
+void lyapunov_step_cost(benchmark::State& state, const Model& model) {
+  ds::StroboscopicMap<Model> map(ds::TrapezoidStepper<Model>(model), ds::make_grid(model.tau(), model.period(), 1000));
+  ds::LyapunovOptions o;
+  o.exponents = 2;
+  o.periods = 300;
+  o.transient = 10;
+  double step_ns = 0, qr_ns = 0;
+  for (auto _ : state) {
+    const auto r = ds::lyapunov_exponents(map, map.constant_history(model.initial_state()), o);
+    step_ns = (r.seconds - r.qr_seconds) / static_cast<double>(r.steps) * 1e9;
+    qr_ns = r.qr_seconds / static_cast<double>(r.steps) * 1e9;
+  }
+  state.counters["step_ns"] = step_ns;
+  state.counters["qr_ns"] = qr_ns;
+}
+
+static void BM_LyapunovStepLinear(benchmark::State& state) {
+  ds::LinearParameters p;  // the docs' scalar run: a = -1, b = 0.5, tau = T = 7.834...
+  p.tau = p.period = 7.834395644862327;
+  lyapunov_step_cost(state, ds::LinearModel(p));
+}
+BENCHMARK(BM_LyapunovStepLinear)->Unit(benchmark::kMillisecond);
+
+static void BM_LyapunovStepMathieu(benchmark::State& state) { lyapunov_step_cost(state, ds::MathieuModel()); }
+BENCHMARK(BM_LyapunovStepMathieu)->Unit(benchmark::kMillisecond);
+
+static void BM_LyapunovStepImpact(benchmark::State& state) {
+  ds::ImpactParameters p;  // the docs' non-impacting run: tau = T, k = 0.2, history (1.2, 0)
+  p.k = 0.2;
+  p.x0 = 1.2;
+  lyapunov_step_cost(state, ds::ImpactModel(p));
+}
+BENCHMARK(BM_LyapunovStepImpact)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

@@ -172,3 +172,64 @@ TEST(EventStep, ContactSubstepsMustBePositive) {
   const ImpactModel model;
   EXPECT_THROW(TrapezoidStepper<ImpactModel>(model, options(EventMode::on, JacobianMode::consistent, 0)), BadInput);
 }
+
+namespace {
+
+// The excursion test as it was before its shortcut (dbf5fbd): the interior extrema of the Hermite
+// cubic from the roots of its derivative, every time.
+bool hermite_extremum_within_by_roots(double ga, double gL, double d0, double d1, double margin, double into) {
+  const double c1 = d0, c2 = -3 * ga - 2 * d0 + 3 * gL - d1, c3 = 2 * ga + d0 - 2 * gL + d1;
+  const double qa = 3 * c3, qb = 2 * c2, qc = c1;
+  double roots[2];
+  int n = 0;
+  if (std::abs(qa) <= 1e-14 * (std::abs(qb) + std::abs(qc))) {
+    if (qb != 0) roots[n++] = -qc / qb;
+  } else {
+    const double disc = qb * qb - 4 * qa * qc;
+    if (disc >= 0) {
+      const double q = -0.5 * (qb + std::copysign(std::sqrt(disc), qb));
+      if (q != 0) roots[n++] = q / qa;
+      roots[n++] = q != 0 ? qc / q : -qb / (2 * qa);
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    const double tau = roots[i];
+    if (!(tau > 0 && tau < 1)) continue;
+    if (into * (ga + tau * (c1 + tau * (c2 + tau * c3))) < margin) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+// The shortcut of the excursion test (skip the roots when the chord bound puts the whole cubic
+// beyond the margin) never changes its answer: random cubics at all distances from H = 0, on
+// both sides, with the distance concentrated near the shortcut's own boundary min - deviation
+// = margin, where a wrong bound would show.
+TEST(EventStep, ExcursionTestShortcutGivesTheAnswerOfTheRoots) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int answers[2] = {0, 0}, near_boundary = 0;
+  for (int i = 0; i < 400000; ++i) {
+    const double scale = std::pow(10.0, 4 * u(rng));  // slopes from 1e-4 to 1e4
+    const double d0 = scale * u(rng), d1 = scale * u(rng);
+    const double into = u(rng) > 0 ? 1 : -1;
+    const double margin = std::abs(d1 - d0) + 1e-14 * std::abs(u(rng));
+    double ga = into * scale * 2 * u(rng), gL = ga + scale * u(rng);
+    if (i % 2 == 0) {  // shift the cubic so that its bound sits just at the margin
+      const double deviation = 0.25 * std::max(std::abs(d0 - (gL - ga)), std::abs(d1 - (gL - ga)));
+      // into * p >= min(into ga, into gL) - deviation: put that minimum at margin + deviation + noise
+      const double target = margin + deviation + scale * 1e-9 * u(rng);
+      const double shift = into * (target - std::min(into * ga, into * gL));
+      ga += shift, gL += shift;
+      ++near_boundary;
+    }
+    const bool expected = hermite_extremum_within_by_roots(ga, gL, d0, d1, margin, into);
+    ASSERT_EQ(detail::hermite_extremum_within(ga, gL, d0, d1, margin, into), expected)
+        << "ga " << ga << " gL " << gL << " d0 " << d0 << " d1 " << d1 << " margin " << margin << " into " << into;
+    ++answers[expected];
+  }
+  EXPECT_GT(answers[0], 1000);  // both answers occur often: the comparison is not vacuous
+  EXPECT_GT(answers[1], 1000);
+  EXPECT_GT(near_boundary, 1000);
+}

@@ -13,6 +13,7 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
+#include "delayspec/detail/flush_subnormals.hpp"
 #include "delayspec/lambert_w.hpp"
 #include "delayspec/lyapunov.hpp"
 #include "delayspec/model_impact.hpp"
@@ -463,6 +464,45 @@ TEST(Lyapunov, StaysFiniteOverManyPeriodsOfStrongContraction) {
     // the same-N value to the error, plus the log of a relative rounding of R_ii per period
     EXPECT_NEAR(r.per_period[i], std::log(std::abs(mu[i])), 3 * r.error_per_period[i] + 1e-9) << i;
   }
+}
+
+// The guard a Lyapunov period runs under: inside it a product with a subnormal result is 0 and a
+// subnormal input counts as 0; afterwards both are back (the caller's mode is restored).
+TEST(FlushSubnormals, FlushesWhileAliveAndRestoresTheCallersMode) {
+  volatile double tiny = 0x1p-1000, small = 0x1p-50;  // volatile: computed at run time
+  volatile double subnormal = 0x1p-1060;              // below the least normal 2^-1022
+  ASSERT_GT(tiny * small, 0.0);                       // 2^-1050: subnormal in the default mode
+  ASSERT_GT(subnormal * 2.0, 0.0);
+  {
+    const ds::detail::FlushSubnormals flush;
+#if defined(__SSE__) || defined(__x86_64__) || defined(__aarch64__)
+    EXPECT_EQ(tiny * small, 0.0);     // result flushed
+    EXPECT_EQ(subnormal * 2.0, 0.0);  // input treated as zero (DAZ; FZ on AArch64)
+#endif
+    EXPECT_EQ(small * small, 0x1p-100);  // normal numbers untouched
+  }
+  EXPECT_EQ(tiny * small, 0x1p-1050);
+  EXPECT_EQ(subnormal * 2.0, 0x1p-1059);
+}
+
+// x' = -x + 0.5 x(t - tau), tau = T = 7.83 (the docs' scalar benchmark): the trajectory decays by
+// e^-0.61 per period and would be subnormal after ~1160 periods; with subnormals flushed it
+// stops near 1e-306, where its increments h/2 f underflow. The exponents over 1500 periods
+// after that equal log |mu| of the same-N multipliers (the map of a linear model does not
+// depend on the trajectory): to the error, as in the long run above.
+TEST(Lyapunov, ATrajectoryDecayedToTheSubnormalRangeLeavesTheExponentsUnchanged) {
+  const double tau = 7.834395644862327;
+  const auto model = linear(-1, 0.5, tau, tau);
+  const int N = 100;
+  LyapunovOptions o;
+  o.exponents = 2;
+  o.transient = 1300;
+  o.periods = 1500;
+  const LyapunovResult r = run(model, N, o);
+  EXPECT_LT(r.final_history.lpNorm<Eigen::Infinity>(), 1e-300);  // decayed to the underflow range
+  const auto mu = ds::testing::dense_multipliers(model, N, 2);
+  for (int i = 0; i < 2; ++i)
+    EXPECT_NEAR(r.per_period[i], std::log(std::abs(mu[i])), 3 * r.error_per_period[i] + 1e-9) << i;
 }
 
 TEST(Lyapunov, OverflowIsANumericalFailure) {

@@ -45,6 +45,11 @@
 //   random-walk scaling), so the error is a conservative bound there (tests/test_lyapunov.cpp).
 //   Both parts are also reported (batch_standard_error_per_period, fluctuation_bound_per_period).
 //
+// Subnormals: each period's steps run with subnormal numbers flushed to zero
+// (detail/flush_subnormals.hpp): a trajectory decaying to a zero orbit otherwise reaches the
+// subnormal range and every later step is about twice as slow; what is flushed is below
+// 1e-300 of the O(1) quantities it would be added to.
+//
 // Layout (as StroboscopicMap and Monodromy): linear buffers of M + 1 + K slots for the
 // trajectory and for the block; slots 0..M hold the history at the start of a period, step l
 // writes slot M + l + 1, the history at the end is slots K..K+M. There the block is factorised
@@ -79,6 +84,7 @@
 
 #include "delayspec/cancellation.hpp"
 #include "delayspec/detail/block_kernel.hpp"
+#include "delayspec/detail/flush_subnormals.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 #include "delayspec/detail/tangent_qr.hpp"
@@ -183,18 +189,29 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   StepMap<D> step_map;
   // One stroboscopic period, trajectory and block fused; afterwards the trajectory history is
   // back in slots 0..M and the (unnormalised) block in slots K..K+M.
-  auto advance = [&](bool record) {
+  // KC: k as a compile-time constant for the common few vectors (step_block), else 0.
+  auto advance_with = [&]<int KC>(bool record) {
+    // A decaying trajectory would go subnormal and run ~2x slower (flush_subnormals.hpp)
+    const detail::FlushSubnormals flush_subnormals;
     auto slot = [&traj](long i) -> const V& { return traj[i]; };
     for (long l = 0; l < K; ++l) {
       const DelayTap<V> tap = grid.delay_tap<V>(l, slot);
       traj[M + l + 1] = stepper.step(tap.t, grid.h, traj[M + l], tap.w0, tap.w1, step_map);
       // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same tap)
-      step_block<D>(step_map, block.data() + (M + l) * stride, block.data() + grid.delayed_slot(l) * stride, k,
-                    grid.theta, block.data() + (M + l + 1) * stride);
-      if (record && (l + 1) % spp == 0 && section_count < options.section_points)
+      step_block<D, detail::PortableTarget, KC>(step_map, block.data() + (M + l) * stride,
+                                                block.data() + grid.delayed_slot(l) * stride, k, grid.theta,
+                                                block.data() + (M + l + 1) * stride);
+      if (record && section_count < options.section_points && (l + 1) % spp == 0)  // (no division unless recording)
         result.section.row(section_count++) = traj[M + l + 1].transpose();
     }
     std::copy(traj.begin() + K, traj.end(), traj.begin());  // history at the end -> slots 0..M
+  };
+  auto advance = [&](bool record) {
+    switch (k) {
+      case 1: return advance_with.template operator()<1>(record);
+      case 2: return advance_with.template operator()<2>(record);
+      default: return advance_with.template operator()<0>(record);
+    }
   };
   auto check_interval = [&](int interval) {
     if (interval <= 1) return;

@@ -1,9 +1,11 @@
 #pragma once
 // Delayed damped Mathieu equation  x'' + kappa x' + (delta + eps cos t) x = b x(t - 2 pi),
 // tau = T = 2 pi, y = (x, v). Linear and T-periodic: the monodromy does not depend on an orbit.
+// cos t through the per-thread memo (remembered_trig.hpp): the step times repeat every period.
 #include <cmath>
 #include <numbers>
 
+#include "delayspec/detail/remembered_trig.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
 
@@ -35,11 +37,11 @@ class MathieuModel {
   double tau() const { return 2 * std::numbers::pi; }
   double period() const { return 2 * std::numbers::pi; }
   V f(int, double t, const V& y, const V& y_tau) const {
-    return V(y[1], -p_.kappa * y[1] - (p_.delta + p_.eps * std::cos(t)) * y[0] + p_.b * y_tau[0]);
+    return V(y[1], -p_.kappa * y[1] - (p_.delta + p_.eps * detail::remembered_cos(t)) * y[0] + p_.b * y_tau[0]);
   }
   M A(int, double t, const V&, const V&) const {
     M a;
-    a << 0, 1, -(p_.delta + p_.eps * std::cos(t)), -p_.kappa;
+    a << 0, 1, -(p_.delta + p_.eps * detail::remembered_cos(t)), -p_.kappa;
     return a;
   }
   M B(int, double, const V&, const V&) const {

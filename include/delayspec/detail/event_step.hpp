@@ -77,6 +77,43 @@ class TrapezoidStepper;  // stepper.hpp: its sub_step() and options() are what a
 
 namespace detail {
 
+// The cubic Hermite polynomial p on [0, 1] (scaled time tau) with p(0) = ga, p(1) = gL,
+// p'(0) = d0, p'(1) = d1: does it have an interior extremum where into * p < margin?
+// (into = +1 or -1: the side of H = 0 the piece is on; EventStepSolver::excursion_suspected.)
+inline bool hermite_extremum_within(double ga, double gL, double d0, double d1, double margin, double into) {
+  // Most steps are far from H = 0: skip the roots (a sqrt and two divisions, measured a third
+  // of the event test) when the whole cubic is beyond the margin. p(tau) = chord(tau) +
+  // tau (1 - tau) [(1 - tau) (d0 - D) - tau (d1 - D)], D = gL - ga, so |p - chord| <=
+  // max(|d0 - D|, |d1 - D|) / 4 on [0, 1] and into p >= into min(ga, gL) - that bound there;
+  // if this exceeds the margin, no extremum is within it and the roots below would answer no.
+  // The slack (1e-12 of the data) is far above their own rounding (~10 eps of it).
+  const double chord_deviation = 0.25 * std::max(std::abs(d0 - (gL - ga)), std::abs(d1 - (gL - ga)));
+  const double slack = 1e-12 * (std::abs(ga) + std::abs(gL) + std::abs(d0) + std::abs(d1));
+  if (std::min(into * ga, into * gL) - chord_deviation > margin + slack) return false;
+  const double c1 = d0, c2 = -3 * ga - 2 * d0 + 3 * gL - d1, c3 = 2 * ga + d0 - 2 * gL + d1;
+  // p'(tau) = c1 + 2 c2 tau + 3 c3 tau^2
+  const double qa = 3 * c3, qb = 2 * c2, qc = c1;
+  double roots[2];
+  int n = 0;
+  if (std::abs(qa) <= 1e-14 * (std::abs(qb) + std::abs(qc))) {
+    if (qb != 0) roots[n++] = -qc / qb;
+  } else {
+    const double disc = qb * qb - 4 * qa * qc;
+    if (disc >= 0) {
+      const double q = -0.5 * (qb + std::copysign(std::sqrt(disc), qb));
+      if (q != 0) roots[n++] = q / qa;
+      roots[n++] = q != 0 ? qc / q : -qb / (2 * qa);
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    const double tau = roots[i];
+    if (!(tau > 0 && tau < 1)) continue;
+    const double p = ga + tau * (c1 + tau * (c2 + tau * c3));
+    if (into * p < margin) return true;
+  }
+  return false;
+}
+
 template <class Model>
 class EventStepSolver {
  public:
@@ -111,12 +148,24 @@ class EventStepSolver {
       if (count == 0) {
         // Most steps have no event: the trial piece over the whole step, with the derivative of
         // its end at fixed ends (da = db = 0), is then the step and its map.
-        const Piece whole = piece_with_fixed_ends(0, h_, u0, dz, j, m);
-        exit = find_exit(0, u0, whole.z, j, false);
-        if (!exit.event) {
-          z = whole.z;
-          dz = whole.X;
-          break;
+        if (m == 1) {  // one sub-step: the plain trapezoid step in region j, its map directly
+          const SubStepResult<D> r = stepper_.sub_step(t_, h_, u0, w0_, w1_, j, j);
+          exit = find_exit(0, u0, r.z1, j, false);
+          if (!exit.event) {
+            if (events) events->count = 0;
+            map.P = r.dz0;
+            map.Q = r.dw0;
+            map.R = r.dw1;
+            return r.z1;
+          }
+        } else {
+          const Piece whole = piece_with_fixed_ends(0, h_, u0, dz, j, m);
+          exit = find_exit(0, u0, whole.z, j, false);
+          if (!exit.event) {
+            z = whole.z;
+            dz = whole.X;
+            break;
+          }
         }
       } else {
         if (a < h_) exit = find_exit(a, z, piece_end(a, h_, z, j, m), j, true);
@@ -347,35 +396,13 @@ class EventStepSolver {
   }
 
   // Does the cubic Hermite interpolant of H on [a, h] have an interior extremum within
-  // `margin` of H = 0 (or beyond it)? tau in [0, 1] is the scaled time.
+  // `margin` of H = 0 (or beyond it)? (hermite_extremum_within, above the class)
   bool excursion_suspected(double a, const V& za, const V& zL, double ga, double gL, int j) const {
     const double L = h_ - a;
     const double d0 = L * model_.grad_H(za).dot(model_.f(j, t_ + a, za, w_at(a)));
     const double d1 = L * model_.grad_H(zL).dot(model_.f(j, t_ + h_, zL, w1_));
-    const double c1 = d0, c2 = -3 * ga - 2 * d0 + 3 * gL - d1, c3 = 2 * ga + d0 - 2 * gL + d1;
     const double margin = std::abs(d1 - d0) + threshold(za);
-    const double into = j == 1 ? 1 : -1;
-    // p'(tau) = c1 + 2 c2 tau + 3 c3 tau^2
-    const double qa = 3 * c3, qb = 2 * c2, qc = c1;
-    double roots[2];
-    int n = 0;
-    if (std::abs(qa) <= 1e-14 * (std::abs(qb) + std::abs(qc))) {
-      if (qb != 0) roots[n++] = -qc / qb;
-    } else {
-      const double disc = qb * qb - 4 * qa * qc;
-      if (disc >= 0) {
-        const double q = -0.5 * (qb + std::copysign(std::sqrt(disc), qb));
-        if (q != 0) roots[n++] = q / qa;
-        roots[n++] = q != 0 ? qc / q : -qb / (2 * qa);
-      }
-    }
-    for (int i = 0; i < n; ++i) {
-      const double tau = roots[i];
-      if (!(tau > 0 && tau < 1)) continue;
-      const double p = ga + tau * (c1 + tau * (c2 + tau * c3));
-      if (into * p < margin) return true;
-    }
-    return false;
+    return hermite_extremum_within(ga, gL, d0, d1, margin, j == 1 ? 1 : -1);
   }
 
   const TrapezoidStepper<Model>& stepper_;
