@@ -132,6 +132,12 @@ void Monodromy<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
 
 template <int D>
 void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const {
+  // One vector: interleaving is a copy, which perform_op makes with its own (smaller) buffer; the
+  // AVX2 transposes would move it element by element (measured slower than the baseline path).
+  if (k == 1) {
+    perform_op(X, Y);
+    return;
+  }
   throw_if_cancelled();
   const long M = grid_.M, K = grid_.K;
   const size_t need = static_cast<size_t>(M + 1 + K) * D * k;
