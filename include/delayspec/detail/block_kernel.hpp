@@ -46,13 +46,22 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
   const long stride = static_cast<long>(D) * k;
   const double* d1 = d0 + stride;  // b[j + 1]
   // s.P, s.Q, s.R: loop-invariant (out is __restrict), broadcast once per step
+  // The sum: one term per statement, so that with FMA each term is one FMA (`acc += a b + c d`
+  // is a multiply, an FMA and an add; starting from acc = 0 adds one more add), and ordered
+  // delayed part first, P u0 last: u0 is the previous step's out, so the steps form a recurrence
+  // and the chain from u0 to out is only the last D FMAs; the Q, R part of the next step, which
+  // does not depend on u0, overlaps it.
   if (theta == 0) {
-    // out_r = sum_c P_rc u0_c + Q_rc b[j]_c + R_rc b[j+1]_c, one pass over the k vectors
+    // out_r = sum_c Q_rc b[j]_c + R_rc b[j+1]_c + sum_c P_rc u0_c, one pass over the k vectors
     for (long v = 0; v < k; ++v)
       for (int r = 0; r < D; ++r) {
-        double acc = 0;
-        for (int c = 0; c < D; ++c)
-          acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * d0[c * k + v] + s.R.coeff(r, c) * d1[c * k + v];
+        double acc = s.Q.coeff(r, 0) * d0[v];
+        acc += s.R.coeff(r, 0) * d1[v];
+        for (int c = 1; c < D; ++c) {
+          acc += s.Q.coeff(r, c) * d0[c * k + v];
+          acc += s.R.coeff(r, c) * d1[c * k + v];
+        }
+        for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u0[c * k + v];
         out[r * k + v] = acc;
       }
     return;
@@ -66,9 +75,13 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
       w1[c] = c0 * d1[c * k + v] + theta * d0[c * k + v];
     }
     for (int r = 0; r < D; ++r) {
-      double acc = 0;
-      for (int c = 0; c < D; ++c)
-        acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * w0[c] + s.R.coeff(r, c) * w1[c];
+      double acc = s.Q.coeff(r, 0) * w0[0];  // the same order as above
+      acc += s.R.coeff(r, 0) * w1[0];
+      for (int c = 1; c < D; ++c) {
+        acc += s.Q.coeff(r, c) * w0[c];
+        acc += s.R.coeff(r, c) * w1[c];
+      }
+      for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u0[c * k + v];
       out[r * k + v] = acc;
     }
   }
