@@ -110,16 +110,16 @@ inline void deinterleave(const double* b, long n, long k, double* __restrict Y, 
   }
 }
 
-// The K steps of one map on k interleaved vectors: b[M + l + 1] from b[M + l] and the delayed
-// slots around j = first_delayed + l (HistoryGrid::delayed_slot(l) = delayed_slot(0) + l).
+// The K steps of one map on k interleaved vectors: step l reads u0 = u[l] and the delayed slots
+// around delayed[l] (slots of D k doubles; delayed[l - 1 .. l + 1] when theta != 0) and writes
+// u[l + 1]. On one linear history b (Monodromy's layout) u = b[M] and delayed = b[j0]
+// (HistoryGrid::delayed_slot(l) = j0 + l); the streaming apply_block passes two staging buffers.
 // KC as in step_block.
 template <int D, class Target, int KC>
-inline void block_steps_k(const StepMap<D>* maps, long K, long M, long first_delayed, double theta, double* b,
-                          long k) {
+inline void block_steps_k(const StepMap<D>* maps, long K, double* u, const double* delayed, double theta, long k) {
   const long stride = static_cast<long>(D) * (KC > 0 ? KC : k);
   for (long l = 0; l < K; ++l)
-    step_block<D, Target, KC>(maps[l], b + (M + l) * stride, b + (first_delayed + l) * stride, k, theta,
-                              b + (M + l + 1) * stride);
+    step_block<D, Target, KC>(maps[l], u + l * stride, delayed + l * stride, k, theta, u + (l + 1) * stride);
 }
 
 // The block sizes the solvers use (block_size 2, 4, 8; to_dense's chunks of 32; 16) run with k
@@ -127,14 +127,14 @@ inline void block_steps_k(const StepMap<D>* maps, long K, long M, long first_del
 // runtime k the loop set-up for a trip count of 2-8 vectors cost more than the step's FMAs
 // (bench_apply, docs/benchmarks.md). Any other k runs the generic loop.
 template <int D, class Target = detail::PortableTarget>
-inline void block_steps(const StepMap<D>* maps, long K, long M, long first_delayed, double theta, double* b, long k) {
+inline void block_steps(const StepMap<D>* maps, long K, double* u, const double* delayed, double theta, long k) {
   switch (k) {
-    case 2: return block_steps_k<D, Target, 2>(maps, K, M, first_delayed, theta, b, k);
-    case 4: return block_steps_k<D, Target, 4>(maps, K, M, first_delayed, theta, b, k);
-    case 8: return block_steps_k<D, Target, 8>(maps, K, M, first_delayed, theta, b, k);
-    case 16: return block_steps_k<D, Target, 16>(maps, K, M, first_delayed, theta, b, k);
-    case 32: return block_steps_k<D, Target, 32>(maps, K, M, first_delayed, theta, b, k);
-    default: return block_steps_k<D, Target, 0>(maps, K, M, first_delayed, theta, b, k);
+    case 2: return block_steps_k<D, Target, 2>(maps, K, u, delayed, theta, k);
+    case 4: return block_steps_k<D, Target, 4>(maps, K, u, delayed, theta, k);
+    case 8: return block_steps_k<D, Target, 8>(maps, K, u, delayed, theta, k);
+    case 16: return block_steps_k<D, Target, 16>(maps, K, u, delayed, theta, k);
+    case 32: return block_steps_k<D, Target, 32>(maps, K, u, delayed, theta, k);
+    default: return block_steps_k<D, Target, 0>(maps, K, u, delayed, theta, k);
   }
 }
 
