@@ -195,7 +195,7 @@ void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, doub
   // from L2 or L3; bench_apply, docs/benchmarks.md). The copies are the same transposes.
   const long M = grid_.M, K = grid_.K, stride = D * k, j0 = grid_.delayed_slot(0);
   const long back = grid_.theta == 0 ? 0 : 1;  // slot j - 1 is read only when theta != 0
-  const long C = std::max<long>(8, 2048 / stride);
+  const long C = std::max<long>(8, 1024 / stride);
   const size_t need = static_cast<size_t>(2 * C + 3) * stride;
   if (block_work_.size() < need) block_work_.resize(need);
   double* in = block_work_.data();     // C + 2 slots: j0 + l0 - back .. j0 + l0 + C
