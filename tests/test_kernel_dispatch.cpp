@@ -22,28 +22,10 @@
 #include "test_support.hpp"
 
 using namespace delayspec;
+using delayspec::testing::KernelEnv;
 using delayspec::testing::random_matrix;
 
 namespace {
-
-// Sets DELAYSPEC_KERNEL for the scope (unset when value is empty); restores the old value.
-class KernelEnv {
- public:
-  explicit KernelEnv(const std::string& value) {
-    if (const char* old = std::getenv("DELAYSPEC_KERNEL")) old_ = old;
-    if (value.empty()) unsetenv("DELAYSPEC_KERNEL");
-    else setenv("DELAYSPEC_KERNEL", value.c_str(), 1);
-  }
-  ~KernelEnv() {
-    if (old_) setenv("DELAYSPEC_KERNEL", old_->c_str(), 1);
-    else unsetenv("DELAYSPEC_KERNEL");
-  }
-  KernelEnv(const KernelEnv&) = delete;
-  KernelEnv& operator=(const KernelEnv&) = delete;
-
- private:
-  std::optional<std::string> old_;
-};
 
 bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
 

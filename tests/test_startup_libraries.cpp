@@ -107,8 +107,8 @@ TEST(StartupLibraries, MissingModuleExits2NamingTheFile) {
 }
 
 const delayspec::cli::EquationsModule& load(const fs::path& file) {
-  return delayspec::cli::load_module<delayspec::cli::EquationsModule>(
-      file, delayspec::cli::equations_module_symbol, delayspec::cli::equations_module_description());
+  return delayspec::cli::load_module<delayspec::cli::EquationsModule>(file, delayspec::cli::equations_module_symbol,
+                                                                      delayspec::cli::equations_module_description());
 }
 
 TEST(EquationsModuleLoader, RefusesAMissingFileAndAnObjectWithoutTheEntryPoint) {

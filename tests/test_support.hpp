@@ -1,7 +1,10 @@
 #pragma once
 // Small helpers shared by the tests.
 #include <complex>
+#include <cstdlib>
+#include <optional>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "delayspec/floquet.hpp"
@@ -38,5 +41,25 @@ inline double distance_to_nearest(const std::vector<std::complex<double>>& value
   for (auto v : values) best = std::min(best, std::abs(v - target));
   return best;
 }
+
+// Sets DELAYSPEC_KERNEL (kernel_dispatch.hpp) for the scope (unset when value is empty) and
+// restores the old value: how the tests force the portable kernel path, as a user would.
+class KernelEnv {
+ public:
+  explicit KernelEnv(const std::string& value) {
+    if (const char* old = std::getenv("DELAYSPEC_KERNEL")) old_ = old;
+    if (value.empty()) unsetenv("DELAYSPEC_KERNEL");
+    else setenv("DELAYSPEC_KERNEL", value.c_str(), 1);
+  }
+  ~KernelEnv() {
+    if (old_) setenv("DELAYSPEC_KERNEL", old_->c_str(), 1);
+    else unsetenv("DELAYSPEC_KERNEL");
+  }
+  KernelEnv(const KernelEnv&) = delete;
+  KernelEnv& operator=(const KernelEnv&) = delete;
+
+ private:
+  std::optional<std::string> old_;
+};
 
 }  // namespace delayspec::testing

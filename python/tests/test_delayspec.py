@@ -41,7 +41,7 @@ def test_floquet_without_scene_equals_cli_json():
 def test_floquet_dict_scene_equals_the_file():
     """A dict stands for a scene file: default.toml's keys as a dict give the file's result."""
     scene = dict(model="impact", zeta=0.01, e=1.26, a=0.7, beta=28, omega=0.802, k=0.2, tau_over_T=1,
-                 x0=-0.0566, v0=1.0101, N=200, nev=6, solver="spectra", analyses=["floquet"])
+                 x0=-0.0566, v0=1.0101, N=200, nev=6, solver="auto", analyses=["floquet"])
     r = delayspec.floquet(scene, N=40, nev=4)
     same_as_cli(r, "floquet", DEFAULT, N=40, nev=4)
 

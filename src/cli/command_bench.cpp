@@ -104,8 +104,9 @@ BenchSettings read_bench_settings(Config& config) {
   s.problem = read_problem(config, 100);
   s.orbit = read_orbit_settings(config);
   s.Ns = read_N_list(config, s.problem, 100, 400);
-  s.solver_names = read_word_list(config, "solvers", "spectra,arpack,dense-lapack",
-                                  {"spectra", "arpack", "block", "dense", "dense-lapack", "dense-eigen", "sdm0", "fdm1"});
+  s.solver_names =
+      read_word_list(config, "solvers", "spectra,arpack,dense-lapack",
+                     {"spectra", "arpack", "block", "dense", "dense-lapack", "dense-eigen", "sdm0", "fdm1"});
   s.base = read_floquet_options(config, 10);
   s.reference_kind =
       parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));

@@ -120,5 +120,4 @@ struct KeysCollected {
   std::set<std::string> keys;
 };
 
-
 }  // namespace delayspec::cli

@@ -52,9 +52,9 @@ bool launcher_says_lead() {
 void start_ranks(int* argc, char*** argv) {
   if (!started_by_mpi_launcher()) return;
   try {
-    mpi = &load_module<MpiModule>(module_file(mpi_module_file), mpi_module_symbol,
-                                  {"a run under an MPI launcher", "delayspec's MPI transport",
-                                   "OpenMPI, Debian package libopenmpi3"});
+    mpi = &load_module<MpiModule>(
+        module_file(mpi_module_file), mpi_module_symbol,
+        {"a run under an MPI launcher", "delayspec's MPI transport", "OpenMPI, Debian package libopenmpi3"});
   } catch (const BadInput& e) {
     // Every rank stops with exit 2 (bad input, as run_cli's), the lead with the message.
     if (launcher_says_lead()) std::cerr << "delayspec: bad input: " << e.what() << "\n";

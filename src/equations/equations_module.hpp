@@ -21,7 +21,8 @@ struct EquationsModule {
   // DELAYSPEC_VERSION " " DELAYSPEC_REVISION of the module's build (delayspec/version.hpp).
   const char* version = nullptr;
   // generate_equation_model (equation_model_source.hpp). Not thread-safe (GiNaC).
-  EquationModelSource (*generate)(const toml::table& equations, const std::vector<std::string>& reserved_keys) = nullptr;
+  EquationModelSource (*generate)(const toml::table& equations,
+                                  const std::vector<std::string>& reserved_keys) = nullptr;
 };
 
 // The module's file name, beside libdelayspec (build tree and installed alike).

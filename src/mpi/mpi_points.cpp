@@ -252,5 +252,4 @@ void worker_points(int threads, const PointTasks& tasks, const std::function<voi
   for (auto& t : pool) t.join();
 }
 
-
 }  // namespace delayspec::cli::mpi

@@ -11,7 +11,10 @@
 // (y may be null: x alone). Rows go in chunks of kGramSchmidtRows (x's and y's pieces stay in the
 // cache while the j columns stream past), four columns at a time (x and y are loaded once per
 // four columns). Sums are formed per chunk and added in chunk order, so the result does not
-// depend on `threads`: the chunks are split between threads, not the sums.
+// depend on `threads`: the chunks are split between threads, not the sums. The chunk bodies run
+// the portable code or, where the CPU has them, AVX2 + FMA (src/gram_schmidt_chunks.hpp;
+// DELAYSPEC_KERNEL=baseline forces the portable path): the two round differently, each the same
+// for any thread count.
 namespace delayspec::detail {
 
 inline constexpr long kGramSchmidtRows = 8192;

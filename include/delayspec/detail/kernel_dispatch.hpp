@@ -10,6 +10,8 @@
 // (__builtin_cpu_supports) and an AVX2 path exists for the state dimension (D = 1, 2, the
 // built-in models, compiled in the library); any other value is BadInput naming it.
 // A model of another D compiled outside the library (an equation model) runs the portable path.
+// The Gram-Schmidt passes of the Krylov-Schur backend and GMRES (src/gram_schmidt_chunks.hpp)
+// make the same choice per call, with their AVX2 + FMA code in src/gram_schmidt_avx2.cpp.
 //
 // The paths compute the same sums; FMA rounds a*b + c once instead of twice, so they agree to
 // rounding (tests/test_kernel_dispatch.cpp), not bit for bit.
