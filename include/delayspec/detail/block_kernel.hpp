@@ -92,22 +92,39 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
 // column-by-column pass over all n rows would evict each line of b k times).
 inline long interleave_tile_rows(long k) { return k >= 256 ? 8 : 2048 / k; }
 
-inline void interleave(const double* X, long ldx, long n, long k, double* __restrict b) {
-  const long rows = interleave_tile_rows(k);
-  for (long i0 = 0; i0 < n; i0 += rows) {
-    const long i1 = i0 + rows < n ? i0 + rows : n;
-    for (long v = 0; v < k; ++v)
-      for (long i = i0; i < i1; ++i) b[i * k + v] = X[v * ldx + i];
+// dst[c ldd + r] = src[r lds + c] for r < rows, c < cols, in 2 x 2 blocks: two rows of two
+// adjacent columns are two 16-byte loads and two unpacks into two 16-byte stores (GCC's SLP
+// vectoriser forms them from the four scalar moves; element by element the copy is one scalar
+// store per double). Column tiles as in interleave_tile_rows.
+inline void transpose_portable(const double* src, long lds, long rows, long cols, double* __restrict dst, long ldd) {
+  const long tile = interleave_tile_rows(rows);
+  const long rows2 = rows & ~1L;
+  for (long c0 = 0; c0 < cols; c0 += tile) {
+    const long c1 = c0 + tile < cols ? c0 + tile : cols;
+    const long c12 = c0 + ((c1 - c0) & ~1L);
+    for (long r = 0; r < rows2; r += 2) {
+      const double* s0 = src + r * lds;
+      const double* s1 = s0 + lds;
+      for (long c = c0; c < c12; c += 2) {
+        const double a0 = s0[c], a1 = s0[c + 1], b0 = s1[c], b1 = s1[c + 1];
+        dst[c * ldd + r] = a0;
+        dst[c * ldd + r + 1] = b0;
+        dst[(c + 1) * ldd + r] = a1;
+        dst[(c + 1) * ldd + r + 1] = b1;
+      }
+      for (long c = c12; c < c1; ++c) dst[c * ldd + r] = s0[c], dst[c * ldd + r + 1] = s1[c];
+    }
+    for (long r = rows2; r < rows; ++r)
+      for (long c = c0; c < c1; ++c) dst[c * ldd + r] = src[r * lds + c];
   }
 }
 
+inline void interleave(const double* X, long ldx, long n, long k, double* __restrict b) {
+  transpose_portable(X, ldx, k, n, b, k);
+}
+
 inline void deinterleave(const double* b, long n, long k, double* __restrict Y, long ldy) {
-  const long rows = interleave_tile_rows(k);
-  for (long i0 = 0; i0 < n; i0 += rows) {
-    const long i1 = i0 + rows < n ? i0 + rows : n;
-    for (long v = 0; v < k; ++v)
-      for (long i = i0; i < i1; ++i) Y[v * ldy + i] = b[i * k + v];
-  }
+  transpose_portable(b, k, n, k, Y, ldy);
 }
 
 // The K steps of one map on k interleaved vectors: step l reads u0 = u[l] and the delayed slots
