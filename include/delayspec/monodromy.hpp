@@ -14,6 +14,8 @@
 // Kernels: perform_op and apply_block run the K steps through block_kernel.hpp; blocks of k > 1
 // on the path chosen at construction (kernel_dispatch.hpp: AVX2 + FMA for D = 1, 2 where the CPU
 // has it, else the portable build; DELAYSPEC_KERNEL=baseline forces the latter). A copy keeps it.
+// apply_block with K <= m streams through two small interleaved buffers instead of the whole
+// linear history (apply_block_streaming says why that is exact).
 //
 // Thread safety: the work buffers are owned by the operator (no allocation per application),
 // so one Monodromy must not be applied from two threads at once. Copy it instead.
