@@ -23,6 +23,7 @@
 // A LinearOperator (linear_operator.hpp): the eigensolvers take it for any d. The bodies are
 // here, so a model of any d instantiates them; d = 1 and 2 are compiled once in the library.
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -168,8 +169,11 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
   // last of them, j0 + K, is still one of x's slots (<= M, i.e. K <= m: the delay is at least
   // one map long), no computed slot is ever read back, and every computed slot M + 1 .. M + K is
   // part of the result (K <= M + 1): the history need not be stored.
+  // Streaming writes Y while it still reads X: only when they do not overlap (apply_block(X, X)
+  // takes the linear layout, which reads all of X first).
   const long first_read = grid_.delayed_slot(0) - (grid_.theta == 0 ? 0 : 1);
-  if (first_read >= 0 && grid_.delayed_slot(0) + grid_.K <= grid_.M)
+  const bool disjoint = std::less<>()(X + (k - 1) * ldx + n_ - 1, Y) || std::less<>()(Y + (k - 1) * ldy + n_ - 1, X);
+  if (disjoint && first_read >= 0 && grid_.delayed_slot(0) + grid_.K <= grid_.M)
     apply_block_streaming(X, ldx, k, Y, ldy);
   else
     apply_block_linear(X, ldx, k, Y, ldy);
