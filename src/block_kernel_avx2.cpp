@@ -26,11 +26,11 @@ namespace {
 struct Avx2Target {};
 }  // namespace
 
-void block_steps_avx2(const StepMap<1>* maps, long K, long M, long first_delayed, double theta, double* b, long k) {
-  block_steps<1, Avx2Target>(maps, K, M, first_delayed, theta, b, k);
+void block_steps_avx2(const StepMap<1>* maps, long K, double* u, const double* delayed, double theta, long k) {
+  block_steps<1, Avx2Target>(maps, K, u, delayed, theta, k);
 }
-void block_steps_avx2(const StepMap<2>* maps, long K, long M, long first_delayed, double theta, double* b, long k) {
-  block_steps<2, Avx2Target>(maps, K, M, first_delayed, theta, b, k);
+void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* delayed, double theta, long k) {
+  block_steps<2, Avx2Target>(maps, K, u, delayed, theta, k);
 }
 
 // dst[c ldd + r] = src[r lds + c] for r < rows, c < cols: 4 x 4 tiles transposed in registers

@@ -2,8 +2,14 @@
 // grid.delay_tap (one vector at a time, Eigen fixed-size products: the formula as stated, no
 // kernel code) and against to_dense(), for d = 1, 2 (AVX2 path in the library) and d = 3 (a
 // dimension instantiated outside the library: portable path only), aligned and fractional
-// delays, k = 1, 3, 8, 32 vectors (not only multiples of the vector width). The portable path is
-// forced by DELAYSPEC_KERNEL=baseline, as a user would.
+// delays, k = 1, 2, 3, 5, 8, 16, 32, 33 vectors: the compile-time block sizes 2, 4, 8, 16, 32 of
+// block_steps and the generic loop (3, 5, 33: not multiples of the vector width). The portable
+// path is forced by DELAYSPEC_KERNEL=baseline, as a user would.
+//
+// apply_block has two layouts (monodromy.hpp): streaming when the delay is at least one map long
+// (K <= m: no computed slot is read back), else the whole interleaved history. The grids below
+// cover both, each with theta = 0 and theta != 0; the streaming ones run several chunks of steps
+// with a short last one for k >= 16 (chunks of max(8, 1024 / (d k)) steps against K = 20-40).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -66,12 +72,12 @@ Eigen::VectorXd reference_apply(const HistoryGrid& grid, const std::vector<StepM
 // coefficient, slot or interpolation weight is an O(h) = O(1e-2) error.
 constexpr double kTol = 1e-13;
 
-// apply_block on k = 1, 3, 8, 32 columns and apply on one vector, against the reference and
+// apply_block on k = 1 .. 33 columns and apply on one vector, against the reference and
 // against to_dense() of an operator on the baseline path.
 template <int D>
 void expect_path_matches(const Monodromy<D>& op, const Eigen::MatrixXd& dense_baseline) {
   const HistoryGrid& grid = op.grid();
-  for (long k : {1L, 3L, 8L, 32L}) {
+  for (long k : {1L, 2L, 3L, 5L, 8L, 16L, 32L, 33L}) {
     SCOPED_TRACE("d = " + std::to_string(D) + ", k = " + std::to_string(k) + ", path " +
                  kernel_path_name(op.kernel_path()) + ", theta = " + std::to_string(grid.theta));
     const Eigen::MatrixXd X = random_matrix(op.rows(), k, 100 + static_cast<unsigned>(k));
@@ -119,15 +125,38 @@ void check_all_paths(const HistoryGrid& grid) {
   expect_path_matches(*dispatched, dense);
 }
 
+// Streaming layout (K <= m).
 HistoryGrid aligned_grid() {
-  HistoryGrid g = make_grid(1.0, 1.0, 40);  // tau = T: K = M = 40, theta = 0
+  HistoryGrid g = make_grid(1.0, 1.0, 40);  // tau = T: K = M = m = 40, theta = 0
   EXPECT_TRUE(g.aligned());
+  EXPECT_LE(g.K, g.m);
   return g;
 }
+HistoryGrid aligned_long_delay_grid() {
+  HistoryGrid g = make_grid(2.0, 1.0, 40);  // tau = 2 T: K = 20, M = m = 40; Y's slots 0 .. 20 are x's
+  EXPECT_TRUE(g.aligned());
+  EXPECT_LT(g.K, g.M);
+  return g;
+}
+HistoryGrid fractional_long_delay_grid() {
+  HistoryGrid g = make_grid(1.37, 1.0, 29);  // K = 21 <= m = 28, theta in (0, 1)
+  EXPECT_FALSE(g.aligned());
+  EXPECT_GT(g.theta, 0.0);
+  EXPECT_LE(g.K, g.m);
+  return g;
+}
+// Linear layout (K > m: the steps read slots they computed).
 HistoryGrid fractional_grid() {
   HistoryGrid g = make_grid(1.0, 1.37, 29);  // tau / T not a ratio of small integers: theta in (0, 1)
   EXPECT_FALSE(g.aligned());
   EXPECT_GT(g.theta, 0.0);
+  EXPECT_GT(g.K, g.m);
+  return g;
+}
+HistoryGrid aligned_short_delay_grid() {
+  HistoryGrid g = make_grid(1.0, 2.0, 20);  // tau = T / 2: K = 40 > m = 20, theta = 0
+  EXPECT_TRUE(g.aligned());
+  EXPECT_GT(g.K, g.m);
   return g;
 }
 
@@ -137,10 +166,32 @@ TEST(KernelDispatch, ScalarAlignedDelay) { check_all_paths<1>(aligned_grid()); }
 TEST(KernelDispatch, ScalarFractionalDelay) { check_all_paths<1>(fractional_grid()); }
 TEST(KernelDispatch, TwoDimensionalAlignedDelay) { check_all_paths<2>(aligned_grid()); }
 TEST(KernelDispatch, TwoDimensionalFractionalDelay) { check_all_paths<2>(fractional_grid()); }
+TEST(KernelDispatch, DelayLongerThanTheMapStreams) {
+  check_all_paths<1>(aligned_long_delay_grid());
+  check_all_paths<1>(fractional_long_delay_grid());
+  check_all_paths<2>(aligned_long_delay_grid());
+  check_all_paths<2>(fractional_long_delay_grid());
+}
+// In place (Y is X): the streaming layout would overwrite x's slots before reading them, so
+// apply_block falls back to the linear one; the result equals the out-of-place one exactly
+// (same path, same arithmetic).
+TEST(KernelDispatch, InPlaceApplyBlockMatchesOutOfPlace) {
+  const HistoryGrid grid = aligned_long_delay_grid();
+  const Monodromy<2> op(grid, random_maps<2>(grid.K, grid.N, 5));
+  Eigen::MatrixXd X = random_matrix(op.rows(), 8, 11), Y;
+  op.apply_block(X, Y);
+  op.apply_block(X, X);
+  EXPECT_EQ(X, Y);
+}
+TEST(KernelDispatch, DelayShorterThanTheMapAligned) {
+  check_all_paths<1>(aligned_short_delay_grid());
+  check_all_paths<2>(aligned_short_delay_grid());
+}
 // d = 3 is compiled here, outside the library, like an equation model: the portable path.
 TEST(KernelDispatch, DimensionOutsideTheLibraryRunsThePortablePath) {
   check_all_paths<3>(aligned_grid());
   check_all_paths<3>(fractional_grid());
+  check_all_paths<3>(fractional_long_delay_grid());
 }
 
 TEST(KernelDispatch, AutoIsTheDefaultChoice) {

@@ -14,6 +14,8 @@
 // Kernels: perform_op and apply_block run the K steps through block_kernel.hpp; blocks of k > 1
 // on the path chosen at construction (kernel_dispatch.hpp: AVX2 + FMA for D = 1, 2 where the CPU
 // has it, else the portable build; DELAYSPEC_KERNEL=baseline forces the latter). A copy keeps it.
+// apply_block with K <= m streams through two small interleaved buffers instead of the whole
+// linear history (apply_block_streaming says why that is exact).
 //
 // Thread safety: the work buffers are owned by the operator (no allocation per application),
 // so one Monodromy must not be applied from two threads at once. Copy it instead.
@@ -21,6 +23,7 @@
 // A LinearOperator (linear_operator.hpp): the eigensolvers take it for any d. The bodies are
 // here, so a model of any d instantiates them; d = 1 and 2 are compiled once in the library.
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -70,9 +73,15 @@ class Monodromy final : public LinearOperator {
 
  private:
   void apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const;
-  // The K steps of one map on the work buffer b of k vectors (k = 1: the plain history), on
-  // this operator's kernel path.
-  void run_steps(double* b, long k) const;
+  // apply_block_raw for k > 1 when no computed slot is read back as a delayed one (K <= m), and
+  // otherwise (the whole interleaved history in block_work_).
+  void apply_block_streaming(const double* X, long ldx, long k, double* Y, long ldy) const;
+  void apply_block_linear(const double* X, long ldx, long k, double* Y, long ldy) const;
+  // On this operator's kernel path: steps l0 .. l0 + count - 1 on k > 1 interleaved vectors
+  // (block_steps' u, delayed); rows of X interleaved into slots and back (interleave, deinterleave).
+  void run_block_steps(long l0, long count, double* u, const double* delayed, long k) const;
+  void to_slots(const double* X, long ldx, long rows, long k, double* b) const;
+  void from_slots(const double* b, long rows, long k, double* Y, long ldy) const;
 
   HistoryGrid grid_;
   std::vector<StepMap<D>> maps_;
@@ -95,30 +104,47 @@ Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
 template <int D>
 void Monodromy<D>::perform_op(const double* x, double* y) const {
   throw_if_cancelled();  // one application = one period: the front end may stop here
-  const long K = grid_.K;
+  const long M = grid_.M, K = grid_.K;
   double* b = work_.data();
   std::copy(x, x + n_, b);
-  run_steps(b, 1);
+  // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the tap of grid.delay_tap (block_kernel.hpp).
+  // Portable code on every path: latency-bound (block_kernel_avx2.cpp).
+  single_steps<D>(maps_.data(), K, M, grid_.delayed_slot(0), grid_.theta, b);
   std::copy(b + K * D, b + K * D + n_, y);
   ++applications_;
 }
 
 template <int D>
-void Monodromy<D>::run_steps(double* b, long k) const {
-  // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the tap of grid.delay_tap (block_kernel.hpp)
-  const long M = grid_.M, K = grid_.K, j0 = grid_.delayed_slot(0);
-  const double theta = grid_.theta;
-  if (k == 1) {
-    single_steps<D>(maps_.data(), K, M, j0, theta, b);  // every path: latency-bound (block_kernel_avx2.cpp)
-    return;
-  }
+void Monodromy<D>::run_block_steps(long l0, long count, double* u, const double* delayed, long k) const {
   if constexpr (kHasAvx2Kernel) {
     if (path_ == KernelPath::avx2) {
-      detail::block_steps_avx2(maps_.data(), K, M, j0, theta, b, k);
+      detail::block_steps_avx2(maps_.data() + l0, count, u, delayed, grid_.theta, k);
       return;
     }
   }
-  block_steps<D>(maps_.data(), K, M, j0, theta, b, k);
+  block_steps<D>(maps_.data() + l0, count, u, delayed, grid_.theta, k);
+}
+
+template <int D>
+void Monodromy<D>::to_slots(const double* X, long ldx, long rows, long k, double* b) const {
+  if constexpr (kHasAvx2Kernel) {
+    if (path_ == KernelPath::avx2) {
+      detail::transpose_avx2(X, ldx, k, rows, b, k);
+      return;
+    }
+  }
+  interleave(X, ldx, rows, k, b);
+}
+
+template <int D>
+void Monodromy<D>::from_slots(const double* b, long rows, long k, double* Y, long ldy) const {
+  if constexpr (kHasAvx2Kernel) {
+    if (path_ == KernelPath::avx2) {
+      detail::transpose_avx2(b, k, rows, k, Y, ldy);
+      return;
+    }
+  }
+  deinterleave(b, rows, k, Y, ldy);
 }
 
 template <int D>
@@ -139,24 +165,58 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
     return;
   }
   throw_if_cancelled();
-  const long M = grid_.M, K = grid_.K;
-  const size_t need = static_cast<size_t>(M + 1 + K) * D * k;
+  // Step l reads the slots j0 + l - 1 .. j0 + l + 1 (j0 + l - 1 only when theta != 0). When the
+  // last of them, j0 + K, is still one of x's slots (<= M, i.e. K <= m: the delay is at least
+  // one map long), no computed slot is ever read back, and every computed slot M + 1 .. M + K is
+  // part of the result (K <= M + 1): the history need not be stored.
+  // Streaming writes Y while it still reads X: only when they do not overlap (apply_block(X, X)
+  // takes the linear layout, which reads all of X first).
+  const long first_read = grid_.delayed_slot(0) - (grid_.theta == 0 ? 0 : 1);
+  const bool disjoint = std::less<>()(X + (k - 1) * ldx + n_ - 1, Y) || std::less<>()(Y + (k - 1) * ldy + n_ - 1, X);
+  if (disjoint && first_read >= 0 && grid_.delayed_slot(0) + grid_.K <= grid_.M)
+    apply_block_streaming(X, ldx, k, Y, ldy);
+  else
+    apply_block_linear(X, ldx, k, Y, ldy);
+  applications_ += k;
+}
+
+template <int D>
+void Monodromy<D>::apply_block_linear(const double* X, long ldx, long k, double* Y, long ldy) const {
+  const long M = grid_.M, K = grid_.K, stride = D * k;
+  const size_t need = static_cast<size_t>(M + 1 + K) * stride;
   if (block_work_.size() < need) block_work_.resize(need);
   double* b = block_work_.data();
   // b[(j D + r) k + v] = X(j D + r, v); K steps; the result (slots K .. K + M) back into Y
-  if constexpr (kHasAvx2Kernel) {
-    if (path_ == KernelPath::avx2) {
-      detail::transpose_avx2(X, ldx, k, n_, b, k);
-      run_steps(b, k);
-      detail::transpose_avx2(b + K * D * k, k, n_, k, Y, ldy);
-      applications_ += k;
-      return;
-    }
+  to_slots(X, ldx, n_, k, b);
+  run_block_steps(0, K, b + M * stride, b + grid_.delayed_slot(0) * stride, k);
+  from_slots(b + K * stride, n_, k, Y, ldy);
+}
+
+template <int D>
+void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, double* Y, long ldy) const {
+  // Chunks of C steps: interleave the x slots the chunk reads into `in`, step into `out` (slot 0
+  // = u0, the previous chunk's last slot), de-interleave out's new slots straight into Y. Both
+  // buffers stay in L1 (~16 KiB each), so X is read once and Y written once, against the linear
+  // path's whole interleaved history (x in, all K new slots, the result out: 2-4x the bytes,
+  // from L2 or L3; bench_apply, docs/benchmarks.md). The copies are the same transposes.
+  const long M = grid_.M, K = grid_.K, stride = D * k, j0 = grid_.delayed_slot(0);
+  const long back = grid_.theta == 0 ? 0 : 1;  // slot j - 1 is read only when theta != 0
+  const long C = std::max<long>(8, 1024 / stride);
+  const size_t need = static_cast<size_t>(2 * C + 3) * stride;
+  if (block_work_.size() < need) block_work_.resize(need);
+  double* in = block_work_.data();     // C + 2 slots: j0 + l0 - back .. j0 + l0 + C
+  double* out = in + (C + 2) * stride;  // C + 1 slots: M + l0 .. M + l0 + C
+  to_slots(X + M * D, ldx, D, k, out);  // u0 of step 0: x's slot M
+  for (long l0 = 0; l0 < K; l0 += C) {
+    const long steps = std::min(C, K - l0);
+    const long lo = j0 + l0 - back, hi = j0 + l0 + steps;  // the slots these steps read
+    to_slots(X + lo * D, ldx, (hi - lo + 1) * D, k, in);
+    run_block_steps(l0, steps, out, in + back * stride, k);
+    from_slots(out + stride, steps * D, k, Y + (M + l0 + 1 - K) * D, ldy);  // slot s is Y's slot s - K
+    std::copy(out + steps * stride, out + (steps + 1) * stride, out);     // the next chunk's u0
   }
-  interleave(X, ldx, n_, k, b);
-  run_steps(b, k);
-  deinterleave(b + K * D * k, n_, k, Y, ldy);
-  applications_ += k;
+  // The result's first slots K .. M are x's slots (none when K = M + 1): a plain copy per column.
+  for (long v = 0; v < k; ++v) std::copy(X + v * ldx + K * D, X + v * ldx + n_, Y + v * ldy);
 }
 
 template <int D>

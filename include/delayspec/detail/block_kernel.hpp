@@ -46,13 +46,22 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
   const long stride = static_cast<long>(D) * k;
   const double* d1 = d0 + stride;  // b[j + 1]
   // s.P, s.Q, s.R: loop-invariant (out is __restrict), broadcast once per step
+  // The sum: one term per statement, so that with FMA each term is one FMA (`acc += a b + c d`
+  // is a multiply, an FMA and an add; starting from acc = 0 adds one more add), and ordered
+  // delayed part first, P u0 last: u0 is the previous step's out, so the steps form a recurrence
+  // and the chain from u0 to out is only the last D FMAs; the Q, R part of the next step, which
+  // does not depend on u0, overlaps it.
   if (theta == 0) {
-    // out_r = sum_c P_rc u0_c + Q_rc b[j]_c + R_rc b[j+1]_c, one pass over the k vectors
+    // out_r = sum_c Q_rc b[j]_c + R_rc b[j+1]_c + sum_c P_rc u0_c, one pass over the k vectors
     for (long v = 0; v < k; ++v)
       for (int r = 0; r < D; ++r) {
-        double acc = 0;
-        for (int c = 0; c < D; ++c)
-          acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * d0[c * k + v] + s.R.coeff(r, c) * d1[c * k + v];
+        double acc = s.Q.coeff(r, 0) * d0[v];
+        acc += s.R.coeff(r, 0) * d1[v];
+        for (int c = 1; c < D; ++c) {
+          acc += s.Q.coeff(r, c) * d0[c * k + v];
+          acc += s.R.coeff(r, c) * d1[c * k + v];
+        }
+        for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u0[c * k + v];
         out[r * k + v] = acc;
       }
     return;
@@ -66,9 +75,13 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
       w1[c] = c0 * d1[c * k + v] + theta * d0[c * k + v];
     }
     for (int r = 0; r < D; ++r) {
-      double acc = 0;
-      for (int c = 0; c < D; ++c)
-        acc += s.P.coeff(r, c) * u0[c * k + v] + s.Q.coeff(r, c) * w0[c] + s.R.coeff(r, c) * w1[c];
+      double acc = s.Q.coeff(r, 0) * w0[0];  // the same order as above
+      acc += s.R.coeff(r, 0) * w1[0];
+      for (int c = 1; c < D; ++c) {
+        acc += s.Q.coeff(r, c) * w0[c];
+        acc += s.R.coeff(r, c) * w1[c];
+      }
+      for (int c = 0; c < D; ++c) acc += s.P.coeff(r, c) * u0[c * k + v];
       out[r * k + v] = acc;
     }
   }
@@ -79,32 +92,74 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
 // column-by-column pass over all n rows would evict each line of b k times).
 inline long interleave_tile_rows(long k) { return k >= 256 ? 8 : 2048 / k; }
 
-inline void interleave(const double* X, long ldx, long n, long k, double* __restrict b) {
-  const long rows = interleave_tile_rows(k);
-  for (long i0 = 0; i0 < n; i0 += rows) {
-    const long i1 = i0 + rows < n ? i0 + rows : n;
-    for (long v = 0; v < k; ++v)
-      for (long i = i0; i < i1; ++i) b[i * k + v] = X[v * ldx + i];
+// dst[c ldd + r] = src[r lds + c] for r < rows, c < cols, in 2 x 2 blocks: two rows of two
+// adjacent columns are two 16-byte loads and two unpacks into two 16-byte stores (GCC's SLP
+// vectoriser forms them from the four scalar moves; element by element the copy is one scalar
+// store per double). Column tiles as in interleave_tile_rows.
+inline void transpose_portable(const double* src, long lds, long rows, long cols, double* __restrict dst, long ldd) {
+  const long tile = interleave_tile_rows(rows);
+  const long rows2 = rows & ~1L;
+  for (long c0 = 0; c0 < cols; c0 += tile) {
+    const long c1 = c0 + tile < cols ? c0 + tile : cols;
+    const long c12 = c0 + ((c1 - c0) & ~1L);
+    for (long r = 0; r < rows2; r += 2) {
+      const double* s0 = src + r * lds;
+      const double* s1 = s0 + lds;
+      for (long c = c0; c < c12; c += 2) {
+        const double a0 = s0[c], a1 = s0[c + 1], b0 = s1[c], b1 = s1[c + 1];
+        dst[c * ldd + r] = a0;
+        dst[c * ldd + r + 1] = b0;
+        dst[(c + 1) * ldd + r] = a1;
+        dst[(c + 1) * ldd + r + 1] = b1;
+      }
+      for (long c = c12; c < c1; ++c) dst[c * ldd + r] = s0[c], dst[c * ldd + r + 1] = s1[c];
+    }
+    for (long r = rows2; r < rows; ++r)
+      for (long c = c0; c < c1; ++c) dst[c * ldd + r] = src[r * lds + c];
   }
+}
+
+inline void interleave(const double* X, long ldx, long n, long k, double* __restrict b) {
+  transpose_portable(X, ldx, k, n, b, k);
 }
 
 inline void deinterleave(const double* b, long n, long k, double* __restrict Y, long ldy) {
-  const long rows = interleave_tile_rows(k);
-  for (long i0 = 0; i0 < n; i0 += rows) {
-    const long i1 = i0 + rows < n ? i0 + rows : n;
-    for (long v = 0; v < k; ++v)
-      for (long i = i0; i < i1; ++i) Y[v * ldy + i] = b[i * k + v];
-  }
+  transpose_portable(b, k, n, k, Y, ldy);
 }
 
-// The K steps of one map on k interleaved vectors: b[M + l + 1] from b[M + l] and the delayed
-// slots around j = first_delayed + l (HistoryGrid::delayed_slot(l) = delayed_slot(0) + l).
+// The K steps of one map on k interleaved vectors: step l reads u0 = u[l] and the delayed slots
+// around delayed[l] (slots of D k doubles; delayed[l - 1 .. l + 1] when theta != 0) and writes
+// u[l + 1]. On one linear history b (Monodromy's layout) u = b[M] and delayed = b[j0]
+// (HistoryGrid::delayed_slot(l) = j0 + l); the streaming apply_block passes two staging buffers.
+// KC as in step_block.
+template <int D, class Target, int KC>
+inline void block_steps_k(const StepMap<D>* maps, long K, double* u, const double* delayed, double theta, long k) {
+  const long stride = static_cast<long>(D) * (KC > 0 ? KC : k);
+  // theta == 0 tested once, not per step: with the literal 0 the inlined step has no branch, and
+  // the compiler broadcasts the 3 D^2 coefficients straight from memory (a load each) instead
+  // of loading them as scalars above the branch and broadcasting in registers (a shuffle each).
+  if (theta == 0)
+    for (long l = 0; l < K; ++l)
+      step_block<D, Target, KC>(maps[l], u + l * stride, delayed + l * stride, k, 0.0, u + (l + 1) * stride);
+  else
+    for (long l = 0; l < K; ++l)
+      step_block<D, Target, KC>(maps[l], u + l * stride, delayed + l * stride, k, theta, u + (l + 1) * stride);
+}
+
+// The block sizes the solvers use (block_size 2, 4, 8; to_dense's chunks of 32; 16) run with k
+// a compile-time constant: the step's loops over v become straight-line vector code. With a
+// runtime k the loop set-up for a trip count of 2-8 vectors cost more than the step's FMAs
+// (bench_apply, docs/benchmarks.md). Any other k runs the generic loop.
 template <int D, class Target = detail::PortableTarget>
-inline void block_steps(const StepMap<D>* maps, long K, long M, long first_delayed, double theta, double* b, long k) {
-  const long stride = static_cast<long>(D) * k;
-  for (long l = 0; l < K; ++l)
-    step_block<D, Target>(maps[l], b + (M + l) * stride, b + (first_delayed + l) * stride, k, theta,
-                          b + (M + l + 1) * stride);
+inline void block_steps(const StepMap<D>* maps, long K, double* u, const double* delayed, double theta, long k) {
+  switch (k) {
+    case 2: return block_steps_k<D, Target, 2>(maps, K, u, delayed, theta, k);
+    case 4: return block_steps_k<D, Target, 4>(maps, K, u, delayed, theta, k);
+    case 8: return block_steps_k<D, Target, 8>(maps, K, u, delayed, theta, k);
+    case 16: return block_steps_k<D, Target, 16>(maps, K, u, delayed, theta, k);
+    case 32: return block_steps_k<D, Target, 32>(maps, K, u, delayed, theta, k);
+    default: return block_steps_k<D, Target, 0>(maps, K, u, delayed, theta, k);
+  }
 }
 
 // The same K steps on one vector (slot j at b + j D), u0 carried in registers.

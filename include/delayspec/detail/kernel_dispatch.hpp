@@ -32,8 +32,8 @@ namespace detail {
 // The AVX2 + FMA instantiations of block_steps (block_kernel.hpp) for D = 1, 2 (k vectors; one
 // vector runs the portable single_steps on every path, src/block_kernel_avx2.cpp says why).
 // Call only when choose_kernel_path returned KernelPath::avx2.
-void block_steps_avx2(const StepMap<1>* maps, long K, long M, long first_delayed, double theta, double* b, long k);
-void block_steps_avx2(const StepMap<2>* maps, long K, long M, long first_delayed, double theta, double* b, long k);
+void block_steps_avx2(const StepMap<1>* maps, long K, double* u, const double* delayed, double theta, long k);
+void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* delayed, double theta, long k);
 // dst[c ldd + r] = src[r lds + c] (r < rows, c < cols): interleave(X, ldx, n, k, b) is
 // transpose_avx2(X, ldx, k, n, b, k), deinterleave(b, n, k, Y, ldy) is transpose_avx2(b, k, n, k, Y, ldy).
 void transpose_avx2(const double* src, long lds, long rows, long cols, double* dst, long ldd);
