@@ -4,8 +4,8 @@
 // -mfma, chosen at run time like the step-map kernels (kernel_dispatch.hpp: DELAYSPEC_KERNEL =
 // baseline forces the portable one). The passes stream the basis from memory, but the portable
 // code also spends an instruction per double per column on two-lane packs without FMA: the
-// AVX2 file, four lanes and fused multiply-adds, measured the eigensolve at N = 10^6 9 % faster
-// (2.88 -> 2.62 s, docs/benchmarks.md). Everything but the table type is in an unnamed
+// AVX2 file, four lanes and fused multiply-adds, measured the eigensolve at N = 10^6 7-9 % faster
+// (2.75-2.81 -> 2.55-2.66 s, docs/benchmarks.md). Everything but the table type is in an unnamed
 // namespace, so each file has its own copies: the linker can never put one file's machine code
 // in place of the other's.
 #include <cstring>
@@ -20,8 +20,8 @@ namespace delayspec::detail {
 struct GramSchmidtChunkKernels {
   void (*coefficients)(const double* Q, long n, long j, const double* x, const double* y, long a, long b, double* s,
                        double* t);
-  ProjectedProducts (*subtract)(const double* Q, long n, long j, const double* s, const double* t, double* x,
-                                double* y, long a, long b);
+  ProjectedProducts (*subtract)(const double* Q, long n, long j, const double* s, const double* t, double* x, double* y,
+                                long a, long b);
 };
 
 // The AVX2 + FMA table (src/gram_schmidt_avx2.cpp); call only where choose_kernel_path said avx2.
