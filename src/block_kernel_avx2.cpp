@@ -33,6 +33,130 @@ void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* d
   block_steps<2, Avx2Target>(maps, K, u, delayed, theta, k);
 }
 
+// The streaming apply_block for d = 2 and k a multiple of 4, fused with its transposes
+// (stream_steps_avx2, kernel_dispatch.hpp). Math as in block_kernel.hpp: step l (slot
+// j = j0 + l) computes
+//
+//   b[M + l + 1] = P u + Q w0 + R w1,   u = b[M + l],  w0 = s[j],  w1 = s[j + 1],
+//   s[i] = b[i] (theta = 0),  s[i] = (1 - theta) b[i] + theta b[i - 1] (theta != 0),
+//
+// (the step's w1 is the next step's w0: one interpolated slot per step). Registers hold 4
+// vectors per __m256d, one component of one slot: Slot {c0, c1}. Column v of X holds vector v's
+// slots one after the other, 2 doubles each, so 4 doubles at X + v ldx + 2 i are slots i and
+// i + 1 of vector v: 4 such loads (4 columns) transposed in registers are slots i, i + 1 of the
+// 4 vectors, components as rows. A pair of steps therefore reads 4 loads + 8 shuffles per 4
+// vectors and writes its two output slots as the inverse transpose + 4 stores straight into Y:
+// no staging buffer, no copies. u and the last slot read stay in registers from step to step
+// (in memory, the recurrence u -> out would add a store-to-load forwarding to its chain).
+// Blocks of 4 vectors run one after the other through all K steps. (Two blocks side by side,
+// sharing the coefficient broadcasts, spilled registers and measured 1.7x slower.) The sums are
+// those of step_block in its order (Q, R interleaved, P u last).
+namespace {
+
+struct Slot {
+  __m256d c0, c1;  // components 0 and 1 of one slot, 4 vectors
+};
+
+// Rows r0..r3 of a 4 x 4 block in, its columns out (in the same registers).
+inline void transpose4(__m256d& r0, __m256d& r1, __m256d& r2, __m256d& r3) {
+  const __m256d a0 = _mm256_unpacklo_pd(r0, r1), a1 = _mm256_unpackhi_pd(r0, r1);
+  const __m256d a2 = _mm256_unpacklo_pd(r2, r3), a3 = _mm256_unpackhi_pd(r2, r3);
+  r0 = _mm256_permute2f128_pd(a0, a2, 0x20);
+  r1 = _mm256_permute2f128_pd(a1, a3, 0x20);
+  r2 = _mm256_permute2f128_pd(a0, a2, 0x31);
+  r3 = _mm256_permute2f128_pd(a1, a3, 0x31);
+}
+
+// Element i of 4 columns (x + v ld, v = 0..3): the first and last slots only.
+inline __m256d gather4(const double* x, long ld, long i) {
+  return _mm256_set_pd(x[3 * ld + i], x[2 * ld + i], x[ld + i], x[i]);
+}
+inline void scatter4(__m256d a, double* y, long ld, long i) {
+  alignas(32) double t[4];
+  _mm256_store_pd(t, a);
+  for (int v = 0; v < 4; ++v) y[v * ld + i] = t[v];
+}
+
+// (1 - theta) b + theta b_prev
+inline Slot lerp(const Slot& b, const Slot& b_prev, __m256d c0, __m256d theta) {
+  return {_mm256_fmadd_pd(c0, b.c0, _mm256_mul_pd(theta, b_prev.c0)),
+          _mm256_fmadd_pd(c0, b.c1, _mm256_mul_pd(theta, b_prev.c1))};
+}
+
+// out = Q w0 + R w1 + P u; Eigen's 2 x 2 matrices are column-major: (r, c) at [2 c + r].
+inline Slot step2(const StepMap<2>& s, const Slot& w0, const Slot& w1, const Slot& u) {
+  const double *P = s.P.data(), *Q = s.Q.data(), *R = s.R.data();
+  Slot out;
+  __m256d a = _mm256_mul_pd(_mm256_broadcast_sd(Q), w0.c0);
+  a = _mm256_fmadd_pd(_mm256_broadcast_sd(R), w1.c0, a);
+  a = _mm256_fmadd_pd(_mm256_broadcast_sd(Q + 2), w0.c1, a);
+  a = _mm256_fmadd_pd(_mm256_broadcast_sd(R + 2), w1.c1, a);
+  a = _mm256_fmadd_pd(_mm256_broadcast_sd(P), u.c0, a);
+  out.c0 = _mm256_fmadd_pd(_mm256_broadcast_sd(P + 2), u.c1, a);
+  __m256d b = _mm256_mul_pd(_mm256_broadcast_sd(Q + 1), w0.c0);
+  b = _mm256_fmadd_pd(_mm256_broadcast_sd(R + 1), w1.c0, b);
+  b = _mm256_fmadd_pd(_mm256_broadcast_sd(Q + 3), w0.c1, b);
+  b = _mm256_fmadd_pd(_mm256_broadcast_sd(R + 3), w1.c1, b);
+  b = _mm256_fmadd_pd(_mm256_broadcast_sd(P + 1), u.c0, b);
+  out.c1 = _mm256_fmadd_pd(_mm256_broadcast_sd(P + 3), u.c1, b);
+  return out;
+}
+
+// The K steps on the 4 vectors in columns X .. X + 3 ldx (their results into Y's columns).
+template <bool Interpolate>
+void stream_block(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
+                  double* Y, long ldy) {
+  const __m256d c0 = _mm256_set1_pd(1 - theta), th = _mm256_set1_pd(theta);
+  // u = b[M + l]; w = s[j] (the step's w0); last = b[j] (the next interpolation's b[i - 1])
+  Slot u{gather4(X, ldx, 2 * M), gather4(X, ldx, 2 * M + 1)};
+  Slot last{gather4(X, ldx, 2 * j0), gather4(X, ldx, 2 * j0 + 1)};
+  Slot w = last;
+  if constexpr (Interpolate) w = lerp(last, Slot{gather4(X, ldx, 2 * j0 - 2), gather4(X, ldx, 2 * j0 - 1)}, c0, th);
+  long l = 0;
+  for (; l + 1 < K; l += 2) {  // steps l, l + 1: slots j + 1, j + 2 read, M + l + 1, M + l + 2 written
+    const double* x = X + 2 * (j0 + l + 1);
+    __m256d r0 = _mm256_loadu_pd(x), r1 = _mm256_loadu_pd(x + ldx);
+    __m256d r2 = _mm256_loadu_pd(x + 2 * ldx), r3 = _mm256_loadu_pd(x + 3 * ldx);
+    transpose4(r0, r1, r2, r3);  // slot j + 1 = (r0, r1), slot j + 2 = (r2, r3)
+    Slot w1{r0, r1}, w2{r2, r3};
+    if constexpr (Interpolate) {
+      w1 = lerp(Slot{r0, r1}, last, c0, th);
+      w2 = lerp(Slot{r2, r3}, Slot{r0, r1}, c0, th);
+      last = {r2, r3};
+    }
+    const Slot o1 = step2(maps[l], w, w1, u);
+    const Slot o2 = step2(maps[l + 1], w1, w2, o1);
+    w = w2;
+    u = o2;
+    __m256d y0 = o1.c0, y1 = o1.c1, y2 = o2.c0, y3 = o2.c1;
+    transpose4(y0, y1, y2, y3);  // row v: vector v's slots M + l + 1, M + l + 2
+    double* y = Y + 2 * (M + l + 1 - K);  // result slot i is Y's slot i - K
+    _mm256_storeu_pd(y, y0);
+    _mm256_storeu_pd(y + ldy, y1);
+    _mm256_storeu_pd(y + 2 * ldy, y2);
+    _mm256_storeu_pd(y + 3 * ldy, y3);
+  }
+  if (l < K) {  // K odd: the last step alone (slot j0 + K <= M read, Y's last slot M written)
+    const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);
+    Slot w1{gather4(X, ldx, in), gather4(X, ldx, in + 1)};
+    if constexpr (Interpolate) w1 = lerp(w1, last, c0, th);
+    const Slot o = step2(maps[l], w, w1, u);
+    scatter4(o.c0, Y, ldy, out);
+    scatter4(o.c1, Y, ldy, out + 1);
+  }
+}
+
+}  // namespace
+
+void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
+                       long k, double* Y, long ldy) {
+  for (long v = 0; v < k; v += 4)
+    if (theta == 0)
+      stream_block<false>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
+    else
+      stream_block<true>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
+}
+
 // dst[c ldd + r] = src[r lds + c] for r < rows, c < cols: 4 x 4 tiles transposed in registers
 // (4 loads, 8 shuffles, 4 stores per 16 doubles; the scalar loop moves one double per cycle),
 // column tiles of ~16 KiB of dst so the 4-row passes find dst's lines still in L1.

@@ -10,6 +10,9 @@
 // (K <= m: no computed slot is read back), else the whole interleaved history. The grids below
 // cover both, each with theta = 0 and theta != 0; the streaming ones run several chunks of steps
 // with a short last one for k >= 16 (chunks of max(8, 1024 / (d k)) steps against K = 20-40).
+// Streaming on the AVX2 path for d = 2 and k a multiple of 4 (4, 8, 12, 16, 32 here) is the fused
+// kernel (stream_steps_avx2: no staging, pairs of steps, a lone last step when K is odd: K = 21
+// below); every check asserts the layout that ran (Monodromy::last_block_layout).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -72,17 +75,30 @@ Eigen::VectorXd reference_apply(const HistoryGrid& grid, const std::vector<StepM
 // coefficient, slot or interpolation weight is an O(h) = O(1e-2) error.
 constexpr double kTol = 1e-13;
 
+// The layout apply_block must take for k vectors (X and Y distinct): the rule of
+// Monodromy::apply_block_raw and apply_block_streaming, restated.
+template <int D>
+typename Monodromy<D>::BlockLayout expected_layout(const Monodromy<D>& op, long k) {
+  using Layout = typename Monodromy<D>::BlockLayout;
+  const HistoryGrid& g = op.grid();
+  if (k == 1) return Layout::single;
+  const bool streams = g.delayed_slot(0) - (g.theta == 0 ? 0 : 1) >= 0 && g.delayed_slot(0) + g.K <= g.M;
+  if (!streams) return Layout::linear;
+  return D == 2 && op.kernel_path() == KernelPath::avx2 && k % 4 == 0 ? Layout::fused : Layout::streaming;
+}
+
 // apply_block on k = 1 .. 33 columns and apply on one vector, against the reference and
 // against to_dense() of an operator on the baseline path.
 template <int D>
 void expect_path_matches(const Monodromy<D>& op, const Eigen::MatrixXd& dense_baseline) {
   const HistoryGrid& grid = op.grid();
-  for (long k : {1L, 2L, 3L, 5L, 8L, 16L, 32L, 33L}) {
+  for (long k : {1L, 2L, 3L, 4L, 5L, 8L, 12L, 16L, 32L, 33L}) {
     SCOPED_TRACE("d = " + std::to_string(D) + ", k = " + std::to_string(k) + ", path " +
                  kernel_path_name(op.kernel_path()) + ", theta = " + std::to_string(grid.theta));
     const Eigen::MatrixXd X = random_matrix(op.rows(), k, 100 + static_cast<unsigned>(k));
     Eigen::MatrixXd Y;
     op.apply_block(X, Y);
+    EXPECT_EQ(op.last_block_layout(), expected_layout(op, k));
     Eigen::MatrixXd reference(op.rows(), k);
     for (long v = 0; v < k; ++v) reference.col(v) = reference_apply<D>(grid, op.step_maps(), X.col(v));
     EXPECT_LE((Y - reference).norm(), kTol * reference.norm());
@@ -138,11 +154,20 @@ HistoryGrid aligned_long_delay_grid() {
   EXPECT_LT(g.K, g.M);
   return g;
 }
+HistoryGrid aligned_long_delay_odd_grid() {
+  HistoryGrid g = make_grid(2.0, 1.0, 42);  // tau = 2 T: K = 21 (odd: the fused kernel's lone last step)
+  EXPECT_TRUE(g.aligned());
+  EXPECT_EQ(g.K % 2, 1);
+  EXPECT_LE(g.K, g.m);
+  return g;
+}
 HistoryGrid fractional_long_delay_grid() {
   HistoryGrid g = make_grid(1.37, 1.0, 29);  // K = 21 <= m = 28, theta in (0, 1)
   EXPECT_FALSE(g.aligned());
   EXPECT_GT(g.theta, 0.0);
   EXPECT_LE(g.K, g.m);
+  EXPECT_EQ(g.K % 2, 1);
+  EXPECT_EQ(g.delayed_slot(0), 1);  // theta != 0 reads slot j0 - 1 = 0, x's first
   return g;
 }
 // Linear layout (K > m: the steps read slots they computed).
@@ -170,18 +195,23 @@ TEST(KernelDispatch, DelayLongerThanTheMapStreams) {
   check_all_paths<1>(aligned_long_delay_grid());
   check_all_paths<1>(fractional_long_delay_grid());
   check_all_paths<2>(aligned_long_delay_grid());
+  check_all_paths<2>(aligned_long_delay_odd_grid());
   check_all_paths<2>(fractional_long_delay_grid());
 }
-// In place (Y is X): the streaming layout would overwrite x's slots before reading them, so
-// apply_block falls back to the linear one; the result equals the out-of-place one exactly
-// (same path, same arithmetic).
+// In place (Y is X): the streaming layouts would overwrite x's slots before reading them, so
+// apply_block falls back to the linear one, which reads all of x first. Out of place the same
+// operator streams (fused on AVX2); both sum the same terms in the same order, so they agree to
+// rounding (kTol, as any two paths).
 TEST(KernelDispatch, InPlaceApplyBlockMatchesOutOfPlace) {
   const HistoryGrid grid = aligned_long_delay_grid();
   const Monodromy<2> op(grid, random_maps<2>(grid.K, grid.N, 5));
   Eigen::MatrixXd X = random_matrix(op.rows(), 8, 11), Y;
   op.apply_block(X, Y);
+  EXPECT_EQ(op.last_block_layout(), expected_layout(op, 8));
+  EXPECT_NE(op.last_block_layout(), Monodromy<2>::BlockLayout::linear);
   op.apply_block(X, X);
-  EXPECT_EQ(X, Y);
+  EXPECT_EQ(op.last_block_layout(), Monodromy<2>::BlockLayout::linear);
+  EXPECT_LE((X - Y).norm(), kTol * Y.norm());
 }
 TEST(KernelDispatch, DelayShorterThanTheMapAligned) {
   check_all_paths<1>(aligned_short_delay_grid());

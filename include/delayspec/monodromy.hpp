@@ -71,6 +71,12 @@ class Monodromy final : public LinearOperator {
   // An AVX2 path is compiled in the library for these dimensions only.
   static constexpr bool kHasAvx2Kernel = D == 1 || D == 2;
 
+  // How the last apply_block ran (the tests assert it): one vector through perform_op; the whole
+  // interleaved history (linear); two L1 staging buffers (streaming); streaming with the
+  // transposes fused into the steps, no staging (fused: AVX2, d = 2, k a multiple of 4).
+  enum class BlockLayout { none, single, linear, streaming, fused };
+  BlockLayout last_block_layout() const { return last_layout_; }
+
  private:
   void apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const;
   // apply_block_raw for k > 1 when no computed slot is read back as a delayed one (K <= m), and
@@ -89,6 +95,7 @@ class Monodromy final : public LinearOperator {
   mutable std::vector<double> work_;        // (M + 1 + K) d, single vector
   mutable std::vector<double> block_work_;  // (M + 1 + K) d k, interleaved
   mutable long applications_ = 0;
+  mutable BlockLayout last_layout_ = BlockLayout::none;
   KernelPath path_ = KernelPath::baseline;
 };
 
@@ -162,6 +169,7 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
   // AVX2 transposes would move it element by element (measured slower than the baseline path).
   if (k == 1) {
     perform_op(X, Y);
+    last_layout_ = BlockLayout::single;
     return;
   }
   throw_if_cancelled();
@@ -182,6 +190,7 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
 
 template <int D>
 void Monodromy<D>::apply_block_linear(const double* X, long ldx, long k, double* Y, long ldy) const {
+  last_layout_ = BlockLayout::linear;
   const long M = grid_.M, K = grid_.K, stride = D * k;
   const size_t need = static_cast<size_t>(M + 1 + K) * stride;
   if (block_work_.size() < need) block_work_.resize(need);
@@ -200,6 +209,19 @@ void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, doub
   // path's whole interleaved history (x in, all K new slots, the result out: 2-4x the bytes,
   // from L2 or L3; bench_apply, docs/benchmarks.md). The copies are the same transposes.
   const long M = grid_.M, K = grid_.K, stride = D * k, j0 = grid_.delayed_slot(0);
+  // The result's first slots K .. M are x's slots (none when K = M + 1): a plain copy per column.
+  const auto copy_x_slots = [&] {
+    for (long v = 0; v < k; ++v) std::copy(X + v * ldx + K * D, X + v * ldx + n_, Y + v * ldy);
+  };
+  if constexpr (D == 2) {
+    if (path_ == KernelPath::avx2 && k % 4 == 0) {
+      detail::stream_steps_avx2(maps_.data(), K, M, j0, grid_.theta, X, ldx, k, Y, ldy);
+      copy_x_slots();
+      last_layout_ = BlockLayout::fused;
+      return;
+    }
+  }
+  last_layout_ = BlockLayout::streaming;
   const long back = grid_.theta == 0 ? 0 : 1;  // slot j - 1 is read only when theta != 0
   const long C = std::max<long>(8, 1024 / stride);
   const size_t need = static_cast<size_t>(2 * C + 3) * stride;
@@ -215,8 +237,7 @@ void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, doub
     from_slots(out + stride, steps * D, k, Y + (M + l0 + 1 - K) * D, ldy);  // slot s is Y's slot s - K
     std::copy(out + steps * stride, out + (steps + 1) * stride, out);     // the next chunk's u0
   }
-  // The result's first slots K .. M are x's slots (none when K = M + 1): a plain copy per column.
-  for (long v = 0; v < k; ++v) std::copy(X + v * ldx + K * D, X + v * ldx + n_, Y + v * ldy);
+  copy_x_slots();
 }
 
 template <int D>
