@@ -102,19 +102,26 @@ inline Slot step2(const StepMap<2>& s, const Slot& w0, const Slot& w1, const Slo
   return out;
 }
 
-// The K steps on the 4 vectors in columns X .. X + 3 ldx (their results into Y's columns).
+// The state of 4 vectors (columns X .. X + 3 ldx of X, their results into Y's) between steps:
+// u = b[M + l]; w = s[j] (the step's w0); last = b[j] (the next interpolation's b[i - 1]).
 template <bool Interpolate>
-void stream_block(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
-                  double* Y, long ldy) {
-  const __m256d c0 = _mm256_set1_pd(1 - theta), th = _mm256_set1_pd(theta);
-  // u = b[M + l]; w = s[j] (the step's w0); last = b[j] (the next interpolation's b[i - 1])
-  Slot u{gather4(X, ldx, 2 * M), gather4(X, ldx, 2 * M + 1)};
-  Slot last{gather4(X, ldx, 2 * j0), gather4(X, ldx, 2 * j0 + 1)};
-  Slot w = last;
-  if constexpr (Interpolate) w = lerp(last, Slot{gather4(X, ldx, 2 * j0 - 2), gather4(X, ldx, 2 * j0 - 1)}, c0, th);
-  long l = 0;
-  for (; l + 1 < K; l += 2) {  // steps l, l + 1: slots j + 1, j + 2 read, M + l + 1, M + l + 2 written
-    const double* x = X + 2 * (j0 + l + 1);
+struct Block4 {
+  const double* X;
+  double* Y;
+  Slot u, w, last;
+
+  Block4(const double* x, long ldx, double* y, long M, long j0, __m256d c0, __m256d th) : X(x), Y(y) {
+    u = {gather4(X, ldx, 2 * M), gather4(X, ldx, 2 * M + 1)};
+    last = {gather4(X, ldx, 2 * j0), gather4(X, ldx, 2 * j0 + 1)};
+    w = last;
+    if constexpr (Interpolate)
+      w = lerp(last, Slot{gather4(X, ldx, 2 * j0 - 2), gather4(X, ldx, 2 * j0 - 1)}, c0, th);
+  }
+
+  // Steps l, l + 1 (maps s[0], s[1]): x's slots j + 1, j + 2 read at element `in` of each column,
+  // the result slots M + l + 1, M + l + 2 written at element `out` of Y's.
+  void pair(const StepMap<2>* s, long in, long ldx, long out, long ldy, __m256d c0, __m256d th) {
+    const double* x = X + in;
     __m256d r0 = _mm256_loadu_pd(x), r1 = _mm256_loadu_pd(x + ldx);
     __m256d r2 = _mm256_loadu_pd(x + 2 * ldx), r3 = _mm256_loadu_pd(x + 3 * ldx);
     transpose4(r0, r1, r2, r3);  // slot j + 1 = (r0, r1), slot j + 2 = (r2, r3)
@@ -124,37 +131,67 @@ void stream_block(const StepMap<2>* maps, long K, long M, long j0, double theta,
       w2 = lerp(Slot{r2, r3}, Slot{r0, r1}, c0, th);
       last = {r2, r3};
     }
-    const Slot o1 = step2(maps[l], w, w1, u);
-    const Slot o2 = step2(maps[l + 1], w1, w2, o1);
+    const Slot o1 = step2(s[0], w, w1, u);
+    const Slot o2 = step2(s[1], w1, w2, o1);
     w = w2;
     u = o2;
     __m256d y0 = o1.c0, y1 = o1.c1, y2 = o2.c0, y3 = o2.c1;
-    transpose4(y0, y1, y2, y3);  // row v: vector v's slots M + l + 1, M + l + 2
-    double* y = Y + 2 * (M + l + 1 - K);  // result slot i is Y's slot i - K
+    transpose4(y0, y1, y2, y3);  // row v: vector v's two result slots
+    double* y = Y + out;
     _mm256_storeu_pd(y, y0);
     _mm256_storeu_pd(y + ldy, y1);
     _mm256_storeu_pd(y + 2 * ldy, y2);
     _mm256_storeu_pd(y + 3 * ldy, y3);
   }
-  if (l < K) {  // K odd: the last step alone (slot j0 + K <= M read, Y's last slot M written)
-    const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);
+
+  // One step alone (K odd: the last one).
+  void single(const StepMap<2>& s, long in, long ldx, long out, long ldy, __m256d c0, __m256d th) {
     Slot w1{gather4(X, ldx, in), gather4(X, ldx, in + 1)};
     if constexpr (Interpolate) w1 = lerp(w1, last, c0, th);
-    const Slot o = step2(maps[l], w, w1, u);
+    const Slot o = step2(s, w, w1, u);
     scatter4(o.c0, Y, ldy, out);
     scatter4(o.c1, Y, ldy, out + 1);
   }
+};
+
+// The K steps on Blocks blocks of 4 vectors (columns X, X + ldx, ...), side by side: one block's
+// steps are a chain of two dependent FMAs per step (P u), which alone leaves the FMA pipes idle.
+template <bool Interpolate, int Blocks>
+void stream_blocks(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
+                   double* Y, long ldy) {
+  const __m256d c0 = _mm256_set1_pd(1 - theta), th = _mm256_set1_pd(theta);
+  Block4<Interpolate> a(X, ldx, Y, M, j0, c0, th);
+  Block4<Interpolate> b(X + (Blocks > 1 ? 4 : 0) * ldx, ldx, Y + (Blocks > 1 ? 4 : 0) * ldy, M, j0, c0, th);
+  long l = 0;
+#pragma GCC unroll 2
+  for (; l + 1 < K; l += 2) {  // steps l, l + 1: slots j + 1, j + 2 read, M + l + 1, M + l + 2 written
+    const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);  // result slot i is Y's slot i - K
+    a.pair(maps + l, in, ldx, out, ldy, c0, th);
+    if constexpr (Blocks > 1) b.pair(maps + l, in, ldx, out, ldy, c0, th);
+  }
+  if (l < K) {  // K odd: the last step alone (slot j0 + K <= M read, Y's last slot M written)
+    const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);
+    a.single(maps[l], in, ldx, out, ldy, c0, th);
+    if constexpr (Blocks > 1) b.single(maps[l], in, ldx, out, ldy, c0, th);
+  }
+}
+
+template <bool Interpolate>
+void stream_all(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx, long k,
+                double* Y, long ldy) {
+  long v = 0;
+  for (; v + 8 <= k && false; v += 8) stream_blocks<Interpolate, 2>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
+  for (; v < k; v += 4) stream_blocks<Interpolate, 1>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
 }
 
 }  // namespace
 
 void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
                        long k, double* Y, long ldy) {
-  for (long v = 0; v < k; v += 4)
-    if (theta == 0)
-      stream_block<false>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
-    else
-      stream_block<true>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
+  if (theta == 0)
+    stream_all<false>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
+  else
+    stream_all<true>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
 }
 
 // dst[c ldd + r] = src[r lds + c] for r < rows, c < cols: 4 x 4 tiles transposed in registers
