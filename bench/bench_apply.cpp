@@ -66,7 +66,7 @@ void BM_ApplyBlock(benchmark::State& state) {
   state.counters["GFlops"] = benchmark::Counter(iters * flops * 1e-9, benchmark::Counter::kIsRate);
   state.counters["working_set_KiB"] = (8.0 * ((N + 1 + K) * d * k + 9.0 * d * d * K / 3.0)) / 1024.0;
 }
-BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 4, 8, 16, 32}, {0, 1, 2}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 2, 4, 8, 16, 32}, {0, 1, 2}})->Unit(benchmark::kMicrosecond);
 
 void BM_PerformOp(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));

@@ -48,9 +48,7 @@ void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* d
 // vectors and writes its two output slots as the inverse transpose + 4 stores straight into Y:
 // no staging buffer, no copies. u and the last slot read stay in registers from step to step
 // (in memory, the recurrence u -> out would add a store-to-load forwarding to its chain).
-// Blocks of 4 vectors run one after the other through all K steps. (Two blocks side by side,
-// sharing the coefficient broadcasts, spilled registers and measured 1.7x slower.) The sums are
-// those of step_block in its order (Q, R interleaved, P u last).
+// The sums are those of step_block in its order (Q, R interleaved, P u last).
 namespace {
 
 struct Slot {
@@ -154,44 +152,30 @@ struct Block4 {
   }
 };
 
-// The K steps on Blocks blocks of 4 vectors (columns X, X + ldx, ...), side by side: one block's
-// steps are a chain of two dependent FMAs per step (P u), which alone leaves the FMA pipes idle.
-template <bool Interpolate, int Blocks>
-void stream_blocks(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
-                   double* Y, long ldy) {
+// The K steps on 4 vectors (columns X .. X + 3 ldx). Blocks of 4 run one after the other: two
+// side by side (8 vectors, their chains u -> out interleaved) measured slower, not faster.
+template <bool Interpolate>
+void stream_block(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
+                  double* Y, long ldy) {
   const __m256d c0 = _mm256_set1_pd(1 - theta), th = _mm256_set1_pd(theta);
   Block4<Interpolate> a(X, ldx, Y, M, j0, c0, th);
-  Block4<Interpolate> b(X + (Blocks > 1 ? 4 : 0) * ldx, ldx, Y + (Blocks > 1 ? 4 : 0) * ldy, M, j0, c0, th);
   long l = 0;
 #pragma GCC unroll 2
-  for (; l + 1 < K; l += 2) {  // steps l, l + 1: slots j + 1, j + 2 read, M + l + 1, M + l + 2 written
-    const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);  // result slot i is Y's slot i - K
-    a.pair(maps + l, in, ldx, out, ldy, c0, th);
-    if constexpr (Blocks > 1) b.pair(maps + l, in, ldx, out, ldy, c0, th);
-  }
-  if (l < K) {  // K odd: the last step alone (slot j0 + K <= M read, Y's last slot M written)
-    const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);
-    a.single(maps[l], in, ldx, out, ldy, c0, th);
-    if constexpr (Blocks > 1) b.single(maps[l], in, ldx, out, ldy, c0, th);
-  }
-}
-
-template <bool Interpolate>
-void stream_all(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx, long k,
-                double* Y, long ldy) {
-  long v = 0;
-  for (; v + 8 <= k && false; v += 8) stream_blocks<Interpolate, 2>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
-  for (; v < k; v += 4) stream_blocks<Interpolate, 1>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
+  for (; l + 1 < K; l += 2)  // steps l, l + 1: slots j + 1, j + 2 read, M + l + 1, M + l + 2 written
+    a.pair(maps + l, 2 * (j0 + l + 1), ldx, 2 * (M + l + 1 - K), ldy, c0, th);  // result slot i: Y's slot i - K
+  if (l < K)  // K odd: the last step alone (slot j0 + K <= M read, Y's last slot M written)
+    a.single(maps[l], 2 * (j0 + l + 1), ldx, 2 * (M + l + 1 - K), ldy, c0, th);
 }
 
 }  // namespace
 
 void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
                        long k, double* Y, long ldy) {
-  if (theta == 0)
-    stream_all<false>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
-  else
-    stream_all<true>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
+  for (long v = 0; v < k; v += 4)
+    if (theta == 0)
+      stream_block<false>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
+    else
+      stream_block<true>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
 }
 
 // dst[c ldd + r] = src[r lds + c] for r < rows, c < cols: 4 x 4 tiles transposed in registers

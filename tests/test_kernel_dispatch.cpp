@@ -10,9 +10,12 @@
 // (K <= m: no computed slot is read back), else the whole interleaved history. The grids below
 // cover both, each with theta = 0 and theta != 0; the streaming ones run several chunks of steps
 // with a short last one for k >= 16 (chunks of max(8, 1024 / (d k)) steps against K = 20-40).
-// Streaming on the AVX2 path for d = 2 and k a multiple of 4 (4, 8, 12, 16, 32 here) is the fused
-// kernel (stream_steps_avx2: no staging, pairs of steps, a lone last step when K is odd: K = 21
-// below); every check asserts the layout that ran (Monodromy::last_block_layout).
+// Streaming for d = 2 runs the fused kernels (no staging): on the AVX2 path for k a multiple of 4
+// (4, 8, 12, 16, 32 here; stream_steps_avx2: pairs of steps, a lone last step when K is odd, K = 21
+// below), else the portable one for k even (2 on the AVX2 path; 2, 4, .., 32 on the baseline path;
+// stream_steps_portable: pairs of vectors, 2 + 4 for k = 6 (not a multiple of 4)); odd k (3, 5,
+// 33) and d = 1, 3 stream through the staging buffers. Every check asserts the layout that ran
+// (Monodromy::last_block_layout).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -84,7 +87,9 @@ typename Monodromy<D>::BlockLayout expected_layout(const Monodromy<D>& op, long 
   if (k == 1) return Layout::single;
   const bool streams = g.delayed_slot(0) - (g.theta == 0 ? 0 : 1) >= 0 && g.delayed_slot(0) + g.K <= g.M;
   if (!streams) return Layout::linear;
-  return D == 2 && op.kernel_path() == KernelPath::avx2 && k % 4 == 0 ? Layout::fused : Layout::streaming;
+  if (D != 2) return Layout::streaming;
+  if (op.kernel_path() == KernelPath::avx2 && k % 4 == 0) return Layout::fused_avx2;
+  return k % 2 == 0 ? Layout::fused_portable : Layout::streaming;
 }
 
 // apply_block on k = 1 .. 33 columns and apply on one vector, against the reference and
@@ -92,7 +97,7 @@ typename Monodromy<D>::BlockLayout expected_layout(const Monodromy<D>& op, long 
 template <int D>
 void expect_path_matches(const Monodromy<D>& op, const Eigen::MatrixXd& dense_baseline) {
   const HistoryGrid& grid = op.grid();
-  for (long k : {1L, 2L, 3L, 4L, 5L, 8L, 12L, 16L, 32L, 33L}) {
+  for (long k : {1L, 2L, 3L, 4L, 5L, 6L, 8L, 12L, 16L, 32L, 33L}) {
     SCOPED_TRACE("d = " + std::to_string(D) + ", k = " + std::to_string(k) + ", path " +
                  kernel_path_name(op.kernel_path()) + ", theta = " + std::to_string(grid.theta));
     const Eigen::MatrixXd X = random_matrix(op.rows(), k, 100 + static_cast<unsigned>(k));
@@ -208,7 +213,7 @@ TEST(KernelDispatch, InPlaceApplyBlockMatchesOutOfPlace) {
   Eigen::MatrixXd X = random_matrix(op.rows(), 8, 11), Y;
   op.apply_block(X, Y);
   EXPECT_EQ(op.last_block_layout(), expected_layout(op, 8));
-  EXPECT_NE(op.last_block_layout(), Monodromy<2>::BlockLayout::linear);
+  EXPECT_NE(op.last_block_layout(), Monodromy<2>::BlockLayout::linear);  // fused, on either path
   op.apply_block(X, X);
   EXPECT_EQ(op.last_block_layout(), Monodromy<2>::BlockLayout::linear);
   EXPECT_LE((X - Y).norm(), kTol * Y.norm());

@@ -73,8 +73,9 @@ class Monodromy final : public LinearOperator {
 
   // How the last apply_block ran (the tests assert it): one vector through perform_op; the whole
   // interleaved history (linear); two L1 staging buffers (streaming); streaming with the
-  // transposes fused into the steps, no staging (fused: AVX2, d = 2, k a multiple of 4).
-  enum class BlockLayout { none, single, linear, streaming, fused };
+  // transposes fused into the steps, no staging, for d = 2: AVX2 + FMA for k a multiple of 4
+  // (fused_avx2), else the portable build for k even (fused_portable, on either path).
+  enum class BlockLayout { none, single, linear, streaming, fused_avx2, fused_portable };
   BlockLayout last_block_layout() const { return last_layout_; }
 
  private:
@@ -217,7 +218,13 @@ void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, doub
     if (path_ == KernelPath::avx2 && k % 4 == 0) {
       detail::stream_steps_avx2(maps_.data(), K, M, j0, grid_.theta, X, ldx, k, Y, ldy);
       copy_x_slots();
-      last_layout_ = BlockLayout::fused;
+      last_layout_ = BlockLayout::fused_avx2;
+      return;
+    }
+    if (k % 2 == 0) {
+      detail::stream_steps_portable(maps_.data(), K, M, j0, grid_.theta, X, ldx, k, Y, ldy);
+      copy_x_slots();
+      last_layout_ = BlockLayout::fused_portable;
       return;
     }
   }

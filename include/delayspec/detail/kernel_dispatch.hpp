@@ -34,13 +34,16 @@ namespace detail {
 // Call only when choose_kernel_path returned KernelPath::avx2.
 void block_steps_avx2(const StepMap<1>* maps, long K, double* u, const double* delayed, double theta, long k);
 void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* delayed, double theta, long k);
-// The streaming apply_block's K steps for d = 2 on k vectors, k a multiple of 4, straight from
-// X (n x k, column-major, leading dimension ldx) into Y (the result slots M + 1 .. M + K, i.e.
-// Y's slots M + 1 - K .. M; the caller copies Y's slots 0 .. M - K). Requires what streaming
-// requires (Monodromy::apply_block_raw): j0 = delayed_slot(0), j0 - 1 >= 0 when theta != 0,
-// j0 + K <= M, X and Y disjoint.
+// The streaming apply_block's K steps for d = 2 on k vectors, straight from X (n x k,
+// column-major, leading dimension ldx) into Y (the result slots M + 1 .. M + K, i.e. Y's slots
+// M + 1 - K .. M; the caller copies Y's slots 0 .. M - K), the transposes fused into the steps.
+// Requires what streaming requires (Monodromy::apply_block_raw): j0 = delayed_slot(0),
+// j0 - 1 >= 0 when theta != 0, j0 + K <= M, X and Y disjoint. The AVX2 + FMA one (k a multiple
+// of 4, src/block_kernel_avx2.cpp) and the portable one (k even, src/stream_kernel.cpp).
 void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
                        long k, double* Y, long ldy);
+void stream_steps_portable(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
+                           long k, double* Y, long ldy);
 // dst[c ldd + r] = src[r lds + c] (r < rows, c < cols): interleave(X, ldx, n, k, b) is
 // transpose_avx2(X, ldx, k, n, b, k), deinterleave(b, n, k, Y, ldy) is transpose_avx2(b, k, n, k, Y, ldy).
 void transpose_avx2(const double* src, long lds, long rows, long cols, double* dst, long ldd);
