@@ -152,6 +152,80 @@ struct Block4 {
   }
 };
 
+// Two blocks' step: each coefficient broadcast once, used for both.
+struct Row2 {
+  __m256d a, b;
+};
+inline Row2 row2x2(const double* P, const double* Q, const double* R, int r, const Slot& w0a, const Slot& w1a,
+                   const Slot& ua, const Slot& w0b, const Slot& w1b, const Slot& ub) {
+  __m256d c = _mm256_broadcast_sd(Q + r);
+  __m256d a = _mm256_mul_pd(c, w0a.c0), b = _mm256_mul_pd(c, w0b.c0);
+  c = _mm256_broadcast_sd(R + r);
+  a = _mm256_fmadd_pd(c, w1a.c0, a), b = _mm256_fmadd_pd(c, w1b.c0, b);
+  c = _mm256_broadcast_sd(Q + 2 + r);
+  a = _mm256_fmadd_pd(c, w0a.c1, a), b = _mm256_fmadd_pd(c, w0b.c1, b);
+  c = _mm256_broadcast_sd(R + 2 + r);
+  a = _mm256_fmadd_pd(c, w1a.c1, a), b = _mm256_fmadd_pd(c, w1b.c1, b);
+  c = _mm256_broadcast_sd(P + r);
+  a = _mm256_fmadd_pd(c, ua.c0, a), b = _mm256_fmadd_pd(c, ub.c0, b);
+  c = _mm256_broadcast_sd(P + 2 + r);
+  return {_mm256_fmadd_pd(c, ua.c1, a), _mm256_fmadd_pd(c, ub.c1, b)};
+}
+
+inline void load_pair(const double* x, long ldx, Slot& s1, Slot& s2) {
+  __m256d r0 = _mm256_loadu_pd(x), r1 = _mm256_loadu_pd(x + ldx);
+  __m256d r2 = _mm256_loadu_pd(x + 2 * ldx), r3 = _mm256_loadu_pd(x + 3 * ldx);
+  transpose4(r0, r1, r2, r3);
+  s1 = {r0, r1};
+  s2 = {r2, r3};
+}
+inline void store_pair(double* y, long ldy, const Slot& o1, const Slot& o2) {
+  __m256d y0 = o1.c0, y1 = o1.c1, y2 = o2.c0, y3 = o2.c1;
+  transpose4(y0, y1, y2, y3);
+  _mm256_storeu_pd(y, y0);
+  _mm256_storeu_pd(y + ldy, y1);
+  _mm256_storeu_pd(y + 2 * ldy, y2);
+  _mm256_storeu_pd(y + 3 * ldy, y3);
+}
+
+// theta = 0 only (experiment)
+void stream_block8(const StepMap<2>* maps, long K, long M, long j0, const double* X, long ldx, double* Y, long ldy) {
+  const double* XB = X + 4 * ldx;
+  double* YB = Y + 4 * ldy;
+  Slot ua{gather4(X, ldx, 2 * M), gather4(X, ldx, 2 * M + 1)}, ub{gather4(XB, ldx, 2 * M), gather4(XB, ldx, 2 * M + 1)};
+  Slot wa{gather4(X, ldx, 2 * j0), gather4(X, ldx, 2 * j0 + 1)}, wb{gather4(XB, ldx, 2 * j0), gather4(XB, ldx, 2 * j0 + 1)};
+  long l = 0;
+  for (; l + 1 < K; l += 2) {
+    const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);
+    Slot w1a, w2a, w1b, w2b, o1a, o1b, o2a, o2b;
+    load_pair(X + in, ldx, w1a, w2a);
+    load_pair(XB + in, ldx, w1b, w2b);
+    {
+      const double *P = maps[l].P.data(), *Q = maps[l].Q.data(), *R = maps[l].R.data();
+      const Row2 r0 = row2x2(P, Q, R, 0, wa, w1a, ua, wb, w1b, ub), r1 = row2x2(P, Q, R, 1, wa, w1a, ua, wb, w1b, ub);
+      o1a = {r0.a, r1.a}, o1b = {r0.b, r1.b};
+    }
+    {
+      const double *P = maps[l + 1].P.data(), *Q = maps[l + 1].Q.data(), *R = maps[l + 1].R.data();
+      const Row2 r0 = row2x2(P, Q, R, 0, w1a, w2a, o1a, w1b, w2b, o1b), r1 = row2x2(P, Q, R, 1, w1a, w2a, o1a, w1b, w2b, o1b);
+      o2a = {r0.a, r1.a}, o2b = {r0.b, r1.b};
+    }
+    wa = w2a, wb = w2b, ua = o2a, ub = o2b;
+    store_pair(Y + out, ldy, o1a, o2a);
+    store_pair(YB + out, ldy, o1b, o2b);
+  }
+  if (l < K) {
+    const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);
+    const auto last_step = [&](const double* x, Slot w, Slot u, double* y) {
+      const Slot o = step2(maps[l], w, Slot{gather4(x, ldx, in), gather4(x, ldx, in + 1)}, u);
+      scatter4(o.c0, y, ldy, out);
+      scatter4(o.c1, y, ldy, out + 1);
+    };
+    last_step(X, wa, ua, Y);
+    last_step(XB, wb, ub, YB);
+  }
+}
+
 // The K steps on 4 vectors (columns X .. X + 3 ldx). Blocks of 4 run one after the other: two
 // side by side (8 vectors, their chains u -> out interleaved) measured slower, not faster.
 template <bool Interpolate>
@@ -171,7 +245,10 @@ void stream_block(const StepMap<2>* maps, long K, long M, long j0, double theta,
 
 void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
                        long k, double* Y, long ldy) {
-  for (long v = 0; v < k; v += 4)
+  long v0 = 0;
+  if (theta == 0)
+    for (; v0 + 8 <= k; v0 += 8) stream_block8(maps, K, M, j0, X + v0 * ldx, ldx, Y + v0 * ldy, ldy);
+  for (long v = v0; v < k; v += 4)
     if (theta == 0)
       stream_block<false>(maps, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
     else
