@@ -138,6 +138,50 @@ void BM_PeakFma(benchmark::State& state) {
 }
 BENCHMARK(BM_PeakFma)->Arg(0)->Arg(1);
 
+// The FP pipes' own peak: 12 independent accumulators a = a y + z held in registers, no memory
+// access, 2 flops per element: with the default flags a multiply and an add on 16-byte vectors
+// (isa 0), with AVX2 + FMA one 32-byte FMA (isa 1). BM_PeakFma above runs the kernel-shaped loop
+// (4 loads and a store per 4 arithmetic instructions, a multiply counted as 1 of 7 flops): a
+// ceiling of that loop, below this one. docs/benchmarks.md says which one bounds what.
+typedef double V2 __attribute__((vector_size(16)));
+typedef double V4 __attribute__((vector_size(32)));
+#define DELAYSPEC_PEAK_PIPES_BODY(V)                                                        \
+  V a0 = s + 0.1, a1 = s + 0.2, a2 = s + 0.3, a3 = s + 0.4, a4 = s + 0.5, a5 = s + 0.6;    \
+  V a6 = s + 0.7, a7 = s + 0.8, a8 = s + 0.9, a9 = s + 1.0, a10 = s + 1.1, a11 = s + 1.2; \
+  for (long i = 0; i < reps; ++i) {                                                       \
+    a0 = a0 * y + z, a1 = a1 * y + z, a2 = a2 * y + z, a3 = a3 * y + z;                   \
+    a4 = a4 * y + z, a5 = a5 * y + z, a6 = a6 * y + z, a7 = a7 * y + z;                   \
+    a8 = a8 * y + z, a9 = a9 * y + z, a10 = a10 * y + z, a11 = a11 * y + z;               \
+  }                                                                                       \
+  const V t = ((a0 + a1) + (a2 + a3)) + ((a4 + a5) + (a6 + a7)) + ((a8 + a9) + (a10 + a11)); \
+  return t[0];
+double peak_pipes_default(long reps, double s0) {
+  const V2 s = {s0, s0}, y = s * 0.999, z = s * 1e-3;
+  DELAYSPEC_PEAK_PIPES_BODY(V2)
+}
+__attribute__((target("avx2,fma"))) double peak_pipes_avx2(long reps, double s0) {
+  const V4 s = {s0, s0, s0, s0}, y = s * 0.999, z = s * 1e-3;
+  DELAYSPEC_PEAK_PIPES_BODY(V4)  // a y + z contracts to one FMA (-ffp-contract=fast, GCC's default)
+}
+
+void BM_PeakFmaPipes(benchmark::State& state) {
+  const bool avx2 = state.range(0) == 1;
+  if (avx2 && !(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) {
+    state.SkipWithError("this CPU has no AVX2 + FMA");
+    return;
+  }
+  constexpr long reps = 100000;
+  double s0 = 1.0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(s0);
+    const double r = avx2 ? peak_pipes_avx2(reps, s0) : peak_pipes_default(reps, s0);
+    benchmark::DoNotOptimize(r);
+  }
+  const double elements = static_cast<double>(state.iterations()) * reps * 12 * (avx2 ? 4 : 2);
+  state.counters["GFlops"] = benchmark::Counter(elements * 2 * 1e-9, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_PeakFmaPipes)->Arg(0)->Arg(1);
+
 }  // namespace
 
 BENCHMARK_MAIN();
