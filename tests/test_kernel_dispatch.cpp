@@ -73,8 +73,8 @@ Eigen::VectorXd reference_apply(const HistoryGrid& grid, const std::vector<StepM
 
 // The tolerance. Every path sums the same 3 D terms per component per step in its own order,
 // with or without FMA (one rounding instead of two): each step perturbs its output by a few
-// eps relative to the terms, and K <= ~100 steps of maps of norm 1 + O(h) accumulate at most
-// c K eps ~ 100 * 2.2e-16 * a few = ~1e-14 of the result's norm. 1e-13 leaves a factor 10; a wrong
+// eps relative to the terms, and K <= ~300 steps of maps of norm 1 + O(h) accumulate at most
+// c K eps ~ 300 * 2.2e-16 * a few = ~3e-14 of the result's norm. 1e-13 leaves a factor 10; a wrong
 // coefficient, slot or interpolation weight is an O(h) = O(1e-2) error.
 constexpr double kTol = 1e-13;
 
@@ -175,6 +175,29 @@ HistoryGrid fractional_long_delay_grid() {
   EXPECT_EQ(g.delayed_slot(0), 1);  // theta != 0 reads slot j0 - 1 = 0, x's first
   return g;
 }
+// Longer maps: the fused AVX2 kernel runs the steps in runs of 128 (all vectors per run; each run
+// restarts from X and the result slots already in Y), so K = 300 is two full runs and a short one,
+// K = 259 ends on an odd run.
+HistoryGrid aligned_many_runs_grid() {
+  HistoryGrid g = make_grid(1.0, 1.0, 300);  // tau = T: K = M = 300
+  EXPECT_TRUE(g.aligned());
+  EXPECT_GT(g.K, 2 * 128);
+  return g;
+}
+HistoryGrid aligned_many_runs_odd_grid() {
+  HistoryGrid g = make_grid(2.0, 1.0, 518);  // tau = 2 T: K = 259, M = 518
+  EXPECT_TRUE(g.aligned());
+  EXPECT_EQ(g.K % 2, 1);
+  EXPECT_GT(g.K, 2 * 128);
+  return g;
+}
+HistoryGrid fractional_many_runs_grid() {
+  HistoryGrid g = make_grid(1.37, 1.0, 200);  // K > 128, theta in (0, 1)
+  EXPECT_FALSE(g.aligned());
+  EXPECT_GT(g.K, 128);
+  EXPECT_LE(g.K, g.m);
+  return g;
+}
 // Linear layout (K > m: the steps read slots they computed).
 HistoryGrid fractional_grid() {
   HistoryGrid g = make_grid(1.0, 1.37, 29);  // tau / T not a ratio of small integers: theta in (0, 1)
@@ -217,6 +240,11 @@ TEST(KernelDispatch, InPlaceApplyBlockMatchesOutOfPlace) {
   op.apply_block(X, X);
   EXPECT_EQ(op.last_block_layout(), Monodromy<2>::BlockLayout::linear);
   EXPECT_LE((X - Y).norm(), kTol * Y.norm());
+}
+TEST(KernelDispatch, LongMapsStreamInRuns) {
+  check_all_paths<2>(aligned_many_runs_grid());
+  check_all_paths<2>(aligned_many_runs_odd_grid());
+  check_all_paths<2>(fractional_many_runs_grid());
 }
 TEST(KernelDispatch, DelayShorterThanTheMapAligned) {
   check_all_paths<1>(aligned_short_delay_grid());
