@@ -14,8 +14,11 @@
 // Kernels: perform_op and apply_block run the K steps through block_kernel.hpp; blocks of k > 1
 // on the path chosen at construction (kernel_dispatch.hpp: AVX2 + FMA for D = 1, 2 where the CPU
 // has it, else the portable build; DELAYSPEC_KERNEL=baseline forces the latter). A copy keeps it.
-// apply_block with K <= m streams through two small interleaved buffers instead of the whole
-// linear history (apply_block_streaming says why that is exact).
+// apply_block with K <= m streams instead of storing the whole linear history
+// (apply_block_streaming says why that is exact): for d = 2 and k even straight from X into Y,
+// the transposes fused into the steps (kernel_dispatch.hpp: stream_steps_avx2 for k a multiple
+// of 4 on the AVX2 path, else stream_steps_portable), otherwise through two small interleaved
+// buffers. last_block_layout() tells which ran.
 //
 // Thread safety: the work buffers are owned by the operator (no allocation per application),
 // so one Monodromy must not be applied from two threads at once. Copy it instead.
@@ -204,6 +207,9 @@ void Monodromy<D>::apply_block_linear(const double* X, long ldx, long k, double*
 
 template <int D>
 void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, double* Y, long ldy) const {
+  // d = 2, k even: the fused kernels read X and write Y themselves (no buffer, no copies;
+  // AVX2 4 vectors at a time, portable 2; bench_apply: 2-3x faster per vector than the staged
+  // loop below, docs/benchmarks.md). Otherwise:
   // Chunks of C steps: interleave the x slots the chunk reads into `in`, step into `out` (slot 0
   // = u0, the previous chunk's last slot), de-interleave out's new slots straight into Y. Both
   // buffers stay in L1 (~16 KiB each), so X is read once and Y written once, against the linear
