@@ -73,9 +73,10 @@ Eigen::VectorXd reference_apply(const HistoryGrid& grid, const std::vector<StepM
 
 // The tolerance. Every path sums the same 3 D terms per component per step in its own order,
 // with or without FMA (one rounding instead of two): each step perturbs its output by a few
-// eps relative to the terms, and K <= ~300 steps of maps of norm 1 + O(h) accumulate at most
-// c K eps ~ 300 * 2.2e-16 * a few = ~3e-14 of the result's norm. 1e-13 leaves a factor 10; a wrong
-// coefficient, slot or interpolation weight is an O(h) = O(1e-2) error.
+// eps relative to the terms, and K steps of maps of norm 1 + O(h) accumulate at most c K eps:
+// ~1e-14 of the result's norm for K <= ~100, ~5e-14 for the K = 600 grids (at worst; as a random
+// walk ~sqrt(K) eps). 1e-13 leaves a factor 2-10; a wrong coefficient, slot or interpolation
+// weight is an O(h) error, >= 1e-3 here.
 constexpr double kTol = 1e-13;
 
 // The layout apply_block must take for k vectors (X and Y distinct): the rule of
@@ -175,26 +176,26 @@ HistoryGrid fractional_long_delay_grid() {
   EXPECT_EQ(g.delayed_slot(0), 1);  // theta != 0 reads slot j0 - 1 = 0, x's first
   return g;
 }
-// Longer maps: the fused AVX2 kernel runs the steps in runs of 128 (all vectors per run; each run
-// restarts from X and the result slots already in Y), so K = 300 is two full runs and a short one,
-// K = 259 ends on an odd run.
+// Longer maps: the fused AVX2 kernel runs the steps in runs of 512 (all vectors per run; each run
+// restarts from X and the result slots already in Y), so K = 600 is a full run and a short one,
+// K = 601 ends on an odd run.
 HistoryGrid aligned_many_runs_grid() {
-  HistoryGrid g = make_grid(1.0, 1.0, 300);  // tau = T: K = M = 300
+  HistoryGrid g = make_grid(1.0, 1.0, 600);  // tau = T: K = M = 600
   EXPECT_TRUE(g.aligned());
-  EXPECT_GT(g.K, 2 * 128);
+  EXPECT_GT(g.K, 512);
   return g;
 }
 HistoryGrid aligned_many_runs_odd_grid() {
-  HistoryGrid g = make_grid(2.0, 1.0, 518);  // tau = 2 T: K = 259, M = 518
+  HistoryGrid g = make_grid(1.0, 1.0, 601);  // K = 601
   EXPECT_TRUE(g.aligned());
   EXPECT_EQ(g.K % 2, 1);
-  EXPECT_GT(g.K, 2 * 128);
+  EXPECT_GT(g.K, 512);
   return g;
 }
 HistoryGrid fractional_many_runs_grid() {
-  HistoryGrid g = make_grid(1.37, 1.0, 200);  // K > 128, theta in (0, 1)
+  HistoryGrid g = make_grid(1.37, 1.0, 760);  // K > 512, theta in (0, 1)
   EXPECT_FALSE(g.aligned());
-  EXPECT_GT(g.K, 128);
+  EXPECT_GT(g.K, 512);
   EXPECT_LE(g.K, g.m);
   return g;
 }
