@@ -18,6 +18,10 @@
 //   bytes = 8 (4 n k + 2 d k K + 3 d^2 K).  flops = 6 d^2 k K (3 d^2 FMAs per step per vector).
 // Roofline time = max(flops / peak_flops, bytes / bandwidth), bandwidth from BM_Triad at the
 // working-set size (buffer (N + 1 + K) d k doubles + step maps).
+// The fused streaming kernels (d = 2, k even: no buffer, no copies) move only X once, Y once and
+// the maps: bytes = 8 (2 n k + 3 d^2 K); against them the model above is not a bound, and the
+// flop ceiling is BM_PeakFmaPipes (docs/benchmarks.md, sixth sitting for apply_block). The
+// model_GBps counter keeps the model above.
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>

@@ -208,8 +208,8 @@ void Monodromy<D>::apply_block_linear(const double* X, long ldx, long k, double*
 template <int D>
 void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, double* Y, long ldy) const {
   // d = 2, k even: the fused kernels read X and write Y themselves (no buffer, no copies;
-  // AVX2 4 vectors at a time, portable 2; bench_apply: 2-3x faster per vector than the staged
-  // loop below, docs/benchmarks.md). Otherwise:
+  // AVX2 4 vectors at a time, portable 2; bench_apply, docs/benchmarks.md: per vector 1.6-2.7x
+  // faster than the staged loop below on AVX2 for k = 8..32, 1.05-1.8x portable). Otherwise:
   // Chunks of C steps: interleave the x slots the chunk reads into `in`, step into `out` (slot 0
   // = u0, the previous chunk's last slot), de-interleave out's new slots straight into Y. Both
   // buffers stay in L1 (~16 KiB each), so X is read once and Y written once, against the linear
