@@ -63,22 +63,17 @@ struct Coefficients {
   }
 };
 
-// out = Q w0 + R w1 + P u, the terms in step_block's order (Q, R interleaved, P u last).
+// Row r of out = Q w0 + R w1 + P u, the terms in step_block's order (Q, R interleaved, P u last).
+inline V2 step_row(const Coefficients& m, int r, const Slot2& w0, const Slot2& w1, const Slot2& u) {
+  V2 a = m.Q[r] * w0.c0;
+  a += m.R[r] * w1.c0;
+  a += m.Q[2 + r] * w0.c1;
+  a += m.R[2 + r] * w1.c1;
+  a += m.P[r] * u.c0;
+  return a + m.P[2 + r] * u.c1;
+}
 inline Slot2 step(const Coefficients& m, const Slot2& w0, const Slot2& w1, const Slot2& u) {
-  Slot2 out;
-  V2 a = m.Q[0] * w0.c0;
-  a += m.R[0] * w1.c0;
-  a += m.Q[2] * w0.c1;
-  a += m.R[2] * w1.c1;
-  a += m.P[0] * u.c0;
-  out.c0 = a + m.P[2] * u.c1;
-  V2 b = m.Q[1] * w0.c0;
-  b += m.R[1] * w1.c0;
-  b += m.Q[3] * w0.c1;
-  b += m.R[3] * w1.c1;
-  b += m.P[1] * u.c0;
-  out.c1 = b + m.P[3] * u.c1;
-  return out;
+  return {step_row(m, 0, w0, w1, u), step_row(m, 1, w0, w1, u)};
 }
 
 // The state of 2 vectors (columns X, X + ldx; results into Y, Y + ldy) between steps:
