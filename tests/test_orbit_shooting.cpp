@@ -102,6 +102,29 @@ TEST(Gmres, ZeroRightHandSideAndSingularSystem) {
   EXPECT_NEAR(singular.relative_residual, 1 / std::sqrt(2.0), 1e-12);
 }
 
+// The Arnoldi basis stays orthonormal where one Gram-Schmidt pass is not enough: A = I + 1e-6 R
+// makes w = A v_j nearly a multiple of v_j, so the first pass removes all but ~1e-6 of w and its
+// rounding (eps |w|) is ~1e-10 of what is left: without the DGKS second pass |V^T V - I| would be
+// ~1e-10. Two passes leave O(n eps) ~ 1e-14 at n = 60; bound 1e-13. The basis is the workspace
+// the caller passes (its first iterations + 1 columns: one cycle here), and a second call reusing
+// it gives the same x bit for bit.
+TEST(Gmres, BasisStaysOrthonormalWhenTheFirstPassCancels) {
+  const int n = 60;
+  std::srand(11);
+  const Eigen::MatrixXd A = Eigen::MatrixXd::Identity(n, n) + 1e-6 * Eigen::MatrixXd::Random(n, n);
+  const Eigen::VectorXd b = Eigen::VectorXd::Random(n);
+  auto apply = [&](const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::VectorXd& y) { y = A * x; };
+  Eigen::MatrixXd basis;
+  const GmresResult r = gmres(apply, b, {1e-13, 20, 100}, &basis);
+  ASSERT_GE(r.iterations, 2);
+  ASSERT_LT(r.iterations, 20) << "one cycle";
+  const Eigen::MatrixXd V = basis.leftCols(r.iterations + 1);
+  EXPECT_LT((V.transpose() * V - Eigen::MatrixXd::Identity(V.cols(), V.cols())).cwiseAbs().maxCoeff(), 1e-13);
+  EXPECT_LE(r.relative_residual, 1e-13);
+  const GmresResult again = gmres(apply, b, {1e-13, 20, 100}, &basis);
+  EXPECT_EQ(again.x, r.x);
+}
+
 // The levels: N, N/8, ... while >= coarse_N, each a valid N for the grid.
 TEST(ShootingLevels, GeometricAndValidForTheGrid) {
   const ImpactModel model(paper(1.0));
@@ -137,7 +160,7 @@ TEST(OrbitShooting, StableAlignedOrbitEqualsSparseNewtonAndSimulation) {
   const PeriodicOrbit shot = orbit_by_nested_shooting(s.map, s.model.initial_state(), o, &at_orbit);
   ASSERT_EQ(shot.levels.size(), 2u);
   EXPECT_EQ(shot.levels[0].N, 100);
-  EXPECT_EQ(shot.levels[0].method, "newton");
+  EXPECT_EQ(shot.levels[0].method, "shooting");  // automatic: shooting, which converges here
   EXPECT_EQ(shot.method, "shooting");
   EXPECT_LE(shot.newton_iterations, 4);
   EXPECT_GT(shot.linear_iterations, 0);
@@ -237,7 +260,7 @@ TEST(OrbitShootingCli, DefaultAutoMatchesSimulationAndReportsLevels) {
   EXPECT_EQ(a["orbit"]["method"], "shooting");
   ASSERT_EQ(a["orbit"]["levels"].size(), 2u);
   EXPECT_EQ(a["orbit"]["levels"][0]["N"], 75);
-  EXPECT_EQ(a["orbit"]["levels"][0]["method"], "newton");
+  EXPECT_EQ(a["orbit"]["levels"][0]["method"], "shooting");
   EXPECT_EQ(a["orbit"]["levels"][1]["N"], 600);
   EXPECT_TRUE(a.contains("orbit_seconds"));
   CliResult simulated =
