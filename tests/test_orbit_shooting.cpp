@@ -225,6 +225,34 @@ TEST(OrbitShooting, UnstableOrbitSimulationCannotReach) {
       NumericalFailure);
 }
 
+// auto's coarsest level: where shooting fails (here: one Newton step allowed, the simulated guess
+// needs three at k = 1), sparse-LU Newton from the same guess finds the orbit, and it is the one
+// sparse_newton finds (1e-10 relative, as above); where both fail the error names both.
+TEST(OrbitShooting, AutomaticCoarseLevelFallsBackToSparseNewton) {
+  ImpactSetup s(paper(1.0), 200);  // N < 8 coarse_N: the coarsest level is the only one
+  NestedShootingOptions o;
+  o.shooting.max_iterations = 1;
+  const PeriodicOrbit orbit = orbit_by_nested_shooting(s.map, s.model.initial_state(), o);
+  ASSERT_EQ(orbit.levels.size(), 1u);
+  EXPECT_EQ(orbit.levels[0].method, "newton");
+  EXPECT_GE(orbit.newton_iterations, 2);
+  EXPECT_LT(relative_distance(orbit.history, sparse_newton(s, 100).history), 1e-10);
+
+  o.newton.max_iterations = 1;
+  try {
+    orbit_by_nested_shooting(s.map, s.model.initial_state(), o);
+    FAIL() << "expected NumericalFailure";
+  } catch (const NumericalFailure& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("shooting from the same guess failed first: orbit by shooting (N = 200): not converged"),
+              std::string::npos)
+        << what;
+  }
+  o.newton.max_iterations = 30;  // enough for the fallback, which orbit = shooting does not take
+  o.coarse_method = CoarseOrbitMethod::shooting;
+  EXPECT_THROW(orbit_by_nested_shooting(s.map, s.model.initial_state(), o), NumericalFailure);
+}
+
 // Failures: too few Newton steps names the level's N and |P(U) - U|; bad options are bad input.
 TEST(OrbitShooting, FailurePathsAreReported) {
   ImpactSetup s(paper(0.2), 512);
