@@ -149,14 +149,14 @@ BENCHMARK(BM_PeakFma)->Arg(0)->Arg(1);
 // ceiling of that loop, below this one. docs/benchmarks.md says which one bounds what.
 typedef double V2 __attribute__((vector_size(16)));
 typedef double V4 __attribute__((vector_size(32)));
-#define DELAYSPEC_PEAK_PIPES_BODY(V)                                                        \
-  V a0 = s + 0.1, a1 = s + 0.2, a2 = s + 0.3, a3 = s + 0.4, a4 = s + 0.5, a5 = s + 0.6;    \
-  V a6 = s + 0.7, a7 = s + 0.8, a8 = s + 0.9, a9 = s + 1.0, a10 = s + 1.1, a11 = s + 1.2; \
-  for (long i = 0; i < reps; ++i) {                                                       \
-    a0 = a0 * y + z, a1 = a1 * y + z, a2 = a2 * y + z, a3 = a3 * y + z;                   \
-    a4 = a4 * y + z, a5 = a5 * y + z, a6 = a6 * y + z, a7 = a7 * y + z;                   \
-    a8 = a8 * y + z, a9 = a9 * y + z, a10 = a10 * y + z, a11 = a11 * y + z;               \
-  }                                                                                       \
+#define DELAYSPEC_PEAK_PIPES_BODY(V)                                                         \
+  V a0 = s + 0.1, a1 = s + 0.2, a2 = s + 0.3, a3 = s + 0.4, a4 = s + 0.5, a5 = s + 0.6;      \
+  V a6 = s + 0.7, a7 = s + 0.8, a8 = s + 0.9, a9 = s + 1.0, a10 = s + 1.1, a11 = s + 1.2;    \
+  for (long i = 0; i < reps; ++i) {                                                          \
+    a0 = a0 * y + z, a1 = a1 * y + z, a2 = a2 * y + z, a3 = a3 * y + z;                      \
+    a4 = a4 * y + z, a5 = a5 * y + z, a6 = a6 * y + z, a7 = a7 * y + z;                      \
+    a8 = a8 * y + z, a9 = a9 * y + z, a10 = a10 * y + z, a11 = a11 * y + z;                  \
+  }                                                                                          \
   const V t = ((a0 + a1) + (a2 + a3)) + ((a4 + a5) + (a6 + a7)) + ((a8 + a9) + (a10 + a11)); \
   return t[0];
 double peak_pipes_default(long reps, double s0) {

@@ -92,8 +92,8 @@ inline Slot lerp(const Slot& b, const Slot& b_prev, __m256d c0, __m256d theta) {
 struct RowPair {
   __m256d a, b;
 };
-inline RowPair step_row(const StepMap<2>& s, int r, const Slot& w0a, const Slot& w1a, const Slot& ua,
-                        const Slot& w0b, const Slot& w1b, const Slot& ub) {
+inline RowPair step_row(const StepMap<2>& s, int r, const Slot& w0a, const Slot& w1a, const Slot& ua, const Slot& w0b,
+                        const Slot& w1b, const Slot& ub) {
   const double *P = s.P.data(), *Q = s.Q.data(), *R = s.R.data();
   __m256d c = _mm256_broadcast_sd(Q + r);
   __m256d a = _mm256_mul_pd(c, w0a.c0), b = _mm256_mul_pd(c, w0b.c0);
@@ -129,7 +129,8 @@ struct Block4 {
   Block4(const double* x, long ldx, double* y, long ldy, long M, long K, long j0, long l, __m256d c0, __m256d th)
       : X(x), Y(y) {
     const long iu = 2 * (M + l - K), j = j0 + l;
-    u = l == 0 ? Slot{gather4(X, ldx, 2 * M), gather4(X, ldx, 2 * M + 1)} : Slot{gather4(Y, ldy, iu), gather4(Y, ldy, iu + 1)};
+    u = l == 0 ? Slot{gather4(X, ldx, 2 * M), gather4(X, ldx, 2 * M + 1)}
+               : Slot{gather4(Y, ldy, iu), gather4(Y, ldy, iu + 1)};
     last = {gather4(X, ldx, 2 * j), gather4(X, ldx, 2 * j + 1)};
     w = last;
     if constexpr (Interpolate) w = lerp(last, Slot{gather4(X, ldx, 2 * j - 2), gather4(X, ldx, 2 * j - 1)}, c0, th);
@@ -222,12 +223,10 @@ void stream_all(const StepMap<2>* maps, long K, long M, long j0, double theta, c
 
 }  // namespace
 
-void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
-                       long k, double* Y, long ldy) {
-  if (theta == 0)
-    stream_all<false>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
-  else
-    stream_all<true>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
+void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx, long k,
+                       double* Y, long ldy) {
+  if (theta == 0) stream_all<false>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
+  else stream_all<true>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
 }
 
 // dst[c ldd + r] = src[r lds + c] for r < rows, c < cols: 4 x 4 tiles transposed in registers

@@ -108,8 +108,8 @@ struct Block2 {
 
 // The K steps on 2 Pairs pairs of vectors (columns X, X + ldx, ...) side by side.
 template <bool Interpolate, int Pairs>
-void stream_pairs(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
-                  double* Y, long ldy) {
+void stream_pairs(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx, double* Y,
+                  long ldy) {
   const V2 c0 = splat(1 - theta), th = splat(theta);
   Block2<Interpolate> a(X, ldx, Y, M, j0, c0, th);
   Block2<Interpolate> b(X + (Pairs > 1 ? 2 * ldx : 0), ldx, Y + (Pairs > 1 ? 2 * ldy : 0), M, j0, c0, th);
@@ -133,10 +133,8 @@ void stream_all(const StepMap<2>* maps, long K, long M, long j0, double theta, c
 
 void stream_steps_portable(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
                            long k, double* Y, long ldy) {
-  if (theta == 0)
-    stream_all<false>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
-  else
-    stream_all<true>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
+  if (theta == 0) stream_all<false>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
+  else stream_all<true>(maps, K, M, j0, theta, X, ldx, k, Y, ldy);
 }
 
 }  // namespace delayspec::detail

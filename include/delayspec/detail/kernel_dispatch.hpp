@@ -40,8 +40,8 @@ void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* d
 // Requires what streaming requires (Monodromy::apply_block_raw): j0 = delayed_slot(0),
 // j0 - 1 >= 0 when theta != 0, j0 + K <= M, X and Y disjoint. The AVX2 + FMA one (k a multiple
 // of 4, src/block_kernel_avx2.cpp) and the portable one (k even, src/stream_kernel.cpp).
-void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
-                       long k, double* Y, long ldy);
+void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx, long k,
+                       double* Y, long ldy);
 void stream_steps_portable(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
                            long k, double* Y, long ldy);
 // dst[c ldd + r] = src[r lds + c] (r < rows, c < cols): interleave(X, ldx, n, k, b) is
