@@ -1,16 +1,17 @@
 #pragma once
-// The QR kernel of the Lyapunov propagation (lyapunov.hpp; implemented in lyapunov.cpp):
+// The QR kernel of the Lyapunov propagation (lyapunov.hpp; implemented in tangent_qr.cpp):
 // internal, trusted by lyapunov_exponents, tested on its own (test_lyapunov.cpp, TangentQR).
 #include <vector>
 
 namespace delayspec {
 
 // The QR step on an n x k block stored row-major (the interleaved layout: row i = entry i of
-// the k vectors), factorised in place by Householder reflections (the LAPACK/Eigen algorithm,
-// written for this layout: Eigen's HouseholderQR on a row-major Ref measured 4x slower;
-// tests compare the two). Binds to the block's memory once; no allocation after construction.
-// A block whose largest entry is beyond 2^+-300 is first scaled by an exact power of two, so
-// squares neither overflow nor underflow.
+// the k vectors), factorised in place by Householder reflections (the LAPACK algorithm,
+// re-associated so that each reflector costs one pass over the rows and Q is formed in one more
+// pass from the compact WY form; the mathematics and the stability argument are in
+// src/tangent_qr.cpp; tests compare with Eigen's HouseholderQR). Binds to the block's memory
+// once; no allocation after construction. A block with a column norm beyond 2^+-300 is first
+// scaled by an exact power of two, so squares neither overflow nor underflow.
 class TangentQR {
  public:
   TangentQR(double* block, long n, int k);
@@ -25,7 +26,8 @@ class TangentQR {
   double* block_;
   long n_;
   int k_;
-  std::vector<double> tau_, r_, norm_;
+  std::vector<double> scalars_;   // per-reflector scalars and per-column sums (7 k)
+  std::vector<double> matrices_;  // the k x k matrices of the Q formation (3 k^2)
 };
 
 }  // namespace delayspec
