@@ -167,7 +167,7 @@ void make_reflector(double* a, int k, int j, Reflectors& f) {
   head[j] = f.r[j];
   for (int c = j + 1; c < k; ++c) {
     const double w = f.tau[j] * (f.gram[c] - beta * head[c]) * f.s[j];  // tau_j v_j^T x_c
-    head[c] -= w;                                                     // R_jc
+    head[c] -= w;                                                       // R_jc
     f.coeff[c] = w * f.s[j];
   }
 }
@@ -228,7 +228,8 @@ void factor_sweeps(double* a, long n, int k_runtime, Reflectors& f) {
   if constexpr (KC > 0) {
     [&]<int... J>(std::integer_sequence<int, J...>) {
       ((sweep<KC, J + 1>(a, n, k, J + 1, f), make_reflector(a, k, J + 1, f)), ...);
-    }(std::make_integer_sequence<int, KC - 1>{});
+    }
+    (std::make_integer_sequence<int, KC - 1>{});
   } else {
     for (int j = 1; j < k; ++j) {
       sweep<0, -1>(a, n, k, j, f);
@@ -310,10 +311,10 @@ void TangentQR::factorise(double* q_out, double* log_r) {
                                ") = " + format_number(r) + " (the tangent block is not finite)");
       const double norm = std::sqrt(f.sq[i]);
       if (!(std::abs(r) > dependence_threshold(n) * norm))
-        throw NumericalFailure("Lyapunov QR: tangent vector " + std::to_string(i + 1) +
-                               " became linearly dependent on the previous ones (|R_ii| = " + format_number(std::abs(r)) +
-                               ", below n eps times its norm " + format_number(norm) +
-                               "); fewer exponents, or a smaller qr_every");
+        throw NumericalFailure(
+            "Lyapunov QR: tangent vector " + std::to_string(i + 1) +
+            " became linearly dependent on the previous ones (|R_ii| = " + format_number(std::abs(r)) +
+            ", below n eps times its norm " + format_number(norm) + "); fewer exponents, or a smaller qr_every");
       log_r[i] = std::log(std::abs(r)) + log_scale;
     }
     make_q_coefficients(a, k, f, q_out);
