@@ -75,6 +75,7 @@ struct Reflectors {
   double* vdot;   // D_ij, k x k row-major (i < j)
   double* t;      // T, k x k row-major
   double* w;      // W, k x k row-major
+  double* q_top;  // rows 0..k-1 of Q, k x k row-major
 };
 
 template <int KC>
@@ -174,8 +175,9 @@ void make_reflector(double* a, int k, int j, Reflectors& f) {
 
 // W = -diag(s) T V_top^T diag(sign R_cc) and rows 0..k-1 of Q (header comment), through T
 // (dlarft, forward columnwise). O(k^3) on k x k matrices; V_top(r, m) = s_m x_m(r) below its unit
-// diagonal. Rows r < k of Q: sign_c (delta_rc - S(r, c)) + sum_{i < r} x_i(r) W_ic.
-void make_q_coefficients(const double* a, int k, Reflectors& f, double* q) {
+// diagonal. Rows r < k of Q, sign_c (delta_rc - S(r, c)) + sum_{i < r} x_i(r) W_ic, go to q_top
+// (Q may overwrite the block, TangentQR::factorise, whose rows 0..k-1 are still read here).
+void make_q_coefficients(const double* a, int k, Reflectors& f) {
   double* t = f.t;
   for (int j = 0; j < k; ++j) {
     for (int i = 0; i < j; ++i) {  // z_i = v_i^T v_j, kept in T(i, j) until multiplied by T(0:j, 0:j)
@@ -197,11 +199,12 @@ void make_q_coefficients(const double* a, int k, Reflectors& f, double* q) {
       f.w[r * k + c] = -f.s[r] * s_rc * sign;
       double q_rc = sign * ((r == c ? 1 : 0) - s_rc);
       for (int i = 0; i < r; ++i) q_rc += a[r * k + i] * f.w[i * k + c];  // row i of W is complete (i < r)
-      q[r * k + c] = q_rc;
+      f.q_top[r * k + c] = q_rc;
     }
 }
 
-// Sweep k, rows r >= k: Q(r, c) = sum_i x_i(r) W_ic.
+// Sweep k, rows r >= k: Q(r, c) = sum_i x_i(r) W_ic, each row read before it is stored (q may
+// be a or lie below it); then rows 0..k-1 from q_top.
 template <int KC>
 void form_q(const double* a, long n, int k_runtime, const Reflectors& f, double* q) {
   const int k = KC > 0 ? KC : k_runtime;
@@ -219,6 +222,7 @@ void form_q(const double* a, long n, int k_runtime, const Reflectors& f, double*
       for (int c = 0; c < k; ++c) row[c] += x[i] * w[i * k + c];
     for (int c = 0; c < k; ++c) q[r * k + c] = row[c];
   }
+  for (int e = 0; e < k * k; ++e) q[e] = f.q_top[e];
 }
 
 template <int KC>
@@ -264,7 +268,7 @@ void with_kernel(int k, Call&& call) {
 }  // namespace
 
 TangentQR::TangentQR(double* block, long n, int k)
-    : block_(block), n_(n), k_(k), scalars_(7 * static_cast<size_t>(k)), matrices_(3 * static_cast<size_t>(k) * k) {
+    : block_(block), n_(n), k_(k), scalars_(6 * static_cast<size_t>(k)), matrices_(4 * static_cast<size_t>(k) * k) {
   if (k > kMaxTangentVectors)
     throw BadInput("`exponents = " + std::to_string(k) + "`: at most " + std::to_string(kMaxTangentVectors) +
                    " tangent vectors");
@@ -276,7 +280,8 @@ void TangentQR::factorise(double* q_out, double* log_r) {
   double* const a = block_;
   double* const sc = scalars_.data();
   double* const mx = matrices_.data();
-  Reflectors f{sc, sc + k, sc + 2 * k, sc + 3 * k, sc + 4 * k, sc + 5 * k, mx, mx + k * k, mx + 2 * k * k};
+  Reflectors f{sc,         sc + k, sc + 2 * k, sc + 3 * k,     sc + 4 * k,
+               sc + 5 * k, mx,     mx + k * k, mx + 2 * k * k, mx + 3 * k * k};
   with_kernel(k, [&](auto kernel) {
     using K = decltype(kernel);
     K::first(a, n, k, f);
@@ -317,7 +322,7 @@ void TangentQR::factorise(double* q_out, double* log_r) {
             ", below n eps times its norm " + format_number(norm) + "); fewer exponents, or a smaller qr_every");
       log_r[i] = std::log(std::abs(r)) + log_scale;
     }
-    make_q_coefficients(a, k, f, q_out);
+    make_q_coefficients(a, k, f);
     K::q(a, n, k, f, q_out);
   });
 }

@@ -4,6 +4,7 @@
 // StroboscopicMap.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -206,6 +207,28 @@ TEST(TangentQR, StaysOrthogonalOnIllConditionedBlocks) {
         EXPECT_GT(mgs_orthogonality_loss(A), 100 * qr_bound(n, k)) << what << ": the block is not hard";
       }
     }
+}
+
+// Q written over the block itself or into the same buffer a few rows before it (as the
+// Lyapunov loop does: Q to slots 0..M, the block in slots K..K+M): the identities hold and Q is
+// the one written to separate memory, bit for bit.
+TEST(TangentQR, QMayOverwriteTheBlockFromBelow) {
+  for (int k : {1, 2, 3, 8, 9}) {
+    const long n = 45;
+    const RowMajor A = random_rows(n, k, 77 + k);
+    const TangentQrResult separate = tangent_qr(A);
+    for (long offset : {0L, 1L, static_cast<long>(k) - 1, 3L * k}) {
+      std::vector<double> buffer((n + offset) * k), log_r(k);
+      double* const block = buffer.data() + offset * k;
+      std::copy(A.data(), A.data() + n * k, block);
+      ds::TangentQR qr(block, n, k);
+      qr.factorise(buffer.data(), log_r.data());
+      const TangentQrResult shared{Eigen::Map<RowMajor>(buffer.data(), n, k), log_r};
+      const std::string what = "k = " + std::to_string(k) + ", Q " + std::to_string(offset) + " rows before the block";
+      expect_backward_stable_qr(A, shared, qr_bound(n, k), what);
+      EXPECT_EQ(shared.Q, separate.Q) << what;
+    }
+  }
 }
 
 // Non-finite entries anywhere (each column, the head row and a tail row, both parities of the

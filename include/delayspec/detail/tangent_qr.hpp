@@ -17,7 +17,11 @@ class TangentQR {
   TangentQR(double* block, long n, int k);
 
   // Factorises the bound block = Q R in place, writes Q (n x k row-major, columns signed so
-  // that R_ii > 0) to q_out (must not overlap the block) and stores log |R_ii| in log_r[0..k).
+  // that R_ii > 0) to q_out and stores log |R_ii| in log_r[0..k). q_out is separate memory, the
+  // block itself, or the same buffer starting before the block (the Lyapunov loop writes Q a
+  // period's slots ahead of the factorised block): row r of Q is stored after rows >= r of the
+  // block were last read, so Q may overwrite it from below; q_out inside (block, block + n k)
+  // is not allowed.
   // NumericalFailure when an entry of the block or of R is not finite, or when |R_ii| is below
   // n eps times the norm of column i (that vector is lost in rounding: dependent on the others).
   void factorise(double* q_out, double* log_r);
@@ -26,8 +30,8 @@ class TangentQR {
   double* block_;
   long n_;
   int k_;
-  std::vector<double> scalars_;   // per-reflector scalars and per-column sums (7 k)
-  std::vector<double> matrices_;  // the k x k matrices of the Q formation (3 k^2)
+  std::vector<double> scalars_;   // per-reflector scalars and per-column sums (6 k)
+  std::vector<double> matrices_;  // the k x k matrices of the Q formation (4 k^2)
 };
 
 }  // namespace delayspec
