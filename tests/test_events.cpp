@@ -176,8 +176,9 @@ TEST(EventStep, ContactSubstepsMustBePositive) {
 namespace {
 
 // The excursion test as it was before its shortcut (dbf5fbd): the interior extrema of the Hermite
-// cubic from the roots of its derivative, every time.
-bool hermite_extremum_within_by_roots(double ga, double gL, double d0, double d1, double margin, double into) {
+// cubic from the roots of its derivative, every time; with minima_only, the minima of into p.
+bool hermite_extremum_within_by_roots(double ga, double gL, double d0, double d1, double margin, double into,
+                                      bool minima_only) {
   const double c1 = d0, c2 = -3 * ga - 2 * d0 + 3 * gL - d1, c3 = 2 * ga + d0 - 2 * gL + d1;
   const double qa = 3 * c3, qb = 2 * c2, qc = c1;
   double roots[2];
@@ -195,6 +196,7 @@ bool hermite_extremum_within_by_roots(double ga, double gL, double d0, double d1
   for (int i = 0; i < n; ++i) {
     const double tau = roots[i];
     if (!(tau > 0 && tau < 1)) continue;
+    if (minima_only && into * (2 * c2 + 6 * c3 * tau) < 0) continue;  // a maximum of into p
     if (into * (ga + tau * (c1 + tau * (c2 + tau * c3))) < margin) return true;
   }
   return false;
@@ -224,12 +226,63 @@ TEST(EventStep, ExcursionTestShortcutGivesTheAnswerOfTheRoots) {
       ga += shift, gL += shift;
       ++near_boundary;
     }
-    const bool expected = hermite_extremum_within_by_roots(ga, gL, d0, d1, margin, into);
-    ASSERT_EQ(detail::hermite_extremum_within(ga, gL, d0, d1, margin, into), expected)
-        << "ga " << ga << " gL " << gL << " d0 " << d0 << " d1 " << d1 << " margin " << margin << " into " << into;
+    const bool minima_only = i % 4 >= 2;
+    const bool expected = hermite_extremum_within_by_roots(ga, gL, d0, d1, margin, into, minima_only);
+    ASSERT_EQ(detail::hermite_extremum_within(ga, gL, d0, d1, margin, into, minima_only), expected)
+        << "ga " << ga << " gL " << gL << " d0 " << d0 << " d1 " << d1 << " margin " << margin << " into " << into
+        << " minima_only " << minima_only;
     ++answers[expected];
   }
   EXPECT_GT(answers[0], 1000);  // both answers occur often: the comparison is not vacuous
   EXPECT_GT(answers[1], 1000);
   EXPECT_GT(near_boundary, 1000);
+}
+
+// The excursion test with minima only (pieces whose ends are both inside) on pieces of smooth
+// H(s), s in [0, L], L = 0.01, both ends inside (into H > 0), one turning point s* in
+// (0.1 L, 0.9 L):
+// - a dip: into H = -delta + c x^2 + 0.01 e x^3 + f x^4, x = s - s*, c in [0.5, 2], |e| <= 5,
+//   |f| <= 10 (convex on the piece), reaching delta in [1e-13, 1e-7] beyond H = 0: always
+//   suspected. The Hermite cubic of the step's data (values and L H' at the ends, as
+//   event_step.hpp forms them) is within max|H''''| L^4 / 384 <= 6e-9 of H, far inside the margin
+//   |d1 - d0| ~ 2 c L^2 >= 1e-4, so its minimum is within the margin of H = 0;
+// - a turn back into the region, into H = m0 - (c x^2 + ...), the top m0 in [0, c L^2 / 2]
+//   (within the margin): not suspected with minima only, suspected without (the maximum within
+//   the margin: what cost the exact searches for nothing in shallow contacts).
+TEST(EventStep, ExcursionTestMinimaOnlyIgnoresTopsAndFindsEveryDip) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double L = 0.01;
+  int dips = 0, tops = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const double into = u(rng) < 0.5 ? 1 : -1;
+    const double s_star = L * (0.1 + 0.8 * u(rng));
+    const double c = 0.5 + 1.5 * u(rng), e = 10 * u(rng) - 5, f = 20 * u(rng) - 10;
+    const bool dip = i % 2 == 0;
+    const double level = dip ? -std::pow(10.0, -13 + 6 * u(rng)) : 0.5 * c * L * L * u(rng);
+    const double sign = dip ? 1 : -1;  // into H convex (dip) or concave (top)
+    auto H = [&](double s) {
+      const double x = s - s_star;
+      return into * (level + sign * (c * x * x + 1e-2 * e * x * x * x + f * x * x * x * x));
+    };
+    auto dH = [&](double s) {
+      const double x = s - s_star;
+      return into * sign * (2 * c * x + 3e-2 * e * x * x + 4 * f * x * x * x);
+    };
+    const double ga = H(0), gL = H(L), d0 = L * dH(0), d1 = L * dH(L);
+    if (!(into * ga > 0 && into * gL > 0)) continue;  // an end outside: case 1, not this test
+    const double margin = std::abs(d1 - d0);
+    if (dip) {
+      ++dips;
+      ASSERT_TRUE(detail::hermite_extremum_within(ga, gL, d0, d1, margin, into, true))
+          << "missed a dip of " << -level << " at " << s_star / L << " L, into " << into;
+    } else {
+      ++tops;
+      ASSERT_FALSE(detail::hermite_extremum_within(ga, gL, d0, d1, margin, into, true))
+          << "suspected a top at " << level << " within margin " << margin;
+      ASSERT_TRUE(detail::hermite_extremum_within(ga, gL, d0, d1, margin, into, false)) << "top " << level;
+    }
+  }
+  EXPECT_GT(dips, 10000);
+  EXPECT_GT(tops, 5000);
 }

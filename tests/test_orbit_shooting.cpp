@@ -102,6 +102,29 @@ TEST(Gmres, ZeroRightHandSideAndSingularSystem) {
   EXPECT_NEAR(singular.relative_residual, 1 / std::sqrt(2.0), 1e-12);
 }
 
+// The Arnoldi basis stays orthonormal where one Gram-Schmidt pass is not enough: A = I + 1e-6 R
+// makes w = A v_j nearly a multiple of v_j, so the first pass removes all but ~1e-6 of w and its
+// rounding (eps |w|) is ~1e-10 of what is left: without the DGKS second pass |V^T V - I| would be
+// ~1e-10. Two passes leave O(n eps) ~ 1e-14 at n = 60; bound 1e-13. The basis is the workspace
+// the caller passes (its first iterations + 1 columns: one cycle here), and a second call reusing
+// it gives the same x bit for bit.
+TEST(Gmres, BasisStaysOrthonormalWhenTheFirstPassCancels) {
+  const int n = 60;
+  std::srand(11);
+  const Eigen::MatrixXd A = Eigen::MatrixXd::Identity(n, n) + 1e-6 * Eigen::MatrixXd::Random(n, n);
+  const Eigen::VectorXd b = Eigen::VectorXd::Random(n);
+  auto apply = [&](const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::VectorXd& y) { y = A * x; };
+  Eigen::MatrixXd basis;
+  const GmresResult r = gmres(apply, b, {1e-13, 20, 100}, &basis);
+  ASSERT_GE(r.iterations, 2);
+  ASSERT_LT(r.iterations, 20) << "one cycle";
+  const Eigen::MatrixXd V = basis.leftCols(r.iterations + 1);
+  EXPECT_LT((V.transpose() * V - Eigen::MatrixXd::Identity(V.cols(), V.cols())).cwiseAbs().maxCoeff(), 1e-13);
+  EXPECT_LE(r.relative_residual, 1e-13);
+  const GmresResult again = gmres(apply, b, {1e-13, 20, 100}, &basis);
+  EXPECT_EQ(again.x, r.x);
+}
+
 // The levels: N, N/8, ... while >= coarse_N, each a valid N for the grid.
 TEST(ShootingLevels, GeometricAndValidForTheGrid) {
   const ImpactModel model(paper(1.0));
@@ -137,7 +160,7 @@ TEST(OrbitShooting, StableAlignedOrbitEqualsSparseNewtonAndSimulation) {
   const PeriodicOrbit shot = orbit_by_nested_shooting(s.map, s.model.initial_state(), o, &at_orbit);
   ASSERT_EQ(shot.levels.size(), 2u);
   EXPECT_EQ(shot.levels[0].N, 100);
-  EXPECT_EQ(shot.levels[0].method, "newton");
+  EXPECT_EQ(shot.levels[0].method, "shooting");  // automatic: shooting, which converges here
   EXPECT_EQ(shot.method, "shooting");
   EXPECT_LE(shot.newton_iterations, 4);
   EXPECT_GT(shot.linear_iterations, 0);
@@ -202,6 +225,34 @@ TEST(OrbitShooting, UnstableOrbitSimulationCannotReach) {
       NumericalFailure);
 }
 
+// auto's coarsest level: where shooting fails (here: one Newton step allowed, the simulated guess
+// needs three at k = 1), sparse-LU Newton from the same guess finds the orbit, and it is the one
+// sparse_newton finds (1e-10 relative, as above); where both fail the error names both.
+TEST(OrbitShooting, AutomaticCoarseLevelFallsBackToSparseNewton) {
+  ImpactSetup s(paper(1.0), 200);  // N < 8 coarse_N: the coarsest level is the only one
+  NestedShootingOptions o;
+  o.shooting.max_iterations = 1;
+  const PeriodicOrbit orbit = orbit_by_nested_shooting(s.map, s.model.initial_state(), o);
+  ASSERT_EQ(orbit.levels.size(), 1u);
+  EXPECT_EQ(orbit.levels[0].method, "newton");
+  EXPECT_GE(orbit.newton_iterations, 2);
+  EXPECT_LT(relative_distance(orbit.history, sparse_newton(s, 100).history), 1e-10);
+
+  o.newton.max_iterations = 1;
+  try {
+    orbit_by_nested_shooting(s.map, s.model.initial_state(), o);
+    FAIL() << "expected NumericalFailure";
+  } catch (const NumericalFailure& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("shooting from the same guess failed first: orbit by shooting (N = 200): not converged"),
+              std::string::npos)
+        << what;
+  }
+  o.newton.max_iterations = 30;  // enough for the fallback, which orbit = shooting does not take
+  o.coarse_method = CoarseOrbitMethod::shooting;
+  EXPECT_THROW(orbit_by_nested_shooting(s.map, s.model.initial_state(), o), NumericalFailure);
+}
+
 // Failures: too few Newton steps names the level's N and |P(U) - U|; bad options are bad input.
 TEST(OrbitShooting, FailurePathsAreReported) {
   ImpactSetup s(paper(0.2), 512);
@@ -237,7 +288,7 @@ TEST(OrbitShootingCli, DefaultAutoMatchesSimulationAndReportsLevels) {
   EXPECT_EQ(a["orbit"]["method"], "shooting");
   ASSERT_EQ(a["orbit"]["levels"].size(), 2u);
   EXPECT_EQ(a["orbit"]["levels"][0]["N"], 75);
-  EXPECT_EQ(a["orbit"]["levels"][0]["method"], "newton");
+  EXPECT_EQ(a["orbit"]["levels"][0]["method"], "shooting");
   EXPECT_EQ(a["orbit"]["levels"][1]["N"], 600);
   EXPECT_TRUE(a.contains("orbit_seconds"));
   CliResult simulated =

@@ -51,6 +51,9 @@ class Monodromy final : public LinearOperator {
   Eigen::Index cols() const { return n_; }
   const HistoryGrid& grid() const { return grid_; }
   const std::vector<StepMap<D>>& step_maps() const { return maps_; }
+  // Hands the step maps back (the operator is empty afterwards): a caller that evaluates the map
+  // again, as Newton does, refills the same storage instead of allocating and faulting it in anew.
+  std::vector<StepMap<D>> take_step_maps() && { return std::move(maps_); }
 
   // y = M x. Checks sizes (BadInput naming both) then calls the unchecked kernel.
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;

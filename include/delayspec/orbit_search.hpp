@@ -4,10 +4,10 @@
 //
 // orbit = auto (default): nested iteration (orbit_shooting.hpp): levels N, N/8, ... down to the
 //   last one >= orbit_coarse_N; at the coarsest, orbit_guess_periods maps simulated from the
-//   constant initial history and sparse-LU Newton; every finer level by Newton-Krylov shooting
-//   from the coarser orbit. With N < 8 orbit_coarse_N there is one level: sparse-LU Newton at N.
-//   Finds unstable orbits too.
-// orbit = shooting: the same levels, Newton-Krylov shooting at the coarsest level too.
+//   constant initial history and Newton-Krylov shooting, or sparse-LU Newton from the same guess
+//   if shooting fails; every finer level by shooting from the coarser orbit. With N < 8
+//   orbit_coarse_N there is one level, N itself. Finds unstable orbits too.
+// orbit = shooting: the same levels, shooting only (no sparse-LU fallback).
 // orbit = simulate: iterate the map from the constant initial history until it settles.
 // orbit = newton: simulate orbit_guess_periods maps from the constant initial history, then
 //   Newton on the discrete periodic problem at N (orbit_newton.hpp, sparse LU).
@@ -52,7 +52,7 @@ PeriodicOrbit find_orbit(const Model& model, const Map& map, const OrbitSettings
       NestedShootingOptions o;
       o.shooting = settings.shooting;
       o.newton = settings.newton;
-      o.coarse_method = settings.method == "auto" ? CoarseOrbitMethod::newton : CoarseOrbitMethod::shooting;
+      o.coarse_method = settings.method == "auto" ? CoarseOrbitMethod::automatic : CoarseOrbitMethod::shooting;
       o.guess_periods = settings.guess_periods;
       o.coarse_N = settings.coarse_N;
       return orbit_by_nested_shooting(map, model.initial_state(), o, at_orbit);

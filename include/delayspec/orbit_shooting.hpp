@@ -16,8 +16,8 @@
 //
 // Nested iteration. Levels N_0 < N_1 < ... < N_L = N, N_{i-1} ~ N_i / 8 (a valid grid: a multiple
 // of p when tau / T = p / q), down to the last one >= coarse_N. The coarsest orbit comes from
-// `guess_periods` maps simulated from the constant initial history, then Newton at N_0 (sparse LU,
-// orbit_newton.hpp, or shooting); each finer level starts from the coarser orbit prolonged in time
+// `guess_periods` maps simulated from the constant initial history, then Newton at N_0 (shooting,
+// sparse LU if that fails: CoarseOrbitMethod below); each finer level starts from the coarser orbit prolonged in time
 // (prolong_periodic_sequence). The prolonged guess is O(h_{i-1}^2) from the level's orbit, so a
 // level needs one or two Newton steps and the whole costs about 1 + 1/8 + 1/64 + ... of the
 // finest level's map evaluations per step, instead of the hundreds of periods simulation needs.
@@ -94,6 +94,7 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
     return G.allFinite();
   };
   Eigen::VectorXd G;
+  Eigen::MatrixXd basis;  // GMRES' workspace, kept across Newton steps
   double r = NAN;
   auto failure = [&](const std::string& why) {
     return NumericalFailure("orbit by shooting (N = " + std::to_string(map.grid().N) + "): " + why + " after " +
@@ -117,14 +118,16 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
     const double tol_abs = opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>());
     eta = std::max(eta, 0.5 * tol_abs / g_norm);  // |r|_inf <= |r|_2 <= eta |G|_2: enough for the test
     eta = std::max(eta, 1e-13);                   // GMRES' own rounding floor
-    // (M - I) s = -G with M the monodromy at U (the step maps of the evaluation of G).
-    const Monodromy<D> monodromy(map.grid(), std::move(lin.maps));
+    // (M - I) s = -G with M the monodromy at U (the step maps of the evaluation of G); the maps'
+    // storage goes back to `lin` for the next evaluation, the Krylov basis stays in `basis`.
+    Monodromy<D> monodromy(map.grid(), std::move(lin.maps));
     const GmresResult step = gmres(
         [&](const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::VectorXd& y) {
           monodromy.perform_op(x.data(), y.data());
           y -= x;  // y = (M - I) x
         },
-        -G, GmresOptions{eta, opt.gmres_restart, opt.gmres_max_iterations});
+        -G, GmresOptions{eta, opt.gmres_restart, opt.gmres_max_iterations}, &basis);
+    lin.maps = std::move(monodromy).take_step_maps();
     orbit.linear_iterations += step.iterations;
     ++orbit.newton_iterations;
     if (!(step.relative_residual < 1))
@@ -152,13 +155,21 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
   return orbit;
 }
 
-// How the coarsest level of nested shooting is solved.
-enum class CoarseOrbitMethod { newton, shooting };
+// How the coarsest level of nested shooting is solved: sparse-LU Newton on the periodic problem
+// (orbit_newton.hpp), shooting, or (automatic) shooting and, if it fails, sparse-LU Newton from
+// the same guess. Why shooting first: from the same guess both take the same number of Newton
+// steps (quadratic convergence to the same fixed point), but a shooting step costs one map
+// evaluation and a few GMRES products, a sparse-LU step the assembly and factorisation of the
+// d K x d K periodic Jacobian (measured at N = 250, impact k = 1: 3 steps in 0.1 ms against
+// 1.3 ms). Why the fallback: all K states being unknowns gives Newton on the periodic problem a
+// wider basin for strongly unstable orbits than shooting on P(U) - U, whose error is amplified by
+// the whole map.
+enum class CoarseOrbitMethod { newton, shooting, automatic };
 
 struct NestedShootingOptions {
   OrbitByShootingOptions shooting;
   OrbitByNewtonOptions newton;  // coarsest level, sparse LU
-  CoarseOrbitMethod coarse_method = CoarseOrbitMethod::newton;
+  CoarseOrbitMethod coarse_method = CoarseOrbitMethod::automatic;
   long guess_periods = 100;  // maps simulated from the initial history for the coarsest guess
   int coarse_N = 64;         // the coarsest level is the last N_i >= coarse_N (or N itself)
   int refinement = 8;        // N_i / N_{i-1}
@@ -200,12 +211,26 @@ PeriodicOrbit orbit_by_nested_shooting(const StroboscopicMap<Model, Stepper>& ma
   long linear_iterations = 0;
   std::vector<PeriodicOrbit::Level> levels;
   const bool last = Ns.size() == 1;
-  if (opt.coarse_method == CoarseOrbitMethod::newton) {
+  auto by_newton = [&] {
     PeriodicOrbitProblem<Map> problem(coarse);
     orbit = orbit_by_newton(coarse, problem.sequence_from_history(U), opt.newton);
     coarse.apply(orbit.history, last && at_orbit ? &lin.maps : nullptr, &lin.states);
-  } else {
+  };
+  if (opt.coarse_method == CoarseOrbitMethod::newton) {
+    by_newton();
+  } else if (opt.coarse_method == CoarseOrbitMethod::shooting) {
     orbit = orbit_by_shooting(coarse, U, opt.shooting, &lin);
+  } else {
+    try {
+      orbit = orbit_by_shooting(coarse, U, opt.shooting, &lin);
+    } catch (const NumericalFailure& shooting_failure) {
+      try {
+        by_newton();
+      } catch (const NumericalFailure& newton_failure) {
+        throw NumericalFailure(std::string(newton_failure.what()) + " (shooting from the same guess failed first: " +
+                               shooting_failure.what() + ")");
+      }
+    }
   }
   linear_iterations += orbit.linear_iterations;
   levels.push_back(

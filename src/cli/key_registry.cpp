@@ -126,7 +126,7 @@ const std::map<std::string, std::string>& key_meanings() {
       {"mass", "milling: modal mass (kg)"},
       {"milling", "milling: down or up (which side of the cut the tooth enters)"},
       // orbit and eigensolver (orbit_settings.cpp, floquet_settings.cpp)
-      {"orbit", "periodic orbit: auto (coarse Newton, then shooting), shooting, simulate, newton"},
+      {"orbit", "periodic orbit: auto (shooting, sparse LU where it fails), shooting, simulate, newton"},
       {"orbit_tolerance", "orbit settled (simulate) / Newton's relative residual |P(U) - U|, > 0"},
       {"orbit_max_periods", "simulate: most periods simulated before giving up (exit 3)"},
       {"orbit_max_iterations", "newton, auto, shooting: Newton steps allowed (per level), 1..10000"},

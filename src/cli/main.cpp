@@ -5,10 +5,12 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "freed_memory.hpp"
 #include "ranks.hpp"
 
 int main(int argc, char** argv) {
   using namespace delayspec::cli;
+  keep_freed_memory();
   start_ranks(&argc, &argv);
   if (is_lead_rank()) return finish_ranks(run_cli(argc, argv, std::cout, std::cerr));
   std::ostringstream out, err;
