@@ -92,7 +92,7 @@
 namespace delayspec {
 
 // The most tangent vectors a run carries: the QR kernel keeps one row of the block in stack
-// buffers of this size (lyapunov.cpp); only leading exponents are meant.
+// buffers of this size (tangent_qr.cpp); only leading exponents are meant.
 inline constexpr int kMaxTangentVectors = 64;
 
 struct LyapunovOptions {
