@@ -42,9 +42,9 @@
 // Cost per row: sweep 0 reads the row (2k multiply-adds), sweep j updates k - j entries
 // (2 (k - j) + j multiply-adds), sweep k writes a row of Q (k^2). For k = 2: three passes over
 // the block (read; read and write column 1; read and write Q) against about 13 in the textbook
-// order (the previous kernel: 3.4x slower at n = 2002, docs/benchmarks.md). Rows go two at a time through independent
-// accumulators (the reductions' add latency). Compile-time k (and j) for k <= 8, runtime k up to kMaxTangentVectors
-// otherwise.
+// order (the previous kernel: 3.4x slower at n = 2002, docs/benchmarks.md). Rows go two at a
+// time through independent accumulators (the reductions' add latency). Compile-time k (and j)
+// for k <= 8, runtime k up to kMaxTangentVectors otherwise.
 #include <algorithm>
 #include <cmath>
 #include <string>
