@@ -8,6 +8,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "cli_test_support.hpp"
 #include "delayspec_test_paths.hpp"
@@ -103,6 +105,23 @@ TEST(LyapunovCli, OverflowExitsThree) {
                      "periods=4", "--set", "transient=0", "--set", "exponents=1"});
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("numerical failure"), std::string::npos) << r.err;
+}
+
+// More exponents than the rank of the period map: its image has fewer dimensions than tangent
+// vectors, so after one period the last vector is a combination of the others (to rounding) and
+// the QR's n eps test must stop the run with exit 3 naming it. x' = -x (b = 0): the map is
+// rank 1 (the history is forgotten); impact with k = 0 is an ODE, rank 2 (d = 2).
+TEST(LyapunovCli, MoreExponentsThanTheRankOfTheMapExitsThree) {
+  const std::vector<std::vector<std::string>> runs = {
+      {"--set", "model=linear", "--set", "b=0", "--set", "exponents=2"},
+      {"--set", "model=impact", "--set", "k=0", "--set", "exponents=3"}};
+  for (const auto& keys : runs) {
+    std::vector<std::string> args = {"lyapunov", "--set", "N=20", "--set", "periods=10", "--set", "transient=0"};
+    args.insert(args.end(), keys.begin(), keys.end());
+    CliResult r = run(args);
+    EXPECT_EQ(r.status, 3) << keys[1] << ": " << r.err;
+    EXPECT_NE(r.err.find("became linearly dependent"), std::string::npos) << r.err;
+  }
 }
 
 TEST_P(SweepBadInput, ExitsTwoNamingKeyAndValue) {

@@ -53,8 +53,8 @@
 // Layout (as StroboscopicMap and Monodromy): linear buffers of M + 1 + K slots for the
 // trajectory and for the block; slots 0..M hold the history at the start of a period, step l
 // writes slot M + l + 1, the history at the end is slots K..K+M. There the block is factorised
-// in place; Q is written back to slots 0..M and the trajectory slots are moved down. All
-// buffers are allocated once per call.
+// in place with Q written straight to slots 0..M (TangentQR allows the overlap), and the
+// trajectory slots are moved down. All buffers are allocated once per call.
 //
 // QR interval. With qr_every = q > 1 the block is not re-orthonormalised for q periods, so its
 // columns separate by the ratio of the Floquet/Lyapunov growth factors over q periods; the
@@ -92,7 +92,7 @@
 namespace delayspec {
 
 // The most tangent vectors a run carries: the QR kernel keeps one row of the block in stack
-// buffers of this size (lyapunov.cpp); only leading exponents are meant.
+// buffers of this size (tangent_qr.cpp); only leading exponents are meant.
 inline constexpr int kMaxTangentVectors = 64;
 
 struct LyapunovOptions {
@@ -166,9 +166,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   for (long j = 0; j <= M; ++j) traj[j] = U0.template segment<D>(j * D);
   std::vector<double> block(static_cast<size_t>((M + 1 + K) * stride));
   double* const result_slots = block.data() + K * stride;  // slots K..K+M: the block after a period
-  const bool q_fits_front = K >= M + 1;                    // slots 0..M and K..K+M do not overlap
-  std::vector<double> q_scratch(q_fits_front ? 0 : static_cast<size_t>(n * k));
-  double* const q_out = q_fits_front ? block.data() : q_scratch.data();
+  double* const q_out = block.data();                      // Q -> slots 0..M (may overlap slots K..K+M: TangentQR)
   TangentQR qr(result_slots, n, k);
   std::vector<double> log_r(k);
   double qr_seconds = 0;
@@ -177,7 +175,6 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   auto reorthonormalise = [&] {
     const auto t0 = std::chrono::steady_clock::now();
     qr.factorise(q_out, log_r.data());
-    if (!q_fits_front) std::copy(q_scratch.begin(), q_scratch.end(), block.begin());
     qr_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
   random_block(result_slots, n, k, options.seed);
