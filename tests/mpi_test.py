@@ -47,9 +47,11 @@ FAILING_CHART = ["chart", "--set", "model=impact", "--set", "N=8", "--set", "cha
                  "--set", "chart_x_range=0,0.2", "--set", "chart_y_range=0,0.1", "--set", "chart_x_points=3",
                  "--set", "chart_y_points=2", "--set", "orbit=simulate", "--set", "orbit_max_periods=2",
                  "--set", "threads=1"]
-# Runs the program given as $0 and reports this rank's own exit status on stderr; exits 0, so
-# that mpirun does not end the other ranks before they report theirs.
-EACH_RANK_STATUS = '"$0" "$@"; s=$?; echo "rank $OMPI_COMM_WORLD_RANK exit $s" >&2'
+# Runs the program given as $0 and writes this rank's own exit status to the file rank_<rank> in
+# the directory $STATUS_DIR; exits 0, so that mpirun does not end the other ranks before they
+# write theirs. A file, not stderr: mpirun's forwarding of a rank's last stderr line raced with
+# its own exit under load (a status line went missing once in ctest next to a sanitizer build).
+EACH_RANK_STATUS = '"$0" "$@"; s=$?; echo "rank $OMPI_COMM_WORLD_RANK exit $s" > "$STATUS_DIR/rank_$OMPI_COMM_WORLD_RANK"'
 # `run`: analyses with and without point loops; the workers must skip floquet and follow the
 # lead through the two grids.
 RUN_SCENE = """analyses = ["floquet", "chart", "basin"]
@@ -122,6 +124,18 @@ def main():
     def mpirun(ranks, *rest):
         return [args.mpirun, "--oversubscribe", "-n", str(ranks), *rest]
 
+    status_runs = 0
+
+    def run_each_rank(ranks, *command):
+        """The command on `ranks` ranks under EACH_RANK_STATUS: (the run, the sorted status lines)."""
+        nonlocal status_runs
+        status_runs += 1
+        directory = Path(scratch) / f"statuses_{status_runs}"
+        directory.mkdir()
+        env = dict(os.environ, STATUS_DIR=str(directory))
+        r = run(mpirun(ranks, "-x", "STATUS_DIR", "sh", "-c", EACH_RANK_STATUS, *command), env=env)
+        return r, sorted(f.read_text().strip() for f in directory.glob("rank_*"))
+
     with tempfile.TemporaryDirectory(prefix="delayspec_mpi_test_") as scratch:
         scratch = Path(scratch)
         scene = scratch / "run_scene.toml"
@@ -138,8 +152,7 @@ def main():
             check(r.returncode == status, f"{name} without mpirun: exit {r.returncode}: {r.stderr}")
             for ranks in (2, 3):
                 out = scratch / f"{name}_{ranks}"
-                r = run(mpirun(ranks, "sh", "-c", EACH_RANK_STATUS, program, *command, "--out", str(out)))
-                statuses = sorted(line for line in r.stderr.splitlines() if line.startswith("rank "))
+                r, statuses = run_each_rank(ranks, program, *command, "--out", str(out))
                 if check(statuses == [f"rank {i} exit {status}" for i in range(ranks)],
                          f"{name} on {ranks} ranks: rank statuses {statuses}\n{r.stderr}"):
                     same_files(reference, out, f"{name} on {ranks} ranks")
@@ -202,8 +215,7 @@ def main():
         for what, command in (("bad key", [*SWEEP, "--set", "sweep_points=0"]),
                               ("bad --out", [*SWEEP, "--out", str(reference)]),
                               ("bad chart", [*CHART, "--set", "chart_x_points=1"])):
-            r = run(mpirun(3, "sh", "-c", EACH_RANK_STATUS, program, *command))
-            statuses = sorted(line for line in r.stderr.splitlines() if line.startswith("rank "))
+            r, statuses = run_each_rank(3, program, *command)
             check(statuses == [f"rank {i} exit 2" for i in range(3)], f"{what}: rank statuses {statuses}\n{r.stderr}")
             check(r.stderr.count("bad input") == 1, f"{what}: the message is not printed once:\n{r.stderr}")
 
@@ -220,8 +232,7 @@ def main():
         alone = ["env", f"LD_LIBRARY_PATH={copy}", str(copy / "delayspec"), *CHART, "--quiet", "--json"]
         r = run(alone)
         check(r.returncode == 0, f"the copy without the MPI module, alone: exit {r.returncode}: {r.stderr}")
-        r = run(mpirun(2, "sh", "-c", EACH_RANK_STATUS, *alone))
-        statuses = sorted(line for line in r.stderr.splitlines() if line.startswith("rank "))
+        r, statuses = run_each_rank(2, *alone)
         check(statuses == [f"rank {i} exit 2" for i in range(2)], f"no MPI module: rank statuses {statuses}\n{r.stderr}")
         missing = f"the module {copy / 'libdelayspec_mpi.so'} (delayspec's MPI transport): it is missing"
         check(r.stderr.count(missing) == 1, f"no MPI module: the message is not printed once:\n{r.stderr}")
