@@ -190,8 +190,7 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
   const bool disjoint = std::less<>()(X + (k - 1) * ldx + n_ - 1, Y) || std::less<>()(Y + (k - 1) * ldy + n_ - 1, X);
   if (disjoint && first_read >= 0 && grid_.delayed_slot(0) + grid_.K <= grid_.M)
     apply_block_streaming(X, ldx, k, Y, ldy);
-  else
-    apply_block_linear(X, ldx, k, Y, ldy);
+  else apply_block_linear(X, ldx, k, Y, ldy);
   applications_ += k;
 }
 
@@ -242,7 +241,7 @@ void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, doub
   const long C = std::max<long>(8, 1024 / stride);
   const size_t need = static_cast<size_t>(2 * C + 3) * stride;
   if (block_work_.size() < need) block_work_.resize(need);
-  double* in = block_work_.data();     // C + 2 slots: j0 + l0 - back .. j0 + l0 + C
+  double* in = block_work_.data();      // C + 2 slots: j0 + l0 - back .. j0 + l0 + C
   double* out = in + (C + 2) * stride;  // C + 1 slots: M + l0 .. M + l0 + C
   to_slots(X + M * D, ldx, D, k, out);  // u0 of step 0: x's slot M
   for (long l0 = 0; l0 < K; l0 += C) {
@@ -251,7 +250,7 @@ void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, doub
     to_slots(X + lo * D, ldx, (hi - lo + 1) * D, k, in);
     run_block_steps(l0, steps, out, in + back * stride, k);
     from_slots(out + stride, steps * D, k, Y + (M + l0 + 1 - K) * D, ldy);  // slot s is Y's slot s - K
-    std::copy(out + steps * stride, out + (steps + 1) * stride, out);     // the next chunk's u0
+    std::copy(out + steps * stride, out + (steps + 1) * stride, out);       // the next chunk's u0
   }
   copy_x_slots();
 }

@@ -227,8 +227,8 @@ PeriodicOrbit orbit_by_nested_shooting(const StroboscopicMap<Model, Stepper>& ma
       try {
         by_newton();
       } catch (const NumericalFailure& newton_failure) {
-        throw NumericalFailure(std::string(newton_failure.what()) + " (shooting from the same guess failed first: " +
-                               shooting_failure.what() + ")");
+        throw NumericalFailure(std::string(newton_failure.what()) +
+                               " (shooting from the same guess failed first: " + shooting_failure.what() + ")");
       }
     }
   }
