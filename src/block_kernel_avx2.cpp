@@ -178,7 +178,10 @@ void stream_blocks(const StepMap<2>* maps, long l0, long l1, long K, long M, lon
                    long ldx, double* Y, long ldy) {
   const __m256d c0 = _mm256_set1_pd(1 - theta), th = _mm256_set1_pd(theta);
   Block4<Interpolate> a(X, ldx, Y, ldy, M, K, j0, l0, c0, th);
-  Block4<Interpolate> b(X + 4 * ldx, ldx, Y + 4 * ldy, ldy, M, K, j0, l0, c0, th);  // unused when Blocks = 1
+  // With Blocks = 1 there is no second block of columns: b is a's (its construction reads only
+  // a's columns; nothing of b is used). Columns 4..7 of X may not exist (ASan: a read past X's end).
+  const long second = Blocks == 2 ? 4 : 0;
+  Block4<Interpolate> b(X + second * ldx, ldx, Y + second * ldy, ldy, M, K, j0, l0, c0, th);
   long l = l0;
   for (; l + 1 < l1; l += 2) {  // steps l, l + 1: slots j + 1, j + 2 read, M + l + 1, M + l + 2 written
     const long in = 2 * (j0 + l + 1), out = 2 * (M + l + 1 - K);  // result slot i is Y's slot i - K
