@@ -183,7 +183,6 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   LyapunovResult result;
   result.section.resize(options.section_points, D);
   long section_count = 0;
-  StepMap<D> step_map;
   // One stroboscopic period, trajectory and block fused; afterwards the trajectory history is
   // back in slots 0..M and the (unnormalised) block in slots K..K+M.
   // KC: k as a compile-time constant for the common few vectors (step_block), else 0.
@@ -193,11 +192,13 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
     auto slot = [&traj](long i) -> const V& { return traj[i]; };
     for (long l = 0; l < K; ++l) {
       const DelayTap<V> tap = grid.delay_tap<V>(l, slot);
-      traj[M + l + 1] = stepper.step(tap.t, grid.h, traj[M + l], tap.w0, tap.w1, step_map);
-      // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same tap)
-      step_block<D, detail::PortableTarget, KC>(step_map, block.data() + (M + l) * stride,
-                                                block.data() + grid.delayed_slot(l) * stride, k, grid.theta,
-                                                block.data() + (M + l + 1) * stride);
+      StepLinearisation<D> step_linearisation;  // a local: kept in registers where the step inlines
+      traj[M + l + 1] = stepper.step(tap.t, grid.h, traj[M + l], tap.w0, tap.w1, step_linearisation);
+      // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same
+      // tap), P, Q, R not formed where the step is one sub-step (apply_step_linearisation)
+      apply_step_linearisation<D, KC>(step_linearisation, block.data() + (M + l) * stride,
+                                      block.data() + grid.delayed_slot(l) * stride, k, grid.theta,
+                                      block.data() + (M + l + 1) * stride);
       if (record && section_count < options.section_points && (l + 1) % spp == 0)  // (no division unless recording)
         result.section.row(section_count++) = traj[M + l + 1].transpose();
     }

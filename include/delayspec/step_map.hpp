@@ -8,6 +8,7 @@
 // theta u_m are the delayed values at the step's two ends (grid.hpp). For an aligned delay
 // (theta = 0) this is the design's P du_0 + Q du_N + R du_{N-1}. Steps containing events have
 // the same form with other blocks.
+#include "delayspec/detail/sub_step_derivative.hpp"
 #include "delayspec/types.hpp"
 
 namespace delayspec {
@@ -17,6 +18,24 @@ struct StepMap {
   Mat<D> P = Mat<D>::Zero();
   Mat<D> Q = Mat<D>::Zero();
   Mat<D> R = Mat<D>::Zero();
+};
+
+// The derivative of one step as a step reports it (TrapezoidStepper::step): a step that is one
+// trapezoid sub-step (no event or time switch inside it: most steps) keeps its derivative
+// factored, S^{-1} [L du_0 + Bl dw0 + Br dw1] (detail/sub_step_derivative.hpp), and a caller
+// that applies it once to a few vectors (the Lyapunov loop: apply_step_linearisation in
+// block_kernel.hpp) never forms P, Q, R; a step split into pieces composes their maps into
+// `map`. formed() is the StepMap either way (what a monodromy stores).
+template <int D>
+struct StepLinearisation {
+  bool factored = false;               // which of the two below holds the derivative
+  detail::SubStepDerivative<D> sub;    // factored: the step's one sub-step
+  StepMap<D> map;                      // otherwise: P, Q, R of the composed pieces
+
+  StepMap<D> formed() const {
+    if (!factored) return map;
+    return StepMap<D>{sub.dz0(), sub.dw0(), sub.dw1()};
+  }
 };
 
 }  // namespace delayspec

@@ -19,6 +19,7 @@
 
 #include "delayspec/detail/event_step.hpp"  // event_step(), called by step()
 #include "delayspec/detail/small_solve.hpp"
+#include "delayspec/detail/sub_step_derivative.hpp"
 #include "delayspec/detail/time_switch_step.hpp"  // time_switch_step(), called by step()
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
@@ -49,17 +50,30 @@ class TrapezoidStepper {
   // through memory cost the scalar Lyapunov step 4 of its 8 ns (bench_lyapunov).
   [[gnu::always_inline]] inline SubStepResult<D> sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1,
                                                           int left_region, int right_region) const {
-    const double t1 = t0 + dt;
     SubStepResult<D> r;
-    detail::SmallSolve<D> lu;
-    r.z1 = solve_sub_step(t0, dt, z0, w0, w1, left_region, right_region, r.right_region, lu);
-    const int jr = r.right_region;
-    // For an affine f the last Newton matrix is already S at z1 (A does not depend on z).
-    if (!Model::affine_in_state) lu.compute(M::Identity() - 0.5 * dt * model_.A(jr, t1, r.z1, w1));
-    r.dz0 = lu.solve(M::Identity() + 0.5 * dt * model_.A(left_region, t0, z0, w0));
-    r.dw0 = lu.solve(0.5 * dt * model_.B(left_region, t0, z0, w0));
-    r.dw1 = lu.solve(0.5 * dt * model_.B(jr, t1, r.z1, w1));
+    detail::SubStepDerivative<D> derivative;
+    r.z1 = factored_sub_step(t0, dt, z0, w0, w1, left_region, right_region, derivative, r.right_region);
+    r.dz0 = derivative.dz0();
+    r.dw0 = derivative.dw0();
+    r.dw1 = derivative.dw1();
     return r;
+  }
+
+  // The same sub-step with its derivative in factored form (sub_step_derivative.hpp: S^{-1}
+  // and the three right-hand matrices, no product formed); right_region_out receives the right
+  // node's region. Returns z1.
+  [[gnu::always_inline]] inline V factored_sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1,
+                                                   int left_region, int right_region,
+                                                   detail::SubStepDerivative<D>& derivative,
+                                                   int& right_region_out) const {
+    const double t1 = t0 + dt;
+    const V z1 = solve_sub_step(t0, dt, z0, w0, w1, left_region, right_region, right_region_out, derivative.s);
+    const int jr = right_region_out;
+    // For an affine f the last Newton matrix is already S at z1 (A does not depend on z).
+    if (!Model::affine_in_state) derivative.s.compute(M::Identity() - 0.5 * dt * model_.A(jr, t1, z1, w1));
+    derivative.set_blocks(0.5 * dt, model_.A(left_region, t0, z0, w0), model_.B(left_region, t0, z0, w0),
+                          model_.B(jr, t1, z1, w1));
+    return z1;
   }
 
   // z1 of the same sub-step without its derivatives (event location evaluates many of these).
@@ -78,28 +92,44 @@ class TrapezoidStepper {
   // Always inlined (a dispatch; the event and time-switch steps stay calls): see sub_step.
   [[gnu::always_inline]] inline V step(double t, double h, const V& u0, const V& w0, const V& w1, StepMap<D>& map,
                                        StepEvents* events = nullptr) const {
+    StepLinearisation<D> linearisation;
+    const V u1 = step(t, h, u0, w0, w1, linearisation, events);
+    map = linearisation.formed();
+    return u1;
+  }
+
+  // The same step with its derivative as a StepLinearisation (step_map.hpp): factored when the
+  // step is one sub-step (no event or time switch inside it), for a caller that applies it once
+  // to a few tangent vectors (the Lyapunov loop) and need not form P, Q, R.
+  [[gnu::always_inline]] inline V step(double t, double h, const V& u0, const V& w0, const V& w1,
+                                       StepLinearisation<D>& linearisation, StepEvents* events = nullptr) const {
     if constexpr (Model::has_switching) {
-      if (options_.events != EventMode::off) return event_step(*this, t, h, u0, w0, w1, map, events);
+      if (options_.events != EventMode::off) return event_step(*this, t, h, u0, w0, w1, linearisation, events);
     }
     if (events) events->count = 0;
     if constexpr (TimeSwitchedModel<Model>) {
       // The switch times are known exactly: `on` and `linear` both split the step there.
-      if (options_.events != EventMode::off) return detail::time_switch_step(*this, t, h, u0, w0, w1, map);
+      if (options_.events != EventMode::off) return detail::time_switch_step(*this, t, h, u0, w0, w1, linearisation);
     }
-    return plain_step(t, h, u0, w0, w1, map);
+    return plain_step(t, h, u0, w0, w1, linearisation);
   }
 
   // The plain (unsplit) trapezoid step, whatever the options: each node in its own region (the
   // region of its state, or for time switches the branch in force at its time).
   [[gnu::always_inline]] inline V plain_step(double t, double h, const V& u0, const V& w0, const V& w1,
                                              StepMap<D>& map) const {
+    StepLinearisation<D> linearisation;
+    const V u1 = plain_step(t, h, u0, w0, w1, linearisation);
+    map = linearisation.formed();
+    return u1;
+  }
+  [[gnu::always_inline]] inline V plain_step(double t, double h, const V& u0, const V& w0, const V& w1,
+                                             StepLinearisation<D>& linearisation) const {
     int left = region_of(model_, u0), right = kRegionOfEndpoint;
     if constexpr (TimeSwitchedModel<Model>) left = model_.time_segment(t), right = model_.time_segment(t + h);
-    SubStepResult<D> s = sub_step(t, h, u0, w0, w1, left, right);
-    map.P = s.dz0;
-    map.Q = s.dw0;
-    map.R = s.dw1;
-    return s.z1;
+    int right_region;
+    linearisation.factored = true;
+    return factored_sub_step(t, h, u0, w0, w1, left, right, linearisation.sub, right_region);
   }
 
   const Model& model() const { return model_; }

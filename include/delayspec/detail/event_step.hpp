@@ -145,7 +145,7 @@ class EventStepSolver {
     wdot_ = (w1 - w0) / h;
   }
 
-  V run(const V& u0, StepMap<D>& map, StepEvents* events) const {
+  V run(const V& u0, StepLinearisation<D>& linearisation, StepEvents* events) const {
     double a = 0;
     V z = u0;
     int j = region_of(model_, u0);
@@ -159,15 +159,14 @@ class EventStepSolver {
       if (count == 0) {
         // Most steps have no event: the trial piece over the whole step, with the derivative of
         // its end at fixed ends (da = db = 0), is then the step and its map.
-        if (m == 1) {  // one sub-step: the plain trapezoid step in region j, its map directly
-          const SubStepResult<D> r = stepper_.sub_step(t_, h_, u0, w0_, w1_, j, j);
-          exit = find_exit(0, u0, r.z1, j, false);
+        if (m == 1) {  // one sub-step: the plain trapezoid step in region j, its derivative factored
+          int jr;
+          const V z1 = stepper_.factored_sub_step(t_, h_, u0, w0_, w1_, j, j, linearisation.sub, jr);
+          exit = find_exit(0, u0, z1, j, false);
           if (!exit.event) {
             if (events) events->count = 0;
-            map.P = r.dz0;
-            map.Q = r.dw0;
-            map.R = r.dw1;
-            return r.z1;
+            linearisation.factored = true;
+            return z1;
           }
         } else {
           const Piece whole = piece_with_fixed_ends(0, h_, u0, dz, j, m);
@@ -208,9 +207,10 @@ class EventStepSolver {
       ++count;
     }
     if (events) events->count = count;
-    map.P = dz.template leftCols<D>();
-    map.Q = dz.template middleCols<D>(D);
-    map.R = dz.template rightCols<D>();
+    linearisation.factored = false;
+    linearisation.map.P = dz.template leftCols<D>();
+    linearisation.map.Q = dz.template middleCols<D>(D);
+    linearisation.map.R = dz.template rightCols<D>();
     return z;
   }
 
@@ -428,8 +428,9 @@ class EventStepSolver {
 
 template <class Model>
 Vec<Model::d> event_step(const TrapezoidStepper<Model>& stepper, double t, double h, const Vec<Model::d>& u0,
-                         const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepMap<Model::d>& map, StepEvents* events) {
-  return detail::EventStepSolver<Model>(stepper, t, h, w0, w1).run(u0, map, events);
+                         const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepLinearisation<Model::d>& linearisation,
+                         StepEvents* events) {
+  return detail::EventStepSolver<Model>(stepper, t, h, w0, w1).run(u0, linearisation, events);
 }
 
 }  // namespace delayspec

@@ -30,6 +30,7 @@ class SmallSolve<D, true> {
   auto solve(const Eigen::MatrixBase<B>& b) const {
     return (inverse_ * b).eval();  // x = S^{-1} b
   }
+  const M& inverse() const { return inverse_; }  // S^{-1}
 
  private:
   M inverse_;

@@ -73,18 +73,17 @@ int time_switch_offsets(const Model& model, double t, double h,
 
 template <class Model>
 Vec<Model::d> time_switch_step(const TrapezoidStepper<Model>& stepper, double t, double h, const Vec<Model::d>& u0,
-                               const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepMap<Model::d>& map) {
+                               const Vec<Model::d>& w0, const Vec<Model::d>& w1,
+                               StepLinearisation<Model::d>& linearisation) {
   constexpr int D = Model::d;
   const Model& model = stepper.model();
   std::array<double, kMaxTimeSwitchesPerStep + 2> s;
   const int pieces = time_switch_offsets(model, t, h, s);
   if (pieces == 1) {  // most steps: one piece, the plain step in the branch of the whole step
     const int j = model.time_segment(t + 0.5 * h);
-    const SubStepResult<D> r = stepper.sub_step(t, h, u0, w0, w1, j, j);
-    map.P = r.dz0;
-    map.Q = r.dw0;
-    map.R = r.dw1;
-    return r.z1;
+    int jr;
+    linearisation.factored = true;
+    return stepper.factored_sub_step(t, h, u0, w0, w1, j, j, linearisation.sub, jr);
   }
   auto w_at = [&](double x) { return Vec<D>((1 - x / h) * w0 + (x / h) * w1); };
   Vec<D> z = u0;
@@ -100,9 +99,10 @@ Vec<Model::d> time_switch_step(const TrapezoidStepper<Model>& stepper, double t,
     X = next;
     z = r.z1;
   }
-  map.P = X.template leftCols<D>();
-  map.Q = X.template middleCols<D>(D);
-  map.R = X.template rightCols<D>();
+  linearisation.factored = false;
+  linearisation.map.P = X.template leftCols<D>();
+  linearisation.map.Q = X.template middleCols<D>(D);
+  linearisation.map.R = X.template rightCols<D>();
   return z;
 }
 
