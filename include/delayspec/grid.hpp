@@ -56,7 +56,9 @@ struct HistoryGrid {
   template <class V, class Slot>
   DelayTap<V> delay_tap(long l, const Slot& b) const {
     const long j = delayed_slot(l);
-    const double t = static_cast<double>(l % steps_per_period) * h;
+    // l mod K_1 without a division where l < K_1 (every step of a one-period map): a 64-bit
+    // idiv sat at the head of the step's dependency chain (t -> forcing -> S -> ...)
+    const double t = static_cast<double>(l < steps_per_period ? l : l % steps_per_period) * h;
     if (theta == 0) return {V(b(j)), V(b(j + 1)), t};
     const double c0 = 1 - theta;
     return {V(c0 * b(j) + theta * b(j - 1)), V(c0 * b(j + 1) + theta * b(j)), t};
