@@ -131,7 +131,7 @@ const std::map<std::string, std::string>& key_meanings() {
       {"orbit_max_periods", "simulate: most periods simulated before giving up (exit 3)"},
       {"orbit_max_iterations", "newton, auto, shooting: Newton steps allowed (per level), 1..10000"},
       {"orbit_guess_periods", "newton, auto, shooting: periods simulated from the initial history before the guess"},
-      {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this; one level below 8x it"},
+      {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this, then this; one level below 2x it"},
       {"nev", "multipliers wanted, >= 1"},
       {"solver",
        "eigensolver: auto (dense n <= 100, spectra n < 2000, arpack n < 200000, else block), spectra, arpack, block, dense, dense-eigen"},
