@@ -134,7 +134,7 @@ const std::map<std::string, std::string>& key_meanings() {
       {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this, then this; one level below 2x it"},
       {"nev", "multipliers wanted, >= 1"},
       {"solver",
-       "eigensolver: auto (dense n <= 100, spectra n < 2000, arpack n < 200000, else block), spectra, arpack, block, dense, dense-eigen"},
+       "eigensolver: auto (dense n <= 100, spectra n < 3000, else block), spectra, arpack, block, dense, dense-eigen"},
       {"block_size", "solver = block: vectors per product (Krylov-Schur; 1 = one vector, DCGS2), 1..64"},
       {"ncv", "Krylov subspace dimension; 0 = max(2 nev + 1, nev + 10), at most n"},
       {"tol", "Krylov: converged when residual estimate <= tol max(|mu|, eps^(2/3))"},
