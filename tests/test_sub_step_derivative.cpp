@@ -158,8 +158,8 @@ TEST(SubStepDerivative, TangentIsTheDerivativeOfTheDiscreteStep) {
     auto z1 = [&](double s) { return stepper.sub_step_state(t0, dt, z0 + s * a, w0 + s * b, w1 + s * c, 1, 1); };
     const Vec<2> fd = (z1(e) - z1(-e)) / (2 * e);
     const Vec<2> tangent = derivative.apply(a, b, c);
-    EXPECT_LE((tangent - fd).norm(), 1e-8 * (1 + fd.norm())) << "trial " << trial << ": tangent " << tangent.transpose()
-                                                             << ", finite difference " << fd.transpose();
+    EXPECT_LE((tangent - fd).norm(), 1e-8 * (1 + fd.norm()))
+        << "trial " << trial << ": tangent " << tangent.transpose() << ", finite difference " << fd.transpose();
     // The control: the same derivative with Bl and Br swapped is far outside the tolerance.
     detail::SubStepDerivative<2> swapped = derivative;
     std::swap(swapped.bl, swapped.br);

@@ -2,9 +2,12 @@
 // Lyapunov exponents of the discretised stroboscopic map (design.md 1.7).
 //
 // A block of k tangent vectors (k = `exponents`, much smaller than n = d (M + 1)) is carried
-// along the trajectory, fused with it step by step: each step of the stepper produces its step
-// map (P, Q, R), which is applied at once to the k interleaved tangent vectors
-// (block_kernel.hpp) and then forgotten; no step map is stored. Every `qr_every` stroboscopic
+// along the trajectory, fused with it step by step: each step of the stepper produces its
+// linearisation, which is applied at once to the k interleaved tangent vectors
+// (block_kernel.hpp, apply_step_linearisation) and then forgotten; no step map is stored, and
+// for a step that is one trapezoid sub-step (no event or time switch in it) none is formed:
+// its factored derivative S^{-1} [L du_0 + Bl dw0 + Br dw1] is applied directly
+// (detail/sub_step_derivative.hpp). Every `qr_every` stroboscopic
 // periods the n x k block is Householder-QR factorised in place (TangentQR), log |R_ii| is
 // accumulated and the block is replaced by Q. The first `transient` periods (trajectory and
 // tangent block both advance, so the block has time to align with the leading Lyapunov

@@ -28,9 +28,9 @@ struct StepMap {
 // `map`. formed() is the StepMap either way (what a monodromy stores).
 template <int D>
 struct StepLinearisation {
-  bool factored = false;               // which of the two below holds the derivative
-  detail::SubStepDerivative<D> sub;    // factored: the step's one sub-step
-  StepMap<D> map;                      // otherwise: P, Q, R of the composed pieces
+  bool factored = false;             // which of the two below holds the derivative
+  detail::SubStepDerivative<D> sub;  // factored: the step's one sub-step
+  StepMap<D> map;                    // otherwise: P, Q, R of the composed pieces
 
   StepMap<D> formed() const {
     if (!factored) return map;

@@ -63,9 +63,9 @@ class TrapezoidStepper {
   // and the three right-hand matrices, no product formed); right_region_out receives the right
   // node's region. Returns z1.
   [[gnu::always_inline]] inline V factored_sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1,
-                                                   int left_region, int right_region,
-                                                   detail::SubStepDerivative<D>& derivative,
-                                                   int& right_region_out) const {
+                                                    int left_region, int right_region,
+                                                    detail::SubStepDerivative<D>& derivative,
+                                                    int& right_region_out) const {
     const double t1 = t0 + dt;
     const V z1 = solve_sub_step(t0, dt, z0, w0, w1, left_region, right_region, right_region_out, derivative.s);
     const int jr = right_region_out;

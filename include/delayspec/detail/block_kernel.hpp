@@ -100,8 +100,9 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
 // step_block's 3 D^2 plus forming P, Q, R (3 D^3 per step): at D = 2, k = 2, 32 against 48.
 // A step that was split (events, time switches) has its map formed: step_block.
 template <int D, int KC>
-[[gnu::always_inline]] inline void apply_factored_step(const detail::SubStepDerivative<D>& s, const double* u0, const double* d0,
-                                long k_runtime, double theta, double* __restrict out) {
+[[gnu::always_inline]] inline void apply_factored_step(const detail::SubStepDerivative<D>& s, const double* u0,
+                                                       const double* d0, long k_runtime, double theta,
+                                                       double* __restrict out) {
   constexpr int C = KC > 0 ? KC : 1;  // vectors per block
   using Slot = Eigen::Matrix<double, D, C, C == 1 ? Eigen::ColMajor : Eigen::RowMajor>;
   // KC > 0: a slot is one contiguous D x KC row-major block; KC = 0: vector v is the column
@@ -128,12 +129,11 @@ template <int D, int KC>
 // A step's linearisation, factored or formed, applied to k interleaved vectors (the Lyapunov
 // loop): the arguments as in step_block.
 template <int D, int KC>
-[[gnu::always_inline]] inline void apply_step_linearisation(const StepLinearisation<D>& s, const double* u0, const double* d0, long k,
-                                     double theta, double* __restrict out) {
-  if (s.factored)
-    apply_factored_step<D, KC>(s.sub, u0, d0, k, theta, out);
-  else
-    step_block<D, detail::PortableTarget, KC>(s.map, u0, d0, k, theta, out);
+[[gnu::always_inline]] inline void apply_step_linearisation(const StepLinearisation<D>& s, const double* u0,
+                                                            const double* d0, long k, double theta,
+                                                            double* __restrict out) {
+  if (s.factored) apply_factored_step<D, KC>(s.sub, u0, d0, k, theta, out);
+  else step_block<D, detail::PortableTarget, KC>(s.map, u0, d0, k, theta, out);
 }
 
 // Interleave an n x k column-major block X (leading dimension ldx) into slots: b[i k + v] = X(i, v),
