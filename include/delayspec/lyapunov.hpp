@@ -192,18 +192,23 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
   auto advance_with = [&]<int KC>(bool record) {
     // A decaying trajectory would go subnormal and run ~2x slower (flush_subnormals.hpp)
     const detail::FlushSubnormals flush_subnormals;
-    auto slot = [&traj](long i) -> const V& { return traj[i]; };
+    // Local copies: the grid's doubles (h, theta) and the buffers' pointers stay in registers
+    // (through the captured references they were reloaded every step: a store of a double may
+    // alias them)
+    const HistoryGrid g = grid;
+    V* const u = traj.data();
+    double* const b = block.data();
+    auto slot = [u](long i) -> const V& { return u[i]; };
     for (long l = 0; l < K; ++l) {
-      const DelayTap<V> tap = grid.delay_tap<V>(l, slot);
+      const DelayTap<V> tap = g.delay_tap<V>(l, slot);
       StepLinearisation<D> step_linearisation;  // a local: kept in registers where the step inlines
-      traj[M + l + 1] = stepper.step(tap.t, grid.h, traj[M + l], tap.w0, tap.w1, step_linearisation);
+      u[M + l + 1] = stepper.step(tap.t, g.h, u[M + l], tap.w0, tap.w1, step_linearisation);
       // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same
       // tap), P, Q, R not formed where the step is one sub-step (apply_step_linearisation)
-      apply_step_linearisation<D, KC>(step_linearisation, block.data() + (M + l) * stride,
-                                      block.data() + grid.delayed_slot(l) * stride, k, grid.theta,
-                                      block.data() + (M + l + 1) * stride);
+      apply_step_linearisation<D, KC>(step_linearisation, b + (M + l) * stride, b + g.delayed_slot(l) * stride, k,
+                                      g.theta, b + (M + l + 1) * stride);
       if (record && section_count < options.section_points && (l + 1) % spp == 0)  // (no division unless recording)
-        result.section.row(section_count++) = traj[M + l + 1].transpose();
+        result.section.row(section_count++) = u[M + l + 1].transpose();
     }
     std::copy(traj.begin() + K, traj.end(), traj.begin());  // history at the end -> slots 0..M
   };
