@@ -167,24 +167,36 @@ __attribute__((target("avx2,fma"))) double peak_pipes_avx2(long reps, double s0)
   const V4 s = {s0, s0, s0, s0}, y = s * 0.999, z = s * 1e-3;
   DELAYSPEC_PEAK_PIPES_BODY(V4)  // a y + z contracts to one FMA (-ffp-contract=fast, GCC's default)
 }
+typedef double V8 __attribute__((vector_size(64)));
+__attribute__((target("avx512f"))) double peak_pipes_avx512(long reps, double s0) {
+  const V8 s = {s0, s0, s0, s0, s0, s0, s0, s0}, y = s * 0.999, z = s * 1e-3;
+  DELAYSPEC_PEAK_PIPES_BODY(V8)  // one 64-byte FMA per accumulator (zmm)
+}
 
 void BM_PeakFmaPipes(benchmark::State& state) {
-  const bool avx2 = state.range(0) == 1;
-  if (avx2 && !(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) {
+  const long isa = state.range(0);
+  if (isa == 1 && !(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) {
     state.SkipWithError("this CPU has no AVX2 + FMA");
+    return;
+  }
+  if (isa == 2 && !__builtin_cpu_supports("avx512f")) {
+    state.SkipWithError("this CPU has no AVX-512F");
     return;
   }
   constexpr long reps = 100000;
   double s0 = 1.0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(s0);
-    const double r = avx2 ? peak_pipes_avx2(reps, s0) : peak_pipes_default(reps, s0);
+    const double r = isa == 2   ? peak_pipes_avx512(reps, s0)
+                     : isa == 1 ? peak_pipes_avx2(reps, s0)
+                                : peak_pipes_default(reps, s0);
     benchmark::DoNotOptimize(r);
   }
-  const double elements = static_cast<double>(state.iterations()) * reps * 12 * (avx2 ? 4 : 2);
+  const double width = isa == 2 ? 8 : isa == 1 ? 4 : 2;  // doubles per vector
+  const double elements = static_cast<double>(state.iterations()) * reps * 12 * width;
   state.counters["GFlops"] = benchmark::Counter(elements * 2 * 1e-9, benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_PeakFmaPipes)->Arg(0)->Arg(1);
+BENCHMARK(BM_PeakFmaPipes)->Arg(0)->Arg(1)->Arg(2);
 
 }  // namespace
 
