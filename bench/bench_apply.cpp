@@ -2,9 +2,10 @@
 //
 //  BM_ApplyBlock/N/k/path   apply_block of the delayed Mathieu monodromy (d = 2, tau = T, K = N
 //                      steps) to k vectors, on kernel path 0 = main's kernel before issue 17
-//                      (kernels_before.hpp), 1 = baseline (portable build), 2 = dispatched (AVX2 +
-//                      FMA where the CPU has it; kernel_dispatch.hpp). Counters: ns per step per
-//                      vector, and the achieved rates under the traffic model below.
+//                      (kernels_before.hpp), 1 = baseline (portable build), 2 = dispatched (the
+//                      widest path the CPU has: AVX-512 or AVX2 + FMA; kernel_dispatch.hpp), 3 =
+//                      AVX2 + FMA forced (the same as 2 on a CPU without AVX-512). Counters: ns per
+//                      step per vector, and the achieved rates under the traffic model below.
 //  BM_PerformOp/N/path single-vector perform_op on the same operator and paths: ns per step.
 //  BM_Triad/n          STREAM-like triad a = b + s c over n doubles per array: memory bandwidth
 //                      (24 bytes per element moved, write-allocate not counted, as in STREAM).
@@ -35,11 +36,12 @@ namespace {
 
 using namespace delayspec;
 
-enum Variant { kBefore = 0, kBaseline = 1, kDispatched = 2 };
+enum Variant { kBefore = 0, kBaseline = 1, kDispatched = 2, kAvx2 = 3 };
 
 // The operator on the kernel path of `variant` (DELAYSPEC_KERNEL is read at construction).
 Monodromy<2> mathieu_monodromy(int N, long variant = kDispatched) {
   if (variant == kBaseline) setenv("DELAYSPEC_KERNEL", "baseline", 1);
+  else if (variant == kAvx2) setenv("DELAYSPEC_KERNEL", "avx2", 1);
   else unsetenv("DELAYSPEC_KERNEL");
   const MathieuModel model({.kappa = 0.1, .delta = 1, .eps = 1, .b = 0.2});
   TrapezoidStepper<MathieuModel> stepper(model);
@@ -70,7 +72,7 @@ void BM_ApplyBlock(benchmark::State& state) {
   state.counters["GFlops"] = benchmark::Counter(iters * flops * 1e-9, benchmark::Counter::kIsRate);
   state.counters["working_set_KiB"] = (8.0 * ((N + 1 + K) * d * k + 9.0 * d * d * K / 3.0)) / 1024.0;
 }
-BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 2, 4, 8, 16, 32}, {0, 1, 2}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 2, 4, 8, 16, 32}, {0, 1, 2, 3}})->Unit(benchmark::kMicrosecond);
 
 void BM_PerformOp(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
