@@ -106,8 +106,19 @@ void BM_Triad(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(state.iterations()) * 24.0 * n * 1e-9, benchmark::Counter::kIsRate);
   state.counters["KiB_total"] = 24.0 * n / 1024.0;
 }
-// 3 arrays of: 16 KiB (L1), 256 KiB (L2), 4 MiB (L3), 64 MiB (memory).
+// 3 arrays of: 16 KiB (L1), 256 KiB (L2), 4 MiB (L3), 64 MiB (memory); then 3 arrays totalling
+// BM_ApplyBlock's streaming working sets (X + Y + maps, d = 2, tau = T) for k = 8, 16, 32 at
+// N = 1000 (352, 608, 1121 KB) and N = 4000 (1408, 2432, 4480 KB): the bandwidth at the
+// kernel's own size, between the levels (docs/benchmarks.md, seventh sitting).
 BENCHMARK(BM_Triad)->Arg(2048)->Arg(32768)->Arg(524288)->Arg(8388608)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Triad)
+    ->Arg(14677)
+    ->Arg(25355)
+    ->Arg(46709)
+    ->Arg(58677)
+    ->Arg(101355)
+    ->Arg(186709)
+    ->Unit(benchmark::kMicrosecond);
 
 // 1000 passes of o = 0.5 o + p a + q b + r c over 32 doubles; the same source compiled twice.
 #define DELAYSPEC_PEAK_FMA_BODY                                                       \
