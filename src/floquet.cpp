@@ -28,8 +28,7 @@ FloquetSolver parse_floquet_solver(const std::string& name) {
 
 FloquetSolver choose_floquet_solver(long n) {
   if (n <= 100) return FloquetSolver::dense_lapack;
-  if (n < 2000) return FloquetSolver::spectra;
-  return n < 200000 ? FloquetSolver::arpack : FloquetSolver::block;
+  return n < 3000 ? FloquetSolver::spectra : FloquetSolver::block;
 }
 
 std::string to_string(FloquetSolver solver) {

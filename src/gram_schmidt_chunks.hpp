@@ -51,6 +51,15 @@ double lanes_sum(Pack v) {
   return sum;
 }
 
+// A sum over rows of one column (a dot product, a squared norm) kept in kChains packs: each pack's
+// multiply-adds form a chain that waits for the previous one (4 cycles an FMA), so one pack
+// bounds the loop at a pack per 4 cycles; four independent ones let it run at the loads' rate
+// (perf, GMRES at n = 4002: the one-pack loops were half of the coefficient pass and a third of
+// the subtraction, whose 4-column loops already keep 4 sums).
+constexpr long kChains = 4;
+
+Pack chains_sum(const Pack (&chains)[kChains]) { return (chains[0] + chains[1]) + (chains[2] + chains[3]); }
+
 // Partial s = Q^T x, t = Q^T y over rows [a, b), four columns per sweep of x and y.
 template <bool kTwo>
 void chunk_coefficients(const double* __restrict Q, long n, long j, const double* __restrict x,
@@ -91,16 +100,22 @@ void chunk_coefficients(const double* __restrict Q, long n, long j, const double
       if constexpr (kTwo) t[c + l] = tc[l];
     }
   }
-  for (; c < j; ++c) {
+  for (; c < j; ++c) {  // the last j mod 4 columns, one at a time: kChains sums each
     const double* q = Q + c * n;
-    Pack sv{}, tv{};
+    Pack sv[kChains]{}, tv[kChains]{};
     long i = a;
+    for (; i + kChains * kLanes <= b; i += kChains * kLanes)
+      for (long u = 0; u < kChains; ++u) {
+        const Pack qv = load(q + i + u * kLanes);
+        sv[u] += qv * load(x + i + u * kLanes);
+        if constexpr (kTwo) tv[u] += qv * load(y + i + u * kLanes);
+      }
     for (; i + kLanes <= b; i += kLanes) {
       const Pack qv = load(q + i);
-      sv += qv * load(x + i);
-      if constexpr (kTwo) tv += qv * load(y + i);
+      sv[0] += qv * load(x + i);
+      if constexpr (kTwo) tv[0] += qv * load(y + i);
     }
-    double sc = lanes_sum(sv), tc = lanes_sum(tv);
+    double sc = lanes_sum(chains_sum(sv)), tc = lanes_sum(chains_sum(tv));
     for (; i < b; ++i) {
       sc += q[i] * x[i];
       if constexpr (kTwo) tc += q[i] * y[i];
@@ -132,18 +147,28 @@ ProjectedProducts chunk_subtract(const double* __restrict Q, long n, long j, con
       if constexpr (kTwo) y[i] -= t[c] * q[i];
     }
   }
-  Pack xx{}, xy{}, yy{};
+  Pack xx[kChains]{}, xy[kChains]{}, yy[kChains]{};
   long i = a;
+  for (; i + kChains * kLanes <= b; i += kChains * kLanes)
+    for (long u = 0; u < kChains; ++u) {
+      const Pack xv = load(x + i + u * kLanes);
+      xx[u] += xv * xv;
+      if constexpr (kTwo) {
+        const Pack yv = load(y + i + u * kLanes);
+        xy[u] += xv * yv;
+        yy[u] += yv * yv;
+      }
+    }
   for (; i + kLanes <= b; i += kLanes) {
     const Pack xv = load(x + i);
-    xx += xv * xv;
+    xx[0] += xv * xv;
     if constexpr (kTwo) {
       const Pack yv = load(y + i);
-      xy += xv * yv;
-      yy += yv * yv;
+      xy[0] += xv * yv;
+      yy[0] += yv * yv;
     }
   }
-  ProjectedProducts p{lanes_sum(xx), lanes_sum(xy), lanes_sum(yy)};
+  ProjectedProducts p{lanes_sum(chains_sum(xx)), lanes_sum(chains_sum(xy)), lanes_sum(chains_sum(yy))};
   for (; i < b; ++i) {
     p.xx += x[i] * x[i];
     if constexpr (kTwo) {

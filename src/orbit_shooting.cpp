@@ -20,11 +20,17 @@ std::vector<int> shooting_levels(const HistoryGrid& grid, int coarse_N, int refi
   std::vector<int> Ns{grid.N};
   for (;;) {
     const double target = static_cast<double>(Ns.back()) / refinement;
-    if (target < coarse_N) break;  // so that N < refinement coarse_N is exactly one level
+    if (target < coarse_N) break;
     const long coarser = multiple * std::max(1L, std::lround(target / static_cast<double>(multiple)));
     if (coarser >= Ns.back()) break;
     Ns.push_back(static_cast<int>(coarser));
   }
+  // Then coarse_N itself (the smallest valid N >= it) unless that is more than half the last level:
+  // the guess is simulated at about coarse_N whatever N is (the attractor a run from the initial
+  // history settles on is chosen on one grid, not on one that depends on where N falls between
+  // powers of 8), and its periods cost a half to an eighth of those at the last level's N.
+  const long coarsest = multiple * ((coarse_N + multiple - 1) / multiple);
+  if (2 * coarsest <= Ns.back()) Ns.push_back(static_cast<int>(coarsest));
   std::reverse(Ns.begin(), Ns.end());
   return Ns;
 }

@@ -199,11 +199,10 @@ TEST(KrylovBlock, OneVectorAtLargeDimensionAgreesWithArpackAndLambertW) {
 TEST(Krylov, AutoPicksByDimension) {
   EXPECT_EQ(choose_floquet_solver(100), FloquetSolver::dense_lapack);
   EXPECT_EQ(choose_floquet_solver(101), FloquetSolver::spectra);
-  EXPECT_EQ(choose_floquet_solver(1999), FloquetSolver::spectra);
-  EXPECT_EQ(choose_floquet_solver(2000), FloquetSolver::arpack);
-  EXPECT_EQ(choose_floquet_solver(199999), FloquetSolver::arpack);
+  EXPECT_EQ(choose_floquet_solver(2999), FloquetSolver::spectra);
+  EXPECT_EQ(choose_floquet_solver(3000), FloquetSolver::block);
   EXPECT_EQ(choose_floquet_solver(200000), FloquetSolver::block);
-  const auto op = zero_orbit_monodromy(LinearModel({.a = -1, .b = -2, .tau = 1, .period = 1}), 200000);
+  const auto op = zero_orbit_monodromy(LinearModel({.a = -1, .b = -2, .tau = 1, .period = 1}), 3000);
   EXPECT_EQ(solve(op, FloquetSolver::automatic, 2).solver, "block");
 }
 

@@ -125,21 +125,28 @@ TEST(Gmres, BasisStaysOrthonormalWhenTheFirstPassCancels) {
   EXPECT_EQ(again.x, r.x);
 }
 
-// The levels: N, N/8, ... while >= coarse_N, each a valid N for the grid.
+// The levels: N, N/8, ... while >= coarse_N, then coarse_N itself when that is at most half the
+// last, each a valid N for the grid.
 TEST(ShootingLevels, GeometricAndValidForTheGrid) {
   const ImpactModel model(paper(1.0));
   EXPECT_EQ(shooting_levels(make_grid(model.tau(), model.period(), 1'000'000), 64, 8),
-            (std::vector<int>{244, 1953, 15625, 125000, 1000000}));
-  EXPECT_EQ(shooting_levels(make_grid(model.tau(), model.period(), 511), 64, 8), (std::vector<int>{511}));
+            (std::vector<int>{64, 244, 1953, 15625, 125000, 1000000}));
+  EXPECT_EQ(shooting_levels(make_grid(model.tau(), model.period(), 2000), 64, 8), (std::vector<int>{64, 250, 2000}));
+  EXPECT_EQ(shooting_levels(make_grid(model.tau(), model.period(), 511), 64, 8), (std::vector<int>{64, 511}));
   EXPECT_EQ(shooting_levels(make_grid(model.tau(), model.period(), 512), 64, 8), (std::vector<int>{64, 512}));
+  EXPECT_EQ(shooting_levels(make_grid(model.tau(), model.period(), 128), 64, 8), (std::vector<int>{64, 128}));
+  EXPECT_EQ(shooting_levels(make_grid(model.tau(), model.period(), 127), 64, 8), (std::vector<int>{127}));
+  EXPECT_EQ(shooting_levels(make_grid(model.tau(), model.period(), 40), 64, 8), (std::vector<int>{40}));
   // tau = 3 T / 2: N must be a multiple of 3, so each level is (N / 8 rounded to a multiple of 3)
+  // and the coarsest the first multiple of 3 from 64
   const double T = model.period();
   const std::vector<int> three = shooting_levels(make_grid(1.5 * T, T, 3000), 64, 8);
-  EXPECT_EQ(three, (std::vector<int>{375, 3000}));
+  EXPECT_EQ(three, (std::vector<int>{66, 375, 3000}));
   for (int N : three) EXPECT_NO_THROW(make_grid(1.5 * T, T, N)) << N;
   // tau = 2 T / 3: N multiple of 2
   const std::vector<int> two = shooting_levels(make_grid(2 * T / 3, T, 10000), 64, 8);
-  EXPECT_EQ(two, (std::vector<int>{156, 1250, 10000}));
+  EXPECT_EQ(two, (std::vector<int>{64, 156, 1250, 10000}));
+  for (int N : two) EXPECT_NO_THROW(make_grid(2 * T / 3, T, N)) << N;
   EXPECT_THROW(shooting_levels(make_grid(T, T, 100), 0, 8), BadInput);
   EXPECT_THROW(shooting_levels(make_grid(T, T, 100), 64, 1), BadInput);
 }
@@ -212,8 +219,8 @@ TEST(OrbitShooting, UnstableOrbitSimulationCannotReach) {
   o.guess_periods = 0;
   OrbitLinearisation<2> at_orbit;
   const PeriodicOrbit shot = orbit_by_nested_shooting(s.map, s.model.initial_state(), o, &at_orbit);
-  ASSERT_EQ(shot.levels.size(), 2u);               // 128, 1024
-  EXPECT_LE(shot.levels[1].newton_iterations, 4);  // measured 4: 1.2e-3, 1.1e-4, 6.8e-7, 5.1e-11, 6.7e-14
+  ASSERT_EQ(shot.levels.size(), 3u);               // 64, 128, 1024
+  EXPECT_LE(shot.levels[2].newton_iterations, 4);  // measured 4: 1.2e-3, 1.1e-4, 6.8e-7, 5.1e-11, 6.7e-14
   const PeriodicOrbit newton = sparse_newton(s, 0);
   EXPECT_LT(relative_distance(shot.history, newton.history), 1e-10);
   FloquetOptions f;
@@ -229,8 +236,9 @@ TEST(OrbitShooting, UnstableOrbitSimulationCannotReach) {
 // needs three at k = 1), sparse-LU Newton from the same guess finds the orbit, and it is the one
 // sparse_newton finds (1e-10 relative, as above); where both fail the error names both.
 TEST(OrbitShooting, AutomaticCoarseLevelFallsBackToSparseNewton) {
-  ImpactSetup s(paper(1.0), 200);  // N < 8 coarse_N: the coarsest level is the only one
+  ImpactSetup s(paper(1.0), 200);
   NestedShootingOptions o;
+  o.coarse_N = 200;  // the coarsest level is the only one
   o.shooting.max_iterations = 1;
   const PeriodicOrbit orbit = orbit_by_nested_shooting(s.map, s.model.initial_state(), o);
   ASSERT_EQ(orbit.levels.size(), 1u);

@@ -64,11 +64,11 @@ std::string to_string(FloquetSolver solver);
 
 // solver = auto: the backend measured fastest for the operator's size (docs/benchmarks.md,
 // "Choosing the eigensolver"): dense LAPACK for n <= 100 (all eigenvalues, no Krylov constraint,
-// as fast as Krylov there), Spectra for n < 2000, ARPACK from n = 2000 (its BLAS dgemv
-// orthogonalisation: 1.2x Spectra at n = 8000, 3x at n = 128000, nev = 20), and from
-// n = 200000 the one-vector Krylov-Schur (block, block_size = 1), whose Gram-Schmidt reads the
-// basis twice per product instead of four times, on all cores: 1.4x ARPACK at n = 250000, 1.8x
-// at n = 2e6; equal at n = 128000, where the basis still fits the cache.
+// as fast as Krylov there), Spectra for n < 3000, and from n = 3000 the one-vector Krylov-Schur
+// (block, block_size = 1), whose Gram-Schmidt reads the basis twice per product (ARPACK's four
+// times), in AVX2 passes on all cores: nev = 10 and 20, it is 1.2-1.5x faster than ARPACK from
+// n = 2000 to 200000 and 2x at n = 2e6, and overtakes Spectra between n = 2500 and 3500. ARPACK,
+// the fastest from n = 2000 before the passes had AVX2 kernels, stays available by name.
 FloquetSolver choose_floquet_solver(long n);
 
 struct FloquetOptions {

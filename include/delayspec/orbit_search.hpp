@@ -3,10 +3,11 @@
 // zero orbit of a linear model), and the orbit's contacts with the switching surface.
 //
 // orbit = auto (default): nested iteration (orbit_shooting.hpp): levels N, N/8, ... down to the
-//   last one >= orbit_coarse_N; at the coarsest, orbit_guess_periods maps simulated from the
-//   constant initial history and Newton-Krylov shooting, or sparse-LU Newton from the same guess
-//   if shooting fails; every finer level by shooting from the coarser orbit. With N < 8
-//   orbit_coarse_N there is one level, N itself. Finds unstable orbits too.
+//   last one >= orbit_coarse_N, then orbit_coarse_N itself unless it exceeds half the last; at
+//   the coarsest, orbit_guess_periods maps simulated from the constant initial history and
+//   Newton-Krylov shooting, or sparse-LU Newton from the same guess if shooting fails; every
+//   finer level by shooting from the coarser orbit. With N < 2 orbit_coarse_N there is one
+//   level, N itself. Finds unstable orbits too.
 // orbit = shooting: the same levels, shooting only (no sparse-LU fallback).
 // orbit = simulate: iterate the map from the constant initial history until it settles.
 // orbit = newton: simulate orbit_guess_periods maps from the constant initial history, then

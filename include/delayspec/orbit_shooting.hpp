@@ -15,7 +15,8 @@
 // steps: the dominant cost) plus a few GMRES products (~ 1 % of a map each).
 //
 // Nested iteration. Levels N_0 < N_1 < ... < N_L = N, N_{i-1} ~ N_i / 8 (a valid grid: a multiple
-// of p when tau / T = p / q), down to the last one >= coarse_N. The coarsest orbit comes from
+// of p when tau / T = p / q), down to the last one >= coarse_N, then N_0 = coarse_N itself (the
+// first valid N from it) unless that exceeds half N_1. The coarsest orbit comes from
 // `guess_periods` maps simulated from the constant initial history, then Newton at N_0 (shooting,
 // sparse LU if that fails: CoarseOrbitMethod below); each finer level starts from the coarser orbit prolonged in time
 // (prolong_periodic_sequence). The prolonged guess is O(h_{i-1}^2) from the level's orbit, so a
@@ -171,12 +172,13 @@ struct NestedShootingOptions {
   OrbitByNewtonOptions newton;  // coarsest level, sparse LU
   CoarseOrbitMethod coarse_method = CoarseOrbitMethod::automatic;
   long guess_periods = 100;  // maps simulated from the initial history for the coarsest guess
-  int coarse_N = 64;         // the coarsest level is the last N_i >= coarse_N (or N itself)
+  int coarse_N = 64;         // the coarsest level (or N itself below 2 coarse_N): shooting_levels
   int refinement = 8;        // N_i / N_{i-1}
 };
 
 // The levels N_0 < ... < N_L = grid.N (header): N_{i-1} = the valid N nearest N_i / refinement,
-// while that is >= coarse_N. One level (N itself) when N < refinement coarse_N.
+// while that is >= coarse_N, then the first valid N >= coarse_N unless that exceeds half the last.
+// One level (N itself) when N < 2 coarse_N.
 std::vector<int> shooting_levels(const HistoryGrid& grid, int coarse_N, int refinement);
 
 // Nested shooting for the map's grid (header), from the constant initial history y0 at the
