@@ -72,7 +72,9 @@ void BM_ApplyBlock(benchmark::State& state) {
   state.counters["GFlops"] = benchmark::Counter(iters * flops * 1e-9, benchmark::Counter::kIsRate);
   state.counters["working_set_KiB"] = (8.0 * ((N + 1 + K) * d * k + 9.0 * d * d * K / 3.0)) / 1024.0;
 }
-BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 2, 4, 8, 16, 32}, {0, 1, 2, 3}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ApplyBlock)
+    ->ArgsProduct({{1000, 4000}, {1, 2, 4, 8, 16, 32}, {0, 1, 2, 3}})
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_PerformOp(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
@@ -111,14 +113,8 @@ void BM_Triad(benchmark::State& state) {
 // N = 1000 (352, 608, 1121 KB) and N = 4000 (1408, 2432, 4480 KB): the bandwidth at the
 // kernel's own size, between the levels (docs/benchmarks.md, seventh sitting).
 BENCHMARK(BM_Triad)->Arg(2048)->Arg(32768)->Arg(524288)->Arg(8388608)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Triad)
-    ->Arg(14677)
-    ->Arg(25355)
-    ->Arg(46709)
-    ->Arg(58677)
-    ->Arg(101355)
-    ->Arg(186709)
-    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Triad)->Arg(14677)->Arg(25355)->Arg(46709)->Arg(58677)->Arg(101355)->Arg(186709)->Unit(
+    benchmark::kMicrosecond);
 
 // 1000 passes of o = 0.5 o + p a + q b + r c over 32 doubles; the same source compiled twice.
 #define DELAYSPEC_PEAK_FMA_BODY                                                       \

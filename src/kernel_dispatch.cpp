@@ -38,8 +38,8 @@ KernelPath choose_kernel_path(KernelPath widest) {
   KernelPath path = cpu;
   if (!wanted.empty() && wanted != "auto") {
     const KernelPath named[] = {KernelPath::baseline, KernelPath::avx2, KernelPath::avx512};
-    const auto it = std::find_if(std::begin(named), std::end(named),
-                                 [&](KernelPath p) { return wanted == kernel_path_name(p); });
+    const auto it =
+        std::find_if(std::begin(named), std::end(named), [&](KernelPath p) { return wanted == kernel_path_name(p); });
     if (it == std::end(named))
       throw BadInput("DELAYSPEC_KERNEL = '" + wanted + "': must be 'baseline', 'avx2', 'avx512' or 'auto' (or unset)");
     if (*it > cpu)

@@ -25,7 +25,9 @@
 //
 // Two blocks of 8 vectors run side by side where k allows (k a multiple of 16, and the 16 of
 // k = 24): they share each coefficient broadcast and interleave two recurrences u -> out (2
-// dependent FMAs per step: one block alone waits on that chain, 8 cycles per step).
+// dependent FMAs per step: one block alone waits on that chain, 8 cycles per step). The steps go
+// in runs of 512 over all vectors (stream_runs.hpp). bench_apply: 1.2-1.35x faster per vector
+// than the AVX2 kernel for k = 8, 16, 32 (docs/benchmarks.md, seventh sitting).
 //
 // Symbols: as in src/block_kernel_avx2.cpp, everything but stream_steps_avx512 is in an unnamed
 // namespace (no weak symbol with AVX-512 code that the linker could pick for a portable caller):
@@ -43,6 +45,7 @@
 #pragma GCC diagnostic pop
 
 #include "delayspec/detail/kernel_dispatch.hpp"
+#include "stream_runs.hpp"
 
 namespace delayspec::detail {
 
@@ -197,20 +200,13 @@ void stream_blocks(const StepMap<2>* maps, long l0, long l1, long K, long M, lon
   }
 }
 
-// Runs of kRun steps, all vectors per run (as in the AVX2 kernel: the blocks after the first
-// re-read the run's 48 KiB of step maps from L1/L2, not L3).
-constexpr long kRun = 512;
-
 template <bool Interpolate>
 void stream_all(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx, long k,
                 double* Y, long ldy) {
-  for (long l0 = 0; l0 < K; l0 += kRun) {
-    const long l1 = l0 + kRun < K ? l0 + kRun : K;
-    long v = 0;
-    for (; v + 16 <= k; v += 16)
-      stream_blocks<Interpolate, 2>(maps, l0, l1, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
-    if (v < k) stream_blocks<Interpolate, 1>(maps, l0, l1, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
-  }
+  stream_in_runs<8>(K, k, [&](long l0, long l1, long v, auto blocks) {
+    stream_blocks<Interpolate, decltype(blocks)::value>(maps, l0, l1, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy,
+                                                        ldy);
+  });
 }
 
 }  // namespace

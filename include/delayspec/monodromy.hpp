@@ -77,7 +77,9 @@ class Monodromy final : public LinearOperator {
 
   // The widest path compiled in the library for D: the AVX-512 kernel is d = 2's streaming one,
   // AVX2 + FMA code exists for D = 1, 2; another D (compiled outside the library) is portable.
-  static constexpr KernelPath kWidestPath = D == 2 ? KernelPath::avx512 : D == 1 ? KernelPath::avx2 : KernelPath::baseline;
+  static constexpr KernelPath kWidestPath = D == 2   ? KernelPath::avx512
+                                            : D == 1 ? KernelPath::avx2
+                                                     : KernelPath::baseline;
   static constexpr bool kHasAvx2Kernel = kWidestPath != KernelPath::baseline;
 
   // How the last apply_block ran (the tests assert it): one vector through perform_op; the whole
