@@ -20,9 +20,10 @@
 // Roofline time = max(flops / peak_flops, bytes / bandwidth), bandwidth from BM_Triad at the
 // working-set size (buffer (N + 1 + K) d k doubles + step maps).
 // The fused streaming kernels (d = 2, k even: no buffer, no copies) move only X once, Y once and
-// the maps: bytes = 8 (2 n k + 3 d^2 K); against them the model above is not a bound, and the
-// flop ceiling is BM_PeakFmaPipes (docs/benchmarks.md, sixth sitting for apply_block). The
-// model_GBps counter keeps the model above.
+// the maps: bytes = 8 (2 n k + 3 d^2 K); against them the model above is not a bound, the flop
+// ceiling is the best BM_PeakFmaPipes over all paths (whichever path is judged) and the
+// bandwidth the triad at X + Y + maps (docs/benchmarks.md, sixth and seventh sittings for
+// apply_block). The model_GBps counter keeps the model above.
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -153,7 +154,8 @@ BENCHMARK(BM_PeakFma)->Arg(0)->Arg(1);
 
 // The FP pipes' own peak: 12 independent accumulators a = a y + z held in registers, no memory
 // access, 2 flops per element: with the default flags a multiply and an add on 16-byte vectors
-// (isa 0), with AVX2 + FMA one 32-byte FMA (isa 1). BM_PeakFma above runs the kernel-shaped loop
+// (isa 0), with AVX2 + FMA one 32-byte FMA (isa 1), with AVX-512F one 64-byte FMA (isa 2; on a
+// CPU with full-width 512-bit FMA units twice isa 1). BM_PeakFma above runs the kernel-shaped loop
 // (4 loads and a store per 4 arithmetic instructions, a multiply counted as 1 of 7 flops): a
 // ceiling of that loop, below this one. docs/benchmarks.md says which one bounds what.
 typedef double V2 __attribute__((vector_size(16)));
