@@ -309,23 +309,27 @@ TEST(KernelDispatch, UnknownKernelNameIsBadInputNamingIt) {
 
 // The fused kernels called directly (kernel_dispatch.hpp) on X and Y whose last column ends where
 // an inaccessible page begins: a read of a column past X's k (the AVX2 kernel's unused second
-// block did that before 5410999, when k - v = 4) or a write past Y's would fault. k covers a last
+// block did that before 5410999, when k - v = 4) or a write past Y's would fault; and on X and Y
+// that start right after one (a read before slot 0, e.g. of the interpolation's slot j0 - 1
+// when j0 = 0). k covers a last
 // block narrower than the kernel's widest (AVX2: 4, 12, 20; AVX-512: 8, 24, 40) and full ones
 // (16, 32), on a grid with runs of steps (K = 600 > 512) and an odd fractional one (K = 21).
 // The results must equal apply_block's on ordinary matrices on the same path: the same kernel,
 // the same sums, so bit for bit (EXPECT_EQ on the matrices, not a tolerance).
 namespace {
+enum class GuardAt { end, start };
 class GuardedColumns {
  public:
-  // n x k doubles whose last element is the last before an inaccessible page.
-  GuardedColumns(long n, long k) {
+  // n x k doubles whose last element is the last before an inaccessible page (GuardAt::end) or
+  // whose first is the first after one (GuardAt::start).
+  GuardedColumns(long n, long k, GuardAt at) {
     const long page = sysconf(_SC_PAGESIZE), bytes = 8 * n * k;
     size_ = (bytes + page - 1) / page * page + page;
     base_ = static_cast<char*>(mmap(nullptr, size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0));
     if (base_ == MAP_FAILED) throw std::runtime_error("mmap failed");
-    char* guard = base_ + size_ - page;
+    char* guard = at == GuardAt::end ? base_ + size_ - page : base_;
     if (mprotect(guard, page, PROT_NONE) != 0) throw std::runtime_error("mprotect failed");
-    data_ = reinterpret_cast<double*>(guard - bytes);
+    data_ = reinterpret_cast<double*>(at == GuardAt::end ? guard - bytes : guard + page);
   }
   ~GuardedColumns() { munmap(base_, size_); }
   GuardedColumns(const GuardedColumns&) = delete;
@@ -353,15 +357,17 @@ void expect_guarded_kernel_matches(KernelPath path, StreamKernel kernel, const H
     Eigen::MatrixXd expected;
     op.apply_block(X, expected);
     ASSERT_EQ(op.last_block_layout(), expected_layout(op, k));
-    GuardedColumns x(n, k), y(n, k);
-    std::copy(X.data(), X.data() + n * k, x.data());
-    std::fill(y.data(), y.data() + n * k, 0.0);
-    kernel(maps.data(), K, grid.M, grid.delayed_slot(0), grid.theta, x.data(), n, k, y.data(), n);
-    // The kernel writes the result slots M + 1 .. M + K (Y's slots M + 1 - K .. M); apply_block
-    // copies x's slots K .. M into Y's first M + 1 - K slots itself.
-    const Eigen::Map<const Eigen::MatrixXd> Y(y.data(), n, k);
-    const long first = 2 * (grid.M + 1 - K);
-    EXPECT_EQ(Y.bottomRows(n - first), expected.bottomRows(n - first));
+    for (GuardAt at : {GuardAt::end, GuardAt::start}) {
+      GuardedColumns x(n, k, at), y(n, k, at);
+      std::copy(X.data(), X.data() + n * k, x.data());
+      std::fill(y.data(), y.data() + n * k, 0.0);
+      kernel(maps.data(), K, grid.M, grid.delayed_slot(0), grid.theta, x.data(), n, k, y.data(), n);
+      // The kernel writes the result slots M + 1 .. M + K (Y's slots M + 1 - K .. M); apply_block
+      // copies x's slots K .. M into Y's first M + 1 - K slots itself.
+      const Eigen::Map<const Eigen::MatrixXd> Y(y.data(), n, k);
+      const long first = 2 * (grid.M + 1 - K);
+      EXPECT_EQ(Y.bottomRows(n - first), expected.bottomRows(n - first));
+    }
   }
 }
 }  // namespace
