@@ -2,9 +2,10 @@
 //
 //  BM_ApplyBlock/N/k/path   apply_block of the delayed Mathieu monodromy (d = 2, tau = T, K = N
 //                      steps) to k vectors, on kernel path 0 = main's kernel before issue 17
-//                      (kernels_before.hpp), 1 = baseline (portable build), 2 = dispatched (AVX2 +
-//                      FMA where the CPU has it; kernel_dispatch.hpp). Counters: ns per step per
-//                      vector, and the achieved rates under the traffic model below.
+//                      (kernels_before.hpp), 1 = baseline (portable build), 2 = dispatched (the
+//                      widest path the CPU has: AVX-512 or AVX2 + FMA; kernel_dispatch.hpp), 3 =
+//                      AVX2 + FMA forced (the same as 2 on a CPU without AVX-512). Counters: ns per
+//                      step per vector, and the achieved rates under the traffic model below.
 //  BM_PerformOp/N/path single-vector perform_op on the same operator and paths: ns per step.
 //  BM_Triad/n          STREAM-like triad a = b + s c over n doubles per array: memory bandwidth
 //                      (24 bytes per element moved, write-allocate not counted, as in STREAM).
@@ -19,9 +20,10 @@
 // Roofline time = max(flops / peak_flops, bytes / bandwidth), bandwidth from BM_Triad at the
 // working-set size (buffer (N + 1 + K) d k doubles + step maps).
 // The fused streaming kernels (d = 2, k even: no buffer, no copies) move only X once, Y once and
-// the maps: bytes = 8 (2 n k + 3 d^2 K); against them the model above is not a bound, and the
-// flop ceiling is BM_PeakFmaPipes (docs/benchmarks.md, sixth sitting for apply_block). The
-// model_GBps counter keeps the model above.
+// the maps: bytes = 8 (2 n k + 3 d^2 K); against them the model above is not a bound, the flop
+// ceiling is the best BM_PeakFmaPipes over all paths (whichever path is judged) and the
+// bandwidth the triad at X + Y + maps (docs/benchmarks.md, sixth and seventh sittings for
+// apply_block). The model_GBps counter keeps the model above.
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -35,11 +37,12 @@ namespace {
 
 using namespace delayspec;
 
-enum Variant { kBefore = 0, kBaseline = 1, kDispatched = 2 };
+enum Variant { kBefore = 0, kBaseline = 1, kDispatched = 2, kAvx2 = 3 };
 
 // The operator on the kernel path of `variant` (DELAYSPEC_KERNEL is read at construction).
 Monodromy<2> mathieu_monodromy(int N, long variant = kDispatched) {
   if (variant == kBaseline) setenv("DELAYSPEC_KERNEL", "baseline", 1);
+  else if (variant == kAvx2) setenv("DELAYSPEC_KERNEL", "avx2", 1);
   else unsetenv("DELAYSPEC_KERNEL");
   const MathieuModel model({.kappa = 0.1, .delta = 1, .eps = 1, .b = 0.2});
   TrapezoidStepper<MathieuModel> stepper(model);
@@ -70,7 +73,9 @@ void BM_ApplyBlock(benchmark::State& state) {
   state.counters["GFlops"] = benchmark::Counter(iters * flops * 1e-9, benchmark::Counter::kIsRate);
   state.counters["working_set_KiB"] = (8.0 * ((N + 1 + K) * d * k + 9.0 * d * d * K / 3.0)) / 1024.0;
 }
-BENCHMARK(BM_ApplyBlock)->ArgsProduct({{1000, 4000}, {1, 2, 4, 8, 16, 32}, {0, 1, 2}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ApplyBlock)
+    ->ArgsProduct({{1000, 4000}, {1, 2, 4, 8, 16, 32}, {0, 1, 2, 3}})
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_PerformOp(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
@@ -104,8 +109,13 @@ void BM_Triad(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(state.iterations()) * 24.0 * n * 1e-9, benchmark::Counter::kIsRate);
   state.counters["KiB_total"] = 24.0 * n / 1024.0;
 }
-// 3 arrays of: 16 KiB (L1), 256 KiB (L2), 4 MiB (L3), 64 MiB (memory).
+// 3 arrays of: 16 KiB (L1), 256 KiB (L2), 4 MiB (L3), 64 MiB (memory); then 3 arrays totalling
+// BM_ApplyBlock's streaming working sets (X + Y + maps, d = 2, tau = T) for k = 8, 16, 32 at
+// N = 1000 (352, 608, 1121 KB) and N = 4000 (1408, 2432, 4480 KB): the bandwidth at the
+// kernel's own size, between the levels (docs/benchmarks.md, seventh sitting).
 BENCHMARK(BM_Triad)->Arg(2048)->Arg(32768)->Arg(524288)->Arg(8388608)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Triad)->Arg(14677)->Arg(25355)->Arg(46709)->Arg(58677)->Arg(101355)->Arg(186709)->Unit(
+    benchmark::kMicrosecond);
 
 // 1000 passes of o = 0.5 o + p a + q b + r c over 32 doubles; the same source compiled twice.
 #define DELAYSPEC_PEAK_FMA_BODY                                                       \
@@ -144,7 +154,8 @@ BENCHMARK(BM_PeakFma)->Arg(0)->Arg(1);
 
 // The FP pipes' own peak: 12 independent accumulators a = a y + z held in registers, no memory
 // access, 2 flops per element: with the default flags a multiply and an add on 16-byte vectors
-// (isa 0), with AVX2 + FMA one 32-byte FMA (isa 1). BM_PeakFma above runs the kernel-shaped loop
+// (isa 0), with AVX2 + FMA one 32-byte FMA (isa 1), with AVX-512F one 64-byte FMA (isa 2; on a
+// CPU with full-width 512-bit FMA units twice isa 1). BM_PeakFma above runs the kernel-shaped loop
 // (4 loads and a store per 4 arithmetic instructions, a multiply counted as 1 of 7 flops): a
 // ceiling of that loop, below this one. docs/benchmarks.md says which one bounds what.
 typedef double V2 __attribute__((vector_size(16)));
@@ -167,24 +178,36 @@ __attribute__((target("avx2,fma"))) double peak_pipes_avx2(long reps, double s0)
   const V4 s = {s0, s0, s0, s0}, y = s * 0.999, z = s * 1e-3;
   DELAYSPEC_PEAK_PIPES_BODY(V4)  // a y + z contracts to one FMA (-ffp-contract=fast, GCC's default)
 }
+typedef double V8 __attribute__((vector_size(64)));
+__attribute__((target("avx512f"))) double peak_pipes_avx512(long reps, double s0) {
+  const V8 s = {s0, s0, s0, s0, s0, s0, s0, s0}, y = s * 0.999, z = s * 1e-3;
+  DELAYSPEC_PEAK_PIPES_BODY(V8)  // one 64-byte FMA per accumulator (zmm)
+}
 
 void BM_PeakFmaPipes(benchmark::State& state) {
-  const bool avx2 = state.range(0) == 1;
-  if (avx2 && !(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) {
+  const long isa = state.range(0);
+  if (isa == 1 && !(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) {
     state.SkipWithError("this CPU has no AVX2 + FMA");
+    return;
+  }
+  if (isa == 2 && !__builtin_cpu_supports("avx512f")) {
+    state.SkipWithError("this CPU has no AVX-512F");
     return;
   }
   constexpr long reps = 100000;
   double s0 = 1.0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(s0);
-    const double r = avx2 ? peak_pipes_avx2(reps, s0) : peak_pipes_default(reps, s0);
+    const double r = isa == 2   ? peak_pipes_avx512(reps, s0)
+                     : isa == 1 ? peak_pipes_avx2(reps, s0)
+                                : peak_pipes_default(reps, s0);
     benchmark::DoNotOptimize(r);
   }
-  const double elements = static_cast<double>(state.iterations()) * reps * 12 * (avx2 ? 4 : 2);
+  const double width = isa == 2 ? 8 : isa == 1 ? 4 : 2;  // doubles per vector
+  const double elements = static_cast<double>(state.iterations()) * reps * 12 * width;
   state.counters["GFlops"] = benchmark::Counter(elements * 2 * 1e-9, benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_PeakFmaPipes)->Arg(0)->Arg(1);
+BENCHMARK(BM_PeakFmaPipes)->Arg(0)->Arg(1)->Arg(2);
 
 }  // namespace
 

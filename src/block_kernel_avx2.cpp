@@ -19,6 +19,7 @@
 
 #include "delayspec/detail/block_kernel.hpp"
 #include "delayspec/detail/kernel_dispatch.hpp"
+#include "stream_runs.hpp"
 
 namespace delayspec::detail {
 
@@ -54,7 +55,8 @@ void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* d
 // Two blocks of 4 vectors run side by side and share each coefficient broadcast (a load that
 // feeds 2 FMAs instead of 1), which also interleaves two recurrences: one block alone is bound by
 // its chain u -> out, 2 dependent FMAs per step (16 cycles per pair against 12 for its 24 FMAs at
-// 2 per cycle). bench_apply: 0.49 against 0.54 ns per step per vector (N = 1000, k = 8).
+// 2 per cycle). bench_apply: 0.49 against 0.54 ns per step per vector (N = 1000, k = 8). The
+// steps go in runs of 512 over all vectors (stream_runs.hpp).
 namespace {
 
 struct Slot {
@@ -205,23 +207,13 @@ void stream_blocks(const StepMap<2>* maps, long l0, long l1, long K, long M, lon
   }
 }
 
-// Runs of kRun steps (even: only the last run can be odd), all vectors per run: each block of 8
-// vectors re-reads the run's step maps (kRun 96 bytes = 48 KiB), which the first block brought
-// into L1/L2; one pass per block over all K maps would read them from L3 at N = 4000 (384 KiB of
-// maps next to 1-4 MiB of X and Y). bench_apply, N = 4000, k = 32: 0.61 -> 0.52 ns per step per
-// vector (runs of 128 and 256: 0.54, 0.51; k = 8, one block, unchanged).
-constexpr long kRun = 512;
-
 template <bool Interpolate>
 void stream_all(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx, long k,
                 double* Y, long ldy) {
-  for (long l0 = 0; l0 < K; l0 += kRun) {
-    const long l1 = l0 + kRun < K ? l0 + kRun : K;
-    long v = 0;
-    for (; v + 8 <= k; v += 8)
-      stream_blocks<Interpolate, 2>(maps, l0, l1, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
-    if (v < k) stream_blocks<Interpolate, 1>(maps, l0, l1, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy, ldy);
-  }
+  stream_in_runs<4>(K, k, [&](long l0, long l1, long v, auto blocks) {
+    stream_blocks<Interpolate, decltype(blocks)::value>(maps, l0, l1, K, M, j0, theta, X + v * ldx, ldx, Y + v * ldy,
+                                                        ldy);
+  });
 }
 
 }  // namespace

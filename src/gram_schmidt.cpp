@@ -41,7 +41,7 @@ long chunk_count(long n) { return (n + kGramSchmidtRows - 1) / kGramSchmidtRows;
 
 // The chunk kernels of the path choose_kernel_path picks (DELAYSPEC_KERNEL, the CPU).
 const GramSchmidtChunkKernels& chunk_kernels() {
-  return choose_kernel_path(true) == KernelPath::avx2 ? gram_schmidt_chunks_avx2() : kChunkKernels;
+  return runs_avx2_code(choose_kernel_path(KernelPath::avx2)) ? gram_schmidt_chunks_avx2() : kChunkKernels;
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ struct GramSchmidtChunkKernels {
                                 long a, long b);
 };
 
-// The AVX2 + FMA table (src/gram_schmidt_avx2.cpp); call only where choose_kernel_path said avx2.
+// The AVX2 + FMA table (src/gram_schmidt_avx2.cpp); call only where runs_avx2_code(choose_kernel_path(..)).
 const GramSchmidtChunkKernels& gram_schmidt_chunks_avx2();
 
 namespace {

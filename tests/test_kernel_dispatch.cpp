@@ -1,22 +1,30 @@
 // Every kernel path of the monodromy (kernel_dispatch.hpp) against a reference written here from
 // grid.delay_tap (one vector at a time, Eigen fixed-size products: the formula as stated, no
-// kernel code) and against to_dense(), for d = 1, 2 (AVX2 path in the library) and d = 3 (a
+// kernel code) and against to_dense(), for d = 1, 2 (wide paths in the library) and d = 3 (a
 // dimension instantiated outside the library: portable path only), aligned and fractional
-// delays, k = 1, 2, 3, 5, 8, 16, 32, 33 vectors: the compile-time block sizes 2, 4, 8, 16, 32 of
-// block_steps and the generic loop (3, 5, 33: not multiples of the vector width). The portable
-// path is forced by DELAYSPEC_KERNEL=baseline, as a user would.
+// delays, k = 1 .. 40 vectors: the compile-time block sizes 2, 4, 8, 16, 32 of block_steps and
+// the generic loop (3, 5, 33: not multiples of the vector width). Each path is forced by
+// DELAYSPEC_KERNEL (baseline, avx2, avx512), as a user would; the ones this CPU cannot run are
+// left out (the test says which ran: the path each operator reports is asserted).
 //
 // apply_block has two layouts (monodromy.hpp): streaming when the delay is at least one map long
 // (K <= m: no computed slot is read back), else the whole interleaved history. The grids below
 // cover both, each with theta = 0 and theta != 0; the streaming ones run several chunks of steps
 // with a short last one for k >= 16 (chunks of max(8, 1024 / (d k)) steps against K = 20-40).
-// Streaming for d = 2 runs the fused kernels (no staging): on the AVX2 path for k a multiple of 4
-// (4, 8, 12, 16, 32 here; stream_steps_avx2: pairs of steps, a lone last step when K is odd, K = 21
-// below), else the portable one for k even (2 on the AVX2 path; 2, 4, .., 32 on the baseline path;
-// stream_steps_portable: pairs of vectors, 2 + 4 for k = 6 (not a multiple of 4)); odd k (3, 5,
-// 33) and d = 1, 3 stream through the staging buffers. Every check asserts the layout that ran
-// (Monodromy::last_block_layout).
+// Streaming for d = 2 runs the fused kernels (no staging): on the AVX-512 path for k a multiple of
+// 8 (stream_steps_avx512: blocks of 16 vectors and a last one of 8, i.e. k = 8, 24, 40 end on a
+// lone block of 8 and 16, 32 do not), on either wide path for k a multiple of 4 otherwise
+// (stream_steps_avx2, 8 vectors side by side and a last block of 4: k = 4, 12, 20; on the AVX2
+// path also 8 .. 40), both in pairs of steps with a lone last step when K is odd (K = 21 below),
+// else the portable one for k even (2, 6, 10 on the wide paths; every even k on the baseline path;
+// pairs of vectors, 2 + 4 for k = 6); odd k (3, 5, 33) and d = 1, 3 stream through the staging
+// buffers. Every check asserts the layout that ran (Monodromy::last_block_layout). A last block
+// narrower than the kernel's widest must not read columns past X's end: GuardPage* below puts the
+// end of X (and of Y) against an inaccessible page, which catches such a read in any build.
 #include <gtest/gtest.h>
+
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <optional>
@@ -34,6 +42,15 @@ using delayspec::testing::random_matrix;
 namespace {
 
 bool cpu_has_avx2_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+bool cpu_has_avx512() { return cpu_has_avx2_fma() && __builtin_cpu_supports("avx512f"); }
+
+// The paths this CPU runs, narrowest first (each can be forced by name).
+std::vector<KernelPath> cpu_paths() {
+  std::vector<KernelPath> paths{KernelPath::baseline};
+  if (cpu_has_avx2_fma()) paths.push_back(KernelPath::avx2);
+  if (cpu_has_avx512()) paths.push_back(KernelPath::avx512);
+  return paths;
+}
 
 // Step maps shaped like a trapezoid step's, h = 1 / N: P = I + h A, Q = R = h B / 2 with random
 // A, B. The product of K of them stays O(1) in norm, so relative errors are meaningful.
@@ -89,16 +106,17 @@ typename Monodromy<D>::BlockLayout expected_layout(const Monodromy<D>& op, long 
   const bool streams = g.delayed_slot(0) - (g.theta == 0 ? 0 : 1) >= 0 && g.delayed_slot(0) + g.K <= g.M;
   if (!streams) return Layout::linear;
   if (D != 2) return Layout::streaming;
-  if (op.kernel_path() == KernelPath::avx2 && k % 4 == 0) return Layout::fused_avx2;
+  if (op.kernel_path() == KernelPath::avx512 && k % 8 == 0) return Layout::fused_avx512;
+  if (op.kernel_path() != KernelPath::baseline && k % 4 == 0) return Layout::fused_avx2;
   return k % 2 == 0 ? Layout::fused_portable : Layout::streaming;
 }
 
-// apply_block on k = 1 .. 33 columns and apply on one vector, against the reference and
+// apply_block on k = 1 .. 40 columns and apply on one vector, against the reference and
 // against to_dense() of an operator on the baseline path.
 template <int D>
 void expect_path_matches(const Monodromy<D>& op, const Eigen::MatrixXd& dense_baseline) {
   const HistoryGrid& grid = op.grid();
-  for (long k : {1L, 2L, 3L, 4L, 5L, 6L, 8L, 12L, 16L, 32L, 33L}) {
+  for (long k : {1L, 2L, 3L, 4L, 5L, 6L, 8L, 10L, 12L, 16L, 20L, 24L, 32L, 33L, 40L}) {
     SCOPED_TRACE("d = " + std::to_string(D) + ", k = " + std::to_string(k) + ", path " +
                  kernel_path_name(op.kernel_path()) + ", theta = " + std::to_string(grid.theta));
     const Eigen::MatrixXd X = random_matrix(op.rows(), k, 100 + static_cast<unsigned>(k));
@@ -118,24 +136,24 @@ void expect_path_matches(const Monodromy<D>& op, const Eigen::MatrixXd& dense_ba
   EXPECT_LE((op.to_dense() - dense_baseline).norm(), kTol * dense_baseline.norm());
 }
 
-// The baseline path (forced) and the dispatched path on one grid, d = D.
+// The path an operator of dimension D takes when `forced` is named (or, for nullopt, by the
+// run-time choice): the named or widest CPU path, capped at the widest compiled for D.
+template <int D>
+KernelPath expected_path(std::optional<KernelPath> forced) {
+  const KernelPath widest = D == 2 ? KernelPath::avx512 : D == 1 ? KernelPath::avx2 : KernelPath::baseline;
+  return std::min(forced ? *forced : cpu_paths().back(), widest);
+}
+
+// Every path this CPU runs (forced by name) and the run-time choice on one grid, d = D.
 template <int D>
 void check_all_paths(const HistoryGrid& grid) {
   const auto maps = random_maps<D>(grid.K, grid.N, 7 + D);
-  std::optional<Monodromy<D>> baseline, dispatched;
+  std::optional<Monodromy<D>> baseline;
   {
     KernelEnv env("baseline");
     baseline.emplace(grid, maps);
   }
-  {
-    KernelEnv env("");  // unset: the run-time choice
-    dispatched.emplace(grid, maps);
-  }
   ASSERT_EQ(baseline->kernel_path(), KernelPath::baseline);
-  // The dispatched path is AVX2 exactly when the library has one for D and the CPU runs it, so
-  // on an AVX2 machine this test does compare two different machine codes.
-  const bool avx2 = Monodromy<D>::kHasAvx2Kernel && cpu_has_avx2_fma();
-  ASSERT_EQ(dispatched->kernel_path(), avx2 ? KernelPath::avx2 : KernelPath::baseline);
 
   // The reference itself against the definition on a unit vector: column 0 of the dense matrix.
   const Eigen::MatrixXd dense = baseline->to_dense();
@@ -144,7 +162,18 @@ void check_all_paths(const HistoryGrid& grid) {
   ASSERT_LE((reference_apply<D>(grid, maps, e0) - dense.col(0)).norm(), kTol * dense.col(0).norm());
 
   expect_path_matches(*baseline, dense);
-  expect_path_matches(*dispatched, dense);
+  // On an AVX-512 machine, for D = 2 these are three different machine codes of the streaming
+  // kernel (portable, AVX2, AVX-512); for D = 1 avx512 is capped at avx2 (asserted).
+  for (KernelPath path : cpu_paths()) {
+    if (path == KernelPath::baseline) continue;
+    KernelEnv env(kernel_path_name(path));
+    const Monodromy<D> forced(grid, maps);
+    ASSERT_EQ(forced.kernel_path(), expected_path<D>(path)) << kernel_path_name(path);
+    expect_path_matches(forced, dense);
+  }
+  KernelEnv env("");  // unset: the run-time choice, the widest path
+  const Monodromy<D> dispatched(grid, maps);
+  ASSERT_EQ(dispatched.kernel_path(), expected_path<D>(std::nullopt));
 }
 
 // Streaming layout (K <= m).
@@ -262,16 +291,96 @@ TEST(KernelDispatch, AutoIsTheDefaultChoice) {
   KernelEnv env("auto");
   const HistoryGrid grid = aligned_grid();
   const Monodromy<2> op(grid, random_maps<2>(grid.K, grid.N, 3));
-  EXPECT_EQ(op.kernel_path(), cpu_has_avx2_fma() ? KernelPath::avx2 : KernelPath::baseline);
+  EXPECT_EQ(op.kernel_path(), cpu_paths().back());
+  const Monodromy<1> scalar(grid, random_maps<1>(grid.K, grid.N, 3));
+  EXPECT_EQ(scalar.kernel_path(), cpu_has_avx2_fma() ? KernelPath::avx2 : KernelPath::baseline);
 }
 
 TEST(KernelDispatch, UnknownKernelNameIsBadInputNamingIt) {
-  KernelEnv env("avx512");
+  KernelEnv env("avx1024");
   const HistoryGrid grid = aligned_grid();
   try {
     Monodromy<2> op(grid, random_maps<2>(grid.K, grid.N, 3));
     FAIL() << "no exception";
   } catch (const BadInput& e) {
-    EXPECT_NE(std::string(e.what()).find("DELAYSPEC_KERNEL = 'avx512'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("DELAYSPEC_KERNEL = 'avx1024'"), std::string::npos) << e.what();
   }
+}
+
+// The fused kernels called directly (kernel_dispatch.hpp) on X and Y whose last column ends where
+// an inaccessible page begins: a read of a column past X's k (the AVX2 kernel's unused second
+// block did that before 5410999, when k - v = 4) or a write past Y's would fault; and on X and Y
+// that start right after one (a read before slot 0, e.g. of the interpolation's slot j0 - 1
+// when j0 = 0). k covers a last
+// block narrower than the kernel's widest (AVX2: 4, 12, 20; AVX-512: 8, 24, 40) and full ones
+// (16, 32), on a grid with runs of steps (K = 600 > 512) and an odd fractional one (K = 21).
+// The results must equal apply_block's on ordinary matrices on the same path: the same kernel,
+// the same sums, so bit for bit (EXPECT_EQ on the matrices, not a tolerance).
+namespace {
+enum class GuardAt { end, start };
+class GuardedColumns {
+ public:
+  // n x k doubles whose last element is the last before an inaccessible page (GuardAt::end) or
+  // whose first is the first after one (GuardAt::start).
+  GuardedColumns(long n, long k, GuardAt at) {
+    const long page = sysconf(_SC_PAGESIZE), bytes = 8 * n * k;
+    size_ = (bytes + page - 1) / page * page + page;
+    base_ = static_cast<char*>(mmap(nullptr, size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0));
+    if (base_ == MAP_FAILED) throw std::runtime_error("mmap failed");
+    char* guard = at == GuardAt::end ? base_ + size_ - page : base_;
+    if (mprotect(guard, page, PROT_NONE) != 0) throw std::runtime_error("mprotect failed");
+    data_ = reinterpret_cast<double*>(at == GuardAt::end ? guard - bytes : guard + page);
+  }
+  ~GuardedColumns() { munmap(base_, size_); }
+  GuardedColumns(const GuardedColumns&) = delete;
+  GuardedColumns& operator=(const GuardedColumns&) = delete;
+  double* data() { return data_; }
+
+ private:
+  char* base_ = nullptr;
+  size_t size_ = 0;
+  double* data_ = nullptr;
+};
+
+using StreamKernel = void (*)(const StepMap<2>*, long, long, long, double, const double*, long, long, double*, long);
+
+void expect_guarded_kernel_matches(KernelPath path, StreamKernel kernel, const HistoryGrid& grid,
+                                   std::initializer_list<long> ks) {
+  const auto maps = random_maps<2>(grid.K, grid.N, 13);
+  KernelEnv env(kernel_path_name(path));
+  const Monodromy<2> op(grid, maps);
+  ASSERT_EQ(op.kernel_path(), path);
+  const long n = op.rows(), K = grid.K;
+  for (long k : ks) {
+    SCOPED_TRACE(std::string(kernel_path_name(path)) + ", k = " + std::to_string(k) + ", K = " + std::to_string(K));
+    const Eigen::MatrixXd X = random_matrix(n, k, 200 + static_cast<unsigned>(k));
+    Eigen::MatrixXd expected;
+    op.apply_block(X, expected);
+    ASSERT_EQ(op.last_block_layout(), expected_layout(op, k));
+    for (GuardAt at : {GuardAt::end, GuardAt::start}) {
+      GuardedColumns x(n, k, at), y(n, k, at);
+      std::copy(X.data(), X.data() + n * k, x.data());
+      std::fill(y.data(), y.data() + n * k, 0.0);
+      kernel(maps.data(), K, grid.M, grid.delayed_slot(0), grid.theta, x.data(), n, k, y.data(), n);
+      // The kernel writes the result slots M + 1 .. M + K (Y's slots M + 1 - K .. M); apply_block
+      // copies x's slots K .. M into Y's first M + 1 - K slots itself.
+      const Eigen::Map<const Eigen::MatrixXd> Y(y.data(), n, k);
+      const long first = 2 * (grid.M + 1 - K);
+      EXPECT_EQ(Y.bottomRows(n - first), expected.bottomRows(n - first));
+    }
+  }
+}
+}  // namespace
+
+// Every fused kernel this CPU runs (the portable one always).
+TEST(KernelDispatch, GuardPageAfterTheLastColumn) {
+  for (const HistoryGrid& grid : {aligned_many_runs_grid(), fractional_long_delay_grid()})
+    for (KernelPath path : cpu_paths()) {
+      if (path == KernelPath::baseline)  // pairs of vectors: k = 2, 6, 10 end on a lone pair
+        expect_guarded_kernel_matches(path, detail::stream_steps_portable, grid, {2, 6, 10});
+      if (path == KernelPath::avx2)  // 8 vectors side by side, then 4
+        expect_guarded_kernel_matches(path, detail::stream_steps_avx2, grid, {4, 12, 20, 16, 32});
+      if (path == KernelPath::avx512)  // 16 vectors side by side, then 8
+        expect_guarded_kernel_matches(path, detail::stream_steps_avx512, grid, {8, 24, 40, 16, 32});
+    }
 }

@@ -12,12 +12,13 @@
 // vectorisable axpy of length k.
 //
 // Kernels: perform_op and apply_block run the K steps through block_kernel.hpp; blocks of k > 1
-// on the path chosen at construction (kernel_dispatch.hpp: AVX2 + FMA for D = 1, 2 where the CPU
-// has it, else the portable build; DELAYSPEC_KERNEL=baseline forces the latter). A copy keeps it.
+// on the path chosen at construction (kernel_dispatch.hpp: AVX-512 for D = 2 and AVX2 + FMA for
+// D = 1, 2 where the CPU has it, else the portable build; DELAYSPEC_KERNEL forces one). A copy keeps it.
 // apply_block with K <= m streams instead of storing the whole linear history
 // (apply_block_streaming says why that is exact): for d = 2 and k even straight from X into Y,
-// the transposes fused into the steps (kernel_dispatch.hpp: stream_steps_avx2 for k a multiple
-// of 4 on the AVX2 path, else stream_steps_portable), otherwise through two small interleaved
+// the transposes fused into the steps (kernel_dispatch.hpp: stream_steps_avx512 for k a multiple
+// of 8 on the AVX-512 path, else stream_steps_avx2 for k a multiple of 4 on either wide path,
+// else stream_steps_portable), otherwise through two small interleaved
 // buffers. last_block_layout() tells which ran.
 //
 // Thread safety: the work buffers are owned by the operator (no allocation per application),
@@ -74,14 +75,19 @@ class Monodromy final : public LinearOperator {
   // The kernel path this operator runs (kernel_dispatch.hpp).
   KernelPath kernel_path() const { return path_; }
 
-  // An AVX2 path is compiled in the library for these dimensions only.
-  static constexpr bool kHasAvx2Kernel = D == 1 || D == 2;
+  // The widest path compiled in the library for D: the AVX-512 kernel is d = 2's streaming one,
+  // AVX2 + FMA code exists for D = 1, 2; another D (compiled outside the library) is portable.
+  static constexpr KernelPath kWidestPath = D == 2   ? KernelPath::avx512
+                                            : D == 1 ? KernelPath::avx2
+                                                     : KernelPath::baseline;
+  static constexpr bool kHasAvx2Kernel = kWidestPath != KernelPath::baseline;
 
   // How the last apply_block ran (the tests assert it): one vector through perform_op; the whole
   // interleaved history (linear); two L1 staging buffers (streaming); streaming with the
-  // transposes fused into the steps, no staging, for d = 2: AVX2 + FMA for k a multiple of 4
-  // (fused_avx2), else the portable build for k even (fused_portable, on either path).
-  enum class BlockLayout { none, single, linear, streaming, fused_avx2, fused_portable };
+  // transposes fused into the steps, no staging, for d = 2: AVX-512 for k a multiple of 8
+  // (fused_avx512, AVX-512 path), AVX2 + FMA for k a multiple of 4 (fused_avx2, either wide path),
+  // else the portable build for k even (fused_portable, on any path).
+  enum class BlockLayout { none, single, linear, streaming, fused_avx512, fused_avx2, fused_portable };
   BlockLayout last_block_layout() const { return last_layout_; }
 
  private:
@@ -108,7 +114,7 @@ class Monodromy final : public LinearOperator {
 
 template <int D>
 Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
-    : grid_(grid), maps_(std::move(maps)), n_(grid.dimension(D)), path_(choose_kernel_path(kHasAvx2Kernel)) {
+    : grid_(grid), maps_(std::move(maps)), n_(grid.dimension(D)), path_(choose_kernel_path(kWidestPath)) {
   if (static_cast<long>(maps_.size()) != grid_.K)
     throw BadInput("Monodromy: " + std::to_string(maps_.size()) +
                    " step maps given, the grid has K = " + std::to_string(grid_.K) + " steps per map");
@@ -131,7 +137,7 @@ void Monodromy<D>::perform_op(const double* x, double* y) const {
 template <int D>
 void Monodromy<D>::run_block_steps(long l0, long count, double* u, const double* delayed, long k) const {
   if constexpr (kHasAvx2Kernel) {
-    if (path_ == KernelPath::avx2) {
+    if (runs_avx2_code(path_)) {
       detail::block_steps_avx2(maps_.data() + l0, count, u, delayed, grid_.theta, k);
       return;
     }
@@ -142,7 +148,7 @@ void Monodromy<D>::run_block_steps(long l0, long count, double* u, const double*
 template <int D>
 void Monodromy<D>::to_slots(const double* X, long ldx, long rows, long k, double* b) const {
   if constexpr (kHasAvx2Kernel) {
-    if (path_ == KernelPath::avx2) {
+    if (runs_avx2_code(path_)) {
       detail::transpose_avx2(X, ldx, k, rows, b, k);
       return;
     }
@@ -153,7 +159,7 @@ void Monodromy<D>::to_slots(const double* X, long ldx, long rows, long k, double
 template <int D>
 void Monodromy<D>::from_slots(const double* b, long rows, long k, double* Y, long ldy) const {
   if constexpr (kHasAvx2Kernel) {
-    if (path_ == KernelPath::avx2) {
+    if (runs_avx2_code(path_)) {
       detail::transpose_avx2(b, k, rows, k, Y, ldy);
       return;
     }
@@ -223,7 +229,13 @@ void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, doub
     for (long v = 0; v < k; ++v) std::copy(X + v * ldx + K * D, X + v * ldx + n_, Y + v * ldy);
   };
   if constexpr (D == 2) {
-    if (path_ == KernelPath::avx2 && k % 4 == 0) {
+    if (path_ == KernelPath::avx512 && k % 8 == 0) {
+      detail::stream_steps_avx512(maps_.data(), K, M, j0, grid_.theta, X, ldx, k, Y, ldy);
+      copy_x_slots();
+      last_layout_ = BlockLayout::fused_avx512;
+      return;
+    }
+    if (runs_avx2_code(path_) && k % 4 == 0) {
       detail::stream_steps_avx2(maps_.data(), K, M, j0, grid_.theta, X, ldx, k, Y, ldy);
       copy_x_slots();
       last_layout_ = BlockLayout::fused_avx2;
