@@ -95,8 +95,8 @@ inline void step_block(const StepMap<D>& s, const double* u0, const double* d0, 
 //   out = S^{-1} [ L u0 + Bl w0 + Br w1 ],   w0, w1 as in step_block.
 //
 // A slot of c vectors is a D x c row-major matrix (slot[r * k + v]); with KC > 0 the k = KC
-// vectors are one fixed-size block and Eigen's products run packed over the vectors (two per
-// SSE2 register), with KC = 0 they go one at a time. 4 D^2 multiply-adds per vector against
+// vectors are one fixed-size block and SubStepDerivative::apply's row operations run packed over
+// the vectors (two per SSE2 register), with KC = 0 they go one at a time. 4 D^2 multiply-adds per vector against
 // step_block's 3 D^2 plus forming P, Q, R (3 D^3 per step): at D = 2, k = 2, 32 against 48.
 // A step that was split (events, time switches) has its map formed: step_block.
 template <int D, int KC>
