@@ -66,7 +66,7 @@ std::string to_string(FloquetSolver solver);
 // "Choosing the eigensolver"): dense LAPACK for n <= 100 (all eigenvalues, no Krylov constraint,
 // as fast as Krylov there), Spectra for n < 3000, and from n = 3000 the one-vector Krylov-Schur
 // (block, block_size = 1), whose Gram-Schmidt reads the basis twice per product (ARPACK's four
-// times), in AVX2 passes on all cores: nev = 10 and 20, it is 1.2-1.5x faster than ARPACK from
+// times), in AVX2 passes on all cores: nev = 10 and 20, it is 1.03-1.7x faster than ARPACK from
 // n = 2000 to 200000 and 2x at n = 2e6, and overtakes Spectra between n = 2500 and 3500. ARPACK,
 // the fastest from n = 2000 before the passes had AVX2 kernels, stays available by name.
 FloquetSolver choose_floquet_solver(long n);
