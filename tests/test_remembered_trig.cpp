@@ -77,6 +77,23 @@ TEST(RememberedTrig, SignedZerosAndNonFiniteArguments) {
   EXPECT_EQ(mismatches({1.0, inf, 1.0}), 0);
 }
 
+// NaNs with any payload, on a new thread (a new, untouched table): a memo that marked empty
+// entries with some NaN's bits would answer 0 for that NaN (the earlier one did, for
+// 0x7ff8dead0000beef).
+TEST(RememberedTrig, EveryNaNPayloadOnAFreshTable) {
+  int not_nan = 0;
+  std::thread fresh([&not_nan] {
+    for (std::uint64_t payload : {0x7ff8dead0000beefull, 0x7ff8000000000001ull, 0xfff8000000000000ull, 0x0ull}) {
+      const double x = std::bit_cast<double>(payload);
+      volatile double s = remembered_sin(x), c = remembered_cos(x);
+      not_nan += payload != 0 && (!std::isnan(s) || !std::isnan(c));
+      not_nan += payload == 0 && (bits(s) != bits(std::sin(x)) || bits(c) != bits(std::cos(x)));
+    }
+  });
+  fresh.join();
+  EXPECT_EQ(not_nan, 0);
+}
+
 // Each thread has its own table: threads working on different arguments do not disturb each other.
 TEST(RememberedTrig, ThreadsHaveTheirOwnTables) {
   int bad[2] = {0, 0};
