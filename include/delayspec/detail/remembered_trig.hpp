@@ -14,8 +14,11 @@
 //
 // The lookup of the newer entry of a set is inline (below); everything else (the older entry,
 // a miss, the table's creation) is the call remembered_trig_miss in src/remembered_trig.cpp.
-// Why inline: the call and its spills cost the Mathieu Lyapunov step about 2 ns of 17
-// (bench_lyapunov, docs/benchmarks.md "Eighth sitting").
+// Why inline: a call into the library spills the live xmm registers; inline, the impact
+// model's Lyapunov step went from 41 to 34 ns (bench_lyapunov, docs/benchmarks.md "Eighth
+// sitting"). GCC shares a [[gnu::const]] call between f and A of a node but not the inline
+// lookups (a miss in between may change the table): Mathieu makes four lookups per step where
+// it made two calls, and gained 0.6 ns of 18.
 //
 // Thread-local, so concurrent maps (threads of a chart, two Python threads) never share it.
 // One definition of the tables, in the library, shared by the built-in models and the models
