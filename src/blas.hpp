@@ -2,9 +2,8 @@
 // The BLAS matrix product for the library's tall products (Krylov bases of n x ~40 at n up to
 // 10^7): OpenBLAS's dgemm, with run-time chosen AVX2 kernels and threads, where Eigen's own
 // product is compiled for the baseline x86-64 (SSE2) and runs on one core. Internal: not installed.
-extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k,
-                       const double* alpha, const double* a, const int* lda, const double* b, const int* ldb,
-                       const double* beta, double* c, const int* ldc);
+// OpenBLAS is loaded on first use (linear_algebra.hpp).
+#include "linear_algebra.hpp"
 
 namespace delayspec {
 
@@ -13,7 +12,7 @@ inline void gemm(char ta, char tb, long m, long n, long k, double alpha, const d
                  long ldb, double beta, double* C, long ldc) {
   const int im = static_cast<int>(m), in = static_cast<int>(n), ik = static_cast<int>(k);
   const int ilda = static_cast<int>(lda), ildb = static_cast<int>(ldb), ildc = static_cast<int>(ldc);
-  dgemm_(&ta, &tb, &im, &in, &ik, &alpha, A, &ilda, B, &ildb, &beta, C, &ildc);
+  detail::linear_algebra().dgemm(&ta, &tb, &im, &in, &ik, &alpha, A, &ilda, B, &ildb, &beta, C, &ildc);
 }
 
 }  // namespace delayspec

@@ -6,10 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "delayspec/errors.hpp"
-
-extern "C" void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a, const int* lda, double* wr,
-                       double* wi, double* vl, const int* ldvl, double* vr, const int* ldvr, double* work,
-                       const int* lwork, int* info);
+#include "linear_algebra.hpp"
 
 namespace delayspec {
 
@@ -30,6 +27,7 @@ std::vector<std::complex<double>> lapack_backend(const Eigen::MatrixXd& A) {
   std::vector<double> wr(n), wi(n);
   int info = 0, lwork = -1, one = 1;
   double query = 0, dummy = 0;
+  const auto dgeev_ = detail::linear_algebra().dgeev;
   dgeev_("N", "N", &n, a.data(), &n, wr.data(), wi.data(), &dummy, &one, &dummy, &one, &query, &lwork, &info);
   lwork = std::max(1, static_cast<int>(query));
   std::vector<double> work(lwork);

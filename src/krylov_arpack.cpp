@@ -13,18 +13,7 @@
 
 #include "delayspec/errors.hpp"
 #include "krylov.hpp"
-
-// The ISO_C_BINDING entry points of ARPACK-ng (arpack/arpack.h declares them too, together with
-// C99 `_Complex` prototypes that are not C++).
-extern "C" {
-void dnaupd_c(a_int* ido, char const* bmat, a_int n, char const* which, a_int nev, double tol, double* resid, a_int ncv,
-              double* v, a_int ldv, a_int* iparam, a_int* ipntr, double* workd, double* workl, a_int lworkl,
-              a_int* info);
-void dneupd_c(a_int rvec, char const* howmny, a_int const* select, double* dr, double* di, double* z, a_int ldz,
-              double sigmar, double sigmai, double* workev, char const* bmat, a_int n, char const* which, a_int nev,
-              double tol, double* resid, a_int ncv, double* v, a_int ldv, a_int* iparam, a_int* ipntr, double* workd,
-              double* workl, a_int lworkl, a_int* info);
-}
+#include "linear_algebra.hpp"
 
 namespace delayspec::krylov {
 
@@ -75,6 +64,7 @@ RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const E
                    " exceeds ARPACK's 32-bit integers; use solver = spectra");
   const a_int n = static_cast<a_int>(op.rows()), nev = s.nev, ncv = s.ncv;
   const a_int lworkl = 3 * ncv * ncv + 6 * ncv;
+  const detail::LinearAlgebra& arpack = detail::linear_algebra();
   std::lock_guard<std::mutex> lock(arpack_mutex);
 
   Eigen::VectorXd resid = start;  // info = 1 on entry: resid is the start vector
@@ -88,7 +78,7 @@ RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const E
   a_int ido = 0, info = 1;
 
   for (;;) {
-    dnaupd_c(&ido, "I", n, "LM", nev, s.tolerance, resid.data(), ncv, V.data(), n, iparam, ipntr, workd.data(),
+    arpack.dnaupd_c(&ido, "I", n, "LM", nev, s.tolerance, resid.data(), ncv, V.data(), n, iparam, ipntr, workd.data(),
              workl.data(), lworkl, &info);
     if (ido == -1 || ido == 1) {
       // workd[ipntr(2)] = M workd[ipntr(1)]
@@ -127,7 +117,7 @@ RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const E
   std::vector<a_int> select(ncv, 1);
   std::vector<double> dr(ncv, 0.0), di(ncv, 0.0), workev(3 * static_cast<size_t>(ncv));
   a_int einfo = 0;
-  dneupd_c(1, "A", select.data(), dr.data(), di.data(), V.data(), n, 0.0, 0.0, workev.data(), "I", n, "LM", nev,
+  arpack.dneupd_c(1, "A", select.data(), dr.data(), di.data(), V.data(), n, 0.0, 0.0, workev.data(), "I", n, "LM", nev,
            s.tolerance, resid.data(), ncv, V.data(), n, iparam, ipntr, workd.data(), workl.data(), lworkl, &einfo);
   if (einfo != 0)
     throw NumericalFailure("Krylov (arpack): dneupd info = " + std::to_string(einfo) + ": " + dneupd_error(einfo));

@@ -41,10 +41,8 @@
 #include "delayspec/floquet.hpp"
 #include "blas.hpp"
 #include "krylov.hpp"
+#include "linear_algebra.hpp"
 
-extern "C" void dgees_(const char* jobvs, const char* sort, int (*select)(const double*, const double*), const int* n,
-                       double* a, const int* lda, int* sdim, double* wr, double* wi, double* vs, const int* ldvs,
-                       double* work, const int* lwork, int* bwork, int* info);
 
 namespace delayspec::krylov {
 
@@ -327,6 +325,7 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
     Eigen::VectorXd wr(p), wi(p);
     std::vector<int> bwork(p);
     std::vector<double> work;
+    const auto dgees_ = detail::linear_algebra().dgees;
     bool restarted = false;
     for (int q = keep - 1; q >= nev - 1 && !restarted; --q) {
       select_threshold = std::abs(theta[order[q]]) * (1 - 1e-12);

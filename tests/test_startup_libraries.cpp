@@ -5,7 +5,9 @@
 // launcher (src/cli/module_loader.hpp; tests/mpi_test.py checks the MPI side). Checked on the
 // built program with the dynamic loader's own trace (LD_DEBUG=files lists every object it maps,
 // at start and by dlopen), so a new link dependency or an eager load fails here; the equations
-// run shows that the trace does see the module when it is loaded.
+// run shows that the trace does see the module when it is loaded. The linear-algebra libraries
+// (OpenBLAS, ARPACK, UMFPACK) are loaded by the library on first use (src/linear_algebra.cpp):
+// a run that needs no solver maps none of them, a run that does maps them.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -68,6 +70,57 @@ TEST(StartupLibraries, BuiltInModelLoadsNeitherGiNaCNorMPI) {
   const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, "floquet --set model=impact --set N=20 --json");
   EXPECT_EQ(p.status, 0) << p.trace;
   expect_no_module_libraries(p);
+}
+
+// The linear-algebra libraries, by the names the library asks for.
+const std::vector<std::string> linear_algebra_libraries = {DELAYSPEC_BLAS_SONAME, DELAYSPEC_LAPACK_SONAME,
+                                                           DELAYSPEC_ARPACK_SONAME, DELAYSPEC_UMFPACK_SONAME};
+
+TEST(StartupLibraries, VersionAndLyapunovLoadNoLinearAlgebra) {
+  for (const char* args : {"--version", "lyapunov --set model=mathieu --set N=50 --set periods=20 --json"}) {
+    const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, args);
+    EXPECT_EQ(p.status, 0) << args << "\n" << p.trace;
+    ASSERT_TRUE(mentions(p.trace, "file=libdelayspec.so")) << p.trace.substr(0, 2000);
+    for (const std::string& library : linear_algebra_libraries)
+      EXPECT_FALSE(mentions(p.trace, "file=" + library)) << args << ": " << library << " loaded";
+  }
+}
+
+// Each solver's first use loads them (the trace names the file), and the run succeeds: dense
+// LAPACK, ARPACK, the block Krylov-Schur (dgemm, dgees), Newton's sparse LU (UMFPACK).
+TEST(StartupLibraries, SolversLoadTheLinearAlgebraOnFirstUse) {
+  for (const char* args : {"floquet --set model=impact --set N=20 --set solver=dense --json",
+                           "floquet --set model=impact --set N=600 --set solver=arpack --json",
+                           "floquet --set model=impact --set N=600 --set solver=block --json",
+                           "floquet --set model=linear --set N=20 --set orbit=newton --json"}) {
+    const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, args);
+    EXPECT_EQ(p.status, 0) << args << "\n" << p.trace.substr(0, 4000);
+    for (const std::string& library : linear_algebra_libraries)
+      EXPECT_TRUE(mentions(p.trace, "file=" + library)) << args << ": " << library << " not loaded";
+  }
+}
+
+// A library that cannot be loaded (here a file under UMFPACK's name that is not a shared object,
+// found first through LD_LIBRARY_PATH): exit 2 naming it, not a crash; a run that needs no
+// solver is not affected.
+TEST(StartupLibraries, AnUnloadableLinearAlgebraLibraryExits2NamingIt) {
+  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_bad_umfpack_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  {
+    std::FILE* f = std::fopen((dir / DELAYSPEC_UMFPACK_SONAME).c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs("not a shared object\n", f);
+    std::fclose(f);
+  }
+  const std::string env = "LD_LIBRARY_PATH='" + dir.string() + "'";
+  const Process p = run_traced(env, DELAYSPEC_CLI_PATH, "floquet --set model=linear --set N=20 --set solver=dense");
+  EXPECT_EQ(p.status, 2) << p.trace;
+  EXPECT_TRUE(mentions(p.trace, std::string("cannot load ") + DELAYSPEC_UMFPACK_SONAME + " (SuiteSparse UMFPACK)"))
+      << p.trace;
+  const Process lyapunov = run_traced(env, DELAYSPEC_CLI_PATH, "lyapunov --set model=mathieu --set N=50 --set periods=20");
+  EXPECT_EQ(lyapunov.status, 0) << lyapunov.trace;
+  fs::remove_all(dir);
 }
 
 TEST(StartupLibraries, EquationsSceneLoadsTheModuleAndGiNaC) {

@@ -1,8 +1,8 @@
 #pragma once
 // SparseLU: a sparse LU factorisation (SuiteSparse UMFPACK, umfpack_di_*) of a square matrix,
 // factored once and solved many times. RAII: the symbolic and numeric objects are freed by
-// the destructor; movable, not copyable. umfpack.h stays out of this header (the library links
-// UMFPACK privately).
+// the destructor; movable, not copyable. umfpack.h stays out of this header (the library loads
+// UMFPACK on first use: linear_algebra_libraries.hpp).
 //
 // Errors: BadInput for a non-square or empty matrix or a right-hand side of the wrong size;
 // NumericalFailure when UMFPACK reports a singular matrix (the message carries UMFPACK's
