@@ -27,11 +27,11 @@ std::vector<std::complex<double>> lapack_backend(const Eigen::MatrixXd& A) {
   std::vector<double> wr(n), wi(n);
   int info = 0, lwork = -1, one = 1;
   double query = 0, dummy = 0;
-  const auto dgeev_ = detail::linear_algebra().dgeev;
-  dgeev_("N", "N", &n, a.data(), &n, wr.data(), wi.data(), &dummy, &one, &dummy, &one, &query, &lwork, &info);
+  const auto dgeev = detail::linear_algebra().dgeev;
+  dgeev("N", "N", &n, a.data(), &n, wr.data(), wi.data(), &dummy, &one, &dummy, &one, &query, &lwork, &info);
   lwork = std::max(1, static_cast<int>(query));
   std::vector<double> work(lwork);
-  dgeev_("N", "N", &n, a.data(), &n, wr.data(), wi.data(), &dummy, &one, &dummy, &one, work.data(), &lwork, &info);
+  dgeev("N", "N", &n, a.data(), &n, wr.data(), wi.data(), &dummy, &one, &dummy, &one, work.data(), &lwork, &info);
   if (info != 0)
     throw NumericalFailure("dense eigenvalues (LAPACK dgeev): info = " + std::to_string(info) +
                            (info > 0 ? " (QR algorithm failed to converge)" : " (illegal argument)"));

@@ -79,7 +79,7 @@ RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const E
 
   for (;;) {
     arpack.dnaupd_c(&ido, "I", n, "LM", nev, s.tolerance, resid.data(), ncv, V.data(), n, iparam, ipntr, workd.data(),
-             workl.data(), lworkl, &info);
+                    workl.data(), lworkl, &info);
     if (ido == -1 || ido == 1) {
       // workd[ipntr(2)] = M workd[ipntr(1)]
       op.perform_op(&workd[ipntr[0] - 1], &workd[ipntr[1] - 1]);
@@ -118,7 +118,8 @@ RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const E
   std::vector<double> dr(ncv, 0.0), di(ncv, 0.0), workev(3 * static_cast<size_t>(ncv));
   a_int einfo = 0;
   arpack.dneupd_c(1, "A", select.data(), dr.data(), di.data(), V.data(), n, 0.0, 0.0, workev.data(), "I", n, "LM", nev,
-           s.tolerance, resid.data(), ncv, V.data(), n, iparam, ipntr, workd.data(), workl.data(), lworkl, &einfo);
+                  s.tolerance, resid.data(), ncv, V.data(), n, iparam, ipntr, workd.data(), workl.data(), lworkl,
+                  &einfo);
   if (einfo != 0)
     throw NumericalFailure("Krylov (arpack): dneupd info = " + std::to_string(einfo) + ": " + dneupd_error(einfo));
   const a_int nconv = std::min<a_int>(iparam[4], ncv);  // dneupd's count of converged Ritz values

@@ -43,7 +43,6 @@
 #include "krylov.hpp"
 #include "linear_algebra.hpp"
 
-
 namespace delayspec::krylov {
 
 using detail::basis_coefficients;
@@ -325,7 +324,7 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
     Eigen::VectorXd wr(p), wi(p);
     std::vector<int> bwork(p);
     std::vector<double> work;
-    const auto dgees_ = detail::linear_algebra().dgees;
+    const auto dgees = detail::linear_algebra().dgees;
     bool restarted = false;
     for (int q = keep - 1; q >= nev - 1 && !restarted; --q) {
       select_threshold = std::abs(theta[order[q]]) * (1 - 1e-12);
@@ -333,12 +332,12 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
       T = Hp;
       int lwork = -1;
       double query = 0;
-      dgees_("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, &query, &lwork,
-             bwork.data(), &info);
+      dgees("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, &query, &lwork,
+            bwork.data(), &info);
       lwork = static_cast<int>(query);
       work.assign(static_cast<size_t>(std::max(1, lwork)), 0.0);
-      dgees_("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, work.data(),
-             &lwork, bwork.data(), &info);
+      dgees("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, work.data(), &lwork,
+            bwork.data(), &info);
       restarted = info == 0 && sdim >= nev && sdim + b <= m;
     }
     if (!restarted)

@@ -26,9 +26,9 @@ struct LinearAlgebra {
                      double* work, const int* lwork, int* bwork, int* info);
   // ARPACK-ng's ISO_C_BINDING entry points (arpack/arpack.h declares them with C99 `_Complex`
   // prototypes that are not C++)
-  using DnaupdC = void(a_int* ido, char const* bmat, a_int n, char const* which, a_int nev, double tol,
-                       double* resid, a_int ncv, double* v, a_int ldv, a_int* iparam, a_int* ipntr, double* workd,
-                       double* workl, a_int lworkl, a_int* info);
+  using DnaupdC = void(a_int* ido, char const* bmat, a_int n, char const* which, a_int nev, double tol, double* resid,
+                       a_int ncv, double* v, a_int ldv, a_int* iparam, a_int* ipntr, double* workd, double* workl,
+                       a_int lworkl, a_int* info);
   using DneupdC = void(a_int rvec, char const* howmny, a_int const* select, double* dr, double* di, double* z,
                        a_int ldz, double sigmar, double sigmai, double* workev, char const* bmat, a_int n,
                        char const* which, a_int nev, double tol, double* resid, a_int ncv, double* v, a_int ldv,

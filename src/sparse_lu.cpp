@@ -70,8 +70,8 @@ SparseLU::SparseLU(const Eigen::SparseMatrix<double>& A) {
   // Jacobian (N = 10^4, 82668 unknowns) the same fill (5.4e6) in 2.1 s instead of 3.6 s.
   control[UMFPACK_ORDERING] = UMFPACK_ORDERING_AMD;
   const int n = static_cast<int>(n_);
-  int status =
-      umf.umfpack_di_symbolic(n, n, column_starts_.data(), row_indices_.data(), values_.data(), &symbolic_, control, info);
+  int status = umf.umfpack_di_symbolic(n, n, column_starts_.data(), row_indices_.data(), values_.data(), &symbolic_,
+                                       control, info);
   if (status != UMFPACK_OK) {
     release();
     check_status(status, "symbolic", n_, 0);
@@ -128,8 +128,9 @@ Eigen::VectorXd SparseLU::solve(const Eigen::VectorXd& b) const {
                    std::to_string(n_) + " x " + std::to_string(n_));
   Eigen::VectorXd x(n_);
   double info[UMFPACK_INFO];
-  const int status = detail::linear_algebra().umfpack_di_solve(UMFPACK_A, column_starts_.data(), row_indices_.data(),
-                                                               values_.data(), x.data(), b.data(), numeric_, nullptr, info);
+  const int status =
+      detail::linear_algebra().umfpack_di_solve(UMFPACK_A, column_starts_.data(), row_indices_.data(), values_.data(),
+                                                x.data(), b.data(), numeric_, nullptr, info);
   check_status(status, "solve", n_, rcond_);
   if (!x.allFinite()) throw NumericalFailure("sparse LU (UMFPACK solve): non-finite solution");
   return x;

@@ -118,7 +118,8 @@ TEST(StartupLibraries, AnUnloadableLinearAlgebraLibraryExits2NamingIt) {
   EXPECT_EQ(p.status, 2) << p.trace;
   EXPECT_TRUE(mentions(p.trace, std::string("cannot load ") + DELAYSPEC_UMFPACK_SONAME + " (SuiteSparse UMFPACK)"))
       << p.trace;
-  const Process lyapunov = run_traced(env, DELAYSPEC_CLI_PATH, "lyapunov --set model=mathieu --set N=50 --set periods=20");
+  const Process lyapunov =
+      run_traced(env, DELAYSPEC_CLI_PATH, "lyapunov --set model=mathieu --set N=50 --set periods=20");
   EXPECT_EQ(lyapunov.status, 0) << lyapunov.trace;
   fs::remove_all(dir);
 }

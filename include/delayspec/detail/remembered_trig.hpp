@@ -48,7 +48,9 @@ extern __thread TrigSet* trig_sets[2] __attribute__((tls_model("initial-exec")))
 
 // The set an argument's bits map to: Fibonacci hashing (the top bits of bits * 2^64 / golden
 // ratio spread neighbouring arguments).
-inline std::uint64_t trig_set_index(std::uint64_t bits) { return (bits * 0x9e3779b97f4a7c15ull) >> (64 - kTrigSetBits); }
+inline std::uint64_t trig_set_index(std::uint64_t bits) {
+  return (bits * 0x9e3779b97f4a7c15ull) >> (64 - kTrigSetBits);
+}
 
 // The lookup past the newer entry: the older entry, a miss (std::sin / std::cos, stored), or
 // the thread's first call (allocates its table).
