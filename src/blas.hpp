@@ -12,7 +12,7 @@ inline void gemm(char ta, char tb, long m, long n, long k, double alpha, const d
                  long ldb, double beta, double* C, long ldc) {
   const int im = static_cast<int>(m), in = static_cast<int>(n), ik = static_cast<int>(k);
   const int ilda = static_cast<int>(lda), ildb = static_cast<int>(ldb), ildc = static_cast<int>(ldc);
-  detail::linear_algebra().dgemm(&ta, &tb, &im, &in, &ik, &alpha, A, &ilda, B, &ildb, &beta, C, &ildc);
+  detail::lapack().dgemm(&ta, &tb, &im, &in, &ik, &alpha, A, &ilda, B, &ildb, &beta, C, &ildc);
 }
 
 }  // namespace delayspec

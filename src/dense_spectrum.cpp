@@ -27,7 +27,7 @@ std::vector<std::complex<double>> lapack_backend(const Eigen::MatrixXd& A) {
   std::vector<double> wr(n), wi(n);
   int info = 0, lwork = -1, one = 1;
   double query = 0, dummy = 0;
-  const auto dgeev = detail::linear_algebra().dgeev;
+  const auto dgeev = detail::lapack().dgeev;
   dgeev("N", "N", &n, a.data(), &n, wr.data(), wi.data(), &dummy, &one, &dummy, &one, &query, &lwork, &info);
   lwork = std::max(1, static_cast<int>(query));
   std::vector<double> work(lwork);

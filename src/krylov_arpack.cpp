@@ -64,7 +64,7 @@ RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const E
                    " exceeds ARPACK's 32-bit integers; use solver = spectra");
   const a_int n = static_cast<a_int>(op.rows()), nev = s.nev, ncv = s.ncv;
   const a_int lworkl = 3 * ncv * ncv + 6 * ncv;
-  const detail::LinearAlgebra& arpack = detail::linear_algebra();
+  const detail::Arpack& arpack = detail::arpack();
   std::lock_guard<std::mutex> lock(arpack_mutex);
 
   Eigen::VectorXd resid = start;  // info = 1 on entry: resid is the start vector

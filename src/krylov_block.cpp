@@ -324,7 +324,7 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
     Eigen::VectorXd wr(p), wi(p);
     std::vector<int> bwork(p);
     std::vector<double> work;
-    const auto dgees = detail::linear_algebra().dgees;
+    const auto dgees = detail::lapack().dgees;
     bool restarted = false;
     for (int q = keep - 1; q >= nev - 1 && !restarted; --q) {
       select_threshold = std::abs(theta[order[q]]) * (1 - 1e-12);

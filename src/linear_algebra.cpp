@@ -18,11 +18,6 @@ namespace delayspec {
 
 namespace {
 
-struct Loaded {
-  detail::LinearAlgebra functions;
-  std::string error;  // empty when every library and entry point was found
-};
-
 // dlopen by SONAME, as the loader would have found a linked library. RTLD_LAZY, as at start-up:
 // RTLD_NOW binds every call of LAPACK's thousands of routines at once and made the load 3 ms
 // instead of 2 (measured at N = 2000, docs/benchmarks.md "Eighth sitting"). RTLD_LOCAL: their
@@ -44,42 +39,61 @@ void find_function(void* handle, const char* soname, const char* name, F*& funct
   if (!function && error.empty()) error = std::string(soname) + " has no function " + name;
 }
 
-Loaded load() {
-  Loaded l;
-  detail::LinearAlgebra& f = l.functions;
-  void* blas = open_library(DELAYSPEC_BLAS_SONAME, "BLAS", l.error);
-  find_function(blas, DELAYSPEC_BLAS_SONAME, "dgemm_", f.dgemm, l.error);
-  void* lapack = open_library(DELAYSPEC_LAPACK_SONAME, "LAPACK", l.error);
-  find_function(lapack, DELAYSPEC_LAPACK_SONAME, "dgeev_", f.dgeev, l.error);
-  find_function(lapack, DELAYSPEC_LAPACK_SONAME, "dgees_", f.dgees, l.error);
-  void* arpack = open_library(DELAYSPEC_ARPACK_SONAME, "ARPACK-ng", l.error);
-  find_function(arpack, DELAYSPEC_ARPACK_SONAME, "dnaupd_c", f.dnaupd_c, l.error);
-  find_function(arpack, DELAYSPEC_ARPACK_SONAME, "dneupd_c", f.dneupd_c, l.error);
-  void* umfpack = open_library(DELAYSPEC_UMFPACK_SONAME, "SuiteSparse UMFPACK", l.error);
-  find_function(umfpack, DELAYSPEC_UMFPACK_SONAME, "umfpack_di_defaults", f.umfpack_di_defaults, l.error);
-  find_function(umfpack, DELAYSPEC_UMFPACK_SONAME, "umfpack_di_symbolic", f.umfpack_di_symbolic, l.error);
-  find_function(umfpack, DELAYSPEC_UMFPACK_SONAME, "umfpack_di_numeric", f.umfpack_di_numeric, l.error);
-  find_function(umfpack, DELAYSPEC_UMFPACK_SONAME, "umfpack_di_solve", f.umfpack_di_solve, l.error);
-  find_function(umfpack, DELAYSPEC_UMFPACK_SONAME, "umfpack_di_free_symbolic", f.umfpack_di_free_symbolic, l.error);
-  find_function(umfpack, DELAYSPEC_UMFPACK_SONAME, "umfpack_di_free_numeric", f.umfpack_di_free_numeric, l.error);
-  // The handles are never closed: the libraries stay for the process's life, as linked ones do.
-  return l;
-}
-
-// Loaded once per process (a function-local static: a second thread waits for the first).
-const Loaded& loaded() {
-  static const Loaded l = load();
-  return l;
-}
-
-}  // namespace
-
-const detail::LinearAlgebra& detail::linear_algebra() {
-  const Loaded& l = loaded();
+// A table filled by fill(table, error) once per process (a function-local static of each
+// instantiation: a second thread waits for the first); the handles are never closed, the
+// libraries stay for the process's life as linked ones do.
+template <class Table, class Fill>
+const Table& loaded_once(Fill fill) {
+  struct Loaded {
+    Table functions;
+    std::string error;  // empty when the library and every entry point were found
+  };
+  static const Loaded l = [&] {
+    Loaded r;
+    fill(r.functions, r.error);
+    return r;
+  }();
   if (!l.error.empty()) throw BadInput(l.error);
   return l.functions;
 }
 
-void load_linear_algebra() { detail::linear_algebra(); }
+}  // namespace
+
+const detail::Lapack& detail::lapack() {
+  return loaded_once<Lapack>([](Lapack& f, std::string& error) {
+    void* blas = open_library(DELAYSPEC_BLAS_SONAME, "BLAS", error);
+    find_function(blas, DELAYSPEC_BLAS_SONAME, "dgemm_", f.dgemm, error);
+    void* lapack = open_library(DELAYSPEC_LAPACK_SONAME, "LAPACK", error);
+    find_function(lapack, DELAYSPEC_LAPACK_SONAME, "dgeev_", f.dgeev, error);
+    find_function(lapack, DELAYSPEC_LAPACK_SONAME, "dgees_", f.dgees, error);
+  });
+}
+
+const detail::Arpack& detail::arpack() {
+  return loaded_once<Arpack>([](Arpack& f, std::string& error) {
+    void* arpack = open_library(DELAYSPEC_ARPACK_SONAME, "ARPACK-ng", error);
+    find_function(arpack, DELAYSPEC_ARPACK_SONAME, "dnaupd_c", f.dnaupd_c, error);
+    find_function(arpack, DELAYSPEC_ARPACK_SONAME, "dneupd_c", f.dneupd_c, error);
+  });
+}
+
+const detail::Umfpack& detail::umfpack() {
+  return loaded_once<Umfpack>([](Umfpack& f, std::string& error) {
+    const char* so = DELAYSPEC_UMFPACK_SONAME;
+    void* umfpack = open_library(so, "SuiteSparse UMFPACK", error);
+    find_function(umfpack, so, "umfpack_di_defaults", f.di_defaults, error);
+    find_function(umfpack, so, "umfpack_di_symbolic", f.di_symbolic, error);
+    find_function(umfpack, so, "umfpack_di_numeric", f.di_numeric, error);
+    find_function(umfpack, so, "umfpack_di_solve", f.di_solve, error);
+    find_function(umfpack, so, "umfpack_di_free_symbolic", f.di_free_symbolic, error);
+    find_function(umfpack, so, "umfpack_di_free_numeric", f.di_free_numeric, error);
+  });
+}
+
+void load_linear_algebra() {
+  detail::lapack();
+  detail::arpack();
+  detail::umfpack();
+}
 
 }  // namespace delayspec

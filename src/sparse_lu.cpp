@@ -64,21 +64,21 @@ SparseLU::SparseLU(const Eigen::SparseMatrix<double>& A) {
 
   double info[UMFPACK_INFO];
   double control[UMFPACK_CONTROL];
-  const detail::LinearAlgebra& umf = detail::linear_algebra();
-  umf.umfpack_di_defaults(control);
+  const detail::Umfpack& umf = detail::umfpack();
+  umf.di_defaults(control);
   // AMD/COLAMD rather than the default CHOLMOD (which adds METIS tries): on the periodic-orbit
   // Jacobian (N = 10^4, 82668 unknowns) the same fill (5.4e6) in 2.1 s instead of 3.6 s.
   control[UMFPACK_ORDERING] = UMFPACK_ORDERING_AMD;
   const int n = static_cast<int>(n_);
-  int status = umf.umfpack_di_symbolic(n, n, column_starts_.data(), row_indices_.data(), values_.data(), &symbolic_,
-                                       control, info);
+  int status =
+      umf.di_symbolic(n, n, column_starts_.data(), row_indices_.data(), values_.data(), &symbolic_, control, info);
   if (status != UMFPACK_OK) {
     release();
     check_status(status, "symbolic", n_, 0);
     throw NumericalFailure("sparse LU (UMFPACK symbolic) failed: " + umfpack_status_name(status));
   }
-  status = umf.umfpack_di_numeric(column_starts_.data(), row_indices_.data(), values_.data(), symbolic_, &numeric_,
-                                  control, info);
+  status =
+      umf.di_numeric(column_starts_.data(), row_indices_.data(), values_.data(), symbolic_, &numeric_, control, info);
   rcond_ = info[UMFPACK_RCOND];
   factor_nonzeros_ = static_cast<long>(info[UMFPACK_LNZ] + info[UMFPACK_UNZ]);
   if (status != UMFPACK_OK) {
@@ -116,9 +116,9 @@ SparseLU& SparseLU::operator=(SparseLU&& other) noexcept {
 }
 
 void SparseLU::release() noexcept {
-  // A factorisation exists only if UMFPACK was loaded, so linear_algebra() does not throw here.
-  if (numeric_) detail::linear_algebra().umfpack_di_free_numeric(&numeric_);
-  if (symbolic_) detail::linear_algebra().umfpack_di_free_symbolic(&symbolic_);
+  // A factorisation exists only if UMFPACK was loaded, so umfpack() does not throw here.
+  if (numeric_) detail::umfpack().di_free_numeric(&numeric_);
+  if (symbolic_) detail::umfpack().di_free_symbolic(&symbolic_);
   numeric_ = symbolic_ = nullptr;
 }
 
@@ -128,8 +128,7 @@ Eigen::VectorXd SparseLU::solve(const Eigen::VectorXd& b) const {
                    std::to_string(n_) + " x " + std::to_string(n_));
   Eigen::VectorXd x(n_);
   double info[UMFPACK_INFO];
-  const int status =
-      detail::linear_algebra().umfpack_di_solve(UMFPACK_A, column_starts_.data(), row_indices_.data(), values_.data(),
+  const int status = detail::umfpack().di_solve(UMFPACK_A, column_starts_.data(), row_indices_.data(), values_.data(),
                                                 x.data(), b.data(), numeric_, nullptr, info);
   check_status(status, "solve", n_, rcond_);
   if (!x.allFinite()) throw NumericalFailure("sparse LU (UMFPACK solve): non-finite solution");

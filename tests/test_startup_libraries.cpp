@@ -86,23 +86,35 @@ TEST(StartupLibraries, VersionAndLyapunovLoadNoLinearAlgebra) {
   }
 }
 
-// Each solver's first use loads them (the trace names the file), and the run succeeds: dense
-// LAPACK, ARPACK, the block Krylov-Schur (dgemm, dgees), Newton's sparse LU (UMFPACK).
-TEST(StartupLibraries, SolversLoadTheLinearAlgebraOnFirstUse) {
-  for (const char* args : {"floquet --set model=impact --set N=20 --set solver=dense --json",
-                           "floquet --set model=impact --set N=600 --set solver=arpack --json",
-                           "floquet --set model=impact --set N=600 --set solver=block --json",
-                           "floquet --set model=linear --set N=20 --set orbit=newton --json"}) {
-    const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, args);
-    EXPECT_EQ(p.status, 0) << args << "\n" << p.trace.substr(0, 4000);
-    for (const std::string& library : linear_algebra_libraries)
-      EXPECT_TRUE(mentions(p.trace, "file=" + library)) << args << ": " << library << " not loaded";
+// Each solver's first use loads its library, and only that one (the trace names the file), and
+// the run succeeds: dense LAPACK, the block Krylov-Schur (dgemm, dgees) and the Ritz vectors of
+// Spectra's (dgemm) OpenBLAS, ARPACK its own, Newton's sparse LU UMFPACK.
+TEST(StartupLibraries, EachSolverLoadsItsLibraryOnFirstUse) {
+  const std::string openblas = DELAYSPEC_BLAS_SONAME, arpack = DELAYSPEC_ARPACK_SONAME,
+                    umfpack = DELAYSPEC_UMFPACK_SONAME;
+  struct Run {
+    const char* args;
+    std::vector<std::string> loaded, not_loaded;
+  };
+  const std::vector<Run> runs = {
+      {"floquet --set model=impact --set N=20 --set solver=dense --json", {openblas}, {arpack, umfpack}},
+      {"floquet --set model=impact --set N=600 --set solver=block --json", {openblas}, {arpack, umfpack}},
+      {"floquet --set model=impact --set N=600 --set solver=arpack --json", {arpack}, {umfpack}},
+      {"floquet --set model=impact --set N=600 --set solver=spectra --json", {openblas}, {arpack, umfpack}},
+      {"floquet --set model=impact --set N=20 --set orbit=newton --set solver=spectra --json", {umfpack}, {arpack}}};
+  for (const Run& run : runs) {
+    const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, run.args);
+    EXPECT_EQ(p.status, 0) << run.args << "\n" << p.trace.substr(0, 4000);
+    for (const std::string& library : run.loaded)
+      EXPECT_TRUE(mentions(p.trace, "file=" + library)) << run.args << ": " << library << " not loaded";
+    for (const std::string& library : run.not_loaded)
+      EXPECT_FALSE(mentions(p.trace, "file=" + library)) << run.args << ": " << library << " loaded";
   }
 }
 
 // A library that cannot be loaded (here a file under UMFPACK's name that is not a shared object,
-// found first through LD_LIBRARY_PATH): exit 2 naming it, not a crash; a run that needs no
-// solver is not affected.
+// found first through LD_LIBRARY_PATH): exit 2 naming it, not a crash, for the run that needs it
+// (Newton's sparse LU); runs that do not need it are not affected.
 TEST(StartupLibraries, AnUnloadableLinearAlgebraLibraryExits2NamingIt) {
   const fs::path dir = fs::temp_directory_path() / ("delayspec_test_bad_umfpack_" + std::to_string(getpid()));
   fs::remove_all(dir);
@@ -114,13 +126,15 @@ TEST(StartupLibraries, AnUnloadableLinearAlgebraLibraryExits2NamingIt) {
     std::fclose(f);
   }
   const std::string env = "LD_LIBRARY_PATH='" + dir.string() + "'";
-  const Process p = run_traced(env, DELAYSPEC_CLI_PATH, "floquet --set model=linear --set N=20 --set solver=dense");
+  const Process p = run_traced(env, DELAYSPEC_CLI_PATH, "floquet --set model=impact --set N=20 --set orbit=newton");
   EXPECT_EQ(p.status, 2) << p.trace;
   EXPECT_TRUE(mentions(p.trace, std::string("cannot load ") + DELAYSPEC_UMFPACK_SONAME + " (SuiteSparse UMFPACK)"))
       << p.trace;
-  const Process lyapunov =
-      run_traced(env, DELAYSPEC_CLI_PATH, "lyapunov --set model=mathieu --set N=50 --set periods=20");
-  EXPECT_EQ(lyapunov.status, 0) << lyapunov.trace;
+  for (const char* args : {"floquet --set model=impact --set N=20 --set orbit=shooting --set solver=dense",
+                           "lyapunov --set model=mathieu --set N=50 --set periods=20"}) {
+    const Process other = run_traced(env, DELAYSPEC_CLI_PATH, args);
+    EXPECT_EQ(other.status, 0) << args << "\n" << other.trace;
+  }
   fs::remove_all(dir);
 }
 
