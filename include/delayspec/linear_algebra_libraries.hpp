@@ -1,8 +1,8 @@
 #pragma once
 // The linear-algebra libraries (OpenBLAS's BLAS and LAPACK, ARPACK-ng, SuiteSparse UMFPACK) are
 // not linked into libdelayspec: the library loads each with dlopen the first time a solver needs
-// it (OpenBLAS: dense LAPACK and the block Krylov-Schur's dgemm and dgees; ARPACK; UMFPACK: the
-// sparse LU of Newton's method), so a process that needs none of them (`--version`, `lyapunov`,
+// it (OpenBLAS: dense LAPACK, the block Krylov-Schur's dgees and the Krylov solvers' dgemm;
+// ARPACK; UMFPACK: the sparse LU of Newton's method), so a process that needs none of them (`--version`, `lyapunov`,
 // `simulate`) does not pay their 2.5 ms of loading (docs/design.md, "Modules loaded on first use").
 
 namespace delayspec {
