@@ -44,6 +44,8 @@ class Config {
   bool has(const std::string& key) const;
   // Where the key's value came from: the scene file's path, "--set", or a command that set it.
   const std::string& origin(const std::string& key) const { return origin_.at(key); }
+  // Whether the key's value comes from a scene (file, text or table) and no --set replaced it.
+  bool from_scene(const std::string& key) const { return scene_keys_.count(key) > 0; }
   double get_double(const std::string& key, double fallback);
   double require_double(const std::string& key);
   long get_int(const std::string& key, long fallback);

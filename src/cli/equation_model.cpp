@@ -1,6 +1,7 @@
 #include "equation_model.hpp"
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <mutex>
 
@@ -9,6 +10,7 @@
 #include "delayspec/errors.hpp"
 #include "equation_plugin.hpp"
 #include "equations_module_loader.hpp"
+#include "model_cache.hpp"
 #include "key_registry.hpp"
 #include "problem.hpp"
 
@@ -16,30 +18,48 @@ namespace delayspec::cli {
 
 namespace {
 
-// A table printed and loaded once per process: the points of a sweep or chart (threads) read the
-// same table again and again with other parameter values.
-struct LoadedEquations {
+// GiNaC is not thread-safe: every use of it (the module's generate and constants), and the
+// registries below, under one lock. The points of a sweep or chart (threads) read the same table
+// again and again with other parameter values: each table is printed once per process, and
+// compiled and loaded once per process and cache directory.
+std::mutex& equations_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+// A printed table, kept for the process: the compiled model's messages point into state_names.
+struct GeneratedModel {
   EquationModelSource source;
-  EquationPlugin plugin;
+  std::vector<const char*> state_names;  // into source.state
 };
 
-const LoadedEquations& load(const std::string& table_text, const std::filesystem::path& cache_dir) {
-  // GiNaC is not thread-safe: every use of it, and the registry, under one lock.
-  static std::mutex mutex;
-  static std::map<std::string, std::unique_ptr<const LoadedEquations>> loaded;
-  const std::lock_guard<std::mutex> lock(mutex);
-  const std::string key = cache_dir.string() + '\n' + table_text;
-  if (auto it = loaded.find(key); it != loaded.end()) return *it->second;
+const GeneratedModel& generated(const std::string& table_text) {
+  static std::map<std::string, std::unique_ptr<const GeneratedModel>> sources;
+  const std::lock_guard<std::mutex> lock(equations_mutex());
+  if (auto it = sources.find(table_text); it != sources.end()) return *it->second;
   toml::table table;
   try {
     table = toml::parse(std::string_view(table_text), std::string_view("[equations]"));
   } catch (const toml::parse_error& e) {
     throw BadInput("`equations`: " + std::string(e.description()));
   }
-  auto entry = std::make_unique<LoadedEquations>();
-  entry->source = equations_module().generate(table, engine_keys());
-  entry->plugin = load_equation_plugin(entry->source.code, cache_dir);
-  return *(loaded[key] = std::move(entry));
+  auto model = std::make_unique<GeneratedModel>();
+  model->source = equations_module().generate(table, engine_keys());
+  for (const auto& name : model->source.state) model->state_names.push_back(name.c_str());
+  return *(sources[table_text] = std::move(model));
+}
+
+std::vector<double> constants_at(const EquationModelSource& source, const std::vector<double>& p) {
+  const std::lock_guard<std::mutex> lock(equations_mutex());
+  return source.constants(p);
+}
+
+const EquationPlugin& compiled(const EquationModelSource& source, const std::filesystem::path& cache_dir) {
+  static std::map<std::string, EquationPlugin> plugins;
+  const std::lock_guard<std::mutex> lock(equations_mutex());
+  const std::string key = cache_dir.string() + '\n' + source.code;
+  if (auto it = plugins.find(key); it != plugins.end()) return it->second;
+  return plugins[key] = load_equation_plugin(source.code, cache_dir);
 }
 
 double positive_value(const std::string& item, double value) {
@@ -63,30 +83,44 @@ std::vector<std::string> engine_keys() {
   return keys;
 }
 
-EquationModel read_equation_model(Config& config) {
+EquationModel read_equation_model(Config& config, const std::function<void(double, double)>& check_grid) {
   if (!config.has("equations"))
     throw BadInput("`model = equations`: the scene has no [equations] table (docs/models.md shows its format)");
   const std::string text = config.get_string("equations", "");
+  // The cache holds code this program runs: a scene, which may come from anywhere, never chooses
+  // it (model_cache.hpp).
+  if (config.has("model_cache") && config.from_scene("model_cache"))
+    throw BadInput("`model_cache` in the scene " + config.origin("model_cache") +
+                   ": a scene may not choose where compiled models are loaded from; give it on the command line " +
+                   "(--set model_cache=DIR), as a Python keyword, or through XDG_CACHE_HOME");
   const std::filesystem::path cache_dir = config.get_string("model_cache", default_model_cache().string());
-  const LoadedEquations& eq = load(text, cache_dir);
-
-  const EquationModelSource& src = eq.source;
+  const GeneratedModel& model_text = generated(text);
+  const EquationModelSource& src = model_text.source;
   std::vector<double> p(src.parameters.size());
   for (size_t k = 0; k < p.size(); ++k) {
     p[k] = config.get_double(src.parameters[k], src.parameter_defaults[k]);
     require_finite(src.parameters[k].c_str(), p[k]);
   }
-  const double period = positive_value("equations.period", eq.plugin.period(p.data()));
-  double tau = 0;
-  if (config.has("tau_over_T")) {
-    const double ratio = config.get_double("tau_over_T", 1);
-    require_positive("tau_over_T", ratio);
-    tau = ratio * period;
-  } else {
-    tau = positive_value("equations.delay", eq.plugin.delay(p.data()));
-  }
+
+  // Everything that can be checked without the compiled model is checked before the compile
+  // (seconds): the constant expressions, and the grid they give with N.
+  const std::vector<double> constants = constants_at(src, p);
+  const double period_exact = positive_value("equations.period", constants[0]);
+  const bool delay_from_ratio = config.has("tau_over_T");
+  if (delay_from_ratio) require_positive("tau_over_T", config.get_double("tau_over_T", 1));
+  const double tau_exact = delay_from_ratio ? config.get_double("tau_over_T", 1) * period_exact
+                                            : positive_value("equations.delay", constants[1]);
+  for (size_t i = 0; i < src.state.size(); ++i)
+    if (!std::isfinite(constants[2 + i]))
+      throw BadInput("`equations.history." + src.state[i] + "` is not a finite number at these parameters");
+  check_grid(tau_exact, period_exact);
+
+  const EquationPlugin& plugin = compiled(src, cache_dir);
+  const double period = positive_value("equations.period", plugin.period(p.data()));
+  const double tau = delay_from_ratio ? config.get_double("tau_over_T", 1) * period
+                                      : positive_value("equations.delay", plugin.delay(p.data()));
   std::vector<double> history(src.state.size());
-  eq.plugin.history(p.data(), history.data());
+  plugin.history(p.data(), history.data());
   for (size_t i = 0; i < history.size(); ++i)
     if (!std::isfinite(history[i]))
       throw BadInput("`equations.history." + src.state[i] + "` evaluates to " + format_number(history[i]) +
@@ -94,7 +128,7 @@ EquationModel read_equation_model(Config& config) {
   EquationModel model;
   model.state = src.state;
   model.parameters = src.parameters;
-  model.analyses.reset(eq.plugin.analyses(p.data(), tau, period, history.data()));
+  model.analyses.reset(plugin.analyses(p.data(), tau, period, history.data(), model_text.state_names.data()));
   return model;
 }
 

@@ -6,6 +6,7 @@
 // any model (`--set k=0.3`, sweep_key, chart_x), read here with the table's values as defaults,
 // so a new parameter value never recompiles. The delay is the `delay` expression, or
 // tau_over_T times the period when that key is given.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,8 +23,10 @@ struct EquationModel {
 };
 
 // Reads the [equations] table (kept whole by Config as the key `equations`), the parameter keys,
-// tau_over_T and model_cache. BadInput for every input error, naming the item.
-EquationModel read_equation_model(Config& config);
+// tau_over_T and model_cache. BadInput for every input error, naming the item. `check_grid(tau,
+// period)` is called with the delay and period before the model is compiled, so that a grid that
+// cannot be made (a delay shorter than a step, too many steps) is refused in milliseconds.
+EquationModel read_equation_model(Config& config, const std::function<void(double tau, double period)>& check_grid);
 
 // The keys an equation parameter may not be named after: those the engine reads whatever the
 // model (N, nev, seed, ...), and model, equations, tau_over_T and model_cache.

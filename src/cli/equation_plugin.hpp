@@ -6,13 +6,18 @@
 // a shared object that links this same libdelayspec, and loaded with dlopen. Nothing is
 // interpreted per step: the model's steps are compiled code with the model's d fixed.
 //
-// Cache: DIR/eq-HASH.so beside its source DIR/eq-HASH.cpp. HASH covers the source, delayspec's
-// version and revision, the compiler (path, size, time) and the library it links (path, size,
-// time). A hit needs both files and the stored source equal to this one, so not even a hash
-// collision loads another model. Concurrent first runs (threads, MPI ranks, processes) take an
-// flock on DIR/eq-HASH.lock: one compiles, into temporary files renamed into place (atomic), the
-// others wait and load its object. A loaded object is never unloaded (its code runs the
-// analyses it made).
+// Cache (model_cache.hpp: a directory private to the user, entries never opened through a link):
+// DIR/eq-HASH.so beside its source DIR/eq-HASH.cpp, its checksum DIR/eq-HASH.sum and the
+// compiler's log DIR/eq-HASH.log. HASH covers the source, delayspec's version and revision, the
+// compiler (path, size, time), the library it links (path, size, time) and the contents of
+// delayspec's headers it is compiled against. A hit needs the stored source equal to this one (so
+// not even a hash collision loads another model) and the object's bytes equal to the checksum
+// recorded when this program compiled it; the object is then opened through the descriptor whose
+// bytes were checked. Concurrent first runs (threads, MPI ranks, processes) take an flock on
+// DIR/eq-HASH.lock: one compiles, into a temporary object that is loaded and checked before it is
+// renamed into place, the others wait and load its object. The compiler runs as a child that dies
+// with delayspec and within a time limit (child_process.hpp). A loaded object is never unloaded
+// (its code runs the analyses it made).
 #include <filesystem>
 #include <string>
 
@@ -22,8 +27,10 @@ namespace delayspec::cli {
 
 struct EquationPlugin {
   // The analyses of the model at the given parameter values (in the order of the source's
-  // parameters), delay, period and constant initial history (d values). The caller owns it.
-  ModelAnalyses* (*analyses)(const double* parameters, double tau, double period, const double* history) = nullptr;
+  // parameters), delay, period and constant initial history (d values); `state_names` (d, or
+  // null), which must outlive the analyses, for messages. The caller owns it.
+  ModelAnalyses* (*analyses)(const double* parameters, double tau, double period, const double* history,
+                             const char* const* state_names) = nullptr;
   double (*period)(const double* parameters) = nullptr;                // the `period` expression
   double (*delay)(const double* parameters) = nullptr;                 // the `delay` expression
   void (*history)(const double* parameters, double* state) = nullptr;  // the `history` expressions
@@ -40,8 +47,5 @@ EquationPlugin load_equation_plugin(const std::string& model_code, const std::fi
 
 // Compilations this process has run (tests: a cache hit compiles nothing).
 long equation_plugin_compilations();
-
-// $XDG_CACHE_HOME/delayspec, else $HOME/.cache/delayspec (the key `model_cache` overrides it).
-std::filesystem::path default_model_cache();
 
 }  // namespace delayspec::cli

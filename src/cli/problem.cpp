@@ -4,6 +4,7 @@
 
 #include "delayspec/builtin_analyses.hpp"
 #include "delayspec/errors.hpp"
+#include "delayspec/grid.hpp"
 #include "equation_model.hpp"
 
 namespace delayspec::cli {
@@ -144,7 +145,10 @@ Problem read_problem(Config& config, int default_N) {
     problem.state_names =
         problem.state_dimension() == 2 ? std::vector<std::string>{"x", "v"} : std::vector<std::string>{"x"};
   } else {
-    EquationModel equations = read_equation_model(config);
+    EquationModel equations = read_equation_model(config, [&](double tau, double period) {
+      make_grid(tau, period, static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000)),
+                static_cast<int>(config.get_int_in_range("orbit_period", 1, 1, 1000)));
+    });
     problem.analyses = std::move(equations.analyses);
     problem.state_names = std::move(equations.state);
   }

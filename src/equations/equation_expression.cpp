@@ -28,6 +28,13 @@ struct Token {
 // (beyond the range of a double either way): bounds the exact rational GiNaC holds.
 constexpr size_t kMaxDigits = 100;
 constexpr long kMaxExponent = 400;
+// Parentheses (and function calls) nested at most this deep, and at most this many tokens per
+// expression. GiNaC's parser, its differentiation and its printer recurse once per level of
+// nesting: 10 000 levels overflowed the stack (a crash where bad input is due, measured); no model
+// written by hand comes near 100. The token bound keeps one expression to what compiles in seconds
+// (the model's whole size is bounded again on the printed code, equation_model_source.cpp).
+constexpr size_t kMaxNesting = 100;
+constexpr size_t kMaxTokens = 20000;
 
 bool is_letter(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
@@ -60,6 +67,11 @@ class ExpressionReader {
     throw BadInput("`" + item_ + "`: \"" + printable(text_) + "\" " + problem);
   }
 
+  [[noreturn]] void fail_nesting(size_t position) const {
+    fail(position, "parentheses nested more than " + std::to_string(kMaxNesting) + " deep",
+         "the limit of delayspec's expression reader");
+  }
+
   // Number: digits [. digits] [e|E [+|-] digits], or . digits [exponent].
   size_t scan_number(size_t i) const {
     while (i < text_.size() && is_digit(text_[i])) ++i;
@@ -82,6 +94,9 @@ class ExpressionReader {
     for (size_t i = 0; i < text_.size();) {
       const char c = text_[i];
       const size_t position = i + 1;
+      if (tokens_.size() >= kMaxTokens)
+        fail(position, "more than " + std::to_string(kMaxTokens) + " numbers, names and operators",
+             "a model this large compiles for minutes; split it or simplify it");
       if (is_space(c)) {
         ++i;
       } else if (is_digit(c) || (c == '.' && i + 1 < text_.size() && is_digit(text_[i + 1]))) {
@@ -155,6 +170,7 @@ class ExpressionReader {
           case TokenKind::name:
             if (is_function_call(k)) {
               check_function(token);
+              if (open.size() >= kMaxNesting) fail_nesting(tokens_[k + 1].position);
               open.push_back(tokens_[k + 1].position);
               last_operator.push_back(0);
               ++k;  // the '('
@@ -164,6 +180,7 @@ class ExpressionReader {
             }
             break;
           case TokenKind::open:
+            if (open.size() >= kMaxNesting) fail_nesting(token.position);
             open.push_back(token.position);
             last_operator.push_back(0);
             break;

@@ -1,6 +1,8 @@
 #include "equation_model_source.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <functional>
 #include <set>
 #include <sstream>
@@ -8,6 +10,7 @@
 
 #include "equation_cxx_printer.hpp"
 #include "equation_model_symbolic.hpp"
+#include "delayspec/errors.hpp"
 #include "equation_names.hpp"
 
 namespace delayspec::cli {
@@ -18,6 +21,10 @@ namespace {
 // the engine), each sign change then bisected to adjacent doubles: two roots within one
 // sub-interval are missed (docs/models.md).
 constexpr int kTimeSwitchSamples = 16;
+
+// The largest model compiled: the printed struct's size. 10^5 distinct terms printed about 8 MB
+// and compiled for minutes; the engine's own models print under 20 kB.
+constexpr size_t kMaxModelCode = 2'000'000;
 
 std::string bool_text(bool b) { return b ? "true" : "false"; }
 
@@ -45,6 +52,7 @@ class ModelPrinter {
          << "  std::array<double, parameter_count> p{};\n"
          << "  double tau_ = 0, period_ = 0;\n"
          << "  Vector history_ = Vector::Zero();\n"
+         << "  const char* const* names_ = nullptr;  // the state's names, for messages (set by the loader)\n"
          << "  double tau() const { return tau_; }\n"
          << "  double period() const { return period_; }\n"
          << "  Vector initial_state() const { return history_; }\n"
@@ -127,7 +135,15 @@ class ModelPrinter {
       const auto& c = components(field);
       for (size_t i = 0; i < c.size(); ++i) out_ << indent << "r[" << i << "] = " << cxx(c[i]) << ";\n";
     });
+    if (name == "f") print_finite_check('f');
     out_ << "    return r;\n  }\n";
+  }
+
+  // f, A and B are checked where they are computed (detail/non_finite_model_value.hpp): a value
+  // that is not finite names its expression and the point, instead of surfacing in the step maps.
+  void print_finite_check(char what) {
+    out_ << "    if (!r.allFinite()) delayspec::detail::throw_non_finite_model_value('" << what << "', j, "
+         << bool_text(m_.fields.size() > 1) << ", r.data(), d, t, y.data(), z.data(), names_);\n";
   }
 
   void print_field_matrix(const std::string& name, const Matrix& matrix) {
@@ -139,6 +155,7 @@ class ModelPrinter {
           if (!entries[i][a].is_zero())
             out_ << indent << "r(" << i << ", " << a << ") = " << cxx(entries[i][a]) << ";\n";
     });
+    print_finite_check(name[0]);
     out_ << "    return r;\n  }\n";
   }
 
@@ -195,6 +212,28 @@ EquationModelSource generate_equation_model(const toml::table& equations,
   source.switches_in_state = model.switch_kind == SwitchKind::state;
   source.switches_in_time = model.switch_kind == SwitchKind::time;
   source.code = ModelPrinter(model).print();
+  if (source.code.size() > kMaxModelCode)
+    throw BadInput("`equations`: the model's derivatives print as " + std::to_string(source.code.size() / 1000) +
+                   " kB of C++, more than the " + std::to_string(kMaxModelCode / 1000) +
+                   " kB delayspec compiles (a model this large compiles for minutes): simplify it");
+  std::vector<GiNaC::ex> constants = {model.period, model.delay};
+  constants.insert(constants.end(), model.history.begin(), model.history.end());
+  source.constants = [constants, p = model.p](const std::vector<double>& values) {
+    GiNaC::lst at;
+    for (size_t k = 0; k < p.size() && k < values.size(); ++k) at.append(p[k] == GiNaC::numeric(values[k]));
+    std::vector<double> out;
+    for (const auto& e : constants) {
+      double v = std::numeric_limits<double>::quiet_NaN();
+      try {
+        const GiNaC::ex x = GiNaC::evalf(e.subs(at));
+        if (GiNaC::is_a<GiNaC::numeric>(x) && GiNaC::ex_to<GiNaC::numeric>(x).is_real())
+          v = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
+      } catch (const std::exception&) {  // 1/0 and other poles at these values
+      }
+      out.push_back(std::isfinite(v) ? v : std::numeric_limits<double>::quiet_NaN());
+    }
+    return out;
+  };
   return source;
 }
 

@@ -5,6 +5,7 @@
 // Nothing of the scene reaches the code as text: user names become generated names (y[i],
 // z[i], p[k], t), numbers their exact values, and every expression is printed by GiNaC from its
 // parsed form (equation_expression.hpp).
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,11 @@ struct EquationModelSource {
   bool switches_in_state = false;          // `switch` given and depends on the state
   bool switches_in_time = false;           // `switch` given and depends on t only
   std::string code;                        // C++ text of `struct EquationModel {...};`
+  // The constant expressions at parameter values (in the order of `parameters`): period, delay,
+  // then the d history values, each GiNaC's evaluation of the exact expression (NaN where that is
+  // not a finite real number, e.g. 1/0). So that they are checked before the model is compiled
+  // (seconds) rather than after. Not thread-safe (GiNaC).
+  std::function<std::vector<double>(const std::vector<double>& p)> constants;
 };
 
 // Throws BadInput naming the item (e.g. "`equations.rhs[2]`: ...") for every input error that
