@@ -157,6 +157,82 @@ TEST_F(EquationsCli, NoCompilerExitsTwoNamingThePackage) {
   EXPECT_TRUE(contains(r.err, "Debian package g++")) << r.err;
 }
 
+// A scene with `rhs` replaced (the table of kScene otherwise).
+std::string scene_with(const std::filesystem::path& dir, const std::string& name, const std::string& from,
+                       const std::string& to) {
+  std::string text = kScene;
+  text.replace(text.find(from), from.size(), to);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST_F(EquationsCli, DeepOrHugeExpressionsAreBadInputNotACrash) {
+  // 10 000 levels overflowed the stack in GiNaC's parser (exit 139; the Python interpreter died).
+  const std::string deep = std::string(10000, '(') + "x" + std::string(10000, ')');
+  std::string nested_calls;
+  for (int i = 0; i < 10000; ++i) nested_calls += "sin(";
+  nested_calls += "x";
+  nested_calls.append(10000, ')');
+  std::string long_sum = "x";
+  for (int i = 0; i < 12000; ++i) long_sum += "+x";
+  const struct {
+    std::string rhs, expected;
+  } cases[] = {{deep, "parentheses nested more than 100 deep"},
+               {nested_calls, "parentheses nested more than 100 deep"},
+               {long_sum, "more than 20000 numbers, names and operators"}};
+  for (const auto& c : cases) {
+    const std::string scene = scene_with(dir_, "deep.toml", "a*x + b*x_tau", c.rhs);
+    const CliResult r = command("floquet", {"N=20"}, scene);
+    EXPECT_EQ(r.status, 2) << c.expected;
+    EXPECT_TRUE(contains(r.err, "`equations.rhs[1]`")) << r.err.substr(0, 300);
+    EXPECT_TRUE(contains(r.err, c.expected)) << r.err.substr(0, 300);
+    EXPECT_LT(r.err.size(), 600u) << "the message shows an excerpt of the expression, not all of it";
+  }
+  // Just inside the limit is fine as far as the reader goes (100 levels).
+  const std::string hundred = std::string(100, '(') + "a*x" + std::string(100, ')') + " + b*x_tau";
+  ::setenv("DELAYSPEC_CXX", "/nonexistent/c++", 1);  // the reader passes; the compile is not the point
+  const CliResult ok = command("floquet", {"N=20"}, scene_with(dir_, "hundred.toml", "a*x + b*x_tau", hundred));
+  ::unsetenv("DELAYSPEC_CXX");
+  EXPECT_EQ(ok.status, 2) << ok.err;
+  EXPECT_TRUE(contains(ok.err, "/nonexistent/c++")) << ok.err;
+}
+
+TEST_F(EquationsCli, ConstantsAndTheGridAreCheckedBeforeTheCompile) {
+  // No compiler at all: each case must be refused for its own reason, so before any compile.
+  ::setenv("DELAYSPEC_CXX", "/nonexistent/c++", 1);
+  const struct {
+    const char *from, *to;
+    std::vector<std::string> sets;
+    const char* expected;
+  } cases[] = {
+      {"delay = \"1\"", "delay = \"b - 0.5\"", {}, "`equations.delay` evaluates to 0"},
+      {"period = \"1\"", "period = \"-b\"", {}, "`equations.period` evaluates to -0.5"},
+      {"delay = \"1\"", "delay = \"1/(a + 1)\"", {}, "`equations.delay` evaluates to nan"},
+      {"delay = \"1\"", "delay = \"b*1e-12\"", {}, "too many steps"},
+      {"delay = \"1\"", "delay = \"b\"", {"b=0"}, "`equations.delay` evaluates to 0"},
+      {"period = \"1\"", "period = \"1e-9\"", {}, "needs N divisible by 1000000000"},
+      {"history = { x = \"x0\" }", "history = { x = \"1/x0\" }", {"x0=0"}, "`equations.history.x`"},
+  };
+  for (const auto& c : cases) {
+    const CliResult r = command("floquet", c.sets, scene_with(dir_, "constants.toml", c.from, c.to));
+    EXPECT_EQ(r.status, 2) << c.to;
+    EXPECT_TRUE(contains(r.err, c.expected)) << c.to << ": " << r.err;
+    EXPECT_FALSE(contains(r.err, "/nonexistent/c++")) << c.to << ": " << r.err;
+  }
+  ::unsetenv("DELAYSPEC_CXX");
+}
+
+TEST_F(EquationsCli, ANonFiniteDerivativeNamesTheExpressionAndThePoint) {
+  // x' = -sqrt(x) from x = 0: the orbit stays at 0, where d/dx = -1/(2 sqrt(x)) is -inf. It used to
+  // end much later in "dense_eigenvalues: matrix has non-finite entries".
+  const std::string scene = scene_with(dir_, "sqrt.toml", "a*x + b*x_tau", "-sqrt(x) + b*x_tau");
+  const CliResult r = command("floquet", {"N=20", "x0=0"}, scene);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "the derivative of `equations.rhs[1]` by x is not finite (-inf)")) << r.err;
+  EXPECT_TRUE(contains(r.err, ", x = 0, x_tau = 0")) << r.err;
+}
+
 TEST_F(EquationsCli, MissingTableIsBadInput) {
   const CliResult r = run({"floquet", "--set", "model=equations"});
   EXPECT_EQ(r.status, 2) << r.err;

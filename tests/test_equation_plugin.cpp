@@ -32,6 +32,7 @@ const char* kLinearCode = R"(struct EquationModel {
   std::array<double, parameter_count> p{};
   double tau_ = 0, period_ = 0;
   Vector history_ = Vector::Zero();
+  const char* const* names_ = nullptr;
   static double period_of(const double*) { return 1.0; }
   static double delay_of(const double*) { return 1.0; }
   static Vector history_of(const double*) { return Vector(1.0); }

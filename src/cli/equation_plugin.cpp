@@ -58,7 +58,7 @@ std::string plugin_source(const std::string& model_code) {
          "  for (int k = 0; k < EquationModel::parameter_count; ++k) m.p[k] = p[k];\n"
          "  m.tau_ = tau;\n  m.period_ = period;\n"
          "  for (int i = 0; i < EquationModel::d; ++i) m.history_[i] = y[i];\n"
-         "  if constexpr (requires { m.names_; }) m.names_ = names;\n"
+         "  m.names_ = names;\n"
          "  return new delayspec::ModelAnalysesFor<EquationModel>(m);\n}\n";
 }
 

@@ -54,17 +54,29 @@ class ExpressionReader {
 
   GiNaC::ex read() {
     tokenize();
-    check_grammar();
+    check_grammar();  // before the size: deep nesting gets its own message
+    if (tokens_.size() > kMaxTokens)
+      fail(tokens_[kMaxTokens].position, "more than " + std::to_string(kMaxTokens) + " numbers, names and operators",
+           "a model this large compiles for minutes; split it or simplify it");
     return parse();
   }
 
  private:
   [[noreturn]] void fail(size_t position, const std::string& problem, const std::string& hint = "") const {
     throw BadInput("`" + item_ + "`: " + problem + " at position " + std::to_string(position) + " of \"" +
-                   printable(text_) + "\"" + (hint.empty() ? "" : " (" + hint + ")"));
+                   excerpt(position) + "\"" + (hint.empty() ? "" : " (" + hint + ")"));
   }
   [[noreturn]] void fail_whole(const std::string& problem) const {
-    throw BadInput("`" + item_ + "`: \"" + printable(text_) + "\" " + problem);
+    throw BadInput("`" + item_ + "`: \"" + excerpt(1) + "\" " + problem);
+  }
+
+  // The expression as a message shows it: whole when short, else the part around `position`.
+  std::string excerpt(size_t position) const {
+    constexpr size_t kBefore = 60, kAfter = 40;
+    if (text_.size() <= kBefore + kAfter) return printable(text_);
+    const size_t from = position > kBefore ? position - kBefore : 0;
+    const size_t to = std::min(text_.size(), std::max(position, from) + kAfter);
+    return (from > 0 ? "..." : "") + printable(text_.substr(from, to - from)) + (to < text_.size() ? "..." : "");
   }
 
   [[noreturn]] void fail_nesting(size_t position) const {
@@ -94,9 +106,6 @@ class ExpressionReader {
     for (size_t i = 0; i < text_.size();) {
       const char c = text_[i];
       const size_t position = i + 1;
-      if (tokens_.size() >= kMaxTokens)
-        fail(position, "more than " + std::to_string(kMaxTokens) + " numbers, names and operators",
-             "a model this large compiles for minutes; split it or simplify it");
       if (is_space(c)) {
         ++i;
       } else if (is_digit(c) || (c == '.' && i + 1 < text_.size() && is_digit(text_[i + 1]))) {
