@@ -235,6 +235,10 @@ std::vector<BadTable> bad_tables() {
   };
   // the table itself
   add("unknown entry", impact_with("histroy", toml::table{}), {"`equations.histroy`", "did you mean `history`?"});
+  add("unknown entry, a prefix", impact_with("param", toml::table{}), {"`equations.param`", "did you mean `parameters`?"});
+  add("unknown entry, longer", impact_with("switching", "x"), {"`equations.switching`", "did you mean `switch`?"});
+  add("unknown entry, far", impact_with("initial", toml::table{}),
+      {"`equations.initial`", "the entries are state, parameters, period, delay, rhs, switch, rhs_switched, history"});
   add("no state", impact_without("state"), {"`equations.state` is required"});
   add("state not an array", impact_with("state", "x"), {"`equations.state`", "array"});
   add("empty state", impact_with("state", toml::array{}), {"`equations.state`", "at least one"});

@@ -10,7 +10,10 @@
 // the process or the output rather than the model: nothing here waits for a real compile.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <linux/fs.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -321,6 +324,49 @@ TEST_F(ModelCache, AStaleTemporaryIsRemovedUnderTheLock) {
                            "--set", "a=-2"});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_FALSE(fs::exists(stale));
+}
+
+// Makes `dir` read-only for this process, root included: the immutable attribute where the file
+// system and the rights allow it, else mode 0500 (enough for a user who is not root).
+bool make_read_only(const fs::path& dir, bool on) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
+  int flags = 0;
+  bool done = fd >= 0 && ::ioctl(fd, FS_IOC_GETFLAGS, &flags) == 0;
+  if (done) {
+    flags = on ? (flags | FS_IMMUTABLE_FL) : (flags & ~FS_IMMUTABLE_FL);
+    done = ::ioctl(fd, FS_IOC_SETFLAGS, &flags) == 0;
+  }
+  if (fd >= 0) ::close(fd);
+  if (!done) fs::permissions(dir, on ? fs::perms::owner_read | fs::perms::owner_exec : fs::perms::owner_all,
+                             fs::perm_options::replace);
+  return done || ::geteuid() != 0;
+}
+
+TEST_F(ModelCache, AReadOnlyCacheServesWhatItHolds) {
+  const fs::path scene = dir_ / "scene.toml";
+  write(scene, std::string("model = \"equations\"\n") + kEquations);
+  const fs::path cache = dir_ / "cache";
+  const std::vector<std::string> args = {"floquet", scene.string(), "--set", "model_cache=" + cache.string(),
+                                         "--set", "N=20", "--set", "solver=dense"};
+  int status = 0;
+  const pid_t compile = start_program(args, {}, dir_ / "err1");  // a real compile
+  ASSERT_EQ(::waitpid(compile, &status, 0), compile);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << read_text(dir_ / "err1");
+  for (const auto& e : fs::directory_iterator(cache))
+    if (e.path().extension() == ".lock") fs::remove(e.path());  // a read-only cache cannot make one
+  ASSERT_TRUE(make_read_only(cache, true)) << "cannot make a directory read-only for root here";
+  const pid_t hit = start_program(args, {}, dir_ / "err2");  // no compile: it could write nothing
+  ASSERT_EQ(::waitpid(hit, &status, 0), hit);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << read_text(dir_ / "err2");
+  // A model it does not hold: refused, saying why.
+  std::vector<std::string> other = args;
+  write(dir_ / "other.toml", std::string("model = \"equations\"\n") + kEquations + "history = { x = \"2\" }\n");
+  other[1] = (dir_ / "other.toml").string();
+  const pid_t miss = start_program(other, {}, dir_ / "err3");
+  ASSERT_EQ(::waitpid(miss, &status, 0), miss);
+  make_read_only(cache, false);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << read_text(dir_ / "err3");
+  EXPECT_TRUE(contains(read_text(dir_ / "err3"), "read-only")) << read_text(dir_ / "err3");
 }
 
 }  // namespace

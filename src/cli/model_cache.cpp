@@ -146,7 +146,7 @@ std::vector<std::string> ModelCacheDir::entries_starting_with(const std::string&
 UniqueFd ModelCacheDir::lock(const std::string& name) const {
   UniqueFd fd(::openat(dir_.get(), name.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0600));
   if (!fd) {
-    if (errno == EROFS || errno == EACCES) return fd;
+    if (errno == EROFS || errno == EACCES || errno == EPERM) return fd;  // EPERM: an immutable directory
     throw BadInput("`model_cache`: cannot create the lock file " + entry_path(name).string() + " (" +
                    (errno == ELOOP ? std::string("a symbolic link, which the cache never follows") : reason()) +
                    "): delete it");

@@ -66,7 +66,7 @@ class ModelCacheDir {
 
   // An exclusive flock on the entry `name` (created 0600, never through a link), held until the
   // returned descriptor closes. Empty when the directory is read-only for this process (EROFS,
-  // EACCES): a read-only cache can still serve the models it holds.
+  // EACCES, EPERM): a read-only cache can still serve the models it holds.
   UniqueFd lock(const std::string& name) const;
 
  private:

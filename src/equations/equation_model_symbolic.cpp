@@ -74,9 +74,16 @@ class EquationsReader {
       const std::string name(key.str());
       const auto& entries = table_entries();
       if (std::find(entries.begin(), entries.end(), name) != entries.end()) continue;
-      const std::string suggestion = closest_key(name, entries);
-      throw BadInput("`" + item_of(printable(name)) + "`: unknown entry of [equations]" +
-                     (suggestion.empty() ? "" : " (did you mean `" + suggestion + "`?)"));
+      // The closest by spelling, else one that the name begins or ends (param, switching), else the list.
+      std::string suggestion = closest_key(name, entries);
+      for (const auto& e : entries)
+        if (suggestion.empty() && name.size() >= 3 &&
+            (e.compare(0, name.size(), name) == 0 || name.compare(0, e.size(), e) == 0))
+          suggestion = e;
+      std::string all;
+      for (const auto& e : entries) all += (all.empty() ? "" : ", ") + e;
+      throw BadInput("`" + item_of(printable(name)) + "`: unknown entry of [equations] (" +
+                     (suggestion.empty() ? "the entries are " + all : "did you mean `" + suggestion + "`?") + ")");
     }
   }
 
