@@ -111,6 +111,21 @@ TEST_F(EquationPluginTest, ConcurrentFirstLoadsCompileOnce) {
   EXPECT_EQ(std::unique_ptr<ModelAnalyses>(second.analyses(p, 1, 1, &y0, nullptr))->state_dimension(), 1);
 }
 
+TEST_F(EquationPluginTest, TwoModelsInOneProcessAreTwoObjects) {
+  // Objects are opened through the descriptor whose bytes were checked (/proc/self/fd/N); the
+  // dynamic loader matches objects by that name, so a second model must not reuse the first's N
+  // and get the first model's code (it did, with the descriptor closed after loading).
+  std::string other = kLinearCode;
+  const std::string period = "static double period_of(const double*) { return 1.0; }";
+  other.replace(other.find(period), period.size(), "static double period_of(const double*) { return 2.0; }");
+  const EquationPlugin first = load_equation_plugin(kLinearCode, cache_);
+  const EquationPlugin second = load_equation_plugin(other, cache_);
+  const double p[2] = {-1.0, 0.5};
+  EXPECT_EQ(first.period(p), 1.0);
+  EXPECT_EQ(second.period(p), 2.0);
+  EXPECT_NE(first.object, second.object);
+}
+
 TEST_F(EquationPluginTest, ACompileErrorIsBadInputWithTheCompilersFirstLines) {
   try {
     load_equation_plugin("struct EquationModel { this is not C++ };", cache_);

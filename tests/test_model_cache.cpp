@@ -21,11 +21,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "cli_test_support.hpp"
 #include "delayspec_test_paths.hpp"
+#include "equation_plugin.hpp"
 #include "equation_toolchain.hpp"
+#include "delayspec/errors.hpp"
 
 namespace {
 
@@ -367,6 +370,33 @@ TEST_F(ModelCache, AReadOnlyCacheServesWhatItHolds) {
   make_read_only(cache, false);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << read_text(dir_ / "err3");
   EXPECT_TRUE(contains(read_text(dir_ / "err3"), "read-only")) << read_text(dir_ / "err3");
+}
+
+TEST_F(ModelCache, HeadersComeOnlyFromTheBuildOrASafelyOwnedInstall) {
+  // The build tree: exactly the include paths compiled in, whatever lies beside the library.
+  const auto build = delayspec::cli::model_headers(DELAYSPEC_PLUGIN_BUILD_LIBDIR);
+  std::vector<std::string> compiled_in;
+  std::stringstream list(DELAYSPEC_PLUGIN_BUILD_INCLUDES);
+  for (std::string dir; std::getline(list, dir, ';');) compiled_in.push_back(dir);
+  EXPECT_EQ(build.include_dirs, compiled_in);
+  // A library elsewhere is an installed delayspec: LIBDIR/../include, only when nobody but its
+  // owner (root or this user) can write it. A world-writable folder holding a planted
+  // delayspec/version.hpp (a build tree in /tmp, say) is refused, not compiled against.
+  const fs::path prefix = dir_ / "prefix";
+  fs::create_directories(prefix / "lib");
+  write(prefix / "include" / "delayspec" / "version.hpp", "#error planted\n");
+  fs::permissions(prefix / "include" / "delayspec", fs::perms::all);
+  EXPECT_THROW(delayspec::cli::model_headers(prefix / "lib"), delayspec::BadInput);
+  fs::permissions(prefix / "include" / "delayspec",
+                  fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                      fs::perms::others_exec,
+                  fs::perm_options::replace);
+  const auto installed = delayspec::cli::model_headers(prefix / "lib");
+  ASSERT_FALSE(installed.include_dirs.empty());
+  EXPECT_EQ(installed.include_dirs.front(), (prefix / "include").string());
+  // The headers' contents are in the cache key: another header, another entry.
+  write(prefix / "include" / "delayspec" / "version.hpp", "#error planted, and changed\n");
+  EXPECT_NE(delayspec::cli::model_headers(prefix / "lib").identity, installed.identity);
 }
 
 }  // namespace

@@ -34,7 +34,9 @@ struct GeneratedModel {
 };
 
 const GeneratedModel& generated(const std::string& table_text) {
-  static std::map<std::string, std::unique_ptr<const GeneratedModel>> sources;
+  // Never destroyed: `constants` holds GiNaC expressions, which must not outlive GiNaC's own
+  // statics, and the module's destructors may run first at exit.
+  static auto& sources = *new std::map<std::string, std::unique_ptr<const GeneratedModel>>;
   const std::lock_guard<std::mutex> lock(equations_mutex());
   if (auto it = sources.find(table_text); it != sources.end()) return *it->second;
   toml::table table;
@@ -46,7 +48,9 @@ const GeneratedModel& generated(const std::string& table_text) {
   auto model = std::make_unique<GeneratedModel>();
   model->source = equations_module().generate(table, engine_keys());
   for (const auto& name : model->source.state) model->state_names.push_back(name.c_str());
-  return *(sources[table_text] = std::move(model));
+  const GeneratedModel& result = *model;
+  sources[table_text] = std::move(model);
+  return result;
 }
 
 std::vector<double> constants_at(const EquationModelSource& source, const std::vector<double>& p) {

@@ -164,6 +164,22 @@ std::string delayspec_headers(const std::vector<std::string>& includes, bool bui
   return text;
 }
 
+}  // namespace
+
+ModelHeaders model_headers(const std::filesystem::path& libdir) {
+  std::error_code ec;
+  const bool build_tree = std::filesystem::equivalent(libdir, DELAYSPEC_PLUGIN_BUILD_LIBDIR, ec);
+  ModelHeaders headers;
+  headers.include_dirs =
+      build_tree ? split(DELAYSPEC_PLUGIN_BUILD_INCLUDES)
+                 : std::vector<std::string>{(libdir / DELAYSPEC_PLUGIN_INSTALLED_INCLUDE).lexically_normal().string(),
+                                            DELAYSPEC_PLUGIN_EIGEN_INCLUDE};
+  headers.identity = delayspec_headers(headers.include_dirs, build_tree);
+  return headers;
+}
+
+namespace {
+
 Toolchain toolchain() {
   Toolchain tc;
   const char* env = std::getenv("DELAYSPEC_CXX");
@@ -175,13 +191,7 @@ Toolchain toolchain() {
                    (env && *env ? " or correct DELAYSPEC_CXX" : ""));
   const std::filesystem::path library = running_library();
   const std::filesystem::path libdir = library.parent_path();
-  std::error_code ec;
-  const bool build_tree = std::filesystem::equivalent(libdir, DELAYSPEC_PLUGIN_BUILD_LIBDIR, ec);
-  const auto includes =
-      build_tree ? split(DELAYSPEC_PLUGIN_BUILD_INCLUDES)
-                 : std::vector<std::string>{(libdir / DELAYSPEC_PLUGIN_INSTALLED_INCLUDE).lexically_normal().string(),
-                                            DELAYSPEC_PLUGIN_EIGEN_INCLUDE};
-  const std::string headers = delayspec_headers(includes, build_tree);
+  const ModelHeaders headers = model_headers(libdir);
   // The optimisation and sanitizer flags of this build come with DELAYSPEC_PLUGIN_FLAGS
   // (CMakeLists.txt); -fno-math-errno as the library (repeated sin/cos are evaluated once).
   tc.flags = {"-std=c++20",
@@ -193,12 +203,12 @@ Toolchain toolchain() {
               "-fvisibility-inlines-hidden",
               "-w"};
   for (const auto& f : split_words(DELAYSPEC_PLUGIN_FLAGS)) tc.flags.push_back(f);
-  for (const auto& dir : includes) tc.flags.push_back("-I" + dir);
+  for (const auto& dir : headers.include_dirs) tc.flags.push_back("-I" + dir);
   tc.flags.push_back("-L" + libdir.string());
   tc.flags.push_back("-Wl,-rpath," + libdir.string());
   tc.flags.push_back("-l:" + library.filename().string());
   tc.identity = std::string(DELAYSPEC_VERSION) + "\n" + DELAYSPEC_REVISION + "\n" + file_stamp(tc.compiler) + "\n" +
-                file_stamp(library) + "\n" + headers;
+                file_stamp(library) + "\n" + headers.identity;
   for (const auto& f : tc.flags) tc.identity += f + "\n";
   return tc;
 }
@@ -239,11 +249,16 @@ F symbol(void* handle, const char* name, const std::filesystem::path& object) {
 }
 
 // dlopen of the file behind an open descriptor (the one whose bytes were checked), not of a path
-// that could meanwhile name another file. Null with the loader's message in `error`.
-void* open_checked_object(int fd, std::string& error) {
-  const std::string through_fd = "/proc/self/fd/" + std::to_string(fd);
+// that could meanwhile name another file. Null with the loader's message in `error`. On success
+// the descriptor stays open for the life of the process: the dynamic loader knows the object by
+// the name /proc/self/fd/N and returns an object already loaded under that name, so N must never
+// name another object (measured: with the descriptor closed, the next model got N again and the
+// first model's code).
+void* open_checked_object(UniqueFd& fd, std::string& error) {
+  const std::string through_fd = "/proc/self/fd/" + std::to_string(fd.get());
   void* handle = dlopen(through_fd.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) error = dlerror();
+  else fd.release();
   return handle;
 }
 
@@ -271,11 +286,11 @@ std::optional<EquationPlugin> cached_plugin(const ModelCacheDir& cache, const st
   if (!stored_source || *stored_source != source) return std::nullopt;
   const std::optional<std::string> recorded = cache.read_entry(name + ".sum");
   if (!recorded) return std::nullopt;
-  const UniqueFd object = cache.open_entry(name + ".so");
+  UniqueFd object = cache.open_entry(name + ".so");
   if (!object) return std::nullopt;
   if (object_checksum(read_fd(object.get())) != *recorded) return std::nullopt;
   std::string error;
-  void* handle = open_checked_object(object.get(), error);
+  void* handle = open_checked_object(object, error);
   if (!handle)
     throw BadInput("equations: the cached model " + cache.entry_path(name + ".so").string() +
                    " cannot be loaded (" + error + "): delete it");
@@ -336,11 +351,11 @@ EquationPlugin compile_plugin(const Toolchain& tc, const ModelCacheDir& cache, c
                        "):" + log_text());
     }
   }
-  const UniqueFd object = cache.open_entry(tmp);
+  UniqueFd object = cache.open_entry(tmp);
   if (!object) throw BadInput("equations: the compiler exited 0 but wrote no object" + where);
   const std::string bytes = read_fd(object.get());
   std::string error;
-  void* handle = bytes.compare(0, 4, "\x7f" "ELF") == 0 ? open_checked_object(object.get(), error) : nullptr;
+  void* handle = bytes.compare(0, 4, "\x7f" "ELF") == 0 ? open_checked_object(object, error) : nullptr;
   if (!handle) {
     cache.remove_entry(tmp);
     throw BadInput("equations: the compiler's output is not a loadable shared object (" +

@@ -20,6 +20,7 @@
 // (its code runs the analyses it made).
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "delayspec/model_analyses.hpp"
 
@@ -44,6 +45,16 @@ struct EquationPlugin {
 // and when the cache cannot be written or the object not loaded. Reports on stderr when it
 // compiles, and how long that took.
 EquationPlugin load_equation_plugin(const std::string& model_code, const std::filesystem::path& cache_dir);
+
+// The headers a model is compiled against, for the library in `libdir`: the build tree's include
+// paths (compiled in) when libdir is this build's, else an installed delayspec's LIBDIR/../include,
+// which must be root's or this user's and writable by its owner alone (BadInput otherwise).
+// `identity`: their names and contents, for the cache key.
+struct ModelHeaders {
+  std::vector<std::string> include_dirs;
+  std::string identity;
+};
+ModelHeaders model_headers(const std::filesystem::path& libdir);
 
 // Compilations this process has run (tests: a cache hit compiles nothing).
 long equation_plugin_compilations();
