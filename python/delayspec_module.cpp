@@ -95,20 +95,24 @@ bool on_main_thread() {
 // A Python value -> the text `--set KEY=VALUE` would carry (and a TOML scene value becomes,
 // config.cpp): booleans true/false, integers in decimal, floats in the shortest round-trip form,
 // sequences joined by commas (Ns = [100, 200] -> "100,200"); numpy scalars and arrays likewise.
-std::string key_text(const std::string& key, py::handle value) {
+// `nested`: value is an element of a list.
+std::string key_text(const std::string& key, py::handle value, bool nested = false) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::str>(value)) return value.cast<std::string>();
   // numpy scalars and arrays as the Python values they hold (an array's __index__ would fail).
   if (py::hasattr(value, "__array__") && py::hasattr(value, "ndim"))
-    return key_text(key, value.attr(value.attr("ndim").cast<int>() == 0 ? "item" : "tolist")());
+    return key_text(key, value.attr(value.attr("ndim").cast<int>() == 0 ? "item" : "tolist")(), nested);
   PyObject* p = value.ptr();
   if (PyLong_Check(p)) return py::str(value);
   if (PyFloat_Check(p)) return delayspec::format_number(value.cast<double>());
   if (py::isinstance<py::sequence>(value)) {
+    // A list key's value is a flat list: joined by commas, [[25], [50]] would read as [25, 50].
+    if (nested) throw BadInput("`" + key + "`: a nested list (" + py::repr(value).cast<std::string>() +
+                               " inside the list): give a flat list of numbers, strings or booleans");
     std::string text;
     for (py::handle element : value) {
       if (!text.empty()) text += ",";
-      text += key_text(key, element);
+      text += key_text(key, element, true);
     }
     return text;
   }
@@ -206,7 +210,7 @@ py::object to_python(const nlohmann::json& j) {
 // 0, or 3 for failures recorded in a complete result, what the command wrote to stderr).
 py::tuple run(const std::string& command, const py::object& scene, const py::dict& keys,
               const std::optional<std::string>& out, bool resume) {
-  if (!delayspec::cli::command_table().count(command)) throw BadInput("unknown command `" + command + "`");
+  delayspec::cli::require_known_command(command);
   std::optional<std::string> scene_path;
   Config config = make_config(scene, keys, scene_path);
   delayspec::cli::check_output_flags(command, out.has_value(), out.value_or(""), resume);

@@ -311,7 +311,16 @@ void krylov_solve(const LinearOperator& op, const FloquetOptions& options, Floqu
   // The retry: ncv doubled (at most n); Spectra's breakdown thresholds are absolute
   // (krylov_spectra.cpp), so it also runs on M / s with |M / s| <= 1 / sqrt(n) or so, |M x| / |x|
   // underestimating |M| by up to sqrt(n).
-  std::string retry_reason;  // why the first attempt was not taken
+  std::string retry_reason;   // why the first attempt was not taken
+  std::string first_failure;  // the first attempt's own message when it did not converge
+  // A failure of the retry says that it was one, and what the first attempt gave: each message
+  // counts its own attempt's iterations against max_iterations and names its own ncv.
+  auto retry_failed = [&](const std::string& message) {
+    return NumericalFailure(message + " [this was the retry with ncv = " + std::to_string(settings.ncv) +
+                            (settings.scale != 1 ? " on M / " + format_number(settings.scale) : "") +
+                            "; the first attempt, with ncv = " + std::to_string(first_ncv) +
+                            (first_failure.empty() ? "," + retry_reason : ": " + first_failure) + "]");
+  };
   auto prepare_retry = [&] {
     settings.ncv = static_cast<int>(std::min<long>(n, 2L * settings.ncv));
     if (options.solver == FloquetSolver::spectra) {
@@ -326,12 +335,14 @@ void krylov_solve(const LinearOperator& op, const FloquetOptions& options, Floqu
       pairs = options.solver == FloquetSolver::block     ? krylov::block_ritz_pairs(op, settings, start)
               : options.solver == FloquetSolver::spectra ? krylov::spectra_ritz_pairs(op, settings, start)
                                                          : krylov::arpack_ritz_pairs(op, settings, start);
-    } catch (const NumericalFailure&) {
+    } catch (const NumericalFailure& e) {
       // The same absolute thresholds can also keep Spectra from converging at all on an operator
       // of norm >> 1 (measured: x' = 5 x, N = 50, rank one, 0 of 1 converged in 300 restarts after
       // a change of the step's rounding): the same retry as for a pair failing the gate.
-      if (attempt > 0 || !options.retry_failed_gate || options.solver != FloquetSolver::spectra) throw;
+      if (attempt > 0) throw retry_failed(e.what());
+      if (!options.retry_failed_gate || options.solver != FloquetSolver::spectra) throw;
       retry_reason = " did not converge";
+      first_failure = e.what();
       prepare_retry();
       continue;
     }

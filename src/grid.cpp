@@ -9,19 +9,23 @@ namespace delayspec {
 
 namespace {
 
+constexpr long kMaxSteps = 2'000'000'000L / 8;  // keeps every block index far inside int
+
 // Integer p/q (q <= 64) equal to x to within 1e-12 relative, or q = 0 when there is none.
+// p is at most kMaxSteps q: an aligned grid has N q / p >= 1 steps per period with N <= kMaxSteps,
+// so a larger p is of no use, and the bound keeps the conversion to long defined (tau / T = 1e300
+// would otherwise be cast to long: undefined behaviour, seen as -9223372036854775808 in messages).
 struct Ratio {
   long p = 0, q = 0;
 };
 Ratio rational_approximation(double x) {
   for (long q = 1; q <= 64; ++q) {
     double p = std::round(x * static_cast<double>(q));
-    if (p >= 1 && std::abs(x * static_cast<double>(q) - p) <= 1e-12 * p) return {static_cast<long>(p), q};
+    if (p >= 1 && p <= static_cast<double>(kMaxSteps * q) && std::abs(x * static_cast<double>(q) - p) <= 1e-12 * p)
+      return {static_cast<long>(p), q};
   }
   return {};
 }
-
-constexpr long kMaxSteps = 2'000'000'000L / 8;  // keeps every block index far inside int
 
 }  // namespace
 
@@ -62,10 +66,17 @@ HistoryGrid make_grid(double tau, double period, int N, int periods_per_map) {
     double k1 = std::round(static_cast<double>(N) * period / tau);
     if (k1 < 1) k1 = 1;
     if (k1 * periods_per_map > static_cast<double>(kMaxSteps))
-      throw BadInput("`N = " + std::to_string(N) + "`: too many steps per map");
+      throw BadInput("`N = " + std::to_string(N) + "`: too many steps per map (N T / tau = " + format_number(k1) +
+                     " steps per period with tau = " + format_number(tau) + ", T = " + format_number(period) + ")");
     g.steps_per_period = static_cast<int>(k1);
     g.h = period / k1;
     double ratio = tau / g.h;
+    // The history holds tau / h steps: checked before the conversion to int below.
+    if (!(ratio <= static_cast<double>(kMaxSteps)))
+      throw BadInput("`tau = " + format_number(tau) + "`: the delay spans " + format_number(ratio) +
+                     " steps of h = " + format_number(g.h) + " (T = " + format_number(period) + " in " +
+                     format_number(k1) + " steps at N = " + std::to_string(N) + "), more than the " +
+                     std::to_string(kMaxSteps) + " steps a history can hold; reduce tau or N");
     double m = std::floor(ratio);
     double theta = ratio - m;
     if (theta > 1 - 1e-12) {  // tau is a whole number of steps after all

@@ -8,6 +8,7 @@
 #include <Spectra/GenEigsSolver.h>
 #include <Spectra/Util/Version.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -102,7 +103,11 @@ RitzPairs spectra_ritz_pairs(const LinearOperator& op, const Settings& s, const 
   }
   RitzPairs pairs;
   pairs.converged = static_cast<int>(nconv);
-  pairs.iterations = static_cast<int>(solver.num_iterations());
+  // Spectra counts one more than it checked when it gives up: its loop restarts max_iterations
+  // times and stops without testing the last restart (GenEigsBase::compute, num_iterations =
+  // restarts + 1). The iterations that counted against max_iterations = 1 + max_restarts are the
+  // tested ones, so the count never exceeds the limit the message names.
+  pairs.iterations = static_cast<int>(std::min<Eigen::Index>(solver.num_iterations(), s.max_iterations));
   if (solver.info() != Spectra::CompInfo::Successful || nconv < s.nev)
     throw NumericalFailure(
         "Krylov (spectra) did not converge: " + std::to_string(nconv) + " of nev = " + std::to_string(s.nev) +

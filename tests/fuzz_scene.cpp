@@ -2,14 +2,19 @@
 // command does with a scene before computing (flatten, typed getters, the problem and orbit
 // keys, the grid, the unknown-key check). Bad input must end in BadInput; anything else (another
 // exception, a crash, a sanitizer report, a hang) is a finding.
-// Not part of the unit tests (the name does not match tests/test_*.cpp). Build and run:
-//     CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DDELAYSPEC_FUZZ=ON -DDELAYSPEC_BUILD_TESTS=OFF \
-//         -DDELAYSPEC_BUILD_BENCH=OFF
+// A scene with model = equations stops before read_problem, which would compile its model: its
+// [equations] table is fuzz_equations.cpp's.
+// With libFuzzer (clang, DELAYSPEC_FUZZ):
+//     CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DDELAYSPEC_FUZZ=ON
+//         -DDELAYSPEC_BUILD_TESTS=OFF -DDELAYSPEC_BUILD_BENCH=OFF     (one line)
 //     ninja -C build-fuzz fuzz_scene
 //     build-fuzz/fuzz_scene -max_total_time=60 -max_len=512 tests/fuzz_corpus
-// (docs/fuzzing.md)
+// and in every test build with the standalone driver tests/fuzz_driver.cpp, as the test
+// fuzz_scene_fixed (a fixed set of mutants of tests/fuzz_corpus/). docs/fuzzing.md.
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "config.hpp"
@@ -34,11 +39,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         }
       }
     }
+    if (config.values().count("model") && config.values().at("model") == "equations") return 0;  // (above)
     delayspec::cli::Problem problem = delayspec::cli::read_problem(config, 100);
     delayspec::cli::read_orbit_settings(config);
     config.get_string("analyses", "");
     config.check_all_used();
-  } catch (const delayspec::BadInput&) {
+  } catch (const delayspec::BadInput& e) {
+    if (std::getenv("DELAYSPEC_FUZZ_SHOW")) std::fprintf(stderr, "BadInput: %s\n", e.what());  // seeds' check
   }
   return 0;
 }

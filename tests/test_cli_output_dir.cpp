@@ -14,9 +14,11 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -493,4 +495,59 @@ TEST(OutputDirectory, RunKeepsGoingAfterAnAnalysisExitsThree) {
   EXPECT_TRUE(fs::exists(dir / "basin.json"));
   EXPECT_TRUE(fs::exists(dir / "floquet.json"));
   fs::remove_all(dir);
+}
+
+// Issue 31: a chart whose bad input shows only when a point runs (tau = 1.5 with period = 1 needs
+// N divisible by 3; N = 10) stopped after chart_settings.json and the first point were written,
+// and the same command then demanded --resume. A run stopped by bad input leaves nothing behind:
+// the directory it created is gone; in a directory that existed, the files it created are.
+TEST(OutputDirectory, BadInputFoundWhenAPointRunsLeavesNothingBehind) {
+  const fs::path dir = fresh_dir("outdir_bad_point");
+  const std::vector<std::string> args = {
+      "chart",          "--quiet",         "--out", dir.string(),      "--set", "model=linear",
+      "--set",          "period=1",        "--set", "N=10",            "--set", "solver=dense",
+      "--set",          "nev=1",           "--set", "threads=1",       "--set", "chart_x=tau",
+      "--set",          "chart_x_range=1,2", "--set", "chart_x_points=3", "--set", "chart_y=a",
+      "--set",          "chart_y_range=-1,0", "--set", "chart_y_points=2"};
+  for (int attempt = 0; attempt < 2; ++attempt) {  // the same command twice: the same answer
+    const CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, "N divisible by 3")) << r.err;
+    EXPECT_FALSE(contains(r.err, "--resume")) << "attempt " << attempt << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir)) << "attempt " << attempt << ": the run created " << dir;
+  }
+  // A directory that existed (with a file of the user's): it stays, with only that file in it
+  // (and the lock file, which always stays).
+  fs::create_directories(dir);
+  std::ofstream(dir / "notes.txt") << "mine\n";
+  const CliResult r = run(args);
+  EXPECT_EQ(r.status, 2) << r.err;
+  std::set<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename().string());
+  EXPECT_EQ(names, (std::set<std::string>{".delayspec-lock", "notes.txt"}));
+  EXPECT_FALSE(contains(run(args).err, "--resume"));
+  fs::remove_all(dir);
+}
+
+// Issue 31: a write past the file-size limit (`ulimit -f`) raised SIGXFSZ, whose default action
+// killed the program in the middle of the write. The program ignores it: the write fails with
+// EFBIG, the run stops with exit 2 naming the file, and nothing of it is left (the directory it
+// created is removed), so no half-written result can look complete.
+TEST(OutputDirectory, FileSizeLimitIsBadInputNamingTheFile) {
+  const fs::path dir = fresh_dir("outdir_fsize");
+  // 1 block (512 bytes in dash, 1024 in bash) against a trajectory of some 20 KB (N = 8, t_end = 40).
+  const std::string command = "ulimit -f 1; exec '" + std::string(DELAYSPEC_CLI_PATH) + "' simulate --quiet --out '" +
+                              dir.string() + "' --set N=8 --set t_end=40 2>&1 >/dev/null";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string err;
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) err.append(buffer, n);
+  const int status = ::pclose(pipe);
+  // Before: killed by SIGXFSZ (the shell exec'd the program, so the signal is the status).
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0) << ": " << err;
+  EXPECT_EQ(WEXITSTATUS(status), 2) << err;
+  EXPECT_TRUE(contains(err, "cannot write `" + dir.string() + "/")) << err;
+  EXPECT_TRUE(contains(err, "File too large")) << err;
+  EXPECT_FALSE(fs::exists(dir)) << "a stopped run left " << dir;
 }

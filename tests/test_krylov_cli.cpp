@@ -58,6 +58,31 @@ TEST(KrylovCli, ForcedNonConvergenceExitsThree) {
   }
 }
 
+// Issue 31: when Spectra did not converge, floquet retried with ncv doubled, and the retry's
+// failure was the only message: "2 Arnoldi iterations (max_iterations = 1 ..., ncv = 16)" for a
+// user's ncv = 8, with no word of the retry. The message now says it was the retry, names both
+// ncv and gives each attempt's count, which cannot exceed max_iterations.
+TEST(KrylovCli, FailedRetryNamesBothAttemptsWithCountsWithinTheLimit) {
+  const CliResult r = run({"floquet", kScene, "--set", "N=100", "--set", "nev=4", "--set", "ncv=8", "--set",
+                           "max_restarts=0", "--set", "solver=spectra"});
+  ASSERT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("the retry with ncv = 16"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the first attempt, with ncv = 8"), std::string::npos) << r.err;
+  // One count per attempt, each against the limit it names.
+  const std::string count = " Arnoldi iterations (max_iterations = ";
+  int attempts = 0;
+  for (size_t at = r.err.find(count); at != std::string::npos; at = r.err.find(count, at + 1)) {
+    ++attempts;
+    const size_t start = r.err.rfind("after ", at) + 6;
+    const int iterations = std::stoi(r.err.substr(start, at - start));
+    const int limit = std::stoi(r.err.substr(at + count.size()));
+    EXPECT_EQ(limit, 1) << r.err;
+    EXPECT_GE(iterations, 1) << r.err;
+    EXPECT_LE(iterations, limit) << r.err;
+  }
+  EXPECT_EQ(attempts, 2) << r.err;
+}
+
 TEST(KrylovCli, BadKrylovKeysExitTwoNamingKeyAndValue) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"ncv", "-1"},           {"ncv", "7"},  // 7 < nev + 2 = 8

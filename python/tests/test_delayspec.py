@@ -238,6 +238,26 @@ def test_bad_value_type_raises_bad_input():
         delayspec.floquet(k=object())
 
 
+def test_keys_help_of_an_unknown_command_raises_bad_input():
+    """Issue 31: keys_help("nope") returned "" (an empty help, as if the command read no keys)."""
+    with pytest.raises(delayspec.BadInput, match=r"unknown command `nope` \(commands: .*floquet.*sweep"):
+        delayspec.keys_help("nope")
+    assert "nev = " in delayspec.keys_help("floquet")  # a known command still has its help
+
+
+@pytest.mark.parametrize("Ns", [[[25], [50]], [25, [50]], np.array([[25], [50]])])
+def test_nested_list_for_a_list_key_raises_bad_input(Ns):
+    """Issue 31: Ns=[[25], [50]] was joined to "25,50" and run; a list key takes a flat list."""
+    with pytest.raises(delayspec.BadInput, match="`Ns`: a nested list"):
+        delayspec.converge(Ns=Ns, nev=2)
+
+
+def test_nested_array_in_a_scene_dict_raises_bad_input():
+    """The same rule for a scene (a dict here, a TOML file alike: config.cpp)."""
+    with pytest.raises(delayspec.BadInput, match="key `Ns` is a nested array"):
+        delayspec.converge({"Ns": [[25], [50]]}, nev=2)
+
+
 def test_forced_krylov_failure_raises_numerical_failure():
     """As tests/test_krylov_cli.cpp: one Arnoldi iteration (max_restarts = 0) cannot converge 10
     Ritz values with ncv = 12 at N = 100."""

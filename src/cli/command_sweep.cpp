@@ -91,6 +91,8 @@ SweepSettings read_sweep_settings(Config& config) {
     if (s.key == reserved) throw BadInput("`sweep_key = " + s.key + "`: not a parameter that can be swept");
   s.from = config.require_double("sweep_from");
   s.to = config.require_double("sweep_to");
+  require_finite_width("`sweep_from = " + format_number(s.from) + "`, `sweep_to = " + format_number(s.to) + "`", s.from,
+                       s.to);
   s.count = config.get_int_in_range("sweep_points", 11, 1, 1'000'000);
   s.threads = read_threads(config);
   // section points are kept in memory (d doubles each) for every point of the sweep

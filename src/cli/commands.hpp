@@ -57,6 +57,10 @@ RunPlan plan_run(Config& config);
 // The command table (name -> function); `run` dispatches a scene's analyses through it.
 const std::map<std::string, CommandFunction>& command_table();
 
+// BadInput "unknown command `NAME` (commands: ...)" unless `command` is in the table: the one
+// check of a command's name, for the program, `keys_help` and the Python module alike.
+void require_known_command(const std::string& command);
+
 // What a command does with `--out DIR`: nothing, writes its files there (run_cli then holds the
 // directory's lock, output_directory.hpp), or reads results from there (plot); and whether it
 // continues an interrupted run with `--resume`. run_cli refuses a flag the command ignores.

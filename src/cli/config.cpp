@@ -34,6 +34,10 @@ std::string to_text(const toml::node& node, const std::string& key, const std::s
   if (const toml::array* arr = node.as_array()) {
     std::string out;
     for (const auto& element : *arr) {
+      // Joined by commas, [[25], [50]] would read as [25, 50]: a list key's value is a flat list.
+      if (element.is_array() || element.is_table())
+        throw BadInput(path + ": key `" + key + "` is a nested array (an array or table inside its array); give a flat "
+                       "list of numbers, strings or booleans");
       if (!out.empty()) out += ",";
       out += to_text(element, key, path);
     }

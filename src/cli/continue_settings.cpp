@@ -1,6 +1,7 @@
 #include "continue_settings.hpp"
 
 #include "delayspec/errors.hpp"
+#include "parameter_grid.hpp"
 
 namespace delayspec::cli {
 
@@ -20,6 +21,8 @@ ContinueSettings read_continue_settings(Config& config) {
   o.from = config.require_double("continue_from");
   o.to = config.require_double("continue_to");
   if (o.from == o.to) throw BadInput("`continue_from = continue_to = " + format_number(o.from) + "`: an empty range");
+  require_finite_width("`continue_from = " + format_number(o.from) + "`, `continue_to = " + format_number(o.to) + "`",
+                       o.from, o.to);
   // 0: the defaults relative to the range (continuation.hpp)
   o.step = config.get_double("continue_step", 0);
   o.step_min = config.get_double("continue_step_min", 0);

@@ -214,8 +214,8 @@ const std::map<std::string, std::string>& key_meanings() {
 }
 
 std::string command_keys_help(const std::string& command) {
+  require_known_command(command);  // (the probes hold every command of the table)
   const auto probes = all_probes().find(command);
-  if (probes == all_probes().end()) return "";
   const auto& by_model = probes->second;
   // Keys every model reads (in the default model's reading order), then each model's own keys.
   auto read_by_all = [&](const std::string& key) {

@@ -38,7 +38,8 @@ const KeyReaders& key_readers();
 const std::map<std::string, std::string>& key_meanings();
 
 // The keys `command` reads, its defaults and their meanings (the tail of `COMMAND --help`):
-// keys every model shares first, then the keys of each model.
+// keys every model shares first, then the keys of each model. BadInput naming the command and
+// listing the commands when it is not one (require_known_command).
 std::string command_keys_help(const std::string& command);
 
 // The message for a given key nobody read. `readers`: the commands that read the Config (empty:

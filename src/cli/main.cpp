@@ -1,6 +1,7 @@
 // The delayspec program: run_cli on the lead rank (the only rank without MPI); under mpirun the
 // worker ranks run it with their output kept in memory (ranks.hpp), and every rank exits with
 // the lead's status.
+#include <csignal>
 #include <iostream>
 #include <sstream>
 
@@ -10,6 +11,11 @@
 
 int main(int argc, char** argv) {
   using namespace delayspec::cli;
+  // A write past the file-size limit (`ulimit -f`) raises SIGXFSZ, whose default action kills the
+  // process mid-write. Ignored, the write fails with EFBIG instead and the output layer reports it
+  // as bad input naming the file (atomic_file.cpp), exit 2, leaving no half-written result.
+  // (CPython ignores SIGXFSZ itself at start-up, so the Python module needs nothing of this.)
+  std::signal(SIGXFSZ, SIG_IGN);
   keep_freed_memory();
   start_ranks(&argc, &argv);
   if (is_lead_rank()) return finish_ranks(run_cli(argc, argv, std::cout, std::cerr));

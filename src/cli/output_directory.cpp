@@ -50,7 +50,12 @@ void OutputDirectory::acquire() {
     // This run found no DIR, so it must be the one to create it: a DIR that appeared meanwhile
     // belongs to another run (which may even have finished and released its lock already).
     std::error_code ec;
-    if (dir_.has_parent_path()) fs::create_directories(dir_.parent_path(), ec);
+    if (dir_.has_parent_path()) {
+      // The outermost missing parent, so that abandon() can remove the parents it made too.
+      for (fs::path p = dir_.parent_path(); !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path())
+        created_parent_ = p;
+      fs::create_directories(dir_.parent_path(), ec);
+    }
     const bool created = !ec && fs::create_directory(dir_, ec);
     if (ec) throw BadInput("cannot write `" + dir_.string() + "`: cannot create the directory: " + ec.message());
     if (!created)
@@ -58,6 +63,7 @@ void OutputDirectory::acquire() {
                      "`: another delayspec run created this directory after this one started; choose another "
                      "directory");
     existed_ = true;
+    created_ = true;
   }
   const fs::path lock_path = dir_ / lock_name;
   const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
@@ -79,6 +85,11 @@ void OutputDirectory::note_write(const fs::path& target) {
   std::lock_guard<std::mutex> guard(mutex_);
   acquire();
   if (relative == marker_name) return;  // finish() itself
+  const std::string entry = relative.begin()->string();
+  if (!entries_.count(entry)) {
+    std::error_code ec;
+    entries_[entry] = !fs::exists(fs::symlink_status(dir_ / entry, ec));
+  }
   if (!marker_removed_) {
     // Before the first new byte lands in DIR, the directory stops claiming to be complete.
     const fs::path marker = dir_ / marker_name;
@@ -103,6 +114,24 @@ void OutputDirectory::finish(const std::string& command, int exit_status) {
                                  {"delayspec_version", DELAYSPEC_VERSION},
                                  {"finished_utc", utc_now_iso8601()}};
   write_file_atomically(dir_ / marker_name, marker.dump(2) + "\n");
+}
+
+void OutputDirectory::abandon() noexcept {
+  std::lock_guard<std::mutex> guard(mutex_);
+  if (lock_fd_ < 0) return;  // nothing written: nothing created
+  std::error_code ec;
+  if (created_) {
+    // The whole directory is this run's (the lock kept every other run out of it).
+    fs::remove_all(dir_, ec);
+    // Parents it created, only while empty: another run may have chosen a directory beside DIR.
+    for (fs::path p = dir_.parent_path(); !created_parent_.empty() && p.has_relative_path(); p = p.parent_path()) {
+      if (!fs::remove(p, ec)) break;  // not empty (or gone): stop
+      if (p == created_parent_) break;
+    }
+    return;
+  }
+  for (const auto& [name, is_new] : entries_)
+    if (is_new) fs::remove_all(dir_ / name, ec);
 }
 
 void before_output_write(const fs::path& target) {

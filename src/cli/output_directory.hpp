@@ -11,6 +11,12 @@
 // that finds the lock held, or finds that DIR was created by someone else after it started,
 // stops with BadInput naming DIR.
 //
+// Bad input: a command that stops with BadInput after it wrote into DIR (a key found bad only
+// when a point runs, a write past a file-size limit) leaves nothing of this run behind:
+// abandon() removes DIR if this run created it, else every file and directory this run created
+// directly in DIR (so a new run needs no --resume; the points of a resumed run, inside the
+// existing points directory, stay for the next --resume).
+//
 // Completeness: `DIR/complete.json` is removed before the run's first write into DIR and written
 // (atomically) after its last, when the command finished (exit 0, or 3 with its failures
 // recorded in the files). It lists the files this run wrote directly in DIR. No complete.json:
@@ -21,6 +27,7 @@
 //     const int status = command(config, inv);  // writes DIR/... through write_file_atomically
 //     out.finish("sweep", status);              // DIR/complete.json
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <set>
 #include <string>
@@ -38,6 +45,10 @@ class OutputDirectory {
   // Writes DIR/complete.json: {"command", "exit_status", "files", "delayspec_version", "finished_utc"}.
   void finish(const std::string& command, int exit_status);
 
+  // After bad input: removes what this run created (see above). Never throws (it runs while a
+  // BadInput propagates); what cannot be removed stays, and DIR still has no complete.json.
+  void abandon() noexcept;
+
   static constexpr const char* lock_name = ".delayspec-lock";
   static constexpr const char* marker_name = "complete.json";
 
@@ -48,9 +59,14 @@ class OutputDirectory {
 
   std::filesystem::path dir_;
   bool existed_ = false;  // DIR existed when the run started (else the run must create it)
+  bool created_ = false;  // this run created DIR
+  std::filesystem::path created_parent_;  // the outermost parent of DIR this run created (or empty)
   int lock_fd_ = -1;
   bool marker_removed_ = false;
   std::set<std::string> files_;  // names written directly in DIR
+  // Each name directly in DIR that this run wrote into (a file, or the directory of a file), and
+  // whether it was new: decided at its first write, before any byte of this run lands there.
+  std::map<std::string, bool> entries_;
   std::mutex mutex_;             // writes come from the worker threads of sweep
   OutputDirectory* previous_ = nullptr;
 };

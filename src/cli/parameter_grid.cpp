@@ -3,6 +3,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -10,6 +11,12 @@
 #include "delayspec/errors.hpp"
 
 namespace delayspec::cli {
+
+void require_finite_width(const std::string& keys, double from, double to) {
+  if (!std::isfinite(to - from))
+    throw BadInput(keys + ": the width of the range overflows (" + format_number(to) + " - " + format_number(from) +
+                   " is not a finite number); give a range narrower than 1.7e308");
+}
 
 ParameterAxis read_parameter_axis(Config& config, const std::string& prefix, const std::string& axis,
                                   const std::string& default_name, double default_min, double default_max,
@@ -32,6 +39,7 @@ ParameterAxis read_parameter_axis(Config& config, const std::string& prefix, con
   }
   if (values.size() != 2 || !(values[0] < values[1]))
     throw BadInput("`" + range_key + " = " + range + "`: must be two numbers [min, max] with min < max");
+  require_finite_width("`" + range_key + " = " + range + "`", values[0], values[1]);
   a.min = values[0];
   a.max = values[1];
   const std::string points_key = prefix + "_" + axis + "_points";

@@ -20,9 +20,15 @@ struct ParameterAxis {
   double value(long i) const { return min + (max - min) * static_cast<double>(i) / static_cast<double>(points - 1); }
 };
 
+// A range of equally spaced values from + (to - from) i / (n - 1) (sweep, chart, basin, the
+// default steps of continue) needs a finite width to - from: from = -1e308, to = 1e308 gives
+// to - from = inf and every value nan. BadInput naming `keys` (e.g. "`sweep_from = -1e308`,
+// `sweep_to = 1e308`") otherwise. from and to are finite (their readers check).
+void require_finite_width(const std::string& keys, double from, double to);
+
 // Reads PREFIX_AXIS, PREFIX_AXIS_range, PREFIX_AXIS_points (AXIS = "x" or "y"); BadInput naming
-// the key and value when the range is not two finite numbers min < max or points is not in
-// [2, 100000].
+// the key and value when the range is not two finite numbers min < max with a finite width, or
+// points is not in [2, 100000].
 ParameterAxis read_parameter_axis(Config& config, const std::string& prefix, const std::string& axis,
                                   const std::string& default_name, double default_min, double default_max,
                                   long default_points);

@@ -63,7 +63,13 @@ int run_command(Config& config, const Invocation& inv) {
   if (!is_lead_rank() && !distributes_points(inv.command)) return 0;
   if (!inv.out_dir || output_use(inv.command).out != OutDirUse::written || !is_lead_rank()) return command(config, inv);
   OutputDirectory directory(*inv.out_dir);  // held until the command returns: one run per DIR
-  const int status = command(config, inv);
+  int status = 0;
+  try {
+    status = command(config, inv);
+  } catch (const BadInput&) {
+    directory.abandon();  // a run stopped by bad input leaves nothing behind (output_directory.hpp)
+    throw;
+  }
   directory.finish(inv.command, status);
   return status;
 }
@@ -77,6 +83,11 @@ std::string command_list() {
 }
 
 }  // namespace
+
+void require_known_command(const std::string& command) {
+  if (!command_table().count(command))
+    throw BadInput("unknown command `" + command + "` (commands: " + command_list() + ")");
+}
 
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
@@ -113,9 +124,10 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
     return 2;
   }
 
-  auto it = command_table().find(command);
-  if (it == command_table().end()) {
-    err << "delayspec: error: unknown command `" << command << "` (commands: " << command_list() << ")\n";
+  try {
+    require_known_command(command);
+  } catch (const BadInput& e) {
+    err << "delayspec: error: " << e.what() << "\n";
     return 2;
   }
   Invocation inv{.command = command,
