@@ -27,6 +27,7 @@
 #include "cli_test_support.hpp"
 #include "delayspec_test_paths.hpp"
 #include "equation_plugin.hpp"
+#include "model_cache.hpp"
 #include "equation_toolchain.hpp"
 #include "delayspec/errors.hpp"
 
@@ -397,6 +398,25 @@ TEST_F(ModelCache, HeadersComeOnlyFromTheBuildOrASafelyOwnedInstall) {
   // The headers' contents are in the cache key: another header, another entry.
   write(prefix / "include" / "delayspec" / "version.hpp", "#error planted, and changed\n");
   EXPECT_NE(delayspec::cli::model_headers(prefix / "lib").identity, installed.identity);
+}
+
+TEST_F(ModelCache, ACompilersGroupWritableObjectIsMadePrivateNotRefused) {
+  // Under a umask of 002 the linker makes the object 0775, which the cache would then refuse as
+  // writable by others; the cache clears those bits of what the compiler made for it.
+  const fs::path cache = dir_ / "cache";
+  const delayspec::cli::ModelCacheDir dir(cache);
+  write(cache / "made.so", "object");
+  fs::permissions(cache / "made.so", fs::perms::owner_all | fs::perms::group_all | fs::perms::others_read,
+                  fs::perm_options::replace);
+  EXPECT_THROW(dir.open_entry("made.so"), delayspec::BadInput);
+  dir.make_private("made.so");
+  EXPECT_EQ(fs::status(cache / "made.so").permissions(), fs::perms::owner_all);
+  EXPECT_TRUE(static_cast<bool>(dir.open_entry("made.so")));
+  // A link is left alone (and its target untouched).
+  fs::create_symlink(cache / "made.so", cache / "link.so");
+  fs::permissions(cache / "made.so", fs::perms::owner_all | fs::perms::group_write, fs::perm_options::replace);
+  dir.make_private("link.so");
+  EXPECT_EQ(fs::status(cache / "made.so").permissions(), fs::perms::owner_all | fs::perms::group_write);
 }
 
 }  // namespace

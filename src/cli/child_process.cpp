@@ -46,7 +46,11 @@ void install_handlers() {
   struct sigaction action {};
   action.sa_handler = kill_children_and_reraise;
   sigemptyset(&action.sa_mask);
-  for (size_t k = 0; k < kStopSignals.size(); ++k) ::sigaction(kStopSignals[k], &action, &previous[k]);
+  for (size_t k = 0; k < kStopSignals.size(); ++k) {
+    ::sigaction(kStopSignals[k], nullptr, &previous[k]);
+    // An ignored signal (SIGHUP under nohup) stays ignored: it must not stop the compile either.
+    if (previous[k].sa_handler != SIG_IGN) ::sigaction(kStopSignals[k], &action, nullptr);
+  }
 }
 
 void restore_handlers() {
@@ -83,11 +87,12 @@ ChildOutcome run_child(const std::vector<std::string>& argv, int output_fd, doub
     ::setpgid(0, 0);
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (::getppid() != parent) ::_exit(127);  // the parent died before prctl
-    // The child starts with default dispositions for the stop signals (a handler would not
-    // survive exec anyway, an ignored signal would).
+    // Our handler is not the child's (exec resets it anyway; this closes the window before exec);
+    // an ignored signal stays ignored, as exec keeps it.
     struct sigaction defaults {};
     defaults.sa_handler = SIG_DFL;
-    for (int sig : kStopSignals) ::sigaction(sig, &defaults, nullptr);
+    for (size_t k = 0; k < kStopSignals.size(); ++k)
+      if (previous[k].sa_handler != SIG_IGN) ::sigaction(kStopSignals[k], &defaults, nullptr);
     ::dup2(output_fd, STDOUT_FILENO);
     ::dup2(output_fd, STDERR_FILENO);
     ::execve(args[0], args.data(), environ);

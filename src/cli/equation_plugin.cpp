@@ -351,6 +351,8 @@ EquationPlugin compile_plugin(const Toolchain& tc, const ModelCacheDir& cache, c
                        "):" + log_text());
     }
   }
+  // The linker makes the object as the umask says (0775 under a umask of 002): ours alone first.
+  cache.make_private(tmp);
   UniqueFd object = cache.open_entry(tmp);
   if (!object) throw BadInput("equations: the compiler exited 0 but wrote no object" + where);
   const std::string bytes = read_fd(object.get());

@@ -44,6 +44,19 @@ std::string owner_and_mode(const struct stat& st) {
 
 std::atomic<unsigned> temporaries{0};
 
+// An entry just opened (`fd`, or -1 with errno set) must be a regular file of this user's that
+// nobody else can write; BadInput naming it otherwise.
+void require_private_file(const UniqueFd& fd, const std::filesystem::path& path, const std::string& action) {
+  if (!fd)
+    throw BadInput("`model_cache`: cannot " + action + " " + path.string() + " (" +
+                   (errno == ELOOP ? std::string("a symbolic link, which the cache never follows") : reason()) +
+                   "): delete it");
+  struct stat st {};
+  if (::fstat(fd.get(), &st) != 0 || !S_ISREG(st.st_mode) || !private_to_user(st))
+    throw BadInput("`model_cache`: " + path.string() + " is not a regular file that is yours and writable by you alone (" +
+                   owner_and_mode(st) + "): delete it");
+}
+
 }  // namespace
 
 ModelCacheDir::ModelCacheDir(const std::filesystem::path& dir) : path_(dir) {
@@ -60,22 +73,15 @@ ModelCacheDir::ModelCacheDir(const std::filesystem::path& dir) : path_(dir) {
   if (::fstat(dir_.get(), &st) != 0) throw BadInput(key + "cannot read the directory (" + reason() + ")");
   if (!private_to_user(st))
     throw BadInput(key + "the directory holds compiled models that delayspec runs, so it must be yours and writable by " +
-                   "you alone (" + owner_and_mode(st) + "): choose another with --set model_cache=DIR");
+                   "you alone (" + owner_and_mode(st) + "): " +
+                   (st.st_uid == ::geteuid() ? "`chmod go-w " + dir.string() + "` if only you ever wrote there, or " : "") +
+                   "choose another with --set model_cache=DIR");
 }
 
 UniqueFd ModelCacheDir::open_entry(const std::string& name) const {
   UniqueFd fd(::openat(dir_.get(), name.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK));
-  if (!fd) {
-    if (errno == ENOENT) return fd;
-    throw BadInput("`model_cache`: cannot open " + entry_path(name).string() + " (" +
-                   (errno == ELOOP ? std::string("a symbolic link, which the cache never follows") : reason()) +
-                   "): delete it");
-  }
-  struct stat st {};
-  if (::fstat(fd.get(), &st) != 0 || !S_ISREG(st.st_mode) || !private_to_user(st))
-    throw BadInput("`model_cache`: " + entry_path(name).string() +
-                   " is not a regular file that is yours and writable by you alone (" + owner_and_mode(st) +
-                   "): delete it");
+  if (!fd && errno == ENOENT) return fd;
+  require_private_file(fd, entry_path(name), "open");
   return fd;
 }
 
@@ -118,6 +124,13 @@ void ModelCacheDir::write_entry(const std::string& name, const std::string& text
   rename_entry(tmp, name);
 }
 
+void ModelCacheDir::make_private(const std::string& name) const {
+  const UniqueFd fd(::openat(dir_.get(), name.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK));
+  struct stat st {};
+  if (fd && ::fstat(fd.get(), &st) == 0 && S_ISREG(st.st_mode) && st.st_uid == ::geteuid())
+    ::fchmod(fd.get(), st.st_mode & 0700);
+}
+
 void ModelCacheDir::rename_entry(const std::string& from, const std::string& to) const {
   // renameat replaces a link named `to` itself, it does not follow it.
   if (::renameat(dir_.get(), from.c_str(), dir_.get(), to.c_str()) != 0)
@@ -145,16 +158,8 @@ std::vector<std::string> ModelCacheDir::entries_starting_with(const std::string&
 
 UniqueFd ModelCacheDir::lock(const std::string& name) const {
   UniqueFd fd(::openat(dir_.get(), name.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0600));
-  if (!fd) {
-    if (errno == EROFS || errno == EACCES || errno == EPERM) return fd;  // EPERM: an immutable directory
-    throw BadInput("`model_cache`: cannot create the lock file " + entry_path(name).string() + " (" +
-                   (errno == ELOOP ? std::string("a symbolic link, which the cache never follows") : reason()) +
-                   "): delete it");
-  }
-  struct stat st {};
-  if (::fstat(fd.get(), &st) != 0 || !S_ISREG(st.st_mode) || !private_to_user(st))
-    throw BadInput("`model_cache`: the lock file " + entry_path(name).string() +
-                   " is not a regular file that is yours and writable by you alone: delete it");
+  if (!fd && (errno == EROFS || errno == EACCES || errno == EPERM)) return fd;  // EPERM: an immutable directory
+  require_private_file(fd, entry_path(name), "create the lock file");
   while (::flock(fd.get(), LOCK_EX) != 0)
     if (errno != EINTR) throw BadInput("`model_cache`: cannot lock " + entry_path(name).string() + " (" + reason() + ")");
   return fd;

@@ -59,6 +59,9 @@ class ModelCacheDir {
   void write_entry(const std::string& name, const std::string& text) const;
   // Creates or truncates the entry for writing (mode 0600, never through a link).
   UniqueFd create_entry(const std::string& name) const;
+  // Clears the group and other bits of an entry this user owns (what a compiler made under the
+  // umask, 0775 under 002); nothing when it does not exist or is a link.
+  void make_private(const std::string& name) const;
   void rename_entry(const std::string& from, const std::string& to) const;
   void remove_entry(const std::string& name) const;  // no error when it does not exist
   // The names of the entries that start with `prefix`.
