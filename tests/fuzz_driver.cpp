@@ -13,8 +13,7 @@
 // thousands of nested parentheses (issue 31, fixed by the depth limit of
 // src/equations/equation_expression.cpp) is not what a fixed CI run should keep finding.
 //
-// Usage: DRIVER [--skip-huge-powers] CORPUS_DIR COUNT   the run above; exit 0, or 1 after an
-//                                     escaped exception (--skip-huge-powers: see known_finding)
+// Usage: DRIVER CORPUS_DIR COUNT     the run above; exit 0, or 1 after an escaped exception
 //        DRIVER CORPUS_DIR COUNT I    writes mutant I (0-based) to stdout, for replay
 //        DRIVER FILE                  runs one input (a crash file, a mutant written as above)
 // A crash (signal, sanitizer report) ends the process: rerun with DELAYSPEC_FUZZ_TRACE=1, which
@@ -175,26 +174,6 @@ std::string mutant(const std::vector<std::string>& seeds, std::uint64_t index) {
   return s;
 }
 
-// A known finding not fixed yet, which would end the fixed run (issue 31, item 4; fixed in
-// src/equations/equation_expression.cpp by bounds on the expressions, not here): a power whose
-// exponent is a large number, e.g. `11^1e308` or `2^(99999)`. GiNaC evaluates a power of exact
-// numbers exactly, so GMP tries to allocate the digits of 11^(10^308) and aborts the process
-// ("GNU MP: Cannot allocate memory"), or takes minutes and gigabytes for 2^(10^9). Such inputs are
-// skipped (and counted) with --skip-huge-powers: after `^`, spaces and `(`, a number of 1e4 or more.
-bool known_finding(const std::string& s) {
-  for (size_t i = s.find('^'); i != std::string::npos; i = s.find('^', i + 1)) {
-    size_t j = i + 1;
-    while (j < s.size() && (s[j] == ' ' || s[j] == '(' || s[j] == '+')) ++j;
-    size_t end = j;
-    while (end < s.size() && (std::isdigit(static_cast<unsigned char>(s[end])) || s[end] == '.' || s[end] == 'e' ||
-                              s[end] == 'E' || ((s[end] == '-' || s[end] == '+') && end > j &&
-                                                (s[end - 1] == 'e' || s[end - 1] == 'E'))))
-      ++end;
-    if (end > j && std::strtod(s.substr(j, end - j).c_str(), nullptr) >= 1e4) return true;
-  }
-  return false;
-}
-
 // One input through the entry point; false (with the input, escaped, on stderr) if an exception
 // escaped it. The entry points catch BadInput themselves: anything else is a finding.
 bool run_one(const std::string& input, const std::string& label) {
@@ -223,13 +202,6 @@ bool run_one(const std::string& input, const std::string& label) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // --skip-huge-powers (first): skip the inputs of known_finding (the equations target's runs).
-  const bool skip_known = argc > 1 && std::string(argv[1]) == "--skip-huge-powers";
-  if (skip_known) {
-    argv[1] = argv[0];
-    ++argv;
-    --argc;
-  }
   if (argc == 2 && fs::is_regular_file(argv[1])) return run_one(read_file(argv[1]), argv[1]) ? 0 : 1;
   if (argc != 3 && argc != 4) {
     std::cerr << "usage: " << argv[0] << " CORPUS_DIR COUNT [INDEX] | " << argv[0] << " FILE\n";
@@ -246,18 +218,14 @@ int main(int argc, char** argv) {
     return 0;
   }
   const bool trace = std::getenv("DELAYSPEC_FUZZ_TRACE") != nullptr;
-  long findings = 0, skipped = 0;
+  long findings = 0;
   for (size_t i = 0; i < seeds.size(); ++i) findings += !run_one(seeds[i], "seed " + std::to_string(i));
   for (long i = 0; i < count; ++i) {
     const std::string input = mutant(seeds, static_cast<std::uint64_t>(i));
-    if (skip_known && known_finding(input)) {
-      ++skipped;
-      continue;
-    }
     if (trace) std::cerr << "mutant " << i << "\n";
     findings += !run_one(input, "mutant " + std::to_string(i));
   }
-  std::cout << argv[0] << ": " << seeds.size() << " seeds and " << count << " mutants (" << skipped
-            << " skipped as a known finding), " << findings << " finding(s)\n";
+  std::cout << argv[0] << ": " << seeds.size() << " seeds and " << count << " mutants, " << findings
+            << " finding(s)\n";
   return findings == 0 ? 0 : 1;
 }

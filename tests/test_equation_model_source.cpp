@@ -235,6 +235,9 @@ std::vector<BadTable> bad_tables() {
   };
   // the table itself
   add("unknown entry", impact_with("histroy", toml::table{}), {"`equations.histroy`", "did you mean `history`?"});
+  // 11^1e308 was evaluated exactly: GMP aborted or the process took all memory (fuzz mutant 10 598).
+  add("huge constant power", impact_with("period", "11^1e308"), {"`equations.period`", "beyond 10000"});
+  add("nested constant powers", impact_rhs2("v + 2^(2^(2^(2^2)))"), {"`equations.rhs[2]`", "beyond 10000"});
   add("unknown entry, a prefix", impact_with("param", toml::table{}), {"`equations.param`", "did you mean `parameters`?"});
   add("unknown entry, longer", impact_with("switching", "x"), {"`equations.switching`", "did you mean `switch`?"});
   add("unknown entry, far", impact_with("initial", toml::table{}),

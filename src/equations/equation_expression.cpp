@@ -35,6 +35,9 @@ constexpr long kMaxExponent = 400;
 // (the model's whole size is bounded again on the printed code, equation_model_source.cpp).
 constexpr size_t kMaxNesting = 100;
 constexpr size_t kMaxTokens = 20000;
+// A constant raised to a constant power is evaluated exactly by GiNaC: 11^10000 has 10 414 digits
+// (milliseconds); 11^1e308 cannot be held (check_powers).
+constexpr int kMaxConstantExponent = 10000;
 
 bool is_letter(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
@@ -260,6 +263,7 @@ class ExpressionReader {
   // table (n0, n1, ...), functions by their (whitelisted) names.
   GiNaC::ex parse() {
     GiNaC::symtab table;
+    GiNaC::exmap exact_numbers, approximate_numbers;
     std::map<std::string, std::string> key_of_name;
     std::string input;
     for (size_t k = 0; k < tokens_.size(); ++k) {
@@ -271,8 +275,17 @@ class ExpressionReader {
         } else {
           key = "n";
           key += std::to_string(table.size());  // (not "n" + ...: a false -Wrestrict of GCC 12)
-          table[key] = token.kind == TokenKind::number ? number_value(token) : scope_.names.at(token.text);
-          if (token.kind == TokenKind::name) key_of_name[token.text] = key;
+          if (token.kind == TokenKind::number) {
+            // A number is a placeholder symbol until the powers are checked (check_powers).
+            const GiNaC::symbol placeholder(key);
+            const GiNaC::ex exact = number_value(token);
+            exact_numbers[placeholder] = exact;
+            approximate_numbers[placeholder] = GiNaC::evalf(exact);
+            table[key] = placeholder;
+          } else {
+            table[key] = scope_.names.at(token.text);
+            key_of_name[token.text] = key;
+          }
         }
         input += key;
       } else {
@@ -284,6 +297,10 @@ class ExpressionReader {
     try {
       GiNaC::parser parser(table, true, function_table());
       value = parser(input);
+      check_powers(value, approximate_numbers);
+      value = value.subs(exact_numbers);
+    } catch (const BadInput&) {
+      throw;
     } catch (const GiNaC::parse_error& e) {
       fail_whole("cannot be parsed: " + first_line(e.what()));
     } catch (const std::exception& e) {  // GiNaC's evaluation: 1/0, log(0), tan(pi/2) (pole_error)
@@ -307,6 +324,30 @@ class ExpressionReader {
         fail_whole("has a number beyond the range of a double");
     }
     return value;
+  }
+
+  // GiNaC raises a number to a number exactly: 11^1e308 asked GMP for more memory than there is
+  // (an abort, or 24 GB before the kernel killed the process; found by the fuzz driver). So the
+  // expression is first parsed with its numbers as placeholder symbols, and every power whose base
+  // is a constant must have an exponent, evaluated in floating point (`approximate` gives each
+  // placeholder its value as a float), of at most kMaxConstantExponent in magnitude. A power of a
+  // variable (x^1e308) is never evaluated exactly and is left to the compiled code.
+  void check_powers(const GiNaC::ex& value, const GiNaC::exmap& approximate) const {
+    for (auto it = value.preorder_begin(); it != value.preorder_end(); ++it) {
+      if (!GiNaC::is_a<GiNaC::power>(*it)) continue;
+      const GiNaC::ex base = it->op(0).subs(approximate), exponent = it->op(1).subs(approximate);
+      if (has_symbol(base) || has_symbol(exponent)) continue;
+      bool too_large = true;
+      try {
+        const GiNaC::ex e = GiNaC::evalf(exponent);
+        too_large = !GiNaC::is_a<GiNaC::numeric>(e) || !GiNaC::ex_to<GiNaC::numeric>(e).is_real() ||
+                    GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(e)) > kMaxConstantExponent;
+      } catch (const std::exception&) {  // the exponent itself overflows
+      }
+      if (too_large)
+        fail_whole("raises a constant to a power beyond " + std::to_string(kMaxConstantExponent) +
+                   " in magnitude, which is evaluated exactly (write a smaller power, or its value)");
+    }
   }
 
   // The whitelisted functions of GiNaC's default reader (one argument each).
