@@ -211,7 +211,7 @@ TEST_F(EquationsCli, ConstantsAndTheGridAreCheckedBeforeTheCompile) {
       {"delay = \"1\"", "delay = \"1/(a + 1)\"", {}, "`equations.delay` evaluates to nan"},
       {"delay = \"1\"", "delay = \"b*1e-12\"", {}, "too many steps"},
       {"delay = \"1\"", "delay = \"b\"", {"b=0"}, "`equations.delay` evaluates to 0"},
-      {"period = \"1\"", "period = \"1e-9\"", {}, "needs N divisible by 1000000000"},
+      {"period = \"1\"", "period = \"1e-9\"", {}, "steps a history can hold"},
       {"history = { x = \"x0\" }", "history = { x = \"1/x0\" }", {"x0=0"}, "`equations.history.x`"},
   };
   for (const auto& c : cases) {
