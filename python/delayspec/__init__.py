@@ -24,7 +24,14 @@ import warnings
 
 import numpy as np
 
-from . import _delayspec
+try:
+    from . import _delayspec
+except ImportError as error:  # the source tree's python/, or a build without the extension
+    raise ImportError(
+        f"delayspec: the compiled extension _delayspec is not beside {__file__} ({error}). Build it with "
+        "`cmake --build build --target delayspec_python` (pybind11-dev and python3-dev installed: "
+        "scripts/setup-debian.sh) and import from build/python with the interpreter it was built for, e.g. "
+        "`PYTHONPATH=build/python /usr/bin/python3` (docs/python.md)") from error
 from ._delayspec import BadInput, NumericalFailure, __version__
 
 BadInput.__module__ = NumericalFailure.__module__ = "delayspec"

@@ -414,3 +414,17 @@ def test_docstrings_list_the_keys():
     for function, key in [(delayspec.floquet, "nev = 6"), (delayspec.lyapunov, "exponents"),
                           (delayspec.sweep, "sweep_key"), (delayspec.chart, "chart_x")]:
         assert key in function.__doc__, function.__name__
+
+
+def test_a_missing_extension_says_how_to_build_it(tmp_path):
+    # The package without its compiled part (the source tree's python/, or a build without the
+    # target): an ImportError naming the target, not "partially initialized module ... (most likely
+    # due to a circular import)".
+    package = tmp_path / "delayspec"
+    package.mkdir()
+    (package / "__init__.py").write_text(pathlib.Path(delayspec.__file__).read_text())
+    p = subprocess.run([sys.executable, "-c", "import delayspec"], capture_output=True, text=True,
+                       env={**os.environ, "PYTHONPATH": str(tmp_path)}, cwd=tmp_path, timeout=60)
+    assert p.returncode != 0
+    assert "ImportError" in p.stderr
+    assert "--target delayspec_python" in p.stderr
