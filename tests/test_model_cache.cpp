@@ -253,6 +253,21 @@ TEST_F(ModelCache, ACompilerThatWritesNothingOrGarbageCachesNothing) {
     EXPECT_EQ(r.status, 2) << r.err;
     EXPECT_TRUE(contains(r.err, "not a loadable shared object")) << r.err;
   }
+  {
+    // A shared object, but not a model: it lacks the entry points (and the version).
+    const fs::path c = dir_ / "other.c", so = dir_ / "other.so";
+    write(c, "int not_a_model(void) { return 1; }\n");
+    const std::string build = std::string(DELAYSPEC_PLUGIN_CXX) + " -x c -shared -fPIC -o " + so.string() + " " +
+                              c.string();
+    ASSERT_EQ(std::system(build.c_str()), 0) << build;
+    const ScopedEnv cxx("DELAYSPEC_CXX", script(dir_ / "other-cc", "while [ \"$1\" != -o ]; do shift; done\ncp " +
+                                                                       so.string() + " \"$2\"\n")
+                                             .string());
+    const CliResult r = run({"floquet", scene.string(), "--set", "model_cache=" + cache.string(), "--set", "N=20",
+                             "--set", "a=-3"});
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, "lacks `delayspec_equation_version`")) << r.err;
+  }
   for (const auto& e : fs::directory_iterator(cache)) {
     const std::string file = e.path().filename().string();
     EXPECT_FALSE(contains(file, ".so")) << "left in the cache: " << file;

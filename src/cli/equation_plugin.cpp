@@ -326,8 +326,8 @@ EquationPlugin compile_plugin(const Toolchain& tc, const ModelCacheDir& cache, c
     std::string command;  // the log's first line: how the object was made
     for (const auto& a : argv) command += a + " ";
     command += "\n";
-    if (::write(log.get(), command.data(), command.size()) < 0) {
-    }
+    // Informational: a log without its first line still holds the compiler's own output.
+    [[maybe_unused]] const ssize_t wrote = ::write(log.get(), command.data(), command.size());
     ++compilations;
     outcome = run_child(argv, log.get(), limit);
   }
@@ -363,7 +363,13 @@ EquationPlugin compile_plugin(const Toolchain& tc, const ModelCacheDir& cache, c
     throw BadInput("equations: the compiler's output is not a loadable shared object (" +
                    (error.empty() ? std::string("no ELF header") : error) + ")" + where + "; nothing was cached");
   }
-  EquationPlugin plugin = plugin_of(handle, cache.entry_path(name + ".so"));
+  EquationPlugin plugin;
+  try {
+    plugin = plugin_of(handle, cache.entry_path(name + ".so"));
+  } catch (const BadInput&) {  // an object, but not this program's model: nothing is cached
+    cache.remove_entry(tmp);
+    throw;
+  }
   cache.write_entry(name + ".sum", object_checksum(bytes));
   cache.rename_entry(tmp, name + ".so");
   return plugin;
