@@ -223,16 +223,6 @@ TEST_F(EquationsCli, ConstantsAndTheGridAreCheckedBeforeTheCompile) {
   ::unsetenv("DELAYSPEC_CXX");
 }
 
-TEST_F(EquationsCli, ANonFiniteDerivativeNamesTheExpressionAndThePoint) {
-  // x' = -sqrt(x) from x = 0: the orbit stays at 0, where d/dx = -1/(2 sqrt(x)) is -inf. It used to
-  // end much later in "dense_eigenvalues: matrix has non-finite entries".
-  const std::string scene = scene_with(dir_, "sqrt.toml", "a*x + b*x_tau", "-sqrt(x) + b*x_tau");
-  const CliResult r = command("floquet", {"N=20", "x0=0"}, scene);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_TRUE(contains(r.err, "the derivative of `equations.rhs[1]` by x is not finite (-inf)")) << r.err;
-  EXPECT_TRUE(contains(r.err, ", x = 0, x_tau = 0")) << r.err;
-}
-
 TEST_F(EquationsCli, MissingTableIsBadInput) {
   const CliResult r = run({"floquet", "--set", "model=equations"});
   EXPECT_EQ(r.status, 2) << r.err;

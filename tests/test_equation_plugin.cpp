@@ -32,7 +32,6 @@ const char* kLinearCode = R"(struct EquationModel {
   std::array<double, parameter_count> p{};
   double tau_ = 0, period_ = 0;
   Vector history_ = Vector::Zero();
-  const char* const* names_ = nullptr;
   static double period_of(const double*) { return 1.0; }
   static double delay_of(const double*) { return 1.0; }
   static Vector history_of(const double*) { return Vector(1.0); }
@@ -77,7 +76,7 @@ TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInAndASecondLoadIsACacheHit)
   double y0 = 0;
   plugin.history(p, &y0);
   EXPECT_EQ(y0, 1.0);
-  const std::unique_ptr<ModelAnalyses> loaded(plugin.analyses(p, 1.0, 1.0, &y0, nullptr));
+  const std::unique_ptr<ModelAnalyses> loaded(plugin.analyses(p, 1.0, 1.0, &y0));
   EXPECT_EQ(loaded->state_dimension(), 1);
   EXPECT_TRUE(loaded->is_linear());
   LinearParameters lp;
@@ -108,7 +107,7 @@ TEST_F(EquationPluginTest, ConcurrentFirstLoadsCompileOnce) {
   EXPECT_EQ(equation_plugin_compilations(), before + 1);
   EXPECT_EQ(first.object, second.object);
   const double p[2] = {-1.0, 0.5}, y0 = 1;
-  EXPECT_EQ(std::unique_ptr<ModelAnalyses>(second.analyses(p, 1, 1, &y0, nullptr))->state_dimension(), 1);
+  EXPECT_EQ(std::unique_ptr<ModelAnalyses>(second.analyses(p, 1, 1, &y0))->state_dimension(), 1);
 }
 
 TEST_F(EquationPluginTest, TwoModelsInOneProcessAreTwoObjects) {

@@ -27,16 +27,10 @@ std::mutex& equations_mutex() {
   return mutex;
 }
 
-// A printed table, kept for the process: the compiled model's messages point into state_names.
-struct GeneratedModel {
-  EquationModelSource source;
-  std::vector<const char*> state_names;  // into source.state
-};
-
-const GeneratedModel& generated(const std::string& table_text) {
+const EquationModelSource& generated(const std::string& table_text) {
   // Never destroyed: `constants` holds GiNaC expressions, which must not outlive GiNaC's own
   // statics, and the module's destructors may run first at exit.
-  static auto& sources = *new std::map<std::string, std::unique_ptr<const GeneratedModel>>;
+  static auto& sources = *new std::map<std::string, std::unique_ptr<const EquationModelSource>>;
   const std::lock_guard<std::mutex> lock(equations_mutex());
   if (auto it = sources.find(table_text); it != sources.end()) return *it->second;
   toml::table table;
@@ -45,11 +39,9 @@ const GeneratedModel& generated(const std::string& table_text) {
   } catch (const toml::parse_error& e) {
     throw BadInput("`equations`: " + std::string(e.description()));
   }
-  auto model = std::make_unique<GeneratedModel>();
-  model->source = equations_module().generate(table, engine_keys());
-  for (const auto& name : model->source.state) model->state_names.push_back(name.c_str());
-  const GeneratedModel& result = *model;
-  sources[table_text] = std::move(model);
+  auto source = std::make_unique<const EquationModelSource>(equations_module().generate(table, engine_keys()));
+  const EquationModelSource& result = *source;
+  sources[table_text] = std::move(source);
   return result;
 }
 
@@ -98,8 +90,7 @@ EquationModel read_equation_model(Config& config, const std::function<void(doubl
                    ": a scene may not choose where compiled models are loaded from; give it on the command line " +
                    "(--set model_cache=DIR), as a Python keyword, or through XDG_CACHE_HOME");
   const std::filesystem::path cache_dir = config.get_string("model_cache", default_model_cache().string());
-  const GeneratedModel& model_text = generated(text);
-  const EquationModelSource& src = model_text.source;
+  const EquationModelSource& src = generated(text);
   std::vector<double> p(src.parameters.size());
   for (size_t k = 0; k < p.size(); ++k) {
     p[k] = config.get_double(src.parameters[k], src.parameter_defaults[k]);
@@ -132,7 +123,7 @@ EquationModel read_equation_model(Config& config, const std::function<void(doubl
   EquationModel model;
   model.state = src.state;
   model.parameters = src.parameters;
-  model.analyses.reset(plugin.analyses(p.data(), tau, period, history.data(), model_text.state_names.data()));
+  model.analyses.reset(plugin.analyses(p.data(), tau, period, history.data()));
   return model;
 }
 

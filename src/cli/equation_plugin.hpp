@@ -28,10 +28,8 @@ namespace delayspec::cli {
 
 struct EquationPlugin {
   // The analyses of the model at the given parameter values (in the order of the source's
-  // parameters), delay, period and constant initial history (d values); `state_names` (d, or
-  // null), which must outlive the analyses, for messages. The caller owns it.
-  ModelAnalyses* (*analyses)(const double* parameters, double tau, double period, const double* history,
-                             const char* const* state_names) = nullptr;
+  // parameters), delay, period and constant initial history (d values). The caller owns it.
+  ModelAnalyses* (*analyses)(const double* parameters, double tau, double period, const double* history) = nullptr;
   double (*period)(const double* parameters) = nullptr;                // the `period` expression
   double (*delay)(const double* parameters) = nullptr;                 // the `delay` expression
   void (*history)(const double* parameters, double* state) = nullptr;  // the `history` expressions

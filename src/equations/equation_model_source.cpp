@@ -53,7 +53,6 @@ class ModelPrinter {
          << "  std::array<double, parameter_count> p{};\n"
          << "  double tau_ = 0, period_ = 0;\n"
          << "  Vector history_ = Vector::Zero();\n"
-         << "  const char* const* names_ = nullptr;  // the state's names, for messages (set by the loader)\n"
          << "  double tau() const { return tau_; }\n"
          << "  double period() const { return period_; }\n"
          << "  Vector initial_state() const { return history_; }\n"
@@ -136,15 +135,7 @@ class ModelPrinter {
       const auto& c = components(field);
       for (size_t i = 0; i < c.size(); ++i) out_ << indent << "r[" << i << "] = " << cxx(c[i]) << ";\n";
     });
-    if (name == "f") print_finite_check('f');
     out_ << "    return r;\n  }\n";
-  }
-
-  // f, A and B are checked where they are computed (detail/non_finite_model_value.hpp): a value
-  // that is not finite names its expression and the point, instead of surfacing in the step maps.
-  void print_finite_check(char what) {
-    out_ << "    if (!r.allFinite()) delayspec::detail::throw_non_finite_model_value('" << what << "', j, "
-         << bool_text(m_.fields.size() > 1) << ", r.data(), d, t, y.data(), z.data(), names_);\n";
   }
 
   void print_field_matrix(const std::string& name, const Matrix& matrix) {
@@ -156,7 +147,6 @@ class ModelPrinter {
           if (!entries[i][a].is_zero())
             out_ << indent << "r(" << i << ", " << a << ") = " << cxx(entries[i][a]) << ";\n";
     });
-    print_finite_check(name[0]);
     out_ << "    return r;\n  }\n";
   }
 
