@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
 namespace delayspec {
 
@@ -18,6 +19,21 @@ std::string format_number(double value) {
     if (exact && (best.empty() || std::string(buffer).size() < best.size())) best = buffer;
   }
   return best;
+}
+
+NonFiniteStep::NonFiniteStep(const std::string& what, std::vector<ModelPoint> points)
+    : NumericalFailure(what), points_(std::move(points)) {}
+
+std::string describe_point(const ModelPoint& point) {
+  auto vector = [](const std::vector<double>& v) {
+    std::string text = "(";
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (i > 0) text += ", ";
+      text += format_number(v[i]);
+    }
+    return text + ")";
+  };
+  return " at t = " + format_number(point.t) + ": y = " + vector(point.y) + ", y(t - tau) = " + vector(point.y_tau);
 }
 
 void require_finite(const char* name, double value) {

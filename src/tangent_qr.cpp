@@ -298,7 +298,7 @@ void TangentQR::factorise(double* q_out, double* log_r) {
     if (!bounded || biggest_sq < kSquaresLow) {
       double biggest = 0;
       for (long i = 0; i < n * k; ++i) {
-        if (!std::isfinite(a[i])) throw NumericalFailure("Lyapunov QR: the tangent block is not finite");
+        if (!std::isfinite(a[i])) throw NonFiniteResult("Lyapunov QR: the tangent block is not finite");
         biggest = std::max(biggest, std::abs(a[i]));
       }
       if (biggest > 0) {
@@ -313,7 +313,7 @@ void TangentQR::factorise(double* q_out, double* log_r) {
     for (int i = 0; i < k; ++i) {
       const double r = f.r[i];
       if (!std::isfinite(r))
-        throw NumericalFailure("Lyapunov QR: R(" + std::to_string(i) + "," + std::to_string(i) +
+        throw NonFiniteResult("Lyapunov QR: R(" + std::to_string(i) + "," + std::to_string(i) +
                                ") = " + format_number(r) + " (the tangent block is not finite)");
       const double norm = std::sqrt(f.sq[i]);
       if (!(std::abs(r) > dependence_threshold(n) * norm))

@@ -223,6 +223,36 @@ TEST_F(EquationsCli, ConstantsAndTheGridAreCheckedBeforeTheCompile) {
   ::unsetenv("DELAYSPEC_CXX");
 }
 
+TEST_F(EquationsCli, ANonFiniteStepNamesTheTermAndThePoint) {
+  // x^(1/3), with the equilibrium x = 1: from x = 0 the derivative 1/3 x^(-2/3) is infinite at
+  // the first step (with the rhs a*x^(1/3) + b*x_tau, whose orbit is x = 0, this gave
+  // "dense_eigenvalues: matrix has non-finite entries", exit 2); from x = -1 the power itself is
+  // not real (C++: NaN, the first step's state).
+  const std::string rhs = "a*(x^(1/3) - 1) + b*(x_tau - 1)";
+  const std::string scene = scene_with(dir_, "cube_root.toml", "a*x + b*x_tau", rhs);
+  const std::string term = "`equations.rhs[1] = \"" + rhs + "\"`";
+  for (const auto& [name, sets] : std::vector<std::pair<std::string, std::vector<std::string>>>{
+           {"floquet", {"N=20", "x0=0", "solver=dense"}},
+           {"floquet", {"N=20", "x0=0"}},
+           {"lyapunov", {"N=20", "x0=0", "periods=20", "transient=0"}}}) {
+    const CliResult r = command(name, sets, scene);
+    EXPECT_EQ(r.status, 3) << name << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "at t = 0, x = 0, x_tau = 0")) << r.err;
+    EXPECT_TRUE(contains(r.err, term)) << r.err;
+    EXPECT_TRUE(contains(r.err, "its derivative by x, ")) << r.err;
+    EXPECT_TRUE(contains(r.err, "is undefined")) << r.err;
+  }
+  for (const std::string name : {"floquet", "simulate"}) {
+    const CliResult r = command(name, {"N=20", "x0=-1"}, scene);
+    EXPECT_EQ(r.status, 3) << name << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "at t = 0, x = -1, x_tau = -1")) << r.err;
+    EXPECT_TRUE(contains(r.err, term + " is not a real number")) << r.err;
+  }
+  // From x = 1, the equilibrium: a finite step everywhere, the multipliers computed.
+  const CliResult fine = command("floquet", {"N=20", "x0=1"}, scene);
+  EXPECT_EQ(fine.status, 0) << fine.err;
+}
+
 TEST_F(EquationsCli, MissingTableIsBadInput) {
   const CliResult r = run({"floquet", "--set", "model=equations"});
   EXPECT_EQ(r.status, 2) << r.err;

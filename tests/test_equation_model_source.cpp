@@ -21,6 +21,7 @@ using delayspec::cli::analyse_equations;
 using delayspec::cli::EquationModelSource;
 using delayspec::cli::generate_equation_model;
 using delayspec::cli::SymbolicEquationModel;
+using delayspec::cli::terms_not_finite;
 
 const std::vector<std::string> kEngineKeys = {"N", "nev", "seed", "solver", "tau_over_T"};
 
@@ -522,6 +523,36 @@ TEST(EquationModelSource, DerivativesOfEveryFunctionMatchFiniteDifferences) {
 TEST(EquationModelSource, TheTwoOscillatorDerivativesMatchFiniteDifferences) {
   const SymbolicEquationModel m = analyse_equations(scene_equations("equations_two_oscillators.toml"), kEngineKeys);
   for (int seed : {0, 1}) expect_derivatives_match_differences(m, point_of(m, seed));
+}
+
+TEST(EquationModelSource, TermsThatAreNotFiniteAtAPointAreNamed) {
+  const toml::table table{
+      {"state", toml::array{"x", "v"}},
+      {"parameters", toml::table{{"a", 2.0}}},
+      {"period", "1"},
+      {"rhs", toml::array{"v", "a*x^(1/3) + log(v_tau)"}},
+      {"history", toml::table{{"x", "1"}, {"v", "1"}}},
+  };
+  const SymbolicEquationModel m = analyse_equations(table, kEngineKeys);
+  // x = 1, v_tau = 1: every term (and derivative) finite.
+  EXPECT_TRUE(terms_not_finite(m, 0, {1, 0}, {0, 1}, {2.0}).empty());
+  // x = 0: d/dx (a x^(1/3)) = a/3 x^(-2/3) is 1/0; nothing else is.
+  const std::vector<std::string> at_zero = terms_not_finite(m, 0.5, {0, 0}, {0, 1}, {2.0});
+  ASSERT_EQ(at_zero.size(), 1u);
+  EXPECT_EQ(at_zero[0].rfind("`equations.rhs[2] = \"a*x^(1/3) + log(v_tau)\"`: its derivative by x, ", 0), 0u)
+      << at_zero[0];
+  EXPECT_TRUE(contains(at_zero[0], "is undefined")) << at_zero[0];
+  // v_tau = 0: log(0) is a pole (the derivative 1/v_tau is not looked at once f is not finite).
+  const std::vector<std::string> log_zero = terms_not_finite(m, 0, {1, 0}, {0, 0}, {2.0});
+  ASSERT_EQ(log_zero.size(), 1u);
+  EXPECT_TRUE(contains(log_zero[0], "`equations.rhs[2] = ") && contains(log_zero[0], "\"` is undefined")) << log_zero[0];
+  // x = -1: (-1)^(1/3) is complex, as std::pow(-1, 1/3.) is NaN.
+  const std::vector<std::string> negative = terms_not_finite(m, 0, {-1, 0}, {0, 1}, {2.0});
+  ASSERT_EQ(negative.size(), 1u);
+  EXPECT_TRUE(contains(negative[0], "` is not a real number")) << negative[0];
+  // The first component (v) is never reported.
+  for (const auto& lines : {at_zero, log_zero, negative})
+    for (const auto& line : lines) EXPECT_FALSE(contains(line, "rhs[1]")) << line;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 //    (iterations, residual). The CLI maps it to exit status 3.
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace delayspec {
 
@@ -20,6 +21,36 @@ class NumericalFailure : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// A NumericalFailure whose cause is a number that is not finite (NaN, infinite) in a result
+// (a tangent block, a residual), found where the step that made it is no longer known. The
+// analyses catch it and locate that step (StroboscopicMap::throw_first_non_finite_step).
+class NonFiniteResult : public NumericalFailure {
+ public:
+  using NumericalFailure::NumericalFailure;
+};
+
+// A point at which a step evaluated the model's f(t, y, y(t - tau)) and its derivatives.
+struct ModelPoint {
+  double t = 0;
+  std::vector<double> y, y_tau;
+};
+
+// A NumericalFailure at one step of the discretisation whose new state or whose derivative (the
+// step map) is not finite, with the points where that step evaluated the model: for the front
+// end that knows the model's terms to say which one is not finite there (model = equations:
+// src/cli/equation_model.cpp). what() describes the step in the engine's words.
+class NonFiniteStep : public NumericalFailure {
+ public:
+  NonFiniteStep(const std::string& what, std::vector<ModelPoint> points);
+  const std::vector<ModelPoint>& points() const { return points_; }
+
+ private:
+  std::vector<ModelPoint> points_;
+};
+
+// " at t = 0.5: y = (1, -2), y(t - tau) = (0.5, 0)": a point of the model in a message.
+std::string describe_point(const ModelPoint& point);
 
 // Formats a double with the fewest digits that read back as the same double (messages,
 // metadata, values passed on as text).

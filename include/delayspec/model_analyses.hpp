@@ -116,6 +116,9 @@ class ModelAnalysesFor final : public ModelAnalyses {
       out.sequence.resize(static_cast<long>(D) * K);
       for (long l = 0; l < K; ++l) out.sequence.template segment<D>(D * l) = at_orbit.states[l];
     }
+    // A model whose derivative is infinite on the orbit (x^(1/3) at 0) gives a monodromy that
+    // no eigensolver can use: say at which step, once here (a pass over K small matrices).
+    if (!all_finite(at_orbit)) map.throw_first_non_finite_step(out.orbit.history, 1, "the map at the periodic orbit");
     out.contacts = orbit_contacts(model_, std::move(at_orbit.states));
     out.monodromy = std::make_unique<Monodromy<D>>(map.grid(), std::move(at_orbit.maps));
     return out;
@@ -123,7 +126,13 @@ class ModelAnalysesFor final : public ModelAnalyses {
 
   LyapunovResult lyapunov(const MapSettings& s, const LyapunovOptions& options) const override {
     const StroboscopicMap<Model> map = make_map(s);
-    return lyapunov_exponents(map, map.constant_history(model_.initial_state()), options);
+    const Eigen::VectorXd U0 = map.constant_history(model_.initial_state());
+    try {
+      return lyapunov_exponents(map, U0, options);
+    } catch (const NonFiniteResult& e) {  // the tangent block: find the step that made it (failures only)
+      map.throw_first_non_finite_step(U0, options.transient + options.periods, e.what());
+      throw;
+    }
   }
 
   std::vector<Eigen::VectorXd> section_sequence(const MapSettings& s, long transient, long count) const override {
@@ -160,6 +169,13 @@ class ModelAnalysesFor final : public ModelAnalyses {
   }
 
  private:
+  static bool all_finite(const OrbitLinearisation<D>& at) {
+    for (const StepMap<D>& m : at.maps)
+      if (!m.P.allFinite() || !m.Q.allFinite() || !m.R.allFinite()) return false;
+    for (const Vec<D>& y : at.states)
+      if (!y.allFinite()) return false;
+    return true;
+  }
   StroboscopicMap<Model> make_map(const MapSettings& s) const {
     return StroboscopicMap<Model>(TrapezoidStepper<Model>(model_, s.step), grid(s));
   }

@@ -58,6 +58,83 @@ const EquationPlugin& compiled(const EquationModelSource& source, const std::fil
   return plugins[key] = load_equation_plugin(source.code, cache_dir);
 }
 
+// The plugin's analyses (compiled from the equations), with a failure at a step that is not
+// finite told in the equations' terms: the engine says which step and where it evaluated the
+// model (NonFiniteStep), GiNaC says which term is not finite there. Only failures pay for it.
+class ExplainedAnalyses final : public ModelAnalyses {
+ public:
+  ExplainedAnalyses(std::unique_ptr<const ModelAnalyses> inner, const EquationModelSource& source,
+                    std::vector<double> p)
+      : inner_(std::move(inner)), source_(source), p_(std::move(p)) {}
+
+  int state_dimension() const override { return inner_->state_dimension(); }
+  bool switches_in_state() const override { return inner_->switches_in_state(); }
+  bool switches_in_time() const override { return inner_->switches_in_time(); }
+  bool is_linear() const override { return inner_->is_linear(); }
+  double tau() const override { return inner_->tau(); }
+  double period() const override { return inner_->period(); }
+  LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
+                                   const OrbitRequest& request) const override {
+    return explained([&] { return inner_->linearised_orbit(map, orbit, request); });
+  }
+  LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const override {
+    return explained([&] { return inner_->lyapunov(map, options); });
+  }
+  std::vector<Eigen::VectorXd> section_sequence(const MapSettings& map, long transient, long count) const override {
+    return explained([&] { return inner_->section_sequence(map, transient, count); });
+  }
+  SimulationRecord<Eigen::Dynamic> simulate(const MapSettings& before_map, const MapSettings& map,
+                                            const SimulationOptions& options,
+                                            const ModelAnalyses* before) const override {
+    const auto* explained_before = dynamic_cast<const ExplainedAnalyses*>(before);
+    const ModelAnalyses* inner_before = explained_before ? explained_before->inner_.get() : before;
+    return explained([&] { return inner_->simulate(before_map, map, options, inner_before); });
+  }
+
+ private:
+  template <class Analysis>
+  auto explained(const Analysis& analysis) const -> decltype(analysis()) {
+    try {
+      return analysis();
+    } catch (const NonFiniteStep& e) {
+      throw NumericalFailure(explanation(e));
+    }
+  }
+
+  // "<the engine's words>; at t = 0, x = 0, x_tau = 0: `equations.rhs[1]` = ...: its derivative
+  // by x, ..., is undefined (...)", each point where some term is not finite.
+  std::string explanation(const NonFiniteStep& e) const {
+    std::string text = e.what();
+    bool named = false;
+    for (const ModelPoint& point : e.points()) {
+      std::vector<std::string> terms;
+      {
+        const std::lock_guard<std::mutex> lock(equations_mutex());
+        terms = source_.terms_not_finite(point.t, point.y, point.y_tau, p_);
+      }
+      if (terms.empty()) continue;
+      text += "; at t = " + format_number(point.t);
+      for (size_t i = 0; i < source_.state.size() && i < point.y.size(); ++i)
+        text += ", " + source_.state[i] + " = " + format_number(point.y[i]);
+      for (size_t i = 0; i < source_.state.size() && i < point.y_tau.size(); ++i)
+        text += ", " + source_.state[i] + "_tau = " + format_number(point.y_tau[i]);
+      for (size_t i = 0; i < terms.size(); ++i) text += (i ? "; " : ": ") + terms[i];
+      named = true;
+      break;  // the first point the step evaluated where a term is not finite
+    }
+    if (!named) {
+      text += "; every term of the equations is finite where this step evaluated them";
+      for (const ModelPoint& point : e.points()) text += describe_point(point);
+      text += ": the step itself is not finite (a larger N gives smaller steps)";
+    }
+    return "model = equations: " + text;
+  }
+
+  std::shared_ptr<const ModelAnalyses> inner_;
+  const EquationModelSource& source_;  // never destroyed (generated())
+  std::vector<double> p_;
+};
+
 double positive_value(const std::string& item, double value) {
   if (!std::isfinite(value) || !(value > 0))
     throw BadInput("`" + item + "` evaluates to " + format_number(value) +
@@ -123,7 +200,8 @@ EquationModel read_equation_model(Config& config, const std::function<void(doubl
   EquationModel model;
   model.state = src.state;
   model.parameters = src.parameters;
-  model.analyses.reset(plugin.analyses(p.data(), tau, period, history.data()));
+  model.analyses = std::make_shared<const ExplainedAnalyses>(
+      std::unique_ptr<const ModelAnalyses>(plugin.analyses(p.data(), tau, period, history.data())), src, p);
   return model;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <functional>
 #include <set>
 #include <sstream>
@@ -225,6 +226,9 @@ EquationModelSource generate_equation_model(const toml::table& equations,
     }
     return out;
   };
+  source.terms_not_finite = [symbolic = std::make_shared<const SymbolicEquationModel>(model)](
+                                double t, const std::vector<double>& y, const std::vector<double>& y_tau,
+                                const std::vector<double>& p) { return terms_not_finite(*symbolic, t, y, y_tau, p); };
   return source;
 }
 

@@ -26,6 +26,11 @@ struct EquationModelSource {
   // not a finite real number, e.g. 1/0). So that they are checked before the model is compiled
   // (seconds) rather than after. Not thread-safe (GiNaC).
   std::function<std::vector<double>(const std::vector<double>& p)> constants;
+  // terms_not_finite (equation_model_symbolic.hpp) of this model at a point and parameter values:
+  // what to say when a step is not finite there. Not thread-safe (GiNaC).
+  std::function<std::vector<std::string>(double t, const std::vector<double>& y, const std::vector<double>& y_tau,
+                                         const std::vector<double>& p)>
+      terms_not_finite;
 };
 
 // Throws BadInput naming the item (e.g. "`equations.rhs[2]`: ...") for every input error that

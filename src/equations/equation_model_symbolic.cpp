@@ -180,6 +180,13 @@ class EquationsReader {
     return field;
   }
 
+  std::vector<std::string> field_text(const std::string& entry) const {
+    std::vector<std::string> text;
+    const toml::array& array = required_array(table_, entry);
+    for (size_t i = 0; i < array.size(); ++i) text.push_back(expression_text(array[i], item_of(entry, i)));
+    return text;
+  }
+
   void read_fields() {
     rhs_ = read_field("rhs");
     const toml::node* h = table_.get("switch");
@@ -249,6 +256,8 @@ class EquationsReader {
 
   SymbolicField differentiate_field(const std::vector<GiNaC::ex>& f, const std::string& entry) const {
     SymbolicField field;
+    field.entry = entry;
+    field.text = field_text(entry);
     field.f = f;
     for (size_t i = 0; i < f.size(); ++i) {
       try {
@@ -305,6 +314,50 @@ GiNaC::ex SymbolicEquationModel::display(const GiNaC::ex& e) const {
   }
   for (size_t k = 0; k < parameters.size(); ++k) names[p[k]] = GiNaC::symbol(parameters[k]);
   return e.subs(names);
+}
+
+std::vector<std::string> terms_not_finite(const SymbolicEquationModel& model, double t, const std::vector<double>& y,
+                                          const std::vector<double>& y_tau, const std::vector<double>& p) {
+  GiNaC::lst at{model.t == GiNaC::numeric(t)};
+  for (size_t i = 0; i < model.y.size() && i < y.size() && i < y_tau.size(); ++i) {
+    at.append(model.y[i] == GiNaC::numeric(y[i]));
+    at.append(model.z[i] == GiNaC::numeric(y_tau[i]));
+  }
+  for (size_t k = 0; k < model.p.size() && k < p.size(); ++k) at.append(model.p[k] == GiNaC::numeric(p[k]));
+  // "" when e is a finite real number at the point, else what it is.
+  auto not_finite = [&](const GiNaC::ex& e) -> std::string {
+    try {
+      const GiNaC::ex v = GiNaC::evalf(e.subs(at));
+      if (!GiNaC::is_a<GiNaC::numeric>(v)) return "undefined";
+      const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(v);
+      if (!n.is_real()) return "not a real number (" + text_of(v) + ")";
+      const double x = n.to_double();
+      return std::isfinite(x) ? "" : "not finite (" + format_number(x) + ")";
+    } catch (const std::exception& e) {  // GiNaC's pole_error: 1/0, log(0), 0^(-2/3)
+      return std::string("undefined (") + e.what() + ")";
+    }
+  };
+  std::vector<std::string> found;
+  for (const SymbolicField& field : model.fields) {
+    for (size_t i = 0; i < field.f.size(); ++i) {
+      std::string text = field.text[i];  // parsed, so printable; long ones cut
+      if (text.size() > 120) text.replace(100, std::string::npos, "...");
+      std::string item = "`";
+      item.append(item_of(field.entry, i)).append(" = \"").append(text).append("\"`");
+      if (const std::string why = not_finite(field.f[i]); !why.empty()) {
+        found.push_back(item + " is " + why);
+        continue;
+      }
+      for (const auto* derivatives : {&field.A, &field.B})
+        for (size_t a = 0; a < derivatives->at(i).size(); ++a) {
+          const GiNaC::ex& e = derivatives->at(i)[a];
+          if (const std::string why = not_finite(e); !why.empty())
+            found.push_back(item + ": its derivative by " + model.state[a] + (derivatives == &field.B ? "_tau" : "") +
+                            ", " + text_of(model.display(e)) + ", is " + why);
+        }
+    }
+  }
+  return found;
 }
 
 SymbolicEquationModel analyse_equations(const toml::table& equations, const std::vector<std::string>& reserved_keys) {

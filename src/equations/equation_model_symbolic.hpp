@@ -17,6 +17,8 @@ enum class SwitchKind { none, time, state };
 
 // One vector field f_j and what the engine needs of it, by GiNaC's diff.
 struct SymbolicField {
+  std::string entry;                         // "rhs" or "rhs_switched"
+  std::vector<std::string> text;             // the entry's components as the scene wrote them (messages)
   std::vector<GiNaC::ex> f;                  // f_j, d components
   std::vector<std::vector<GiNaC::ex>> A, B;  // A[i][a] = d f_i / d y_a, B[i][a] = d f_i / d z_a
   std::vector<GiNaC::ex> f_t, f_tt;          // d f / dt, d2 f / dt2 at fixed y, z
@@ -43,6 +45,14 @@ struct SymbolicEquationModel {
   // e with the user's names for the generated symbols, for messages.
   GiNaC::ex display(const GiNaC::ex& e) const;
 };
+
+// What of the model is not a finite real number at a point (t, y, y(t - tau)) and parameter
+// values p, evaluated by GiNaC from the exact expressions (not the compiled code): each component
+// of every field and its derivatives by y and y_tau, one line each, e.g. "`equations.rhs[1]` =
+// a*x^(1/3)+b*x_tau: its derivative by x, 1/3*a*x^(-2/3), is undefined (division by zero)".
+// Empty when all are finite. For messages about a step that failed. Not thread-safe (GiNaC).
+std::vector<std::string> terms_not_finite(const SymbolicEquationModel& model, double t, const std::vector<double>& y,
+                                          const std::vector<double>& y_tau, const std::vector<double>& p);
 
 // BadInput naming the item for every input error (docs/models.md, "What is checked").
 // reserved_keys: the engine's keys, which a parameter may not be named. Not thread-safe (GiNaC).
