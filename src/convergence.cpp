@@ -146,8 +146,8 @@ OrderReport track_order(const std::vector<int>& Ns, const std::vector<std::compl
     }
     for (size_t i = 0; i + 1 < d.size(); ++i)
       if (usable[i] && usable[i + 1]) {
-        const double ratio = std::sqrt(double(Ns[i + 2]) / Ns[i]);  // geometric mean step ratio
-        r.pair_orders.push_back(std::log(d[i] / d[i + 1]) / std::log(ratio));
+        // h = 1 / N: any ratios (order_of_differences, richardson.hpp)
+        r.pair_orders.push_back(order_of_differences(1.0 / Ns[i], 1.0 / Ns[i + 1], 1.0 / Ns[i + 2], d[i], d[i + 1]));
         r.pair_N.push_back(Ns[i + 2]);
       }
   }

@@ -30,7 +30,8 @@
 //     levels whose error is above 10x the reference precision;
 //   otherwise: from successive differences d_i = |mu_{i+1} - mu_i| (they do not depend on a
 //     reference built from the same levels, which would make the order tautological):
-//     p = log(d_i / d_{i+1}) / log(r), r the geometric mean step ratio of the three levels.
+//     p solves d_{i+1} / d_i = (h_{i+1}^p - h_{i+2}^p) / (h_i^p - h_{i+1}^p), h = 1 / N
+//     (order_of_differences, richardson.hpp; log(d_i / d_{i+1}) / log(r) for equal ratios r).
 //   The least-squares slope of log e (or log d) against log N over all usable levels.
 //   Settled when the last (up to 3) pair orders spread by at most `settled_spread`; only then is
 //   `observed` set (the slope over the levels of those pairs). Otherwise it stays empty and `note`

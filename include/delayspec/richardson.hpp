@@ -19,9 +19,10 @@
 // correction) shrinks as if it had: measured on the impact orbit, 4 columns claimed 1.8e-6 for
 // a value off by 3.1e-5. So every column is checked against the data before it is built upon:
 //   * Column j's entries T[j..L-1][j] should converge like h^{e_{j+1}}: for three consecutive
-//     entries with differences d1 (coarser), d2 and step ratio r (geometric mean over the
-//     three levels), d2 = d1 r^{-e_{j+1}}. The column is consistent when its last two triples
-//     (or its only one) satisfy d1 r^{-e-tol} - 2 noise <= d2 <= d1 r^{-e+tol} + 2 noise,
+//     entries at h0 > h1 > h2 with differences d1 (coarser), d2, d2 = d1 rho(e_{j+1}),
+//     rho(p) = (h1^p - h2^p) / (h0^p - h1^p) (= r^-p for equal step ratios r; levels 25, 50,
+//     200 need the general form). The column is consistent when its last two triples
+//     (or its only one) satisfy d1 rho(e + tol) - 2 noise <= d2 <= d1 rho(e - tol) + 2 noise,
 //     tol = order_tolerance, noise = sum_i |w_i| a_i (an entry's round-off: w the weights of
 //     the entry, a_i the accuracy of input i, `input_errors` or input_precision |x_i|; at the
 //     round-off floor any column passes, and further columns change nothing).
@@ -85,8 +86,9 @@ struct Extrapolation {
                                        // when column J is inconsistent: max(that column's tail estimate,
                                        // round-off); infinity when J = 0 and column 0 cannot be checked, or
                                        // when column J's differences grow
-  std::vector<double> column_orders;   // per column: order from its last three entries, log(d1 / d2) / log r
-                                       // (NaN with fewer than three entries or a zero difference)
+  std::vector<double> column_orders;   // per column: order from its last three entries, the p with
+                                       // rho(p) = d2 / d1 (log(d1 / d2) / log r for equal ratios r; NaN
+                                       // with fewer than three entries or a zero difference)
   std::vector<int> column_consistent;  // per column: 1 consistent, 0 inconsistent, -1 not checkable
   std::string note;                    // why column J, in words with the numbers
   double amplification = 1;            // sum_i |w_i| of value = sum_i w_i x_i
@@ -94,6 +96,12 @@ struct Extrapolation {
   int levels = 0;                      // levels combined in value (J + 1)
   double remaining_order = 0;          // the error exponent of value, e_{J+1}, if the expansion holds
 };
+
+// d2 / d1 for three levels h0 > h1 > h2 of a sequence whose error is exactly C h^p.
+double difference_ratio(double h0, double h1, double h2, double p);
+// The order shown by the differences d1 = |x1 - x0|, d2 = |x2 - x1| at h0 > h1 > h2: the p with
+// difference_ratio(h0, h1, h2, p) = d2 / d1 (log(d1 / d2) / log r for equal step ratios r).
+double order_of_differences(double h0, double h1, double h2, double d1, double d2);
 
 // The whole tableau. BadInput: sizes differ, fewer than one level, steps not strictly
 // decreasing and positive, a non-finite value, order or order_step <= 0, max_columns < 1.

@@ -213,72 +213,6 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
   if (!s.stop_note.empty()) out << "stopped: " << s.stop_note << "\n";
 }
 
-// A level of the study: orbit, monodromy, multipliers and their accuracy (convergence.hpp). The
-// orbits of the levels that succeeded are kept (states of one map, a few MB at most) so that a
-// level whose orbit failed can be retried with Newton from its nearest neighbour's.
-class ConvergeLevels {
- public:
-  ConvergeLevels(const Problem& problem, EventMode events, const OrbitSettings& orbit, const FloquetOptions& solver,
-                 Progress& progress)
-      : problem_(problem), events_(events), orbit_(orbit), solver_(solver), progress_(progress) {}
-
-  LevelResult level(int N, int count) { return run(N, count, nullptr); }
-
-  // Only a level whose orbit failed is worth a second try; any other failure stands.
-  std::optional<LevelResult> retry(int N, int count, int from_N) {
-    if (!orbit_failed_.count(N) || !sequences_.count(from_N)) return std::nullopt;
-    return run(N, count, &sequences_.at(from_N), from_N);
-  }
-
- private:
-  LevelResult run(int N, int count, const Eigen::VectorXd* guess, int from_N = 0) {
-    LevelResult r;
-    const auto start = std::chrono::steady_clock::now();
-    bool orbit_found = false;
-    Eigen::VectorXd sequence;
-    Problem level = problem_;
-    level.N = N;
-    const long K = level.grid().K;
-    try {
-      with_monodromy(problem_, events_, orbit_, N,
-                     [&](const LinearOperator& op, const LinearisedOrbit& at_orbit, double) {
-                       sequence = at_orbit.sequence;
-                       orbit_found = true;
-                       FloquetOptions fo = solver_;
-                       fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
-                       const FloquetResult f = floquet_multipliers(op, fo);
-                       r.multipliers = f.multipliers;
-                       r.operator_applications = f.operator_applications;
-                       const double radius = f.multipliers.empty() ? 0.0 : std::abs(f.multipliers.front());
-                       for (size_t k = 0; k < f.multipliers.size(); ++k)
-                         r.accuracy.push_back(multiplier_accuracy(
-                             f.multipliers[k], k < f.residuals.size() ? f.residuals[k] : NAN, op.rows(), K, radius));
-                     },
-                     {guess, true});
-      if (sequence.size() > 0) sequences_[N] = std::move(sequence);
-      if (guess)
-        r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);
-    } catch (const NumericalFailure& e) {
-      r = {};
-      r.failure = e.what();
-      if (!orbit_found) orbit_failed_.insert(N);
-      failed_[N] = r.failure;
-    }
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    progress_.add();
-    return r;
-  }
-
-  const Problem& problem_;
-  EventMode events_;
-  const OrbitSettings& orbit_;
-  const FloquetOptions& solver_;
-  Progress& progress_;
-  std::map<int, Eigen::VectorXd> sequences_;  // N -> orbit states of one map, levels that succeeded
-  std::set<int> orbit_failed_;                // N whose orbit (not the eigen-solve) failed
-  std::map<int, std::string> failed_;         // N -> why it failed
-};
-
 }  // namespace
 
 int command_converge(Config& config, const Invocation& inv) {
@@ -342,12 +276,12 @@ int command_converge(Config& config, const Invocation& inv) {
                     inv.quiet);
   for (const std::string& ev : events) {
     ConvergenceOptions options = base;
-    // Without event handling a step across the switching surface is first order (design 1.5):
-    // the error expansion is then c1 h + c2 h^2 + ...
-    const bool first_order = switching && ev == "off";
-    options.richardson.order = order_given ? x_order : first_order ? 1 : 2;
-    options.richardson.order_step = step_given ? x_step : first_order ? 1 : 2;
-    ConvergeLevels levels(problem, parse_event_mode(ev), orbit_settings, solver_options, progress);
+    Problem with_events = problem;
+    with_events.events = parse_event_mode(ev);
+    const RichardsonOptions expansion = error_expansion(with_events);  // h, h^2 with events = off
+    options.richardson.order = order_given ? x_order : expansion.order;
+    options.richardson.order_step = step_given ? x_step : expansion.order_step;
+    StudyLevels levels(problem, with_events.events, orbit_settings, solver_options, &progress);
     studies.push_back(
         run_convergence_study([&](int N, int count) { return levels.level(N, count); }, options,
                               [&](int N, int count, int from_N) { return levels.retry(N, count, from_N); }));

@@ -1,10 +1,12 @@
 // delayspec floquet: the leading Floquet multipliers of the periodic orbit (CLI contract).
 #include <algorithm>
 #include <chrono>
+#include <optional>
 
 #include "commands.hpp"
 #include "delayspec/floquet.hpp"
 #include "floquet_settings.hpp"
+#include "level_runner.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 #include "orbit_settings.hpp"
 #include "output.hpp"
@@ -17,6 +19,8 @@ int command_floquet(Config& config, const Invocation& inv) {
   Problem problem = read_problem(config, 100);
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   const FloquetOptions options = read_floquet_options(config);
+  // The error bars (error_bars.hpp): two coarser solves, about 1.3x the single one.
+  const bool with_error_bars = config.get_choice("error_bars", "on", {"on", "off"}) == "on";
   config.check_all_used();
   const long n = problem.dimension();
   validate_floquet_options(options, n);  // before the orbit: fail fast
@@ -26,13 +30,20 @@ int command_floquet(Config& config, const Invocation& inv) {
   PeriodicOrbit orbit;
   ContactSummary contacts;
   double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
+  std::optional<ErrorBars> bars;
+  double error_bar_seconds = 0;
   {
     const auto orbit_start = std::chrono::steady_clock::now();
-    LinearisedOrbit at_orbit = problem.analyses->linearised_orbit(problem.map_settings(), orbit_settings);
+    OrbitRequest request;
+    request.sequence = with_error_bars;  // the orbit at N: where a coarser level's Newton may start
+    LinearisedOrbit at_orbit = problem.analyses->linearised_orbit(problem.map_settings(), orbit_settings, request);
     orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
     orbit = std::move(at_orbit.orbit);
     contacts = at_orbit.contacts;
     result = floquet_multipliers(*at_orbit.monodromy, options);
+    if (with_error_bars)
+      bars = floquet_error_bars(problem, orbit_settings, options, result, std::move(at_orbit.sequence),
+                                error_bar_seconds);
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -42,6 +53,11 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["dimension"] = n;
     json["solver"] = result.solver;
     json["multipliers"] = multipliers_json(result.multipliers);
+    if (bars) {
+      add_error_bars_json(json["multipliers"], *bars);
+      json["verdict"] = to_string(bars->verdict);
+      json["error_bars"] = error_bars_json(*bars, error_bar_seconds);
+    }
     json["seconds"] = seconds;
     json["orbit_seconds"] = orbit_seconds;
     json["eigensolver_seconds"] = result.seconds;
@@ -71,6 +87,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << result.solver << ", "
             << result.operator_applications << " operator applications):\n";
     print_multipliers(inv.out, result.multipliers);
+    if (bars) print_error_bars(inv.out, result.multipliers, *bars);
     if (!result.residuals.empty()) {
       double worst = 0;
       for (double r : result.residuals) worst = std::max(worst, r);

@@ -133,6 +133,9 @@ const std::map<std::string, std::string>& key_meanings() {
       {"orbit_guess_periods", "newton, auto, shooting: periods simulated from the initial history before the guess"},
       {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this, then this; one level below 2x it"},
       {"nev", "multipliers wanted, >= 1"},
+      {"error_bars",
+       "on: each multiplier's distance to the N -> infinity value, from solves at N/16 and N/4 (about 1.3x the "
+       "time), and a verdict stable / unstable / undecided; off: the solve at N alone"},
       {"solver",
        "eigensolver: auto (dense n <= 100, spectra n < 3000, else block), spectra, arpack, block, dense, dense-eigen"},
       {"block_size", "solver = block: vectors per product (Krylov-Schur; 1 = one vector, DCGS2), 1..64"},

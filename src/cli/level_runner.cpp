@@ -1,6 +1,8 @@
 #include "level_runner.hpp"
 
+#include <algorithm>
 #include <climits>
+#include <cmath>
 #include <sstream>
 
 #include "delayspec/errors.hpp"
@@ -68,6 +70,96 @@ std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int 
     return linear_dde_multipliers(p.a, p.b, p.tau, p.period, count);
   }
   return {};
+}
+
+LevelResult level_result(const FloquetResult& result, long n, long K) {
+  LevelResult r;
+  r.multipliers = result.multipliers;
+  r.operator_applications = result.operator_applications;
+  const double radius = result.multipliers.empty() ? 0.0 : std::abs(result.multipliers.front());
+  for (size_t k = 0; k < result.multipliers.size(); ++k)
+    r.accuracy.push_back(multiplier_accuracy(result.multipliers[k],
+                                             k < result.residuals.size() ? result.residuals[k] : NAN, n, K, radius));
+  return r;
+}
+
+RichardsonOptions error_expansion(const Problem& problem) {
+  RichardsonOptions options;
+  const bool first_order = problem.switching() && problem.events == EventMode::off;
+  options.order = first_order ? 1 : 2;
+  options.order_step = first_order ? 1 : 2;
+  return options;
+}
+
+LevelResult StudyLevels::run(int N, int count, const Eigen::VectorXd* guess, int from_N) {
+  LevelResult r;
+  const auto start = std::chrono::steady_clock::now();
+  bool orbit_found = false;
+  Eigen::VectorXd sequence;
+  Problem level = problem_;
+  level.N = N;
+  const long K = level.grid().K;
+  try {
+    with_monodromy(problem_, events_, orbit_, N,
+                   [&](const LinearOperator& op, const LinearisedOrbit& at_orbit, double) {
+                     sequence = at_orbit.sequence;
+                     orbit_found = true;
+                     FloquetOptions fo = solver_;
+                     fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
+                     r = level_result(floquet_multipliers(op, fo), op.rows(), K);
+                   },
+                   {guess, true});
+    if (sequence.size() > 0) sequences_[N] = std::move(sequence);
+    if (guess) r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);
+  } catch (const NumericalFailure& e) {
+    r = {};
+    r.failure = e.what();
+    if (!orbit_found) orbit_failed_.insert(N);
+    failed_[N] = r.failure;
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (progress_) progress_->add();
+  return r;
+}
+
+ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
+                             const FloquetResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  constexpr int kExtra = 2;  // candidates beyond nev for the matching (convergence.hpp)
+  FloquetOptions coarse = solver;
+  coarse.ncv = 0;  // the automatic subspace: a user's ncv may exceed a coarse level's dimension
+  coarse.nev = solver.nev + kExtra;
+  auto valid = [&](int N) {
+    try {
+      Problem at = problem;
+      at.N = N;
+      at.grid();
+      FloquetOptions checked = coarse;
+      checked.nev = static_cast<int>(std::min<long>(coarse.nev, at.dimension()));
+      validate_floquet_options(checked, at.dimension());
+      return at.dimension() > coarse.nev;  // more than the candidates: a proper sub-spectrum
+    } catch (const BadInput&) {
+      return false;
+    }
+  };
+  std::vector<int> Ns = coarser_levels(problem.N, valid);
+  StudyLevels levels(problem, problem.events, orbit, coarse);
+  std::vector<LevelResult> results;
+  for (int N : Ns) results.push_back(levels.level(N, coarse.nev));
+  if (orbit_at_N.size() > 0) {
+    levels.keep_orbit(problem.N, std::move(orbit_at_N));
+    for (size_t i = 0; i < Ns.size(); ++i)
+      if (!results[i].failure.empty())
+        if (std::optional<LevelResult> again = levels.retry(Ns[i], coarse.nev, problem.N)) {
+          const std::string first = results[i].failure;
+          results[i] = std::move(*again);
+          if (!results[i].failure.empty()) results[i].failure = first + "; retried: " + results[i].failure;
+        }
+  }
+  Ns.push_back(problem.N);
+  results.push_back(level_result(at_N, problem.dimension(), problem.grid().K));
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return error_bars(Ns, results, error_expansion(problem));
 }
 
 }  // namespace delayspec::cli

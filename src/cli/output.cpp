@@ -1,5 +1,7 @@
 #include "output.hpp"
 
+#include "delayspec/errors.hpp"
+
 #include <cmath>
 #include <cstdio>
 
@@ -34,6 +36,60 @@ void print_multipliers(std::ostream& out, const std::vector<std::complex<double>
                   std::abs(values[i]));
     out << line;
   }
+}
+
+void add_error_bars_json(nlohmann::json& multipliers, const ErrorBars& bars) {
+  for (size_t i = 0; i < bars.bars.size() && i < multipliers.size(); ++i) {
+    const MultiplierErrorBar& bar = bars.bars[i];
+    multipliers[i]["error_estimate"] = number_or_null(bar.error_estimate);
+    if (bar.extrapolated)
+      multipliers[i]["extrapolated"] = {{"re", bar.extrapolated->real()},
+                                        {"im", bar.extrapolated->imag()},
+                                        {"abs", std::abs(*bar.extrapolated)},
+                                        {"error_estimate", number_or_null(bar.extrapolated_error)}};
+  }
+}
+
+nlohmann::json error_bars_json(const ErrorBars& bars, double seconds) {
+  nlohmann::json j;
+  j["Ns"] = bars.Ns;
+  j["failures"] = bars.failures;
+  j["order"] = bars.order ? number_or_null(*bars.order) : nlohmann::json(nullptr);
+  j["deciding_N"] = bars.deciding_N > 0 ? nlohmann::json(bars.deciding_N) : nlohmann::json(nullptr);
+  j["note"] = bars.note;
+  j["seconds"] = seconds;
+  return j;
+}
+
+void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>& values, const ErrorBars& bars) {
+  out << "error bars (distance to the N -> infinity value; levels N =";
+  for (int N : bars.Ns) out << " " << N;
+  out << "):\n";
+  char line[200];
+  for (size_t i = 0; i < bars.bars.size() && i < values.size(); ++i) {
+    const MultiplierErrorBar& bar = bars.bars[i];
+    if (std::isfinite(bar.error_estimate))
+      std::snprintf(line, sizeof line, "  %3zu  |mu| = %.10g +- %.2g", i + 1, std::abs(values[i]), bar.error_estimate);
+    else
+      std::snprintf(line, sizeof line, "  %3zu  |mu| = %.10g, no error bar", i + 1, std::abs(values[i]));
+    out << line;
+    if (bar.extrapolated) {
+      std::snprintf(line, sizeof line, "   extrapolated |mu| = %.12g +- %.2g", std::abs(*bar.extrapolated),
+                    bar.extrapolated_error);
+      out << line;
+    }
+    out << "\n";
+  }
+  out << "verdict: " << to_string(bars.verdict);
+  if (bars.verdict == StabilityVerdict::undecided) {
+    out << " (the unit circle is within an error bar";
+    if (bars.deciding_N > 0)
+      out << "; about N = " << bars.deciding_N << " would decide it if the error falls like N^-"
+          << format_number(bars.expected_order);
+    out << ")";
+  }
+  out << "\n";
+  if (!bars.note.empty()) out << "error bars: " << bars.note << "\n";
 }
 
 nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& contacts) {

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "delayspec/error_bars.hpp"
 #include "delayspec/lyapunov.hpp"
 #include "delayspec/orbit_contacts.hpp"
 #include "delayspec/periodic_orbit.hpp"
@@ -26,6 +27,15 @@ nlohmann::json lyapunov_json(const LyapunovResult& r);
 nlohmann::json multipliers_json(const std::vector<std::complex<double>>& values);
 // One line per multiplier: index, re, im, |mu|.
 void print_multipliers(std::ostream& out, const std::vector<std::complex<double>>& values);
+
+// Each multiplier's "error_estimate" (of the value at N; null: none possible) and, where the
+// order is shown, "extrapolated": {"re", "im", "abs", "error_estimate"} (error_bars.hpp), added to
+// the objects of multipliers_json.
+void add_error_bars_json(nlohmann::json& multipliers, const ErrorBars& bars);
+// {"Ns", "failures", "order", "deciding_N", "note", "seconds"}: how the bars were obtained.
+nlohmann::json error_bars_json(const ErrorBars& bars, double seconds);
+// The bars under print_multipliers' table, and the verdict in words (which N would decide it).
+void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>& values, const ErrorBars& bars);
 // The periodic orbit the multipliers belong to: {"method", "residual", "periods", "contacts",
 // "nodes_in_contact", "max_H", and for newton "newton_iterations", "newton_residuals",
 // "newton_step_fractions", "jacobian_reciprocal_condition", "jacobian_nonzeros", "factor_nonzeros"}.

@@ -1,0 +1,117 @@
+// `delayspec floquet` reports each multiplier's distance to the N -> infinity value and a verdict
+// by default (issue 32, item 1). Checked against the exact multipliers of the linear DDE
+// x' = a x + b x(t - tau) (Lambert W, lambert_w.hpp, itself checked against mpmath): every bar
+// covers the actual error, and the verdict is never on the wrong side of the unit circle, also at
+// the stability boundary b = -pi/2 (a = 0, tau = 1), where it must be `undecided`.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_test_support.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec/lambert_w.hpp"
+
+namespace {
+
+using delayspec::testing::CliResult;
+using delayspec::testing::run;
+using cd = std::complex<double>;
+
+struct LinearCase {
+  double a, b, tau, period;
+  int N;
+};
+
+nlohmann::json floquet_json(const LinearCase& c, std::vector<std::string> extra = {}) {
+  std::vector<std::string> args = {"floquet", "--json", "--set", "model=linear", "--set",
+                                   "a=" + delayspec::format_number(c.a), "--set",
+                                   "b=" + delayspec::format_number(c.b), "--set",
+                                   "tau=" + delayspec::format_number(c.tau), "--set",
+                                   "period=" + delayspec::format_number(c.period), "--set",
+                                   "N=" + std::to_string(c.N), "--set", "nev=4"};
+  for (const auto& e : extra) args.insert(args.end(), {"--set", e});
+  const CliResult r = run(args);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return nlohmann::json::parse(r.out);
+}
+
+cd value(const nlohmann::json& m) { return {m.at("re").get<double>(), m.at("im").get<double>()}; }
+
+TEST(FloquetErrorBars, EveryBarCoversTheExactErrorAndTheVerdictIsRight) {
+  const double pi = std::numbers::pi;
+  for (const LinearCase& c : {LinearCase{-1, 0.5, 1, 1, 200}, LinearCase{-1, -2, 1, 1, 400},
+                              LinearCase{0.1, -1, 1, 1, 100}, LinearCase{-0.5, 1.2, 1, 1, 300},
+                              LinearCase{-1, -1.8, 1.3, 1, 260}, LinearCase{0, -pi / 2 - 0.05, 1, 1, 400}}) {
+    const nlohmann::json j = floquet_json(c);
+    const std::vector<cd> exact = delayspec::linear_dde_multipliers(c.a, c.b, c.tau, c.period, 8);
+    ASSERT_TRUE(j.contains("verdict")) << j.dump();
+    for (const auto& m : j.at("multipliers")) {
+      const cd mu = value(m);
+      double actual = INFINITY;  // to the nearest exact multiplier
+      for (const cd& x : exact) actual = std::min(actual, std::abs(mu - x));
+      ASSERT_FALSE(m.at("error_estimate").is_null()) << "a = " << c.a << " b = " << c.b << ": " << j.at("error_bars");
+      EXPECT_GE(m.at("error_estimate").get<double>(), actual)
+          << "a = " << c.a << " b = " << c.b << " N = " << c.N << ": |mu| = " << std::abs(mu);
+      if (m.contains("extrapolated")) {
+        const cd x = value(m.at("extrapolated"));
+        double to_exact = INFINITY;
+        for (const cd& e : exact) to_exact = std::min(to_exact, std::abs(x - e));
+        EXPECT_GE(m.at("extrapolated").at("error_estimate").get<double>(), to_exact) << "a = " << c.a << " b = " << c.b;
+      }
+    }
+    const double leading = std::abs(exact.front());
+    const std::string verdict = j.at("verdict");
+    if (verdict == "stable") {
+      EXPECT_LT(leading, 1) << "a = " << c.a << " b = " << c.b;
+    } else if (verdict == "unstable") {
+      EXPECT_GT(leading, 1) << "a = " << c.a << " b = " << c.b;
+    }
+    // Far from the circle at these N the bars are small: a verdict is reached.
+    if (std::abs(leading - 1) > 0.05) {
+      EXPECT_NE(verdict, "undecided") << "a = " << c.a << " b = " << c.b;
+    }
+  }
+}
+
+TEST(FloquetErrorBars, AtTheStabilityBoundaryTheVerdictIsUndecidedWithTheNThatWouldDecide) {
+  // a = 0, tau = 1: the roots cross the imaginary axis at b = -pi/2. Just inside, |mu_1| = 1 - 1e-7:
+  // at N = 100 the discretisation error (~1e-5) is far larger than the distance to the circle.
+  const LinearCase c{0, -std::numbers::pi / 2 + 1e-7, 1, 1, 100};
+  const double leading = std::abs(delayspec::linear_dde_multipliers(c.a, c.b, c.tau, c.period, 1).front());
+  ASSERT_LT(leading, 1);
+  ASSERT_GT(leading, 1 - 1e-6);
+  const nlohmann::json j = floquet_json(c);
+  EXPECT_EQ(j.at("verdict"), "undecided") << j.dump(1);
+  EXPECT_GT(j.at("error_bars").at("deciding_N").get<long>(), c.N);
+  // The text says which N would decide it.
+  const CliResult text = run({"floquet", "--set", "model=linear", "--set", "a=0", "--set",
+                              "b=" + delayspec::format_number(c.b), "--set", "tau=1", "--set", "period=1", "--set",
+                              "N=100", "--set", "nev=4"});
+  EXPECT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("verdict: undecided"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("would decide it"), std::string::npos) << text.out;
+}
+
+TEST(FloquetErrorBars, OffGivesTheSingleSolveWithoutBarsOrVerdict) {
+  const LinearCase c{-1, 0.5, 1, 1, 200};
+  const nlohmann::json on = floquet_json(c);
+  const nlohmann::json off = floquet_json(c, {"error_bars=off"});
+  EXPECT_FALSE(off.contains("verdict"));
+  EXPECT_FALSE(off.contains("error_bars"));
+  ASSERT_EQ(on.at("multipliers").size(), off.at("multipliers").size());
+  for (size_t i = 0; i < off.at("multipliers").size(); ++i) {
+    EXPECT_FALSE(off.at("multipliers")[i].contains("error_estimate"));
+    // The solve at N is the same either way (the coarser levels are separate solves).
+    EXPECT_EQ(value(on.at("multipliers")[i]), value(off.at("multipliers")[i]));
+  }
+  const CliResult bad = run({"floquet", "--set", "model=linear", "--set", "error_bars=maybe"});
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_NE(bad.err.find("error_bars"), std::string::npos) << bad.err;
+}
+
+}  // namespace
