@@ -441,3 +441,24 @@ TEST(ConvergeCli, ListAndRangeTogetherIsBadInput) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("finest"), std::string::npos) << r.err;
 }
+
+TEST(ConvergeCli, DefaultLevelsAreValidGridsWhenTheDelayIsSeveralPeriods) {
+  // tau/T = 2 needs even N and tau/T = 4 multiples of 4 (grid.hpp): the defaults 25, 50, ... were
+  // refused ("`N = 25`"). They now start at the first valid N and double as often; the study
+  // is second order against Lambert W as on any other grid.
+  for (const char* period : {"0.5", "0.25"}) {
+    const CliResult r = run({"converge", "--json", "--set", "model=linear", "--set", "a=0", "--set", "b=-0.3",
+                             "--set", "tau=1", "--set", std::string("period=") + period, "--set", "nev=4"});
+    ASSERT_EQ(r.status, 0) << period << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j.at("rows").size(), 5u);
+    EXPECT_EQ(j.at("rows")[0].at("N"), std::string(period) == "0.5" ? 26 : 28);
+    for (size_t i = 1; i < 5; ++i) EXPECT_EQ(j.at("rows")[i].at("N"), 2 * j.at("rows")[i - 1].at("N").get<int>());
+    EXPECT_NEAR(j.at("observed_order").get<double>(), 2.0, 0.1) << j.at("observed_order");
+  }
+  // Given explicitly, an invalid range is still the user's to fix.
+  const CliResult given = run({"converge", "--set", "model=linear", "--set", "tau=1", "--set", "period=0.5",
+                               "--set", "N_min=25", "--set", "N_max=100"});
+  EXPECT_EQ(given.status, 2) << given.err;
+  EXPECT_NE(given.err.find("`N = 25`"), std::string::npos) << given.err;
+}

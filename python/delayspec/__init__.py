@@ -147,11 +147,21 @@ class Result:
 class FloquetResult(Result):
     """`floquet`: `multipliers` (complex128, by modulus, largest first), `residuals` (float64,
     |M v - mu v| / (|mu| |v|); empty for dense solvers), `operator_applications`, `seconds`,
-    `orbit` (a dict, its numeric lists as arrays) and the other fields of the CLI's JSON."""
+    `orbit` (a dict, its numeric lists as arrays) and the other fields of the CLI's JSON. With
+    error bars (the default): `error_estimates` (float64, each multiplier's distance to the
+    N -> infinity value; NaN where none could be estimated) and `verdict` ("stable",
+    "unstable", "undecided"; docs/cli.md, floquet)."""
 
     @property
     def multipliers(self):
         return multipliers_array(self._data["multipliers"])
+
+    @property
+    def error_estimates(self):
+        if "verdict" not in self._data:
+            raise ValueError("`floquet` ran with error_bars = off: no error estimates")
+        return np.array([np.nan if m.get("error_estimate") is None else m["error_estimate"]
+                         for m in self._data["multipliers"]], dtype=np.float64)
 
     @property
     def residuals(self):

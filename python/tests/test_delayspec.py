@@ -33,6 +33,21 @@ def test_floquet_equals_cli_json():
     same_as_cli(r, "floquet", DEFAULT, **FLOQUET_KEYS)
 
 
+def test_floquet_reports_error_estimates_and_a_verdict():
+    # x' = -x + 0.5 x(t - 1): |mu_1| = 0.73 (Lambert W), far inside the circle; at N = 200 the
+    # bars are ~1e-7 (docs/cli.md, floquet).
+    r = delayspec.floquet(model="linear", a=-1, b=0.5, N=200, nev=3)
+    assert r.verdict == "stable"
+    assert r.error_estimates.shape == r.multipliers.shape
+    assert np.all(np.isfinite(r.error_estimates)) and np.all(r.error_estimates > 0)
+    assert np.all(r.error_estimates < 1e-4)
+    off = delayspec.floquet(model="linear", a=-1, b=0.5, N=200, nev=3, error_bars="off")
+    assert "verdict" not in off
+    with pytest.raises(ValueError, match="error_bars = off"):
+        off.error_estimates
+    np.testing.assert_array_equal(off.multipliers, r.multipliers)
+
+
 def test_floquet_without_scene_equals_cli_json():
     r = delayspec.floquet(N=20, k=0.1, orbit="newton")
     same_as_cli(r, "floquet", N=20, k=0.1, orbit="newton")

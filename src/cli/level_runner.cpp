@@ -23,8 +23,28 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
       Ns.push_back(static_cast<int>(N));
     }
   } else {
-    const long lo = config.get_int_in_range("N_min", default_min, 1, INT_MAX);
-    const long hi = config.get_int_in_range("N_max", default_max, lo, INT_MAX);  // lo = N_min
+    long lo = config.get_int_in_range("N_min", default_min, 1, INT_MAX);
+    long hi = config.get_int_in_range("N_max", default_max, lo, INT_MAX);  // lo = N_min
+    if (!has_range) {
+      // The defaults, on a grid that needs multiples (tau/T = 2 needs even N): the first valid N
+      // from default_min on, doubled as often as the defaults are (26, 52, ... for 25, 50, ...).
+      auto valid = [&](long N) {
+        try {
+          Problem at_N = problem;
+          at_N.N = static_cast<int>(N);
+          at_N.grid();
+          return true;
+        } catch (const BadInput&) {
+          return false;
+        }
+      };
+      long first = lo;
+      while (first < 2 * lo && !valid(first)) ++first;
+      if (valid(first)) {
+        hi = first * (hi / lo);
+        lo = first;
+      }
+    }
     for (long N = lo; N <= hi; N *= 2) Ns.push_back(static_cast<int>(N));
   }
   for (size_t i = 1; i < Ns.size(); ++i)

@@ -21,7 +21,8 @@
 namespace delayspec::cli {
 
 // `Ns` (comma list), or `N_min` .. `N_max` doubling (N_min, 2 N_min, ... <= N_max); defaults
-// when neither is given. Validated: each N >= 1, strictly increasing, and a valid grid for the
+// when neither is given (moved up to the first valid N when the grid needs multiples: 26, 52, ...
+// for tau/T = 2). Validated: each N >= 1, strictly increasing, and a valid grid for the
 // problem (make_grid names N when the delay/period ratio needs a multiple).
 std::vector<int> read_N_list(Config& config, const Problem& problem, int default_min, int default_max);
 
