@@ -44,6 +44,21 @@ TEST(CommandHelp, ListsTheKeysTheCommandReadsWithDefaults) {
   EXPECT_FALSE(contains(r.out, "sweep_key")) << r.out;
 }
 
+TEST(CommandHelp, EveryCommandStartsWithWhatItDoes) {
+  // Each command of the table, the first line: "delayspec COMMAND ...: <a sentence>." (issue 37
+  // item 4), so that a command added without its sentence fails here.
+  for (const auto& [command, function] : delayspec::cli::command_table()) {
+    const CliResult r = run({command, "--help"});
+    ASSERT_EQ(r.status, 0) << command << ": " << r.err;
+    const std::string first = r.out.substr(0, r.out.find('\n'));
+    EXPECT_EQ(first.rfind(std::string("delayspec ") + command + " ", 0), 0u) << first;
+    EXPECT_TRUE(contains(first, ": ")) << first;
+    EXPECT_EQ(first.back(), '.') << first;
+    EXPECT_GT(first.size(), 60u) << "a sentence, not a name: " << first;
+  }
+  EXPECT_EQ(run({"plot", "--help"}).out.rfind("delayspec plot DIR: ", 0), 0u);
+}
+
 TEST(CommandHelp, ModelKeysAreListedPerModel) {
   CliResult r = run({"floquet", "--help"});
   ASSERT_EQ(r.status, 0) << r.err;

@@ -56,6 +56,9 @@ RunPlan plan_run(Config& config);
 
 // The command table (name -> function); `run` dispatches a scene's analyses through it.
 const std::map<std::string, CommandFunction>& command_table();
+// What a command does, in one sentence that starts with its usage ("delayspec plot DIR: ..."):
+// the first line of `delayspec COMMAND --help`. Empty for an unknown command.
+const std::string& command_summary(const std::string& command);
 
 // BadInput "unknown command `NAME` (commands: ...)" unless `command` is in the table: the one
 // check of a command's name, for the program, `keys_help` and the Python module alike.

@@ -26,6 +26,43 @@ const std::map<std::string, CommandFunction>& command_table() {
   return table;
 }
 
+const std::string& command_summary(const std::string& command) {
+  static const std::map<std::string, std::string> summaries = {
+      {"floquet",
+       "delayspec floquet [SCENE]: the leading Floquet multipliers of the periodic orbit, each with its distance to "
+       "the N -> infinity value, and a verdict: stable, unstable or undecided."},
+      {"lyapunov",
+       "delayspec lyapunov [SCENE]: the leading Lyapunov exponents of a trajectory from the constant initial "
+       "history, with their statistical errors."},
+      {"sweep",
+       "delayspec sweep [SCENE]: one parameter over a range; at each point the leading Lyapunov exponents and the "
+       "Poincare section (bifurcation-diagram data)."},
+      {"converge",
+       "delayspec converge [SCENE]: the leading multipliers at several N: their errors, the observed order and the "
+       "Richardson extrapolation to N -> infinity."},
+      {"bench",
+       "delayspec bench [SCENE]: speed against error, the Krylov and the dense eigensolvers side by side at several "
+       "N."},
+      {"chart", "delayspec chart [SCENE]: a stability chart, the spectral radius |mu_1| over a grid of two parameters."},
+      {"basin",
+       "delayspec basin [SCENE]: basins of attraction, the attractor (its period) reached from each constant initial "
+       "history of a grid."},
+      {"plot",
+       "delayspec plot DIR: figures (PNG, SVG and their gnuplot scripts) of the results a command wrote in DIR, into "
+       "DIR/plots/."},
+      {"simulate",
+       "delayspec simulate [SCENE]: a trajectory from the constant initial history: time series, Poincare points "
+       "and impacts."},
+      {"continue",
+       "delayspec continue [SCENE]: the periodic orbit continued in one parameter, its bifurcations located and "
+       "extrapolated to N -> infinity."},
+      {"run", "delayspec run SCENE --out DIR: the analyses the scene lists, each result kept as a file in DIR."},
+  };
+  static const std::string none;
+  auto it = summaries.find(command);
+  return it == summaries.end() ? none : it->second;
+}
+
 OutputUse output_use(const std::string& command) {
   static const std::map<std::string, OutputUse> table = {
       {"sweep", {OutDirUse::written, true}},  // point files: --resume computes only the missing points
@@ -112,6 +149,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
+    if (command_table().count(command)) out << command_summary(command) << "\n\n";
     out << app.help();
     if (command_table().count(command)) out << command_keys_help(command);
     else out << "\n`delayspec COMMAND --help` lists the keys COMMAND reads, with their defaults.\n";
