@@ -23,6 +23,14 @@ cd initial_guess(cd z, int k) {
     return -1.0 + p - p * p / 3.0 + 11.0 / 72.0 * p * p * p;
   };
   if ((k == 0 || k == -1) && std::abs(ez1) < 0.3) return branch_point_series(k == 0 ? 1.0 : -1.0);
+  // z real below -1/e: W_0 is complex (upper half plane, scipy's convention on the cut), but
+  // log(1 + z) below is real for z in (-1, -1/e), and Halley from a real start stays real: it
+  // returned -0.173 for W_0(-0.5) (residual 0.35). Start from the branch-point series, whose
+  // p = i sqrt(-2 (e z + 1)) is imaginary.
+  if (k == 0 && z.imag() == 0 && ez1.real() < 0 && z.real() > -1) {
+    const cd p(0, std::sqrt(-2.0 * ez1.real()));
+    return -1.0 + p - p * p / 3.0 + 11.0 / 72.0 * p * p * p;
+  }
   if (k == 0 && std::abs(z) <= 3.0) return std::abs(1.0 + z) >= 0.3 ? std::log(1.0 + z) : branch_point_series(1.0);
   const cd L1 = std::log(z) + cd(0, 2 * std::numbers::pi * k);
   return L1 - std::log(L1);
@@ -47,6 +55,12 @@ cd lambert_w(cd z, int k) {
     w -= step;
     if (std::abs(step) <= 4e-16 * (1 + std::abs(w))) break;
   }
+  // Never a value that is not a root: |w e^w - z| within the rounding of e^w (the identity test's
+  // bound, 1e-14 |z| (1 + |w|), with a margin of 100).
+  if (!(std::abs(w * std::exp(w) - z) <= 1e-12 * std::abs(z) * (1 + std::abs(w))))
+    throw NumericalFailure("lambert_w: Halley's iteration did not converge for z = " + format_number(z.real()) +
+                           (z.imag() < 0 ? " - " : " + ") + format_number(std::abs(z.imag())) + "i on branch " +
+                           std::to_string(k));
   return w;
 }
 

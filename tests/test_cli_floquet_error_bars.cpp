@@ -7,6 +7,9 @@
 
 #include <cmath>
 #include <complex>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <numbers>
 #include <string>
 
@@ -112,6 +115,66 @@ TEST(FloquetErrorBars, OffGivesTheSingleSolveWithoutBarsOrVerdict) {
   const CliResult bad = run({"floquet", "--set", "model=linear", "--set", "error_bars=maybe"});
   EXPECT_EQ(bad.status, 2) << bad.err;
   EXPECT_NE(bad.err.find("error_bars"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+
+namespace {
+
+using delayspec::testing::fresh_dir;
+
+TEST(ChartErrorBars, EachPointsVerdictAgreesWithLambertWAndItsBarCoversTheError) {
+  // The linear DDE's (a, b) plane at tau = T = 1, N = 200: every point's |mu_1| against the exact
+  // one; a verdict is never on the wrong side, and the boundary's points may be undecided only.
+  const CliResult r = run({"chart", "--json", "--set", "model=linear", "--set", "chart_x=a", "--set", "chart_y=b",
+                           "--set", "chart_x_range=-2,0.5", "--set", "chart_y_range=-2,1", "--set", "chart_x_points=6",
+                           "--set", "chart_y_points=5", "--set", "N=200", "--set", "error_bars=on"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  long stable = 0, undecided = 0;
+  for (const auto& row : j.at("rows")) {
+    const double a = row.at("x"), b = row.at("y");
+    const double exact = std::abs(delayspec::linear_dde_multipliers(a, b, 1, 1, 1).front());
+    const double radius = row.at("spectral_radius");
+    const std::string verdict = row.at("verdict");
+    ASSERT_TRUE(row.at("error_estimate").is_number()) << row.dump();
+    EXPECT_GE(row.at("error_estimate").get<double>(), std::abs(radius - exact)) << row.dump();
+    if (verdict == "stable") {
+      EXPECT_LT(exact, 1) << row.dump();
+      ++stable;
+    } else if (verdict == "unstable") {
+      EXPECT_GT(exact, 1) << row.dump();
+    } else {
+      ++undecided;
+      EXPECT_LT(std::abs(exact - 1), 0.01) << "undecided far from the circle: " << row.dump();
+    }
+  }
+  EXPECT_EQ(j.at("stable_points"), stable);
+  EXPECT_EQ(j.at("undecided_points"), undecided);
+  EXPECT_GT(stable, 0);
+}
+
+TEST(ChartErrorBars, UndecidedPointsAreInTheCsvAndMarkedInThePlot) {
+  // Mathieu's plane at N = 40: levels 5 and 10 are too coarse, most points are undecided.
+  const auto dir = fresh_dir("chart_error_bars");
+  const CliResult r = run({"chart", "--set", "model=mathieu", "--set", "chart_x_points=5", "--set", "chart_y_points=5",
+                           "--set", "error_bars=on", "--out", (dir / "chart").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("undecided"), std::string::npos) << r.out;
+  std::ifstream csv(dir / "chart" / "chart.csv");
+  std::string line, header;
+  while (std::getline(csv, line))
+    if (!line.empty() && line[0] != '#') {
+      header = line;
+      break;
+    }
+  EXPECT_EQ(header, "delta,b,spectral_radius,error_estimate,undecided");
+  const CliResult plot = run({"plot", (dir / "chart").string()});
+  ASSERT_EQ(plot.status, 0) << plot.err;
+  std::ifstream gp(dir / "chart" / "plots" / "chart.gp");
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  EXPECT_NE(script.find("title 'undecided"), std::string::npos) << script.substr(0, 400);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

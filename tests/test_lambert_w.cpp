@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <complex>
+#include <tuple>
 
 #include "delayspec/errors.hpp"
 #include "delayspec/lambert_w.hpp"
@@ -31,6 +32,11 @@ TEST(LambertW, MatchesScipyOnSeveralBranches) {
       {{-1.0, 0}, 1, {-2.0622777295982839, 7.5886311784725127}},
       {{2.5, 0}, 3, {-1.9329763323947831, 17.166631096828652}},
       {{0.3, 0.4}, -2, {-3.0179039620808661, -9.7686426704025315}},
+      // z real in (-0.7, -0.48): the principal branch is complex; a real start gave -0.173.
+      {{-0.5, 0}, 0, {-0.7940236323446893, 0.7701117505103791}},
+      {{-0.5, 0}, -1, {-0.7940236323446893, -0.7701117505103791}},
+      {{-0.95, 0}, 0, {-0.3538605994511856, 1.306247069557099}},
+      {{-1.6207963267948966, 0}, 0, {0.022313363332166672, 1.5848743445818942}},
   };
   for (const auto& r : refs) {
     const cd w = lambert_w(r.z, r.k);
@@ -40,7 +46,7 @@ TEST(LambertW, MatchesScipyOnSeveralBranches) {
 }
 
 TEST(LambertW, SatisfiesDefiningIdentity) {
-  for (double re : {-3.0, -0.36, -0.1, 0.05, 1.0, 40.0})
+  for (double re : {-3.0, -2.9, -2.0, -0.7, -0.6, -0.5, -0.48, -0.36, -0.1, 0.05, 1.0, 40.0})
     for (double im : {0.0, 0.5, -2.0})
       for (int k = -6; k <= 6; ++k) {
         const cd z(re, im);
@@ -57,9 +63,14 @@ TEST(LambertW, RejectsBadArguments) {
 }
 
 TEST(LinearDdeRoots, SolveTheCharacteristicEquation) {
-  const double a = -1, b = -2, tau = 1.3;
-  for (cd lambda : delayspec::linear_dde_roots(a, b, tau, 5)) {
-    const cd residual = lambda - a - b * std::exp(-lambda * tau);
-    EXPECT_LE(std::abs(residual), 1e-12 * (1 + std::abs(lambda))) << lambda;
-  }
+  // (a, b, tau) with b tau e^{-a tau} at -2.7 e, -0.5 (the principal branch on the cut, once
+  // wrong) and positive.
+  for (const auto& [a, b, tau] : {std::tuple{-1.0, -2.0, 1.3}, std::tuple{0.0, -0.5, 1.0}, std::tuple{0.2, 0.7, 2.0}})
+    for (cd lambda : delayspec::linear_dde_roots(a, b, tau, 5)) {
+      const cd residual = lambda - a - b * std::exp(-lambda * tau);
+      EXPECT_LE(std::abs(residual), 1e-12 * (1 + std::abs(lambda))) << lambda << " for a = " << a << ", b = " << b;
+    }
+  // The rightmost root of x' = -0.5 x(t - 1): W_0(-0.5) = -0.794 + 0.770i (scipy), so |mu_1| =
+  // e^-0.794 = 0.452 over T = 1 (was 0.841 from the wrong branch value).
+  EXPECT_NEAR(std::abs(delayspec::linear_dde_multipliers(0, -0.5, 1, 1, 1).front()), 0.45202235954898110, 1e-14);
 }

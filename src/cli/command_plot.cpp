@@ -88,19 +88,28 @@ void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   renderer.figure("multipliers", gp.str());
 }
 
-// chart.csv: X,Y,spectral_radius (nan: a failed point, left blank) -> image with the |mu_1| = 1
-// contour.
+// chart.csv: X,Y,spectral_radius[,error_estimate,undecided] (nan: a failed point, left blank) ->
+// image with the |mu_1| = 1 contour, and the undecided points marked.
 void plot_chart(FigureRenderer& renderer, const fs::path& file) {
-  const ResultTable t = read_result_table(file, [](const std::string& c) { return c == "spectral_radius"; });
+  const ResultTable t = read_result_table(file, [](const std::string& c) {
+    return c == "spectral_radius" || c == "error_estimate" || c == "undecided";
+  });
   t.require_header({"X", "Y", "spectral_radius"});
   t.require_rows();
   t.require_grid();
+  const int undecided_column = t.column("undecided");  // charts with error bars (command_chart.cpp)
   std::string rows;
-  bool any_radius = false;
+  bool any_radius = false, any_undecided = false;
   for (const auto& row : t.rows) {
-    rows += row.empty() ? "\n"
-                        : gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(row[2]) + "\n";
-    any_radius = any_radius || (!row.empty() && !std::isnan(row[2]));
+    if (row.empty()) {
+      rows += "\n";
+      continue;
+    }
+    const double undecided = undecided_column >= 0 ? row[undecided_column] : 0;
+    rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(row[2]) + " " +
+            gnuplot_number(undecided) + "\n";
+    any_radius = any_radius || !std::isnan(row[2]);
+    any_undecided = any_undecided || undecided == 1;
   }
   // gnuplot cannot draw a chart without one value: say why instead of its "all points undefined".
   if (!any_radius)
@@ -116,8 +125,14 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
   gp << "set xlabel " << gnuplot_label(t.columns[0]) << "\nset ylabel " << gnuplot_label(t.columns[1]) << "\n";
   gp << "set cblabel '|{/Symbol m}_1| (clipped at 2)'\nset cbrange [0:2]\n"
         "set palette defined (0 '#08306b', 0.5 '#4292c6', 0.999 '#c6dbef', 1.001 '#fee391', 1.5 '#fb6a4a', 2 '#67000d')\n";
-  gp << "set autoscale fix\nset key off\n";
-  gp << "plot $chart using 1:2:($3 > 2 ? 2 : $3) with image, $boundary using 1:2 with lines lc rgb 'white' lw 2\n";
+  gp << "set autoscale fix\n" << (any_undecided ? "set key top right opaque\n" : "set key off\n");
+  gp << "plot $chart using 1:2:($3 > 2 ? 2 : $3) with image notitle, $boundary using 1:2 with lines lc rgb 'white' lw 2 "
+        "notitle";
+  // Points whose error bar holds the unit circle: no verdict there (error_bars.hpp)
+  if (any_undecided)
+    gp << ", \\\n     $chart using 1:2:($4 == 1 ? 1 : NaN) with points pt 6 ps 0.8 lc rgb 'black' "
+          "title 'undecided (|{/Symbol m}_1| = 1 within its error bar)'";
+  gp << "\n";
   renderer.figure("chart", gp.str());
 }
 
