@@ -105,9 +105,10 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
       rows += "\n";
       continue;
     }
+    rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(row[2]);
     const double undecided = undecided_column >= 0 ? row[undecided_column] : 0;
-    rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(row[2]) + " " +
-            gnuplot_number(undecided) + "\n";
+    if (undecided_column >= 0) rows += " " + gnuplot_number(undecided);  // 4th column: charts with error bars
+    rows += "\n";
     any_radius = any_radius || !std::isnan(row[2]);
     any_undecided = any_undecided || undecided == 1;
   }
