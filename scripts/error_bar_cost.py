@@ -35,8 +35,14 @@ def main():
     ap.add_argument("--runs", type=int, default=7)
     args = ap.parse_args()
     load = os.getloadavg()
+    cpu = platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
     print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load {load[0]:.2f} {load[1]:.2f}, "
-          f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores")
+          f"{cpu}, {os.cpu_count()} cores, {args.runs} pairs")
     print(f"# {'case':24s} {'off s':>8s} {'on s':>8s} {'on/off':>7s}  bar of |mu_1| at N (verdict)")
     for name, keys in CASES:
         base = [args.delayspec, "floquet", "--json", "--set", "nev=6"] + keys
