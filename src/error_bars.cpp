@@ -89,9 +89,12 @@ ErrorBars error_bars(const std::vector<int>& Ns, const std::vector<LevelResult>&
       bar.error_estimate = x.error_estimate;  // column 0: the value at N (or infinity)
     }
     const double modulus = std::abs(best);
+    // The leading multiplier at N (and its conjugate, or any of its modulus): the spectral radius,
+    // whose limit bounds every other multiplier's (header comment).
+    const bool leading = std::abs(at_N[i]) >= std::abs(at_N[0]) * (1 - 1e-12);
     if (modulus - best_error > 1) {
       any_unstable = true;
-    } else if (!(modulus + best_error < 1)) {
+    } else if (leading && !(modulus + best_error < 1)) {
       any_undecided = true;
       const double gap = std::abs(modulus - 1);
       // The expected order: an observed one from three levels can be pre-asymptotic (0.4 on a

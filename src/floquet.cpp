@@ -221,21 +221,37 @@ std::vector<size_t> failing_pairs(const std::vector<double>& residuals, double b
 // residual O(1)), but a pair with |mu| <= r and |M v - mu v| / |v| <= r, r = 1e3 eps |M x| / |x|,
 // is an eigenpair of M + E with |E| ~ r, i.e. zero to working precision. Those are returned as
 // exactly 0 (the honest value: 0 +- r), residual |M v| / (|M x| / |x| |v|), and named in `note`;
-// they leave `failing`. Returns how many were zeroed.
+// they leave `failing`. A pair with |mu| > r whose absolute residual is at that level is as good
+// as the operator allows (x' = -x + 1e-8 x(t - 1): mu_2 = 6e-10 next to mu_1 = 0.37, |M v - mu v|
+// / |v| = 1.5e-15, relative to |mu| 2e-6): kept, with its relative residual, and named in `note`;
+// it leaves `failing` too (it failed the relative gate before: exit 3; issue 32, item 2). Its
+// digits are the residual times its condition number, unknown here and large for such clusters
+// (dense and Krylov differ by 25 % on that mu_2): the error bars (error_bars.hpp) say how far it
+// is. Returns how many were zeroed.
 size_t zero_round_off_pairs(FloquetResult& r, const std::vector<double>& absolute, std::vector<size_t>& failing,
                             double size) {
   const double level = 1e3 * std::numeric_limits<double>::epsilon() * size;
-  std::vector<size_t> still_failing, zeroed;
+  std::vector<size_t> still_failing, zeroed, at_level;
   for (size_t k : failing) {
     if (std::abs(r.multipliers[k]) <= level && absolute[k] <= level) {
       r.multipliers[k] = 0;
       r.residuals[k] = absolute[k] / size;
       zeroed.push_back(k);
+    } else if (absolute[k] <= level) {
+      at_level.push_back(k);
     } else {
       still_failing.push_back(k);
     }
   }
   failing.swap(still_failing);
+  if (!at_level.empty()) {
+    double worst = 0;
+    for (size_t k : at_level) worst = std::max(worst, absolute[k]);
+    r.note += std::string(r.note.empty() ? "" : "; ") + "multipliers " + std::to_string(at_level.front() + 1) + ".." +
+              std::to_string(at_level.back() + 1) + " have residuals at the operator's round-off level (|M v - mu v| / " +
+              "|v| <= " + format_number(worst) + "): known to that level times their condition number, which " +
+              "for multipliers this small next to mu_1 can be large; their relative digits are not vouched for";
+  }
   if (!zeroed.empty())
     r.note += std::string(r.note.empty() ? "" : "; ") + "multipliers " + std::to_string(zeroed.front() + 1) + ".." +
               std::to_string(zeroed.back() + 1) +

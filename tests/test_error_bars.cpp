@@ -109,6 +109,15 @@ TEST(ErrorBars, TheVerdictIsNeverOnTheWrongSideOfTheUnitCircle) {
   EXPECT_EQ(bars.verdict, StabilityVerdict::undecided) << bars.note;
   ASSERT_GT(bars.deciding_N, 400);
   EXPECT_LT(std::abs(near.at(static_cast<int>(bars.deciding_N)) - near.limit), 1e-6);
+  // A small multiplier without a bar (two of its levels wildly apart) does not hold back the
+  // verdict the leading one gives: the spectral radius bounds it in the limit too.
+  std::vector<LevelResult> levels = levels_of({{0.5, 1.0, 0.0}, {1e-9, 0.0, 0.0}}, Ns);
+  levels[0].multipliers[1] = 1e-9;  // differences 1e-10, then 2e-9: growing, no estimate
+  levels[1].multipliers[1] = 1.1e-9;
+  levels[2].multipliers[1] = 3.1e-9;
+  const ErrorBars with_tiny = error_bars(Ns, levels, {});
+  EXPECT_FALSE(std::isfinite(with_tiny.bars[1].error_estimate)) << with_tiny.note;
+  EXPECT_EQ(with_tiny.verdict, StabilityVerdict::stable);
   // The same limit approached from inside: the value at N is stable, the bar still holds the circle.
   const Sequence inside{1 - 1e-6, -1.0, 0.0};
   EXPECT_EQ(error_bars(Ns, levels_of({inside}, Ns), {}).verdict, StabilityVerdict::undecided);

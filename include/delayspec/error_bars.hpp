@@ -15,16 +15,17 @@
 //                      estimate of column 0 (from its last differences, max(d_last, d_prev);
 //                      infinity when they grow or only two levels succeeded).
 //
-// Verdict, over the multipliers computed, each taken at its best value x (the extrapolated one
-// where there is one, else mu_N) with that value's bar e:
+// Verdict, each multiplier taken at its best value x (the extrapolated one where there is one,
+// else mu_N) with that value's bar e. It rests on the leading multiplier at N (and any of its
+// modulus, its conjugate): the spectral radius, whose N -> infinity limit bounds every other
+// multiplier's, so a tiny multiplier without a bar (x' = -x + 1e-8 x(t - 1): 6e-10, the levels
+// disagree) does not hold the verdict back:
 //   unstable   some |x| - e > 1;
-//   stable     every |x| + e < 1;
-//   undecided  otherwise: the unit circle lies within a bar (or a bar is infinite). deciding_N is
+//   stable     |x_1| + e_1 < 1 for the leading ones;
+//   undecided  otherwise: the unit circle lies within a leading bar (or it is infinite). deciding_N is
 //              then the N at which the bar of mu_N would shrink below the distance | |x| - 1 |,
 //              from error ~ N^-p with p the expected order (an order observed over three levels
 //              may be pre-asymptotic); 0 when no N can tell (an infinite bar, or |x| = 1).
-// The multipliers beyond the ones computed are smaller than the last one at N; their bars are not
-// known, and are not part of the verdict.
 #include <complex>
 #include <functional>
 #include <optional>
