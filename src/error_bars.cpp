@@ -47,6 +47,9 @@ ErrorBars error_bars(const std::vector<int>& Ns, const std::vector<LevelResult>&
   out.expected_order = richardson.order;
   for (const LevelResult& level : levels) out.failures.push_back(level.failure);
   out.bars.assign(at_N.size(), MultiplierErrorBar{kInfinity, std::nullopt, 0});
+  out.resolved.assign(at_N.size(), true);
+  for (size_t i = 0; i < at_N.size() && i < finest.accuracy.size(); ++i)
+    out.resolved[i] = multiplier_resolved(at_N[i], finest.accuracy[i]);
   if (at_N.empty()) return out;
 
   size_t succeeded = 0;
@@ -87,6 +90,11 @@ ErrorBars error_bars(const std::vector<int>& Ns, const std::vector<LevelResult>&
       best = x.value;
     } else {
       bar.error_estimate = x.error_estimate;  // column 0: the value at N (or infinity)
+    }
+    if (!out.resolved[i]) {
+      bar.error_estimate = kInfinity;  // no digit to bar (multiplier_resolved)
+      bar.extrapolated.reset();
+      continue;
     }
     const double modulus = std::abs(best);
     // The leading multiplier at N (and its conjugate, or any of its modulus): the spectral radius,

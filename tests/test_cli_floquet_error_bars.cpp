@@ -218,3 +218,34 @@ TEST(FloquetRoundOff, TinyMultipliersNextToALargeOneAreNotAFailure) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(FloquetRoundOff, MultipliersBelowTheirAccuracyAreNeverPrintedAsValues) {
+  // x' = 50 x + 0.5 x(t - 1), N = 200: mu_1 = 6.7e21, the second has a true modulus ~0.01, far
+  // below eps |mu_1| ~ 1e6: dense-eigen printed -93948, dense -0.045, spectra 0 (issue 32 item 2).
+  // Every solver: not resolved (null value, its bound), and the verdict never counts them.
+  for (const char* solver : {"dense-eigen", "dense", "spectra"}) {
+    const CliResult r = run({"floquet", "--json", "--set", "model=linear", "--set", "a=50", "--set", "b=0.5", "--set",
+                             "N=200", "--set", "nev=3", "--set", std::string("solver=") + solver});
+    ASSERT_EQ(r.status, 0) << solver << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    const auto& mu = j.at("multipliers");
+    EXPECT_TRUE(mu[0].at("resolved").get<bool>()) << solver;
+    EXPECT_GT(mu[0].at("abs").get<double>(), 1e21) << solver;
+    for (size_t k : {1u, 2u}) {
+      EXPECT_FALSE(mu[k].at("resolved").get<bool>()) << solver << " " << k << ": " << mu[k];
+      EXPECT_TRUE(mu[k].at("re").is_null() && mu[k].at("abs").is_null()) << solver;
+      // The bound covers the true modulus (~0.01) and what each solver computed.
+      EXPECT_GT(mu[k].at("bound").get<double>(), 1e5) << solver;
+      EXPECT_FALSE(mu[k].contains("error_estimate")) << solver;
+    }
+    EXPECT_NE(j.at("verdict"), "stable") << solver;
+    const CliResult text = run({"floquet", "--set", "model=linear", "--set", "a=50", "--set", "b=0.5", "--set",
+                                "N=200", "--set", "nev=3", "--set", std::string("solver=") + solver});
+    EXPECT_NE(text.out.find("not resolved: |mu| <= "), std::string::npos) << text.out;
+    EXPECT_EQ(text.out.find("93948"), std::string::npos) << text.out;
+  }
+}
+
+}  // namespace

@@ -20,6 +20,8 @@
 // modulus, its conjugate): the spectral radius, whose N -> infinity limit bounds every other
 // multiplier's, so a tiny multiplier without a bar (x' = -x + 1e-8 x(t - 1): 6e-10, the levels
 // disagree) does not hold the verdict back:
+// A multiplier that is not resolved at N (multiplier_resolved, from the level's accuracy) has no
+// bar and no part in the verdict.
 //   unstable   some |x| - e > 1;
 //   stable     |x_1| + e_1 < 1 for the leading ones;
 //   undecided  otherwise: the unit circle lies within a leading bar (or it is infinite). deciding_N is
@@ -54,6 +56,7 @@ struct ErrorBars {
   std::vector<int> Ns;                     // the levels, coarsest first; the last is N
   std::vector<std::string> failures;       // per level: why it failed ("" when it did not)
   std::vector<MultiplierErrorBar> bars;    // in the order of the multipliers at N
+  std::vector<bool> resolved;              // per multiplier at N (multiplier_resolved; all true without accuracies)
   std::optional<double> order;             // observed order of the leading track, when settled
   double expected_order = 2;               // the expansion's leading order (used when none is observed)
   StabilityVerdict verdict = StabilityVerdict::undecided;

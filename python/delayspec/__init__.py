@@ -60,8 +60,10 @@ def _is_multiplier(x):
 
 def multipliers_array(values):
     """[{"re": .., "im": .., "abs": ..}, ...] -> numpy complex128 (the CLI's order: by modulus,
-    largest first)."""
-    return np.array([complex(m["re"], m["im"]) for m in values], dtype=np.complex128)
+    largest first); a multiplier that is not resolved (`re`, `im` null, its `bound` given:
+    docs/cli.md, floquet) is NaN."""
+    return np.array([complex(np.nan, np.nan) if m["re"] is None else complex(m["re"], m["im"]) for m in values],
+                    dtype=np.complex128)
 
 
 def _to_numpy(value):

@@ -46,6 +46,8 @@ int command_floquet(Config& config, const Invocation& inv) {
                                 error_bar_seconds);
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Each multiplier's accuracy (multiplier_accuracy): the ones below it are not printed as values.
+  const std::vector<double> accuracy = level_result(result, n, problem.grid().K).accuracy;
 
   if (inv.json) {
     json["model"] = problem.model_name;
@@ -53,6 +55,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["dimension"] = n;
     json["solver"] = result.solver;
     json["multipliers"] = multipliers_json(result.multipliers);
+    add_resolution_json(json["multipliers"], result.multipliers, accuracy);
     if (bars) {
       add_error_bars_json(json["multipliers"], *bars);
       json["verdict"] = to_string(bars->verdict);
@@ -86,7 +89,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     print_orbit(inv.out, orbit, contacts);
     inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << result.solver << ", "
             << result.operator_applications << " operator applications):\n";
-    print_multipliers(inv.out, result.multipliers);
+    print_multipliers(inv.out, result.multipliers, accuracy);
     if (bars) print_error_bars(inv.out, result.multipliers, *bars);
     if (!result.residuals.empty()) {
       double worst = 0;

@@ -66,6 +66,7 @@ void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   double radius = 1;
   const JsonField multipliers = j.at("multipliers");
   for (const JsonField& m : multipliers.elements()) {
+    if (m.at("re").is_null()) continue;  // not resolved (floquet: no value, a bound): not drawn
     const double re = m.at("re").number(), im = m.at("im").number();
     rows += gnuplot_number(re) + " " + gnuplot_number(im) + "\n";
     radius = std::max(radius, std::hypot(re, im));

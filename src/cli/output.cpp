@@ -1,5 +1,6 @@
 #include "output.hpp"
 
+#include "delayspec/convergence.hpp"
 #include "delayspec/errors.hpp"
 
 #include <cmath>
@@ -28,18 +29,41 @@ nlohmann::json multipliers_json(const std::vector<std::complex<double>>& values)
 }
 
 void print_multipliers(std::ostream& out, const std::vector<std::complex<double>>& values) {
+  print_multipliers(out, values, {});
+}
+
+void add_resolution_json(nlohmann::json& multipliers, const std::vector<std::complex<double>>& values,
+                         const std::vector<double>& accuracy) {
+  for (size_t i = 0; i < values.size() && i < multipliers.size() && i < accuracy.size(); ++i) {
+    const bool resolved = multiplier_resolved(values[i], accuracy[i]);
+    multipliers[i]["resolved"] = resolved;
+    if (resolved) continue;
+    multipliers[i]["re"] = nullptr;
+    multipliers[i]["im"] = nullptr;
+    multipliers[i]["abs"] = nullptr;
+    multipliers[i]["bound"] = accuracy[i];
+  }
+}
+
+void print_multipliers(std::ostream& out, const std::vector<std::complex<double>>& values,
+                       const std::vector<double>& accuracy) {
   char line[160];
   std::snprintf(line, sizeof line, "  %3s  %22s  %22s  %18s\n", "#", "re", "im", "|mu|");
   out << line;
   for (size_t i = 0; i < values.size(); ++i) {
-    std::snprintf(line, sizeof line, "  %3zu  %22.15e  %22.15e  %18.15f\n", i + 1, values[i].real(), values[i].imag(),
-                  std::abs(values[i]));
+    if (i < accuracy.size() && !multiplier_resolved(values[i], accuracy[i]))
+      std::snprintf(line, sizeof line, "  %3zu  not resolved: |mu| <= %.3g (the accuracy next to mu_1)\n", i + 1,
+                    accuracy[i]);
+    else
+      std::snprintf(line, sizeof line, "  %3zu  %22.15e  %22.15e  %18.15f\n", i + 1, values[i].real(),
+                    values[i].imag(), std::abs(values[i]));
     out << line;
   }
 }
 
 void add_error_bars_json(nlohmann::json& multipliers, const ErrorBars& bars) {
   for (size_t i = 0; i < bars.bars.size() && i < multipliers.size(); ++i) {
+    if (multipliers[i].contains("resolved") && !multipliers[i]["resolved"].get<bool>()) continue;
     const MultiplierErrorBar& bar = bars.bars[i];
     multipliers[i]["error_estimate"] = number_or_null(bar.error_estimate);
     if (bar.extrapolated)
@@ -68,6 +92,11 @@ void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>
   char line[200];
   for (size_t i = 0; i < bars.bars.size() && i < values.size(); ++i) {
     const MultiplierErrorBar& bar = bars.bars[i];
+    if (!std::isfinite(bar.error_estimate) && !bar.extrapolated && i < bars.resolved.size() && !bars.resolved[i]) {
+      std::snprintf(line, sizeof line, "  %3zu  not resolved\n", i + 1);
+      out << line;
+      continue;
+    }
     if (std::isfinite(bar.error_estimate))
       std::snprintf(line, sizeof line, "  %3zu  |mu| = %.10g +- %.2g", i + 1, std::abs(values[i]), bar.error_estimate);
     else

@@ -28,6 +28,15 @@ nlohmann::json multipliers_json(const std::vector<std::complex<double>>& values)
 // One line per multiplier: index, re, im, |mu|.
 void print_multipliers(std::ostream& out, const std::vector<std::complex<double>>& values);
 
+// Each multiplier's "resolved" (multiplier_resolved, convergence.hpp, from `accuracy`, one per
+// multiplier); one that is not has "re", "im", "abs" null and its "bound" (|mu| <= bound): no
+// value is printed that double precision does not vouch for.
+void add_resolution_json(nlohmann::json& multipliers, const std::vector<std::complex<double>>& values,
+                         const std::vector<double>& accuracy);
+// print_multipliers with the unresolved ones as their bound.
+void print_multipliers(std::ostream& out, const std::vector<std::complex<double>>& values,
+                       const std::vector<double>& accuracy);
+
 // Each multiplier's "error_estimate" (of the value at N; null: none possible) and, where the
 // order is shown, "extrapolated": {"re", "im", "abs", "error_estimate"} (error_bars.hpp), added to
 // the objects of multipliers_json.
