@@ -462,3 +462,17 @@ TEST(ConvergeCli, DefaultLevelsAreValidGridsWhenTheDelayIsSeveralPeriods) {
   EXPECT_EQ(given.status, 2) << given.err;
   EXPECT_NE(given.err.find("`N = 25`"), std::string::npos) << given.err;
 }
+
+TEST(ConvergeCli, APlateauRefusesTheEstimateAndTheTarget) {
+  // The impact orbit at tau = T, k = 0.55 with events = off: |mu_1| is piecewise constant in N
+  // while the set of grid nodes in contact stays the same. Over 200 .. 1600 the last differences
+  // are 1.9e-4 and 4.7e-5 while the limit is 1.2e-2 away (0.82558: floquet, events = on); the
+  // estimate was 4.7e-4 and `converge_target = 1e-3` reported target_met (issue 32, item 3).
+  const CliResult r = run({"converge", "--json", "--set", "tau_over_T=1", "--set", "k=0.55", "--set", "nev=2", "--set",
+                           "events=off", "--set", "Ns=200,400,800,1600", "--set", "converge_target=1e-3", "--set",
+                           "converge_max_N=1600"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j.at("extrapolated")[0].at("error_estimate").is_null()) << j.at("extrapolated")[0];
+  EXPECT_FALSE(j.at("target_met").get<bool>());
+}

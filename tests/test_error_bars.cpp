@@ -163,3 +163,29 @@ TEST(ErrorBars, AFailedCoarseLevelLeavesNoBarAndNoVerdict) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(ErrorBars, APlateauGivesNoEstimate) {
+  // The impact orbit at tau = T, k = 0.55, events = off (first order), |mu_1| at N = 200, 400, 800,
+  // 1600 as converge computed it: one jump, then differences of 1.9e-4 and 4.7e-5 on a plateau,
+  // while the limit, 0.82558 (events = on, N = 12800, extrapolated +- 2.6e-5), is 1.2e-2 away
+  // (issue 32, item 3). The tail of the column claimed 4.7e-4.
+  RichardsonOptions first_order;
+  first_order.order = 1;
+  first_order.order_step = 1;
+  const std::vector<double> h = {1.0 / 200, 1.0 / 400, 1.0 / 800, 1.0 / 1600};
+  const std::vector<cd> x = {0.878994467421311, 0.813074764231099, 0.813260232550181, 0.813306915963554};
+  const Extrapolation e = richardson_extrapolate(h, x, first_order);
+  EXPECT_TRUE(std::isinf(e.error_estimate)) << e.error_estimate << ": " << e.note;
+  EXPECT_NE(e.note.find("plateau"), std::string::npos) << e.note;
+  // Equal values at two levels after a real difference: the same.
+  const Extrapolation equal = richardson_extrapolate(h, {0.9, 0.85, 0.85, 0.849}, first_order);
+  EXPECT_TRUE(std::isinf(equal.error_estimate)) << equal.note;
+  // A sequence whose differences shrink at a rate the expansion allows keeps its estimate.
+  const Extrapolation smooth = richardson_extrapolate(h, {0.9 + 3e-3, 0.9 + 1.2e-3, 0.9 + 0.45e-3, 0.9 + 0.2e-3},
+                                                      first_order);
+  EXPECT_TRUE(std::isfinite(smooth.error_estimate)) << smooth.note;
+}
+
+}  // namespace

@@ -46,6 +46,10 @@
 //     d_last that is small by an accidental cancellation from passing as accuracy (the column
 //     cannot shrink faster than the slowest order its terms can have, e_J). When the column's
 //     differences grow (d_last > d_prev, above round-off), no estimate is possible: infinity.
+//     Nor when, in the column's last two triples, a difference falls far faster than the expansion allows
+//     (pair order > 2 e_J + 1), to round-off after one above it, or jumps up after a flat stretch
+//     (pair order < -1): a plateau, whose small last
+//     differences say nothing of the next jump (the impact orbit with events = off).
 //   With check_orders = false the highest column is used with the textbook estimate.
 //
 // Example:
