@@ -232,3 +232,27 @@ TEST(ContinueCli, SwitchAtPeriodDoublingReachesTheKnownPeriodTwoOrbit) {
     EXPECT_NEAR(last["multipliers"][i]["im"].get<double>(), fj["multipliers"][i]["im"].get<double>(), 1e-9) << i;
   }
 }
+
+namespace {
+
+TEST(ContinueCli, StartsAtTheEndOfAKeysRange) {
+  // milling's depth from 0: the central difference for F_p asked for depth = -6e-9 and the start
+  // failed with "the model rejects parameter 0" (issue 32, item 4). The one-sided difference at
+  // the bound: the branch starts, and the Neimark-Sacker point is where a start inside the range
+  // finds it (a point solves F = 0 whatever F_p is: the two differ only in rounding, 1e-12).
+  auto ns_depth = [](const char* from) -> double {
+    const CliResult r = run({"continue", "--json", "--set", "model=milling", "--set", "continue_key=depth", "--set",
+                             std::string("continue_from=") + from, "--set", "continue_to=0.001"});
+    EXPECT_EQ(r.status, 0) << from << ": " << r.err;
+    if (r.status != 0) return NAN;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    for (const auto& b : j.at("bifurcations"))
+      if (b.at("type") == "neimark-sacker") return b.at("parameter").get<double>();
+    return NAN;
+  };
+  const double from_zero = ns_depth("0"), from_inside = ns_depth("1e-5");
+  ASSERT_TRUE(std::isfinite(from_zero) && std::isfinite(from_inside));
+  EXPECT_NEAR(from_zero, from_inside, 1e-12 * from_inside);
+}
+
+}  // namespace

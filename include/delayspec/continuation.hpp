@@ -23,6 +23,8 @@
 // any model key (a gap, a gain, a frequency that changes the step h), so F_p is the central
 // difference (F(x, p + delta) - F(x, p - delta)) / (2 delta), delta = eps^(1/3) max(|p|, |to -
 // from|): truncation delta^2 |F_ppp| / 6 plus rounding eps |F| / delta, both ~ 1e-11 relative.
+// At a bound of the key's range (p - delta or p + delta rejected by the model) the one-sided
+// second-order difference on the other side: the same order.
 // Why that is enough: F_p enters only the Newton matrix and the tangent, never the equations a
 // point satisfies. A point is accepted when |F(x, p)|_inf <= tolerance (1 + |x|_inf), whatever
 // F_p; an F_p error of 1e-11 makes Newton's contraction factor ~1e-11 instead of 0 (still
@@ -367,9 +369,27 @@ class PeriodicBranch {
     F = PeriodicOrbitProblem<Map>(map).residual(x, &Fx);
     const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max({std::abs(p), range_, 1e-300});
     const double up = p + delta, down = p - delta;
-    const Map map_up = map_at(up), map_down = map_at(down);
-    Fp =
-        (PeriodicOrbitProblem<Map>(map_up).residual(x) - PeriodicOrbitProblem<Map>(map_down).residual(x)) / (up - down);
+    // At a bound of the key's range (milling's depth from 0: p - delta = -6e-9 is rejected) the
+    // one-sided second-order stencil on the side the model accepts, (-3 F(p) + 4 F(p + s) -
+    // F(p + 2 s)) / (2 s), s = +-delta: the same order, and truncation 2x the central one's.
+    auto residual_at = [&](double q) { return PeriodicOrbitProblem<Map>(map_at(q)).residual(x); };
+    auto accepted = [&](double q) {
+      try {
+        map_at(q);
+        return true;
+      } catch (const BadInput&) {
+        return false;
+      }
+    };
+    if (accepted(down) && accepted(up)) {
+      Fp = (residual_at(up) - residual_at(down)) / (up - down);
+      return;
+    }
+    const double side = accepted(up) ? delta : -delta;  // (map_at(p) itself was accepted above)
+    const double s1 = (p + side) - p, s2 = (p + 2 * side) - p;  // the steps as represented
+    const Eigen::VectorXd F1 = residual_at(p + side), F2 = residual_at(p + 2 * side);
+    // Quadratic through (0, F), (s1, F1), (s2, F2), differentiated at 0.
+    Fp = (-(s1 + s2) / (s1 * s2)) * F + (s2 / (s1 * (s2 - s1))) * F1 - (s1 / (s2 * (s2 - s1))) * F2;
   }
 
   // Weighted inner product of the state parts plus the parameters' product.
