@@ -78,6 +78,7 @@ ErrorBars error_bars(const std::vector<int>& Ns, const std::vector<LevelResult>&
   double worst_ratio = 0;  // undecided multipliers: (bar of mu_N / distance to the circle)^(1/p)
   bool decidable = true, any_undecided = false, any_unstable = false;
   for (size_t i = 0; i < at_N.size(); ++i) {
+    if (!out.resolved[i]) continue;  // no digit to bar (multiplier_resolved): infinite, no verdict
     const int k = track_of[i];
     const ExtrapolatedMultiplier& x = study.extrapolated.at(k);
     MultiplierErrorBar& bar = out.bars[i];
@@ -90,11 +91,6 @@ ErrorBars error_bars(const std::vector<int>& Ns, const std::vector<LevelResult>&
       best = x.value;
     } else {
       bar.error_estimate = x.error_estimate;  // column 0: the value at N (or infinity)
-    }
-    if (!out.resolved[i]) {
-      bar.error_estimate = kInfinity;  // no digit to bar (multiplier_resolved)
-      bar.extrapolated.reset();
-      continue;
     }
     const double modulus = std::abs(best);
     // The leading multiplier at N (and its conjugate, or any of its modulus): the spectral radius,

@@ -17,47 +17,39 @@ using namespace delayspec;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-// y' = -y + 0.5 y(t - 1), T = tau = 1, whose derivative by the delayed state is declared infinite
-// from t = switch_time on (as x^(1/3)'s is at x = 0): the step map of the first step whose right
-// end t1 reaches switch_time is not finite, and every earlier one is. The state never is (f and
-// A are finite). With infinite_from > 1, finite everywhere.
-struct DerivativeInfiniteFrom {
+// What the two scalar test models share: y' = -y + g(t, y(t - 1)), T = tau = 1, no switching.
+struct ScalarUnitDelay {
   static constexpr int d = 1;
   static constexpr bool has_switching = false;
   static constexpr bool affine_in_state = true;
-  static constexpr bool is_linear = true;
   using V = Vec<1>;
   using M = Mat<1>;
-  double infinite_from = 0.25;
-
   double tau() const { return 1; }
   double period() const { return 1; }
-  V f(int, double, const V& y, const V& w) const { return V(-y[0] + 0.5 * w[0]); }
   M A(int, double, const V&, const V&) const { return M(-1.0); }
+  double H(const V&) const { return 1; }
+  V grad_H(const V&) const { return V::Zero(); }
+};
+
+// y' = -y + 0.5 y(t - 1), whose derivative by the delayed state is declared infinite from
+// t = infinite_from on (as x^(1/3)'s is at x = 0): the step map of the first step whose right
+// end t1 reaches infinite_from is not finite, and every earlier one is. The state never is (f
+// and A are finite). With infinite_from > 1, finite everywhere.
+struct DerivativeInfiniteFrom : ScalarUnitDelay {
+  static constexpr bool is_linear = true;
+  double infinite_from = 0.25;
+  V f(int, double, const V& y, const V& w) const { return V(-y[0] + 0.5 * w[0]); }
   M B(int, double t, const V&, const V&) const {
     return M(t >= infinite_from ? std::numeric_limits<double>::infinity() : 0.5);
   }
-  double H(const V&) const { return 1; }
-  V grad_H(const V&) const { return V::Zero(); }
   V initial_state() const { return V(1.0); }
 };
 
 // y' = -y + sqrt(y(t - 1)) from the history y = -1: f is NaN at the first step's left end.
-struct SqrtOfNegativeHistory {
-  static constexpr int d = 1;
-  static constexpr bool has_switching = false;
-  static constexpr bool affine_in_state = true;
+struct SqrtOfNegativeHistory : ScalarUnitDelay {
   static constexpr bool is_linear = false;
-  using V = Vec<1>;
-  using M = Mat<1>;
-
-  double tau() const { return 1; }
-  double period() const { return 1; }
   V f(int, double, const V& y, const V& w) const { return V(-y[0] + std::sqrt(w[0])); }
-  M A(int, double, const V&, const V&) const { return M(-1.0); }
   M B(int, double, const V&, const V& w) const { return M(0.5 / std::sqrt(w[0])); }
-  double H(const V&) const { return 1; }
-  V grad_H(const V&) const { return V::Zero(); }
   V initial_state() const { return V(-1.0); }
 };
 

@@ -372,22 +372,23 @@ class PeriodicBranch {
     // At a bound of the key's range (milling's depth from 0: p - delta = -6e-9 is rejected) the
     // one-sided second-order stencil on the side the model accepts, (-3 F(p) + 4 F(p + s) -
     // F(p + 2 s)) / (2 s), s = +-delta: the same order, and truncation 2x the central one's.
-    auto residual_at = [&](double q) { return PeriodicOrbitProblem<Map>(map_at(q)).residual(x); };
-    auto accepted = [&](double q) {
+    auto map_if_accepted = [&](double q) -> std::optional<Map> {
       try {
-        map_at(q);
-        return true;
+        return map_at(q);
       } catch (const BadInput&) {
-        return false;
+        return std::nullopt;
       }
     };
-    if (accepted(down) && accepted(up)) {
-      Fp = (residual_at(up) - residual_at(down)) / (up - down);
+    auto residual = [&](const Map& m) { return PeriodicOrbitProblem<Map>(m).residual(x); };
+    const std::optional<Map> map_up = map_if_accepted(up), map_down = map_if_accepted(down);
+    if (map_up && map_down) {
+      Fp = (residual(*map_up) - residual(*map_down)) / (up - down);
       return;
     }
-    const double side = accepted(up) ? delta : -delta;  // (map_at(p) itself was accepted above)
+    if (!map_up && !map_down) map_at(down);  // neither side: the model's reason (BadInput)
+    const double side = map_up ? delta : -delta;
     const double s1 = (p + side) - p, s2 = (p + 2 * side) - p;  // the steps as represented
-    const Eigen::VectorXd F1 = residual_at(p + side), F2 = residual_at(p + 2 * side);
+    const Eigen::VectorXd F1 = residual(map_up ? *map_up : *map_down), F2 = residual(map_at(p + 2 * side));
     // Quadratic through (0, F), (s1, F1), (s2, F2), differentiated at 0.
     Fp = (-(s1 + s2) / (s1 * s2)) * F + (s2 / (s1 * (s2 - s1))) * F1 - (s1 / (s2 * (s2 - s1))) * F2;
   }

@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <Eigen/LU>
 
@@ -27,6 +28,12 @@
 #include "delayspec/step_options.hpp"
 
 namespace delayspec {
+
+// (t, y, y(t - tau)) as a NonFiniteStep reports it (errors.hpp).
+template <int D>
+ModelPoint model_point(double t, const Vec<D>& y, const Vec<D>& y_tau) {
+  return ModelPoint{t, std::vector<double>(y.data(), y.data() + D), std::vector<double>(y_tau.data(), y_tau.data() + D)};
+}
 
 template <class Model>
 class TrapezoidStepper {
@@ -205,14 +212,10 @@ class TrapezoidStepper {
     int jr = 0;
     detail::SmallSolve<D> lu;
     const V z = solve_sub_step<true>(t0, dt, z0, w0, w1, left_region, right_region, jr, lu, &last_finite);
-    auto point = [](double t, const V& y, const V& y_tau) {
-      return ModelPoint{t, std::vector<double>(y.data(), y.data() + D),
-                        std::vector<double>(y_tau.data(), y_tau.data() + D)};
-    };
     throw NonFiniteStep("trapezoid step at t = " + format_number(t0) + ", dt = " + format_number(dt) +
                             ": the new state is not finite (" + format_number(z[0]) + ", region changes " +
                             std::to_string(region_changes) + ")",
-                        {point(t0, z0, w0), point(t0 + dt, last_finite, w1)});
+                        {model_point<D>(t0, z0, w0), model_point<D>(t0 + dt, last_finite, w1)});
   }
 
   Model model_;

@@ -76,10 +76,6 @@ class StroboscopicMap {
     const long M = grid_.M, K = grid_.K;
     std::vector<V> b(static_cast<size_t>(M + 1 + K));
     auto slot = [&b](long i) -> const V& { return b[i]; };
-    auto point = [](double t, const V& y, const V& y_tau) {
-      return ModelPoint{t, std::vector<double>(y.data(), y.data() + D),
-                        std::vector<double>(y_tau.data(), y_tau.data() + D)};
-    };
     for (long m = 0; m < maps; ++m) {
       throw_if_cancelled();
       for (long j = 0; j <= M; ++j) b[j] = U.segment<D>(j * D);
@@ -98,7 +94,8 @@ class StroboscopicMap {
                                   format_number(tap.t) + " to " + format_number(tap.t + grid_.h) + " has a " +
                                   (b[M + l + 1].allFinite() ? "derivative (step map)" : "new state") +
                                   " that is not finite",
-                              {point(tap.t, b[M + l], tap.w0), point(tap.t + grid_.h, b[M + l + 1], tap.w1)});
+                              {model_point<D>(tap.t, b[M + l], tap.w0),
+                               model_point<D>(tap.t + grid_.h, b[M + l + 1], tap.w1)});
       }
       for (long j = 0; j <= M; ++j) U.segment<D>(j * D) = b[K + j];
     }

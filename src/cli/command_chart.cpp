@@ -97,7 +97,8 @@ int command_chart(Config& config, const Invocation& inv) {
       radius[i] = std::abs(result.multipliers.at(0));
       if (with_error_bars) {
         double seconds = 0;
-        const ErrorBars bars = floquet_error_bars(p, orbit_settings, options, result, {}, seconds);
+        const ErrorBars bars =
+            floquet_error_bars(p, orbit_settings, options, level_result(result, p.dimension(), p.grid().K), {}, seconds);
         verdict[i] = to_string(bars.verdict);
         bar[i] = bars.bars.at(0).error_estimate;
       }

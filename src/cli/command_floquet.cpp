@@ -30,6 +30,7 @@ int command_floquet(Config& config, const Invocation& inv) {
   PeriodicOrbit orbit;
   ContactSummary contacts;
   double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
+  LevelResult at_N;  // the solve's multipliers with their accuracy
   std::optional<ErrorBars> bars;
   double error_bar_seconds = 0;
   {
@@ -41,13 +42,14 @@ int command_floquet(Config& config, const Invocation& inv) {
     orbit = std::move(at_orbit.orbit);
     contacts = at_orbit.contacts;
     result = floquet_multipliers(*at_orbit.monodromy, options);
+    // Each multiplier's accuracy (multiplier_accuracy): the ones below it are not printed as values.
+    at_N = level_result(result, n, problem.grid().K);
     if (with_error_bars)
-      bars = floquet_error_bars(problem, orbit_settings, options, result, std::move(at_orbit.sequence),
+      bars = floquet_error_bars(problem, orbit_settings, options, at_N, std::move(at_orbit.sequence),
                                 error_bar_seconds);
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // Each multiplier's accuracy (multiplier_accuracy): the ones below it are not printed as values.
-  const std::vector<double> accuracy = level_result(result, n, problem.grid().K).accuracy;
+  const std::vector<double>& accuracy = at_N.accuracy;
 
   if (inv.json) {
     json["model"] = problem.model_name;

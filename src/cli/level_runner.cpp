@@ -10,6 +10,22 @@
 
 namespace delayspec::cli {
 
+namespace {
+
+// Whether the problem's grid can be made at N (make_grid: a delay/period ratio may need multiples).
+bool valid_grid(const Problem& problem, long N) {
+  try {
+    Problem at_N = problem;
+    at_N.N = static_cast<int>(N);
+    at_N.grid();
+    return true;
+  } catch (const BadInput&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 std::vector<int> read_N_list(Config& config, const Problem& problem, int default_min, int default_max) {
   std::vector<int> Ns;
   const bool has_list = config.has("Ns");
@@ -28,19 +44,9 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
     if (!has_range) {
       // The defaults, on a grid that needs multiples (tau/T = 2 needs even N): the first valid N
       // from default_min on, doubled as often as the defaults are (26, 52, ... for 25, 50, ...).
-      auto valid = [&](long N) {
-        try {
-          Problem at_N = problem;
-          at_N.N = static_cast<int>(N);
-          at_N.grid();
-          return true;
-        } catch (const BadInput&) {
-          return false;
-        }
-      };
       long first = lo;
-      while (first < 2 * lo && !valid(first)) ++first;
-      if (valid(first)) {
+      while (first < 2 * lo && !valid_grid(problem, first)) ++first;
+      if (valid_grid(problem, first)) {
         hi = first * (hi / lo);
         lo = first;
       }
@@ -143,24 +149,27 @@ LevelResult StudyLevels::run(int N, int count, const Eigen::VectorXd* guess, int
 }
 
 ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
-                             const FloquetResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds) {
+                             const LevelResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds) {
   const auto start = std::chrono::steady_clock::now();
   constexpr int kExtra = 2;  // candidates beyond nev for the matching (convergence.hpp)
   FloquetOptions coarse = solver;
   coarse.ncv = 0;  // the automatic subspace: a user's ncv may exceed a coarse level's dimension
   coarse.nev = solver.nev + kExtra;
+  // A valid grid on which the solver's options hold, with more than the candidates (a proper
+  // sub-spectrum).
   auto valid = [&](int N) {
+    if (!valid_grid(problem, N)) return false;
+    Problem at = problem;
+    at.N = N;
+    const long n = at.dimension();
+    FloquetOptions checked = coarse;
+    checked.nev = static_cast<int>(std::min<long>(coarse.nev, n));
     try {
-      Problem at = problem;
-      at.N = N;
-      at.grid();
-      FloquetOptions checked = coarse;
-      checked.nev = static_cast<int>(std::min<long>(coarse.nev, at.dimension()));
-      validate_floquet_options(checked, at.dimension());
-      return at.dimension() > coarse.nev;  // more than the candidates: a proper sub-spectrum
+      validate_floquet_options(checked, n);
     } catch (const BadInput&) {
       return false;
     }
+    return n > coarse.nev;
   };
   std::vector<int> Ns = coarser_levels(problem.N, valid);
   StudyLevels levels(problem, problem.events, orbit, coarse);
@@ -177,7 +186,7 @@ ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit,
         }
   }
   Ns.push_back(problem.N);
-  results.push_back(level_result(at_N, problem.dimension(), problem.grid().K));
+  results.push_back(at_N);
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return error_bars(Ns, results, error_expansion(problem));
 }

@@ -91,11 +91,11 @@ class StudyLevels {
 };
 
 // floquet's error bars (delayspec/error_bars.hpp) for the multipliers `at_N` of the problem at
-// its N: the coarser levels (N/16 and N/4, valid grids on which the solver's options hold), each
+// its N (level_result of its solve): the coarser levels (N/16 and N/4, valid grids on which the solver's options hold), each
 // solved as a study level with nev + 2 candidates (a level whose orbit failed is retried by Newton
 // from `orbit_at_N`, the orbit's states at N, when given), then analysed. `seconds` receives what
 // the coarser levels cost.
 ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
-                             const FloquetResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds);
+                             const LevelResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds);
 
 }  // namespace delayspec::cli

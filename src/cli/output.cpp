@@ -1,10 +1,10 @@
 #include "output.hpp"
 
-#include "delayspec/convergence.hpp"
-#include "delayspec/errors.hpp"
-
 #include <cmath>
 #include <cstdio>
+
+#include "delayspec/convergence.hpp"
+#include "delayspec/errors.hpp"
 
 namespace delayspec::cli {
 
@@ -63,7 +63,7 @@ void print_multipliers(std::ostream& out, const std::vector<std::complex<double>
 
 void add_error_bars_json(nlohmann::json& multipliers, const ErrorBars& bars) {
   for (size_t i = 0; i < bars.bars.size() && i < multipliers.size(); ++i) {
-    if (multipliers[i].contains("resolved") && !multipliers[i]["resolved"].get<bool>()) continue;
+    if (i < bars.resolved.size() && !bars.resolved[i]) continue;  // no value, so no bar (add_resolution_json)
     const MultiplierErrorBar& bar = bars.bars[i];
     multipliers[i]["error_estimate"] = number_or_null(bar.error_estimate);
     if (bar.extrapolated)
@@ -92,7 +92,7 @@ void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>
   char line[200];
   for (size_t i = 0; i < bars.bars.size() && i < values.size(); ++i) {
     const MultiplierErrorBar& bar = bars.bars[i];
-    if (!std::isfinite(bar.error_estimate) && !bar.extrapolated && i < bars.resolved.size() && !bars.resolved[i]) {
+    if (i < bars.resolved.size() && !bars.resolved[i]) {
       std::snprintf(line, sizeof line, "  %3zu  not resolved\n", i + 1);
       out << line;
       continue;
