@@ -16,14 +16,15 @@
 
 #include <unistd.h>
 
-#include "config.hpp"
+#include "scene/keys/config.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/version.hpp"
 #include "delayspec_test_paths.hpp"
-#include "equation_model.hpp"
-#include "equation_model_source.hpp"
-#include "equation_plugin.hpp"
-#include "problem.hpp"
+#include "scene/equations/equation_model.hpp"
+#include "modules/equations/equation_model_source.hpp"
+#include "scene/equations/equation_plugin.hpp"
+#include "scene/problem/problem.hpp"
+#include "scene/commands/key_registry.hpp"
 
 namespace ds = delayspec;
 namespace cli = delayspec::cli;
@@ -46,6 +47,7 @@ std::string cache_dir() {
 // The problem as equations or as the built-in model with the scene's values, at N.
 cli::Problem impact(bool equations, int N) {
   cli::Config config = equations ? cli::Config::from_scene_file(kScene) : cli::Config();
+  config.set_key_index(cli::key_index());
   if (equations) {
     config.set("model_cache", cache_dir(), "bench");
   } else {  // equations_impact.toml's values: the built-in defaults but k and the history
@@ -102,7 +104,7 @@ static void BM_Compile(benchmark::State& state) {
   const std::string table = config.get_string("equations", "");
   const std::filesystem::path dir = cache_dir() + "-compile";
   std::filesystem::remove_all(dir);
-  const cli::EquationModelSource source = cli::generate_equation_model(toml::parse(table), cli::engine_keys());
+  const cli::EquationModelSource source = cli::generate_equation_model(toml::parse(table), cli::engine_keys(cli::key_index()));
   for (auto _ : state) cli::load_equation_plugin(source.code, dir);
   std::filesystem::remove_all(dir);
 }
@@ -115,7 +117,7 @@ static void BM_CachedLoad(benchmark::State& state) {
   impact(true, 10);  // compiled into the cache (or found there)
   const long compiled = cli::equation_plugin_compilations();
   for (auto _ : state) {
-    const cli::EquationModelSource source = cli::generate_equation_model(toml::parse(table), cli::engine_keys());
+    const cli::EquationModelSource source = cli::generate_equation_model(toml::parse(table), cli::engine_keys(cli::key_index()));
     benchmark::DoNotOptimize(cli::load_equation_plugin(source.code, dir).analyses);
   }
   if (cli::equation_plugin_compilations() != compiled) state.SkipWithError("the cached load compiled");

@@ -25,12 +25,12 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "commands.hpp"
-#include "config.hpp"
+#include "scene/commands/commands.hpp"
+#include "scene/keys/config.hpp"
 #include "delayspec/cancellation.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/version.hpp"
-#include "key_registry.hpp"
+#include "scene/commands/key_registry.hpp"
 
 namespace py = pybind11;
 using delayspec::BadInput;

@@ -225,6 +225,8 @@ def main():
     parser.add_argument("--source", required=True, help="the source tree (docs, data)")
     parser.add_argument("--update", action="store_true",
                         help="rewrite the help blocks (docs/cli.md) from the program, run nothing")
+    parser.add_argument("--keep", metavar="DIR",
+                        help="copy each document's scratch directory (the files its commands wrote) to DIR/DOC")
     parser.add_argument("docs", nargs="*", default=["README.md", "docs/tutorial.md", "docs/cli.md"])
     a = parser.parse_args()
     program = os.path.abspath(a.delayspec)
@@ -274,6 +276,9 @@ def main():
                         if want not in output:
                             failures.append(f"{doc}:{line}: output lacks the documented line `{want}`;"
                                             f" got: {output.strip()[-600:]}")
+            if a.keep:  # what the commands wrote, not the source tree's data/ and docs/ linked in
+                shutil.copytree(scratch, os.path.join(a.keep, doc), symlinks=True,
+                                ignore=lambda d, names: [n for n in names if os.path.islink(os.path.join(d, n))])
     print("\n".join(log))
     if failures:
         print(f"\n{len(failures)} doc-test failure(s):\n" + "\n".join(failures))

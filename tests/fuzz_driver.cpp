@@ -11,7 +11,7 @@
 //      no std:: distributions, whose results differ between standard libraries).
 // Mutants are at most max_length bytes (2 KB): the known stack overflow of GiNaC's parser on
 // thousands of nested parentheses (issue 31, fixed by the depth limit of
-// src/equations/equation_expression.cpp) is not what a fixed CI run should keep finding.
+// src/modules/equations/equation_expression.cpp) is not what a fixed CI run should keep finding.
 //
 // Usage: DRIVER CORPUS_DIR COUNT     the run above; exit 0, or 1 after an escaped exception
 //        DRIVER CORPUS_DIR COUNT I    writes mutant I (0-based) to stdout, for replay

@@ -1,6 +1,6 @@
 // libFuzzer target for the [equations] reader of model = equations: arbitrary bytes as a scene
 // file, then what the program does with its [equations] table before it compiles anything
-// (src/cli/equation_model.cpp, load): the table as the text Config keeps, parsed again by toml++,
+// (src/scene/equations/equation_model.cpp, load): the table as the text Config keeps, parsed again by toml++,
 // then the equations module's generate_equation_model (equation_model_source.hpp): the entries,
 // names and expressions checked, parsed and differentiated by GiNaC, the switch rules, and the
 // model printed as C++. The C++ is never compiled here (no compiler call, no cache): that is the
@@ -20,10 +20,11 @@
 
 #include <toml++/toml.h>
 
-#include "config.hpp"
+#include "scene/keys/config.hpp"
 #include "delayspec/errors.hpp"
-#include "equation_model.hpp"  // engine_keys
-#include "equations_module_loader.hpp"
+#include "scene/equations/equation_model.hpp"  // engine_keys
+#include "scene/equations/equations_module_loader.hpp"
+#include "scene/commands/key_registry.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
@@ -39,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     } catch (const toml::parse_error& e) {
       throw delayspec::BadInput("`equations`: " + std::string(e.description()));
     }
-    static const std::vector<std::string> reserved = delayspec::cli::engine_keys();
+    static const std::vector<std::string> reserved = delayspec::cli::engine_keys(delayspec::cli::key_index());
     const delayspec::cli::EquationModelSource source = delayspec::cli::equations_module().generate(table, reserved);
     // The source is C++ text of one struct, never empty for a table that passed the checks.
     if (source.code.empty() || source.state.empty()) throw std::logic_error("generate_equation_model: empty model");

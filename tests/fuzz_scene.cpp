@@ -17,15 +17,17 @@
 #include <cstdlib>
 #include <string>
 
-#include "config.hpp"
+#include "scene/keys/config.hpp"
 #include "delayspec/errors.hpp"
-#include "orbit_settings.hpp"
-#include "problem.hpp"
+#include "scene/problem/orbit_settings.hpp"
+#include "scene/problem/problem.hpp"
+#include "scene/commands/key_registry.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
     delayspec::cli::Config config = delayspec::cli::Config::from_scene_text(text, "fuzz.toml");
+    config.set_key_index(delayspec::cli::key_index());  // as run_command gives it
     // Every key the scene gives, through every typed getter (each must throw BadInput or succeed).
     for (const auto& [key, value] : config.values()) {  // the getters below work on copies
       for (int getter = 0; getter < 4; ++getter) {

@@ -16,7 +16,7 @@ column (`seconds`) of sweep's exponents.csv. Everything else, including every nu
 printed with 17 significant digits, must be identical byte for byte. Without --out, the JSON
 printed on stdout is compared the same way.
 
-The killed run uses the test hook DELAYSPEC_TEST_KILL_RANK=R:K (src/cli/distributed_points.hpp):
+The killed run uses the test hook DELAYSPEC_TEST_KILL_RANK=R:K (src/scene/points/distributed_points.hpp):
 rank R raises SIGKILL after its K-th point, as a node failure or `scancel` would end it.
 """
 import argparse

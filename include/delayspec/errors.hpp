@@ -39,7 +39,7 @@ struct ModelPoint {
 // A NumericalFailure at one step of the discretisation whose new state or whose derivative (the
 // step map) is not finite, with the points where that step evaluated the model: for the front
 // end that knows the model's terms to say which one is not finite there (model = equations:
-// src/cli/equation_model.cpp). what() describes the step in the engine's words.
+// src/scene/equations/equation_model.cpp). what() describes the step in the engine's words.
 class NonFiniteStep : public NumericalFailure {
  public:
   NonFiniteStep(const std::string& what, std::vector<ModelPoint> points);

@@ -26,7 +26,7 @@
 //     and never averages out; likewise the alignment of the block after a short transient adds
 //     a bounded excess. The error is then up to range(g) / n, and batch means miss it when the
 //     rotation per batch is near a multiple of 2 pi (every batch sees the same phase change):
-//     measured 60 SE on the impact orbit of tests/test_lyapunov.cpp.
+//     measured 60 SE on the impact orbit of tests/engine/test_lyapunov.cpp.
 //   The detrended cumulative sum D(i) = S(i) - (i / I) S(I) = g(i) - g(0) - (i / I)(g(I) - g(0))
 //   is observable (D(0) = D(I) = 0). For a bounded g that goes through its range in P intervals,
 //   range_i D >= range g - (P / I) |g(I) - g(0)| >= |g(I) - g(0)| (1 - P / I), so
@@ -45,7 +45,7 @@
 //   a small factor of it. On chaotic runs the error measured 1.3x the batch SE (Mackey-Glass);
 //   for bounded fluctuations with a random end phase (the zero exponent of the flow direction)
 //   both SE and F overestimate the actual spread (SE by about sqrt(B), since it assumes
-//   random-walk scaling), so the error is a conservative bound there (tests/test_lyapunov.cpp).
+//   random-walk scaling), so the error is a conservative bound there (tests/engine/test_lyapunov.cpp).
 //   Both parts are also reported (batch_standard_error_per_period, fluctuation_bound_per_period).
 //
 // Subnormals: each period's steps run with subnormal numbers flushed to zero

@@ -291,7 +291,7 @@ Eigen::MatrixXd Monodromy<D>::to_dense() const {
   return dense;
 }
 
-// Compiled once in the library (src/monodromy.cpp) for the built-in dimensions.
+// Compiled once in the library (src/engine/monodromy.cpp) for the built-in dimensions.
 extern template class Monodromy<1>;
 extern template class Monodromy<2>;
 

@@ -274,7 +274,7 @@ def test_nested_array_in_a_scene_dict_raises_bad_input():
 
 
 def test_forced_krylov_failure_raises_numerical_failure():
-    """As tests/test_krylov_cli.cpp: one Arnoldi iteration (max_restarts = 0) cannot converge 10
+    """As tests/cli/test_krylov_cli.cpp: one Arnoldi iteration (max_restarts = 0) cannot converge 10
     Ritz values with ncv = 12 at N = 100."""
     keys = dict(N=100, nev=10, ncv=12, max_restarts=0, solver="spectra")
     status, out, err = cli_error("floquet", DEFAULT, **keys)

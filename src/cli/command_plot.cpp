@@ -27,11 +27,11 @@
 #include <map>
 #include <sstream>
 
-#include "commands.hpp"
+#include "scene/commands/commands.hpp"
 #include "delayspec/errors.hpp"
-#include "gnuplot_script.hpp"
-#include "plot_continuation.hpp"
-#include "plot_inputs.hpp"
+#include "cli/gnuplot_script.hpp"
+#include "cli/plot_continuation.hpp"
+#include "cli/plot_inputs.hpp"
 
 #include <nlohmann/json.hpp>
 

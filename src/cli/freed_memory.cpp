@@ -1,4 +1,4 @@
-#include "freed_memory.hpp"
+#include "cli/freed_memory.hpp"
 
 #if defined(__GLIBC__)
 #include <malloc.h>

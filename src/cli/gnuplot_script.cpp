@@ -1,4 +1,4 @@
-#include "gnuplot_script.hpp"
+#include "cli/gnuplot_script.hpp"
 
 #include <string_view>
 
@@ -12,7 +12,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "atomic_file.hpp"
+#include "scene/output/atomic_file.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec::cli {

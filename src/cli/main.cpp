@@ -5,9 +5,9 @@
 #include <iostream>
 #include <sstream>
 
-#include "commands.hpp"
-#include "freed_memory.hpp"
-#include "ranks.hpp"
+#include "scene/commands/commands.hpp"
+#include "cli/freed_memory.hpp"
+#include "scene/points/ranks.hpp"
 
 int main(int argc, char** argv) {
   using namespace delayspec::cli;

@@ -1,4 +1,4 @@
-#include "plot_continuation.hpp"
+#include "cli/plot_continuation.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "delayspec/errors.hpp"
-#include "plot_inputs.hpp"
+#include "cli/plot_inputs.hpp"
 
 namespace delayspec::cli {
 

@@ -7,7 +7,7 @@
 // Inputs read strictly (plot_inputs.hpp): bad files are BadInput naming the file and field.
 #include <filesystem>
 
-#include "gnuplot_script.hpp"
+#include "cli/gnuplot_script.hpp"
 
 namespace delayspec::cli {
 

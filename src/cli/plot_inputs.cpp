@@ -1,4 +1,4 @@
-#include "plot_inputs.hpp"
+#include "cli/plot_inputs.hpp"
 
 #include <cmath>
 #include <cstdlib>

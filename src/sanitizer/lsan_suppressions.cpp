@@ -1,7 +1,7 @@
 // LeakSanitizer's built-in suppressions for the programs of a DELAYSPEC_SANITIZE build
 // (CMakeLists.txt adds this file to them; LSan calls the hook at start-up).
 //
-// CLN, GiNaC's number library (equation models: src/equations, the module
+// CLN, GiNaC's number library (equation models: src/modules/equations, the module
 // libdelayspec_equations), allocates tables in its static initialisers and never frees them: 26
 // bytes reported at exit of any program that loads it (the tests link it), before a single
 // equation is read. GiNaC itself keeps one 40-byte object it allocates on

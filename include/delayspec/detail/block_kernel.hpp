@@ -23,7 +23,7 @@
 // P u0 + (Q w0 + R w1), with the delayed part computed off that critical path.
 //
 // Target: an instantiation tag. The portable kernels use PortableTarget; a translation unit
-// compiled for another instruction set (src/block_kernel_avx2.cpp) instantiates the same
+// compiled for another instruction set (src/engine/kernels/block_kernel_avx2.cpp) instantiates the same
 // templates with its own tag of internal linkage, so the two machine codes get distinct
 // symbols and the linker can never merge one into the other (kernel_dispatch.hpp).
 // No allocation, no checks: the callers check sizes.

@@ -1,7 +1,7 @@
 #pragma once
 // Classical Gram-Schmidt against a tall orthonormal basis Q (n x j, column-major, leading
 // dimension n: the first j columns of an Eigen::MatrixXd), for the Krylov-Schur backend
-// (src/krylov_block.cpp) and GMRES (gmres.hpp). Compiled in the library (src/gram_schmidt.cpp).
+// (src/engine/eigen/krylov_block.cpp) and GMRES (gmres.hpp). Compiled in the library (src/engine/kernels/gram_schmidt.cpp).
 //
 // At large n the Krylov solve is bound by reading Q (2 x 10^6 rows x 41 columns = 656 MB), not by
 // the operator (one application of the monodromy at N = 10^6 is ~2 ms, one read of Q ~30 ms). So
@@ -12,7 +12,7 @@
 // cache while the j columns stream past), four columns at a time (x and y are loaded once per
 // four columns). Sums are formed per chunk and added in chunk order, so the result does not
 // depend on `threads`: the chunks are split between threads, not the sums. The chunk bodies run
-// the portable code or, where the CPU has them, AVX2 + FMA (src/gram_schmidt_chunks.hpp;
+// the portable code or, where the CPU has them, AVX2 + FMA (src/engine/kernels/gram_schmidt_chunks.hpp;
 // DELAYSPEC_KERNEL=baseline forces the portable path): the two round differently, each the same
 // for any thread count.
 namespace delayspec::detail {

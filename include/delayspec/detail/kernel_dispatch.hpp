@@ -1,9 +1,9 @@
 #pragma once
 // Which machine code runs the step-map kernels (block_kernel.hpp): the portable build (SSE2 on
 // x86-64, what every CPU of the target runs), a path compiled for AVX2 + FMA in its own
-// translation unit (src/block_kernel_avx2.cpp), or the AVX-512 path: the AVX2 + FMA code plus one
+// translation unit (src/engine/kernels/block_kernel_avx2.cpp), or the AVX-512 path: the AVX2 + FMA code plus one
 // kernel of its own, the fused streaming apply_block for d = 2 and k a multiple of 8
-// (src/stream_kernel_avx512.cpp), chosen at run time. One binary runs everywhere and uses the
+// (src/engine/kernels/stream_kernel_avx512.cpp), chosen at run time. One binary runs everywhere and uses the
 // widest path the CPU has.
 //
 // Choice (choose_kernel_path, once per Monodromy, at construction): the environment variable
@@ -13,11 +13,11 @@
 // fma for both wide paths). Either way the choice is capped at the widest path compiled for the
 // caller: avx512 for D = 2, avx2 for D = 1 and the Gram-Schmidt passes, baseline for a model of
 // another D compiled outside the library (an equation model). Any other value is BadInput naming it.
-// The Gram-Schmidt passes of the Krylov-Schur backend and GMRES (src/gram_schmidt_chunks.hpp)
-// make the same choice per call, with their AVX2 + FMA code in src/gram_schmidt_avx2.cpp.
+// The Gram-Schmidt passes of the Krylov-Schur backend and GMRES (src/engine/kernels/gram_schmidt_chunks.hpp)
+// make the same choice per call, with their AVX2 + FMA code in src/engine/kernels/gram_schmidt_avx2.cpp.
 //
 // The paths compute the same sums; FMA rounds a*b + c once instead of twice, so they agree to
-// rounding (tests/test_kernel_dispatch.cpp), not bit for bit.
+// rounding (tests/engine/test_kernel_dispatch.cpp), not bit for bit.
 #include "delayspec/step_map.hpp"
 
 namespace delayspec {
@@ -37,7 +37,7 @@ inline bool runs_avx2_code(KernelPath path) { return path != KernelPath::baselin
 
 namespace detail {
 // The AVX2 + FMA instantiations of block_steps (block_kernel.hpp) for D = 1, 2 (k vectors; one
-// vector runs the portable single_steps on every path, src/block_kernel_avx2.cpp says why).
+// vector runs the portable single_steps on every path, src/engine/kernels/block_kernel_avx2.cpp says why).
 // Call only when runs_avx2_code(choose_kernel_path(..)).
 void block_steps_avx2(const StepMap<1>* maps, long K, double* u, const double* delayed, double theta, long k);
 void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* delayed, double theta, long k);
@@ -46,8 +46,8 @@ void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* d
 // M + 1 - K .. M; the caller copies Y's slots 0 .. M - K), the transposes fused into the steps.
 // Requires what streaming requires (Monodromy::apply_block_raw): j0 = delayed_slot(0),
 // j0 - 1 >= 0 when theta != 0, j0 + K <= M, X and Y disjoint. The AVX-512 one (k a multiple of
-// 8, src/stream_kernel_avx512.cpp; call only on KernelPath::avx512), the AVX2 + FMA one (k a
-// multiple of 4, src/block_kernel_avx2.cpp) and the portable one (k even, src/stream_kernel.cpp).
+// 8, src/engine/kernels/stream_kernel_avx512.cpp; call only on KernelPath::avx512), the AVX2 + FMA one (k a
+// multiple of 4, src/engine/kernels/block_kernel_avx2.cpp) and the portable one (k even, src/engine/kernels/stream_kernel.cpp).
 void stream_steps_avx512(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
                          long k, double* Y, long ldy);
 void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx, long k,

@@ -13,7 +13,7 @@
 // returns what the same call with the same argument bits returned before.
 //
 // The lookup of the newer entry of a set is inline (below); everything else (the older entry,
-// a miss, the table's creation) is the call remembered_trig_miss in src/remembered_trig.cpp.
+// a miss, the table's creation) is the call remembered_trig_miss in src/engine/remembered_trig.cpp.
 // Why inline: a call into the library spills the live xmm registers; inline, the impact
 // model's Lyapunov step went from 41 to 34 ns (bench_lyapunov, docs/benchmarks.md "Eighth
 // sitting"). GCC shares a [[gnu::const]] call between f and A of a node but not the inline

@@ -14,7 +14,7 @@
 // its step maps and applies them many times (form once); the Lyapunov loop applies each step's
 // map once to its k (1-8) tangent vectors and forgets it (apply factored: at d = 2, k = 2, 32
 // multiply-adds against 48). The two differ by rounding only (re-association of the same sums);
-// tests/test_sub_step_derivative.cpp ties them together.
+// tests/engine/test_sub_step_derivative.cpp ties them together.
 #include <Eigen/Core>
 
 #include "delayspec/detail/small_solve.hpp"

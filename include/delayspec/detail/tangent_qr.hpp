@@ -9,7 +9,7 @@ namespace delayspec {
 // the k vectors), factorised in place by Householder reflections (the LAPACK algorithm,
 // re-associated so that each reflector costs one pass over the rows and Q is formed in one more
 // pass from the compact WY form; the mathematics and the stability argument are in
-// src/tangent_qr.cpp; tests compare with Eigen's HouseholderQR). Binds to the block's memory
+// src/engine/tangent_qr.cpp; tests compare with Eigen's HouseholderQR). Binds to the block's memory
 // once; no allocation after construction. A block with a column norm beyond 2^+-300 is first
 // scaled by an exact power of two, so squares neither overflow nor underflow.
 class TangentQR {

@@ -1,0 +1,357 @@
+// Krylov-Schur backend of floquet_multipliers() (solver = block, block_size = b vectors per
+// product). b = 1 (the default, auto's choice at large n): one vector per product and classical
+// Gram-Schmidt with delayed reorthogonalisation (expand_single), two passes over the basis per
+// product in threaded row chunks (detail/gram_schmidt.hpp). b > 1: the operator applied to b vectors at
+// once (Monodromy::apply_block), the basis orthogonalised with BLAS-3.
+//
+// Relation kept throughout (V orthonormal, p multiplied columns, the last b columns not yet):
+//     M V(:, 0:p) = V(:, 0:p + b) H(0:p + b, 0:p).
+// Expansion (b > 1): W = M V(:, p:p+b); block classical Gram-Schmidt twice against V(:, 0:p+b) (two
+// dgemm each: c = V^T W, W -= V c), then the block itself orthonormalised by Cholesky QR twice (two
+// more passes over W); H gets c and the triangular factor. When a new direction is numerically
+// absent (|R_ii| <= 1e-12 |M v_i|: the Krylov space is invariant in it, e.g. a rank-deficient or
+// strongly unstable monodromy whose other multipliers are below round-off) the block is
+// orthonormalised column by column and that column replaced by a random vector orthogonal to the
+// basis, with a zero coefficient: the relation holds to rounding and the search goes on in a fresh
+// direction (expand_single does the same for its one vector).
+// Rayleigh-Ritz: Ritz values theta of H_p = H(0:p, 0:p), Ritz vectors V y, residual estimates
+// |H(p:p+b, 0:p) y| (|y| = 1); a pair has converged when estimate <= tol max(|theta|, eps^(2/3)),
+// the criterion Spectra and ARPACK use. Restart (Krylov-Schur, Stewart 2001): the real Schur form
+// of H_p with the k largest-modulus values first (LAPACK dgees with a selection), V <- V Z_k (in
+// place, by row chunks), H_k <- T_k, the coupling row block <- H(p:p+b, 0:p) Z_k; the last block
+// stays the not yet multiplied one. k = (nev + m) / 2 keeps the wanted values and a margin.
+//
+// Cost per product at large n, where reading the n x m basis is what costs (an application of the
+// monodromy at N = 10^6 takes ~2 ms, one read of a 41-column basis ~20 ms): b = 1 reads the j
+// basis columns twice (CGS2 as ARPACK does it: four times); b > 1 makes 8 n p b flops of dgemm
+// per expansion of b vectors but needs 1.7-5x the products for the same accuracy
+// (docs/benchmarks.md). Per restart 2 n p k flops.
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "delayspec/detail/gram_schmidt.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec/floquet.hpp"
+#include "engine/linalg/blas.hpp"
+#include "engine/eigen/krylov.hpp"
+#include "engine/linalg/linear_algebra.hpp"
+
+namespace delayspec::krylov {
+
+using detail::basis_coefficients;
+using detail::gram_schmidt_threads;
+using detail::ProjectedProducts;
+using detail::subtract_in_basis;
+
+namespace {
+
+// dgees' selection: |lambda| >= threshold (the wanted, largest-modulus values).
+thread_local double select_threshold = 0;
+int select_large(const double* re, const double* im) { return std::hypot(*re, *im) >= select_threshold ? 1 : 0; }
+
+class BlockKrylovSchur {
+ public:
+  BlockKrylovSchur(long n, int b, int m) : n_(n), b_(b), m_(m), V_(n, m + b), H_(Eigen::MatrixXd::Zero(m + b, m)) {}
+
+  // Orthonormalises W (n x b) against V(:, 0:j) and within itself: W_in = V(:, 0:j) c + W R.
+  void orthonormalise(long j, Eigen::MatrixXd& W, Eigen::MatrixXd& c, Eigen::MatrixXd& R) {
+    const Eigen::VectorXd norm_in = W.colwise().norm().transpose();
+    c = Eigen::MatrixXd::Zero(j, b_);
+    if (j > 0) {
+      Eigen::MatrixXd pass(j, b_);
+      for (int twice = 0; twice < 2; ++twice) {                                             // CGS2
+        gemm('T', 'N', j, b_, n_, 1.0, V_.data(), n_, W.data(), n_, 0.0, pass.data(), j);   // pass = V^T W
+        gemm('N', 'N', n_, b_, j, -1.0, V_.data(), n_, pass.data(), j, 1.0, W.data(), n_);  // W -= V pass
+        c += pass;
+      }
+    }
+    if (!cholesky_qr2(W, R, norm_in)) column_qr(j, W, R, norm_in);
+  }
+
+  // W = Q R by Cholesky QR twice; false when a column is (nearly) dependent: then nothing changed.
+  bool cholesky_qr2(Eigen::MatrixXd& W, Eigen::MatrixXd& R, const Eigen::VectorXd& norm_in) {
+    Eigen::MatrixXd Q = W;
+    R = Eigen::MatrixXd::Identity(b_, b_);
+    for (int twice = 0; twice < 2; ++twice) {
+      Eigen::MatrixXd G(b_, b_);
+      gemm('T', 'N', b_, b_, n_, 1.0, Q.data(), n_, Q.data(), n_, 0.0, G.data(), b_);  // G = Q^T Q
+      Eigen::LLT<Eigen::MatrixXd> llt(G);
+      if (llt.info() != Eigen::Success) return false;
+      const Eigen::MatrixXd Ri = llt.matrixU();
+      const Eigen::VectorXd d = Ri.diagonal();
+      // a direction lost to rounding, or too ill-conditioned for Cholesky QR (cond > 1e6)
+      if (twice == 0) {
+        for (int i = 0; i < b_; ++i)
+          if (!(d[i] > 1e-12 * norm_in[i])) return false;
+        if (d.minCoeff() < 1e-6 * d.maxCoeff()) return false;
+      }
+      Ri.triangularView<Eigen::Upper>().solveInPlace<Eigen::OnTheRight>(Q);  // Q <- Q Ri^{-1}
+      R = Ri * R;
+    }
+    W = std::move(Q);
+    return true;
+  }
+
+  // Gram-Schmidt column by column (twice), a lost direction replaced by a random one (R_ii = 0).
+  void column_qr(long j, Eigen::MatrixXd& W, Eigen::MatrixXd& R, const Eigen::VectorXd& norm_in) {
+    R = Eigen::MatrixXd::Zero(b_, b_);
+    for (int i = 0; i < b_; ++i) {
+      Eigen::VectorXd w = W.col(i);
+      for (int twice = 0; twice < 2; ++twice) {
+        const Eigen::VectorXd r = W.leftCols(i).transpose() * w;
+        w.noalias() -= W.leftCols(i) * r;
+        R.col(i).head(i) += r;
+      }
+      const double rho = w.norm();
+      if (rho > 1e-12 * norm_in[i]) {
+        W.col(i) = w / rho;
+        R(i, i) = rho;
+        continue;
+      }
+      w = start_vector(n_, 0x5eedULL + seed_++);
+      for (int twice = 0; twice < 2; ++twice) {
+        if (j > 0) w -= V_.leftCols(j) * (V_.leftCols(j).transpose() * w).eval();
+        w -= W.leftCols(i) * (W.leftCols(i).transpose() * w).eval();
+      }
+      W.col(i) = w.normalized();
+    }
+  }
+
+  // Expansion with one vector per product (b = 1): Arnoldi with classical Gram-Schmidt and delayed
+  // reorthogonalisation (DCGS2; Bielich, Langou, Thomas, Swirydowicz, Yamazaki, Boman 2022), two
+  // reads of the basis per product where CGS2 takes four. On entry columns 0..j-1 exist; Q =
+  // V(:, 0:j-1) is orthonormal, u = V(:, j-1) has been projected against Q once (not twice, not
+  // normalised) and enters the relation through its row, M Q = Q H(0:j-1, 0:j-1) + u H(j-1, 0:j-1).
+  // One step, with w = M u:
+  //   pass 1 (reads Q):  s = Q^T u,  t = Q^T w
+  //   pass 2 (reads Q):  u <- u - Q s,  w <- w - Q t;  r = |u|, q = u / r, g = q^T w
+  // u = Q s + r q turns the relation into M Q = [Q q] H' with H(0:j-1, :) += s row, H(j-1, :) = r row,
+  // and M q = (M u - M Q s) / r = (w_in - [Q q] H' s) / r, whose coefficients on [Q q] are
+  // c = ([t; g] - H' s) / r and whose remainder z = (w - q g) / r (w projected once) is the next u.
+  // Rounding: s = O(eps) |u| after the first projection, so the delayed second one corrects H' by
+  // O(eps) and c loses O(eps |s| / r) <= O(eps) |M| as long as r > 1e-12 |M q_prev| (below that the
+  // direction is lost and replaced, as in column_qr).
+  void expand_single(const LinearOperator& op, long& j, long m) {
+    Eigen::VectorXd w(n_), s, t, hs;
+    while (j <= m) {
+      const long q_cols = j - 1;
+      double* u = V_.col(j - 1).data();
+      op.perform_op(u, w.data());
+      s.resize(q_cols);
+      t.resize(q_cols);
+      basis_coefficients(V_.data(), n_, q_cols, u, w.data(), s.data(), t.data(), threads_);
+      const ProjectedProducts p = subtract_in_basis(V_.data(), n_, q_cols, s.data(), t.data(), u, w.data(), threads_);
+      // A non-finite product would pass for a lost direction below: say what it is, at once.
+      if (!std::isfinite(p.xx + p.yy))
+        throw NumericalFailure("Krylov (block): the operator returned a non-finite vector (product " +
+                               std::to_string(j) + " of the basis)");
+      const double r = std::sqrt(p.xx);
+      const Eigen::RowVectorXd row = H_.row(j - 1).head(q_cols);
+      H_.topLeftCorner(q_cols, q_cols) += s * row;
+      if (!(r > 1e-12 * source_norm_)) {  // u was rounding noise: M's space is invariant so far
+        H_.row(j - 1).head(q_cols).setZero();
+        replace_lost_column(j - 1);
+        continue;
+      }
+      H_.row(j - 1).head(q_cols) = r * row;
+      const double g = p.xy / r;
+      hs = H_.topLeftCorner(j, q_cols) * s;
+      Eigen::VectorXd c(j);
+      c.head(q_cols) = t - hs.head(q_cols);
+      c[q_cols] = g - hs[q_cols];
+      c /= r;
+      H_.col(j - 1).head(j) = c;
+      detail::divide_and_split(n_, r, g, V_.col(j - 1).data(), w.data(), V_.col(j).data(), threads_);
+      H_.row(j).head(j).setZero();
+      H_(j, j - 1) = 1;
+      // |M q|^2 = |c|^2 + |z|^2, |z|^2 = (|w|^2 - g^2) / r^2
+      source_norm_ = std::sqrt(c.squaredNorm() + std::max(0.0, p.yy - g * g) / (r * r));
+      ++j;
+    }
+    finish_single(m);
+  }
+
+  // The last column V(:, m) gets its second projection and is normalised: the relation
+  // M V(:, 0:m) = V(:, 0:m + 1) H(0:m + 1, 0:m) with V orthonormal, as the block expansion leaves it.
+  void finish_single(long m) {
+    double* u = V_.col(m).data();
+    Eigen::VectorXd s(m);
+    basis_coefficients(V_.data(), n_, m, u, nullptr, s.data(), nullptr, threads_);
+    const ProjectedProducts p = subtract_in_basis(V_.data(), n_, m, s.data(), nullptr, u, nullptr, threads_);
+    const double r = std::sqrt(p.xx);
+    const Eigen::RowVectorXd row = H_.row(m).head(m);
+    H_.topLeftCorner(m, m) += s * row;
+    if (!(r > 1e-12 * source_norm_)) {  // invariant subspace: no coupling, any orthonormal successor
+      H_.row(m).head(m).setZero();
+      replace_lost_column(m);
+      return;
+    }
+    H_.row(m).head(m) = r * row;
+    V_.col(m) /= r;
+  }
+
+  // V(:, i) <- a random unit vector orthogonal to V(:, 0:i) (CGS2); the caller zeroes its row.
+  void replace_lost_column(long i) {
+    V_.col(i) = start_vector(n_, 0x5eedULL + seed_++);
+    Eigen::VectorXd s(i);
+    for (int twice = 0; twice < 2; ++twice) {
+      basis_coefficients(V_.data(), n_, i, V_.col(i).data(), nullptr, s.data(), nullptr, threads_);
+      subtract_in_basis(V_.data(), n_, i, s.data(), nullptr, V_.col(i).data(), nullptr, threads_);
+    }
+    V_.col(i).normalize();
+    source_norm_ = 1;
+  }
+
+  // V(:, 0:k) <- V(:, 0:p) Z in place, a chunk of rows at a time: no second n x k matrix.
+  void rotate_basis(long p, const Eigen::MatrixXd& Z, long k) {
+    constexpr long kRows = 4096;
+    Eigen::MatrixXd rows(kRows, k);
+    for (long a = 0; a < n_; a += kRows) {
+      const long h = std::min(kRows, n_ - a);
+      gemm('N', 'N', h, k, p, 1.0, V_.data() + a, n_, Z.data(), p, 0.0, rows.data(), kRows);
+      V_.block(a, 0, h, k) = rows.topRows(h);
+    }
+  }
+
+  long n_;
+  int b_, m_;
+  Eigen::MatrixXd V_, H_;
+  std::uint64_t seed_ = 0;
+  int threads_ = gram_schmidt_threads(n_);
+  double source_norm_ = 1;  // |M q| of the vector the current u was projected from (|start| at first)
+};
+
+}  // namespace
+
+RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Eigen::VectorXd& start) {
+  const long n = op.rows();
+  const int nev = s.nev;
+  // Block size at most a third of the room above nev; basis m >= nev + 2 b + 2 so that a restart
+  // keeping (nev + m) / 2 values (one more for a split pair) leaves room for a block.
+  const int b = static_cast<int>(std::max<long>(1, std::min<long>(s.block_size, (n - nev) / 3)));
+  const int m = static_cast<int>(std::min<long>(std::max(s.ncv, nev + 2 * b + 2), n - b));
+  const int keep = std::max(nev, std::min((nev + m) / 2, m - b - 1));
+  BlockKrylovSchur k(n, b, m);
+  Eigen::MatrixXd& V = k.V_;
+  Eigen::MatrixXd& H = k.H_;
+
+  // Start block: the common start vector and b - 1 more from the same generator.
+  Eigen::MatrixXd W(n, b), c, R, X, Y;
+  W.col(0) = start;
+  for (int i = 1; i < b; ++i) W.col(i) = start_vector(n, 0xb10cULL + static_cast<std::uint64_t>(i));
+  k.orthonormalise(0, W, c, R);
+  V.leftCols(b) = W;
+  long j = b;  // basis columns; the last b not yet multiplied
+
+  RitzPairs pairs;
+  const double eps23 = std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);
+  for (int iteration = 1;; ++iteration) {
+    // Expand while a whole block fits: M V(:, j-b:j) -> new block.
+    if (b == 1) k.expand_single(op, j, m);
+    while (j + b <= m + b) {
+      X = V.middleCols(j - b, b);
+      op.apply_block(X, Y);
+      k.orthonormalise(j, Y, c, R);
+      H.block(0, j - b, j, b) = c;
+      H.block(j, j - b, b, b) = R;
+      V.middleCols(j, b) = Y;
+      j += b;
+    }
+    const long p = j - b;  // Rayleigh quotient size
+    const Eigen::MatrixXd Hp = H.topLeftCorner(p, p);
+    const Eigen::MatrixXd coupling = H.block(p, 0, b, p);
+    Eigen::EigenSolver<Eigen::MatrixXd> es(Hp);
+    if (es.info() != Eigen::Success)
+      throw NumericalFailure("Krylov (block): the eigenvalues of the " + std::to_string(p) + " x " + std::to_string(p) +
+                             " Rayleigh quotient did not converge");
+    const Eigen::VectorXcd theta = es.eigenvalues();
+    const Eigen::MatrixXcd Yc = es.eigenvectors();  // unit columns
+    std::vector<long> order(p);
+    for (long i = 0; i < p; ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](long a, long c2) { return std::abs(theta[a]) > std::abs(theta[c2]); });
+    // A pair split by nev counts whole.
+    int wanted = nev;
+    if (wanted < p && theta[order[wanted - 1]].imag() != 0 &&
+        theta[order[wanted]] == std::conj(theta[order[wanted - 1]]))
+      ++wanted;
+    std::vector<std::complex<double>> values;
+    std::vector<double> estimates;
+    int converged = 0;
+    bool all = true;
+    for (int i = 0; i < wanted; ++i) {
+      const long col = order[i];
+      const double est = (coupling.cast<std::complex<double>>() * Yc.col(col)).norm();
+      values.push_back(theta[col]);
+      estimates.push_back(est);
+      const bool ok = est <= s.tolerance * std::max(std::abs(theta[col]), eps23);
+      converged += ok;
+      all = all && ok;
+    }
+    if (all) {
+      std::vector<std::complex<double>> wanted_theta;
+      std::vector<Eigen::VectorXcd> wanted_y;
+      for (int i = 0; i < wanted; ++i) {
+        wanted_theta.push_back(theta[order[i]]);
+        wanted_y.push_back(Yc.col(order[i]));
+      }
+      pairs = ritz_pairs_in_basis(wanted_theta, wanted_y, V.leftCols(p));
+      pairs.converged = converged;
+      pairs.iterations = iteration;
+      return pairs;
+    }
+    if (iteration >= s.max_iterations)
+      throw NumericalFailure(
+          "Krylov (block) did not converge: " + std::to_string(converged) + " of nev = " + std::to_string(nev) +
+          " Ritz values converged after " + std::to_string(iteration) +
+          " iterations (max_iterations = " + std::to_string(s.max_iterations) + " = 1 + max_restarts, basis " +
+          std::to_string(m) + ", block " + std::to_string(b) + "), largest relative residual estimate " +
+          format_number(largest_relative_estimate(values, estimates, nev)) + " > tol " + short_number(s.tolerance));
+
+    // Restart: ordered real Schur form, the `keep` largest moduli first. dgees selects by modulus;
+    // ties (exact zeros of a rank-deficient monodromy, round-off-level values of a strongly
+    // unstable one) can select more than fit: then a larger threshold, down to nev values.
+    Eigen::MatrixXd T, Z(p, p);
+    const int ip = static_cast<int>(p);
+    int sdim = 0, info = 0;
+    Eigen::VectorXd wr(p), wi(p);
+    std::vector<int> bwork(p);
+    std::vector<double> work;
+    const auto dgees = detail::lapack().dgees;
+    bool restarted = false;
+    for (int q = keep - 1; q >= nev - 1 && !restarted; --q) {
+      select_threshold = std::abs(theta[order[q]]) * (1 - 1e-12);
+      if (!(select_threshold > 0)) continue;
+      T = Hp;
+      int lwork = -1;
+      double query = 0;
+      dgees("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, &query, &lwork,
+            bwork.data(), &info);
+      lwork = static_cast<int>(query);
+      work.assign(static_cast<size_t>(std::max(1, lwork)), 0.0);
+      dgees("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, work.data(), &lwork,
+            bwork.data(), &info);
+      restarted = info == 0 && sdim >= nev && sdim + b <= m;
+    }
+    if (!restarted)
+      throw NumericalFailure("Krylov (block): no restart keeps between nev = " + std::to_string(nev) + " and " +
+                             std::to_string(m - b) + " Ritz values (dgees info " + std::to_string(info) + ", " +
+                             std::to_string(sdim) + " selected); try another solver");
+    k.rotate_basis(p, Z, sdim);                  // V(:, 0:sdim) <- V Z_k
+    V.middleCols(sdim, b) = V.middleCols(p, b);  // disjoint: sdim + b <= m = p
+    H.setZero();
+    H.topLeftCorner(sdim, sdim) = T.topLeftCorner(sdim, sdim);
+    H.block(sdim, 0, b, sdim) = coupling * Z.leftCols(sdim);
+    k.source_norm_ = 1;
+    j = sdim + b;
+  }
+}
+
+}  // namespace delayspec::krylov

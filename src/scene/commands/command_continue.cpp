@@ -1,0 +1,327 @@
+// delayspec continue: pseudo-arclength continuation of the periodic orbit in one model key, with
+// its bifurcations located and, with continue_Ns, extrapolated to N -> infinity (issue 15;
+// continuation.hpp; docs/continuation.md).
+//
+// The start: the orbit at continue_from found as `floquet` finds it (orbit = simulate | newton;
+// linear models: the zero orbit), then corrected by the continuation's own Newton. With
+// continue_Ns the whole branch is computed at every N of the list; the branch reported is the
+// finest one, each bifurcation carries its location at every N where it was found.
+//
+// Files with --out DIR (after the metadata comment lines):
+//   branch.csv         one row per point: parameter, stability, |mu_1|, the measures, the multipliers
+//   bifurcations.csv   one row per bifurcation: type, location at the finest N, extrapolation,
+//                      error estimate, angle, locations by N
+//   continue.json  the --json result
+// A branch that ends in a failure (a step that cannot be reduced further) is written as far as it
+// got, the failure named in the files and on stderr, exit 3.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/output/atomic_file.hpp"
+#include "scene/commands/commands.hpp"
+#include "scene/problem/continue_settings.hpp"
+#include "delayspec/continuation.hpp"
+#include "scene/problem/floquet_settings.hpp"
+#include "scene/output/metadata.hpp"
+#include "scene/problem/orbit_settings.hpp"
+#include "scene/output/output.hpp"
+#include "scene/problem/problem.hpp"
+#include "scene/output/progress.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+using nlohmann::json;
+
+// The model of `base` with `key` set to p (the same validation as any scene value).
+template <class Model>
+struct ModelWithKey {
+  const Config& base;
+  const std::string& key;
+  Model operator()(double p) const {
+    Config c = base;
+    c.set(key, format_number(p), "continue");
+    return std::get<Model>(*read_problem(c, 100).model);
+  }
+};
+
+// One level N with the continued key at p: the scene the model factory reads (ModelWithKey keeps
+// a reference to `config`), its problem, and the options' discretisation taken from it.
+struct Level {
+  Config config;
+  Problem problem;
+};
+Level level_at(const Config& config, const std::string& key, double p, int N, ContinuationOptions& options,
+               Progress& progress) {
+  Level level{config, {}};
+  level.config.set("N", std::to_string(N), "continue_Ns");
+  level.config.set(key, format_number(p), "continue");
+  level.problem = read_problem(level.config, 100);
+  options.N = N;
+  options.periods_per_map = level.problem.orbit_period;
+  options.step_options = step_options(level.problem);
+  options.on_point = [&progress](const ContinuationPoint&) { progress.add(); };
+  return level;
+}
+
+// The branch at one N: the start orbit at `from`, then continue_orbit.
+ContinuationResult branch_at(const Config& config, const ContinueSettings& settings,
+                             const OrbitSettings& orbit_settings, ContinuationOptions options, int N,
+                             Progress& progress) {
+  const Level level = level_at(config, settings.key, options.from, N, options, progress);
+  return with_map(
+      level.problem,
+      [&](const auto& model, const auto& map) {
+        using Model = std::decay_t<decltype(model)>;
+        const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
+        const Eigen::VectorXd guess =
+            PeriodicOrbitProblem<std::decay_t<decltype(map)>>(map).sequence_from_history(orbit.history);
+        return continue_orbit<Model>(ModelWithKey<Model>{level.config, settings.key}, guess, options);
+      },
+      "`continue`");
+}
+
+// The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
+ContinuationResult switched_at(const Config& config, const ContinueSettings& settings, ContinuationOptions options,
+                               int N, const Bifurcation& pd, Progress& progress) {
+  const Level level = level_at(config, settings.key, pd.parameter, N, options, progress);
+  return std::visit(
+      [&](const auto& model) {
+        using Model = std::decay_t<decltype(model)>;
+        return continue_period_doubled<Model>(ModelWithKey<Model>{level.config, settings.key}, pd, options);
+      },
+      *level.problem.model);
+}
+
+json measures_json(const OrbitMeasures& m) {
+  json j;
+  j["max"] = m.max;
+  j["min"] = m.min;
+  j["max_H"] = m.max_H;  // NaN (no switching) is written as null
+  j["contact_time"] = m.contact_time;
+  return j;
+}
+
+std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : "nan"; }
+
+json points_json(const std::vector<ContinuationPoint>& points) {
+  json list = json::array();
+  for (const auto& p : points) {
+    json pj;
+    pj["parameter"] = p.parameter;
+    pj["multipliers"] = multipliers_json(p.multipliers);
+    pj["unstable"] = p.unstable;
+    pj["stable"] = p.stable();
+    pj["measures"] = measures_json(p.measures);
+    pj["newton_iterations"] = p.newton_iterations;
+    pj["step"] = p.step;
+    list.push_back(pj);
+  }
+  return list;
+}
+
+}  // namespace
+
+int command_continue(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  const ContinueSettings settings = read_continue_settings(config);
+  const OrbitSettings orbit_settings = read_orbit_settings(config);
+  ContinuationOptions options = settings.options;
+  options.floquet = read_floquet_options(config);
+  options.newton.tolerance = orbit_settings.newton.tolerance;       // the corrector's relative residual
+  options.start_iterations = orbit_settings.newton.max_iterations;  // the first point's Newton
+  // The continued key takes the start value; reading the problem with it validates it and marks
+  // it as used (a key no model reads is then reported as unknown).
+  config.set(settings.key, format_number(options.from), "continue_from");
+  const Problem problem = read_problem(config, 100);
+  if (!problem.model) throw BadInput("`continue` takes the built-in models only, not model = equations");
+  config.check_all_used();
+  const std::vector<int> Ns = settings.Ns.empty() ? std::vector<int>{problem.N} : settings.Ns;
+  const bool switching = problem.analyses->switches_in_state();
+
+  Progress progress(inv.err, "continue", 0, inv.quiet);
+  std::vector<ContinuationResult> levels;
+  for (int N : Ns) levels.push_back(branch_at(config, settings, orbit_settings, options, N, progress));
+  const ContinuationResult& branch = levels.back();
+  std::vector<std::vector<Bifurcation>> by_N;
+  for (const auto& r : levels) by_N.push_back(r.bifurcations);
+  const double tolerance = options.tolerance > 0 ? options.tolerance : 1e-10 * std::abs(options.to - options.from);
+  RichardsonOptions richardson;
+  if (switching && problem.events == EventMode::off) richardson.order = richardson.order_step = 1;  // design.md 1.5
+  const std::vector<BifurcationEstimate> estimates = extrapolate_bifurcations(Ns, by_N, tolerance, richardson);
+  // continue_switch: the period-2 branch of every period doubling on the finest branch.
+  std::vector<ContinuationResult> switched;
+  std::vector<double> switched_from;
+  if (settings.switch_period_doubling)
+    for (const Bifurcation& b : branch.bifurcations)
+      if (b.type == BifurcationType::period_doubling) {
+        switched.push_back(switched_at(config, settings, options, Ns.back(), b, progress));
+        switched_from.push_back(b.parameter);
+      }
+  progress.finish();
+  std::string failures;
+  for (size_t i = 0; i < switched.size(); ++i)
+    if (!switched[i].failure.empty())
+      failures += (failures.empty() ? "" : "; ") + std::string("period-2 branch from ") +
+                  format_number(switched_from[i]) + ": " + switched[i].failure;
+  for (size_t i = 0; i < levels.size(); ++i)
+    if (!levels[i].failure.empty())
+      failures +=
+          (failures.empty() ? "" : "; ") + std::string("N = ") + std::to_string(Ns[i]) + ": " + levels[i].failure;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  json j;
+  j["model"] = problem.model_name;
+  j["continue_key"] = settings.key;
+  j["N"] = Ns.back();
+  j["Ns"] = Ns;
+  j["events"] = to_string(problem.events);
+  j["jacobian"] = to_string(problem.jacobian);
+  j["end"] = branch.end;
+  if (!failures.empty()) j["failure"] = failures;
+  j["points"] = points_json(branch.points);
+  j["bifurcations"] = json::array();
+  for (size_t b = 0; b < estimates.size(); ++b) {
+    const BifurcationEstimate& e = estimates[b];
+    const Bifurcation& finest = branch.bifurcations[b];
+    json bj;
+    bj["type"] = to_string(e.type);
+    bj["parameter"] = e.parameter;
+    bj["multipliers"] = multipliers_json(finest.multipliers);
+    bj["angle"] = e.angle;  // NaN for grazing: null
+    bj["measures"] = measures_json(finest.measures);
+    bj["by_N"] = json::array();
+    for (size_t i = 0; i < e.Ns.size(); ++i) bj["by_N"].push_back({{"N", e.Ns[i]}, {"parameter", e.parameters[i]}});
+    bj["extrapolated"] = e.extrapolated;
+    bj["error_estimate"] = e.error_estimate;  // infinity (one level): null
+    bj["observed_order"] = e.observed_order;
+    bj["bracket"] = finest.bracket;
+    if (!e.note.empty() || !finest.note.empty()) bj["note"] = finest.note + (finest.note.empty() ? "" : "; ") + e.note;
+    j["bifurcations"].push_back(bj);
+  }
+  if (settings.switch_period_doubling) {
+    j["switched"] = json::array();
+    for (size_t i = 0; i < switched.size(); ++i) {
+      json sj;
+      sj["from_parameter"] = switched_from[i];
+      sj["orbit_period"] = 2 * problem.orbit_period;
+      sj["N"] = Ns.back();
+      sj["end"] = switched[i].end;
+      sj["points"] = points_json(switched[i].points);
+      sj["bifurcations"] = json::array();
+      for (const Bifurcation& b : switched[i].bifurcations)
+        sj["bifurcations"].push_back({{"type", to_string(b.type)},
+                                      {"parameter", b.parameter},
+                                      {"angle", b.angle},
+                                      {"multipliers", multipliers_json(b.multipliers)},
+                                      {"note", b.note}});
+      j["switched"].push_back(sj);
+    }
+  }
+  json cost;
+  cost["points"] = branch.points.size();
+  cost["newton_iterations"] = branch.newton_iterations;
+  cost["krylov_solves"] = branch.krylov_solves;
+  cost["newton_seconds"] = branch.newton_seconds;
+  cost["krylov_seconds"] = branch.krylov_seconds;
+  cost["locate_seconds"] = branch.locate_seconds;
+  cost["branch_seconds"] = branch.seconds;
+  j["cost_finest_N"] = cost;
+  j["seconds"] = seconds;
+
+  if (inv.out_dir) {
+    const std::filesystem::path dir(*inv.out_dir);
+    OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
+    metadata.parameters.erase(settings.key);  // per row (plot labels the x axis with continue_key)
+    std::string header = metadata_comment_lines(metadata);
+    if (!failures.empty()) header += "# INCOMPLETE: the branch ended in a failure: " + failures + "\n";
+    std::ostringstream rows;
+    rows << header << "parameter,stable,unstable,abs_mu1";
+    const size_t d = branch.points.front().measures.max.size();
+    for (size_t c = 0; c < d; ++c) rows << ",max_y" << c + 1;
+    for (size_t c = 0; c < d; ++c) rows << ",min_y" << c + 1;
+    rows << ",max_H,contact_time,newton_iterations";
+    for (int k = 0; k < options.floquet.nev; ++k) rows << ",mu" << k + 1 << "_re,mu" << k + 1 << "_im";
+    rows << "\n";
+    for (const auto& p : branch.points) {
+      rows << csv_number(p.parameter) << "," << (p.stable() ? 1 : 0) << "," << p.unstable << ","
+           << csv_number(p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]));
+      for (double v : p.measures.max) rows << "," << csv_number(v);
+      for (double v : p.measures.min) rows << "," << csv_number(v);
+      rows << "," << csv_number(p.measures.max_H) << "," << csv_number(p.measures.contact_time) << ","
+           << p.newton_iterations;
+      for (int k = 0; k < options.floquet.nev; ++k) {
+        const bool has = static_cast<size_t>(k) < p.multipliers.size();
+        rows << "," << csv_number(has ? p.multipliers[k].real() : NAN) << ","
+             << csv_number(has ? p.multipliers[k].imag() : NAN);
+      }
+      rows << "\n";
+    }
+    std::ostringstream bifs;
+    bifs << header << "type,parameter,extrapolated,error_estimate,observed_order,angle,abs_mu,by_N\n";
+    for (size_t b = 0; b < estimates.size(); ++b) {
+      const BifurcationEstimate& e = estimates[b];
+      std::complex<double> critical;
+      const double g = e.type == BifurcationType::grazing ? NAN
+                                                          : continuation_detail::multiplier_test(
+                                                                e.type, branch.bifurcations[b].multipliers, &critical);
+      bifs << to_string(e.type) << "," << csv_number(e.parameter) << "," << csv_number(e.extrapolated) << ","
+           << csv_number(e.error_estimate) << "," << csv_number(e.observed_order) << "," << csv_number(e.angle) << ","
+           << csv_number(std::isfinite(g) ? std::abs(critical) : NAN) << ",";
+      for (size_t i = 0; i < e.Ns.size(); ++i)
+        bifs << (i ? ";" : "") << e.Ns[i] << ":" << format_number(e.parameters[i]);
+      bifs << "\n";
+    }
+    write_file_atomically(dir / "branch.csv", rows.str());
+    write_file_atomically(dir / "bifurcations.csv", bifs.str());
+    json file = j;
+    file["metadata"] = metadata_json(metadata);
+    write_file_atomically(dir / "continue.json", file.dump(2) + "\n");
+  }
+
+  if (!failures.empty()) {
+    inv.err << "delayspec continue: numerical failure: " << failures
+            << (inv.out_dir ? "; the branch so far is in " + *inv.out_dir : std::string()) << "\n";
+    return 3;
+  }
+  if (inv.json) {
+    inv.out << j.dump(2) << "\n";
+    return 0;
+  }
+  char line[256];
+  inv.out << "delayspec continue: model " << problem.model_name << ", " << settings.key << " from "
+          << format_number(options.from) << " to " << format_number(options.to) << ", N = ";
+  for (size_t i = 0; i < Ns.size(); ++i) inv.out << (i ? "," : "") << Ns[i];
+  inv.out << "\nbranch (N = " << Ns.back() << "): " << branch.points.size() << " points, ended at `" << branch.end
+          << "`\n";
+  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s\n", settings.key.c_str(), "|mu_1|", "unstable", "max y1");
+  inv.out << line;
+  for (const auto& p : branch.points) {
+    std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g\n", p.parameter,
+                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0]);
+    inv.out << line;
+  }
+  inv.out << "bifurcations: " << estimates.size() << "\n";
+  for (size_t b = 0; b < estimates.size(); ++b) {
+    const BifurcationEstimate& e = estimates[b];
+    inv.out << "  " << to_string(e.type) << " at " << settings.key << " = " << format_number(e.parameter);
+    if (e.type != BifurcationType::grazing)
+      inv.out << ", angle " << e.angle << " (" << e.angle / std::numbers::pi << " pi)";
+    if (e.Ns.size() > 1)
+      inv.out << "; extrapolated " << format_number(e.extrapolated) << " +- " << e.error_estimate << " (order "
+              << e.observed_order << ")";
+    inv.out << "\n";
+    if (!branch.bifurcations[b].note.empty()) inv.out << "    note: " << branch.bifurcations[b].note << "\n";
+  }
+  inv.out << "time: " << seconds << " s (finest N: Newton " << branch.newton_seconds << " s, Krylov "
+          << branch.krylov_seconds << " s)\n";
+  return 0;
+}
+
+}  // namespace delayspec::cli

@@ -1,0 +1,108 @@
+// delayspec floquet: the leading Floquet multipliers of the periodic orbit (CLI contract).
+#include <algorithm>
+#include <chrono>
+#include <optional>
+
+#include "scene/commands/commands.hpp"
+#include "delayspec/floquet.hpp"
+#include "scene/problem/floquet_settings.hpp"
+#include "scene/problem/level_runner.hpp"
+#include "delayspec/stroboscopic_map.hpp"
+#include "scene/problem/orbit_settings.hpp"
+#include "scene/output/output.hpp"
+#include "scene/problem/problem.hpp"
+
+namespace delayspec::cli {
+
+int command_floquet(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  Problem problem = read_problem(config, 100);
+  const OrbitSettings orbit_settings = read_orbit_settings(config);
+  const FloquetOptions options = read_floquet_options(config);
+  // The error bars (error_bars.hpp): two coarser solves, about 1.3x the single one.
+  const bool with_error_bars = config.get_choice("error_bars", "on", {"on", "off"}) == "on";
+  config.check_all_used();
+  const long n = problem.dimension();
+  validate_floquet_options(options, n);  // before the orbit: fail fast
+
+  nlohmann::json json;
+  FloquetResult result;
+  PeriodicOrbit orbit;
+  ContactSummary contacts;
+  double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
+  LevelResult at_N;  // the solve's multipliers with their accuracy
+  std::optional<ErrorBars> bars;
+  double error_bar_seconds = 0;
+  {
+    const auto orbit_start = std::chrono::steady_clock::now();
+    OrbitRequest request;
+    request.sequence = with_error_bars;  // the orbit at N: where a coarser level's Newton may start
+    LinearisedOrbit at_orbit = problem.analyses->linearised_orbit(problem.map_settings(), orbit_settings, request);
+    orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
+    orbit = std::move(at_orbit.orbit);
+    contacts = at_orbit.contacts;
+    result = floquet_multipliers(*at_orbit.monodromy, options);
+    // Each multiplier's accuracy (multiplier_accuracy): the ones below it are not printed as values.
+    at_N = level_result(result, n, problem.grid().K);
+    if (with_error_bars)
+      bars = floquet_error_bars(problem, orbit_settings, options, at_N, std::move(at_orbit.sequence),
+                                error_bar_seconds);
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::vector<double>& accuracy = at_N.accuracy;
+
+  if (inv.json) {
+    json["model"] = problem.model_name;
+    json["N"] = problem.N;
+    json["dimension"] = n;
+    json["solver"] = result.solver;
+    json["multipliers"] = multipliers_json(result.multipliers);
+    add_resolution_json(json["multipliers"], result.multipliers, accuracy);
+    if (bars) {
+      add_error_bars_json(json["multipliers"], *bars);
+      json["verdict"] = to_string(bars->verdict);
+      json["error_bars"] = error_bars_json(*bars, error_bar_seconds);
+    }
+    json["seconds"] = seconds;
+    json["orbit_seconds"] = orbit_seconds;
+    json["eigensolver_seconds"] = result.seconds;
+    json["operator_applications"] = result.operator_applications;
+    json["converged"] = result.converged;
+    json["restarts"] = result.restarts;
+    json["residuals"] = result.residuals;  // |M v - mu v| / (|mu| |v|) per multiplier; [] for dense
+    if (result.ncv > 0) {
+      json["ncv"] = result.ncv;
+      json["tol"] = options.tolerance;
+      json["iterations"] = result.iterations;
+      json["seed"] = options.seed;
+    }
+    json["h"] = problem.grid().h;
+    json["steps_per_map"] = problem.grid().K;
+    json["events"] = to_string(problem.events);
+    json["jacobian"] = to_string(problem.jacobian);
+    json["orbit_residual"] = orbit.residual;
+    json["orbit_periods"] = orbit.maps;
+    json["orbit"] = orbit_json(orbit, contacts);
+    if (!result.note.empty()) json["note"] = result.note;
+    inv.out << json.dump(2) << "\n";
+  } else {
+    inv.out << "delayspec floquet: model " << problem.model_name << ", " << problem.grid().describe() << ", n = " << n
+            << "\n";
+    print_orbit(inv.out, orbit, contacts);
+    inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << result.solver << ", "
+            << result.operator_applications << " operator applications):\n";
+    print_multipliers(inv.out, result.multipliers, accuracy);
+    if (bars) print_error_bars(inv.out, result.multipliers, *bars);
+    if (!result.residuals.empty()) {
+      double worst = 0;
+      for (double r : result.residuals) worst = std::max(worst, r);
+      inv.out << "Krylov: ncv = " << result.ncv << ", " << result.converged << " converged, " << result.restarts
+              << " restarts, largest residual |M v - mu v| / |mu| = " << worst << "\n";
+    }
+    if (!result.note.empty()) inv.out << "note: " << result.note << "\n";
+    inv.out << "time: " << seconds << " s\n";
+  }
+  return 0;
+}
+
+}  // namespace delayspec::cli

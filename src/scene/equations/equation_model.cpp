@@ -1,0 +1,200 @@
+#include "scene/equations/equation_model.hpp"
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <mutex>
+
+#include <toml++/toml.h>
+
+#include "delayspec/errors.hpp"
+#include "scene/equations/equation_plugin.hpp"
+#include "scene/equations/equations_module_loader.hpp"
+#include "scene/equations/model_cache.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+// GiNaC is not thread-safe: every use of it (the module's generate and constants), and the
+// registries below, under one lock. The points of a sweep or chart (threads) read the same table
+// again and again with other parameter values: each table is printed once per process, and
+// compiled and loaded once per process and cache directory.
+std::mutex& equations_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+const EquationModelSource& generated(const std::string& table_text, const KeyIndex& index) {
+  // Never destroyed: `constants` holds GiNaC expressions, which must not outlive GiNaC's own
+  // statics, and the module's destructors may run first at exit.
+  static auto& sources = *new std::map<std::string, std::unique_ptr<const EquationModelSource>>;
+  const std::lock_guard<std::mutex> lock(equations_mutex());
+  if (auto it = sources.find(table_text); it != sources.end()) return *it->second;
+  toml::table table;
+  try {
+    table = toml::parse(std::string_view(table_text), std::string_view("[equations]"));
+  } catch (const toml::parse_error& e) {
+    throw BadInput("`equations`: " + std::string(e.description()));
+  }
+  auto source = std::make_unique<const EquationModelSource>(equations_module().generate(table, engine_keys(index)));
+  const EquationModelSource& result = *source;
+  sources[table_text] = std::move(source);
+  return result;
+}
+
+std::vector<double> constants_at(const EquationModelSource& source, const std::vector<double>& p) {
+  const std::lock_guard<std::mutex> lock(equations_mutex());
+  return source.constants(p);
+}
+
+const EquationPlugin& compiled(const EquationModelSource& source, const std::filesystem::path& cache_dir) {
+  static std::map<std::string, EquationPlugin> plugins;
+  const std::lock_guard<std::mutex> lock(equations_mutex());
+  const std::string key = cache_dir.string() + '\n' + source.code;
+  if (auto it = plugins.find(key); it != plugins.end()) return it->second;
+  return plugins[key] = load_equation_plugin(source.code, cache_dir);
+}
+
+// The plugin's analyses (compiled from the equations), with a failure at a step that is not
+// finite told in the equations' terms: the engine says which step and where it evaluated the
+// model (NonFiniteStep), GiNaC says which term is not finite there. Only failures pay for it.
+class ExplainedAnalyses final : public ModelAnalyses {
+ public:
+  ExplainedAnalyses(std::unique_ptr<const ModelAnalyses> inner, const EquationModelSource& source,
+                    std::vector<double> p)
+      : inner_(std::move(inner)), source_(source), p_(std::move(p)) {}
+
+  int state_dimension() const override { return inner_->state_dimension(); }
+  bool switches_in_state() const override { return inner_->switches_in_state(); }
+  bool switches_in_time() const override { return inner_->switches_in_time(); }
+  bool is_linear() const override { return inner_->is_linear(); }
+  double tau() const override { return inner_->tau(); }
+  double period() const override { return inner_->period(); }
+  LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
+                                   const OrbitRequest& request) const override {
+    return explained([&] { return inner_->linearised_orbit(map, orbit, request); });
+  }
+  LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const override {
+    return explained([&] { return inner_->lyapunov(map, options); });
+  }
+  std::vector<Eigen::VectorXd> section_sequence(const MapSettings& map, long transient, long count) const override {
+    return explained([&] { return inner_->section_sequence(map, transient, count); });
+  }
+  SimulationRecord<Eigen::Dynamic> simulate(const MapSettings& before_map, const MapSettings& map,
+                                            const SimulationOptions& options,
+                                            const ModelAnalyses* before) const override {
+    const auto* explained_before = dynamic_cast<const ExplainedAnalyses*>(before);
+    const ModelAnalyses* inner_before = explained_before ? explained_before->inner_.get() : before;
+    return explained([&] { return inner_->simulate(before_map, map, options, inner_before); });
+  }
+
+ private:
+  template <class Analysis>
+  auto explained(const Analysis& analysis) const -> decltype(analysis()) {
+    try {
+      return analysis();
+    } catch (const NonFiniteStep& e) {
+      throw NumericalFailure(explanation(e));
+    }
+  }
+
+  // "<the engine's words>; at t = 0, x = 0, x_tau = 0: `equations.rhs[1]` = ...: its derivative
+  // by x, ..., is undefined (...)", each point where some term is not finite.
+  std::string explanation(const NonFiniteStep& e) const {
+    std::string text = e.what();
+    bool named = false;
+    for (const ModelPoint& point : e.points()) {
+      std::vector<std::string> terms;
+      {
+        const std::lock_guard<std::mutex> lock(equations_mutex());
+        terms = source_.terms_not_finite(point.t, point.y, point.y_tau, p_);
+      }
+      if (terms.empty()) continue;
+      text += "; at t = " + format_number(point.t);
+      for (size_t i = 0; i < source_.state.size() && i < point.y.size(); ++i)
+        text += ", " + source_.state[i] + " = " + format_number(point.y[i]);
+      for (size_t i = 0; i < source_.state.size() && i < point.y_tau.size(); ++i)
+        text += ", " + source_.state[i] + "_tau = " + format_number(point.y_tau[i]);
+      for (size_t i = 0; i < terms.size(); ++i) text += (i ? "; " : ": ") + terms[i];
+      named = true;
+      break;  // the first point the step evaluated where a term is not finite
+    }
+    if (!named) {
+      text += "; every term of the equations is finite where this step evaluated them";
+      for (const ModelPoint& point : e.points()) text += describe_point(point);
+      text += ": the step itself is not finite (a larger N gives smaller steps)";
+    }
+    return "model = equations: " + text;
+  }
+
+  std::shared_ptr<const ModelAnalyses> inner_;
+  const EquationModelSource& source_;  // never destroyed (generated())
+  std::vector<double> p_;
+};
+
+double positive_value(const std::string& item, double value) {
+  if (!std::isfinite(value) || !(value > 0))
+    throw BadInput("`" + item + "` evaluates to " + format_number(value) +
+                   " at these parameters: must be > 0 and finite");
+  return value;
+}
+
+}  // namespace
+
+std::vector<std::string> engine_keys(const KeyIndex& index) {
+  std::vector<std::string> keys = {"model", "equations", "tau_over_T", "model_cache"};
+  for (const auto& key : keys_of_every_model(index)) keys.push_back(key);
+  return keys;
+}
+
+EquationModel read_equation_model(Config& config, const std::function<void(double, double)>& check_grid) {
+  if (!config.has("equations"))
+    throw BadInput("`model = equations`: the scene has no [equations] table (docs/models.md shows its format)");
+  const std::string text = config.get_string("equations", "");
+  // The cache holds code this program runs: a scene, which may come from anywhere, never chooses
+  // it (model_cache.hpp).
+  if (config.has("model_cache") && config.from_scene("model_cache"))
+    throw BadInput("`model_cache` in the scene " + config.origin("model_cache") +
+                   ": a scene may not choose where compiled models are loaded from; give it on the command line " +
+                   "(--set model_cache=DIR), as a Python keyword, or through XDG_CACHE_HOME");
+  const std::filesystem::path cache_dir = config.get_string("model_cache", default_model_cache().string());
+  const EquationModelSource& src = generated(text, config.key_index());
+  std::vector<double> p(src.parameters.size());
+  for (size_t k = 0; k < p.size(); ++k) {
+    p[k] = config.get_double(src.parameters[k], src.parameter_defaults[k]);
+    require_finite(src.parameters[k].c_str(), p[k]);
+  }
+
+  // Everything that can be checked without the compiled model is checked before the compile
+  // (seconds): the constant expressions, and the grid they give with N.
+  const std::vector<double> constants = constants_at(src, p);
+  const double period_exact = positive_value("equations.period", constants[0]);
+  const bool delay_from_ratio = config.has("tau_over_T");
+  if (delay_from_ratio) require_positive("tau_over_T", config.get_double("tau_over_T", 1));
+  const double tau_exact = delay_from_ratio ? config.get_double("tau_over_T", 1) * period_exact
+                                            : positive_value("equations.delay", constants[1]);
+  for (size_t i = 0; i < src.state.size(); ++i)
+    if (!std::isfinite(constants[2 + i]))
+      throw BadInput("`equations.history." + src.state[i] + "` is not a finite number at these parameters");
+  check_grid(tau_exact, period_exact);
+
+  const EquationPlugin& plugin = compiled(src, cache_dir);
+  const double period = positive_value("equations.period", plugin.period(p.data()));
+  const double tau = delay_from_ratio ? config.get_double("tau_over_T", 1) * period
+                                      : positive_value("equations.delay", plugin.delay(p.data()));
+  std::vector<double> history(src.state.size());
+  plugin.history(p.data(), history.data());
+  for (size_t i = 0; i < history.size(); ++i)
+    if (!std::isfinite(history[i]))
+      throw BadInput("`equations.history." + src.state[i] + "` evaluates to " + format_number(history[i]) +
+                     " at these parameters: must be finite");
+  EquationModel model;
+  model.state = src.state;
+  model.parameters = src.parameters;
+  model.analyses = std::make_shared<const ExplainedAnalyses>(
+      std::unique_ptr<const ModelAnalyses>(plugin.analyses(p.data(), tau, period, history.data())), src, p);
+  return model;
+}
+
+}  // namespace delayspec::cli

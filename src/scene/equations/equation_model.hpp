@@ -1,0 +1,35 @@
+#pragma once
+// model = equations: a model written in the scene's [equations] table (docs/models.md). The
+// table is checked, differentiated and printed as C++ by GiNaC (src/modules/equations, a module loaded
+// on first use: equations_module_loader.hpp), then compiled at run time and loaded
+// (equation_plugin.hpp). Its parameters are keys like those of
+// any model (`--set k=0.3`, sweep_key, chart_x), read here with the table's values as defaults,
+// so a new parameter value never recompiles. The delay is the `delay` expression, or
+// tau_over_T times the period when that key is given.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scene/keys/config.hpp"
+#include "delayspec/model_analyses.hpp"
+
+namespace delayspec::cli {
+
+struct EquationModel {
+  std::vector<std::string> state;       // the state's names (output columns)
+  std::vector<std::string> parameters;  // the parameters' names (keys)
+  std::shared_ptr<const ModelAnalyses> analyses;
+};
+
+// Reads the [equations] table (kept whole by Config as the key `equations`), the parameter keys,
+// tau_over_T and model_cache. BadInput for every input error, naming the item. `check_grid(tau,
+// period)` is called with the delay and period before the model is compiled, so that a grid that
+// cannot be made (a delay shorter than a step, too many steps) is refused in milliseconds.
+EquationModel read_equation_model(Config& config, const std::function<void(double tau, double period)>& check_grid);
+
+// The keys an equation parameter may not be named after: those the engine reads whatever the
+// model (N, nev, seed, ...: keys_of_every_model), and model, equations, tau_over_T and model_cache.
+std::vector<std::string> engine_keys(const KeyIndex& index);
+
+}  // namespace delayspec::cli

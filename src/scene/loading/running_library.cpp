@@ -1,0 +1,18 @@
+#include "scene/loading/running_library.hpp"
+
+#include <dlfcn.h>
+
+#include "delayspec/errors.hpp"
+#include "delayspec/grid.hpp"
+
+namespace delayspec::cli {
+
+std::filesystem::path running_library() {
+  // make_grid: any function defined in libdelayspec; dladdr names the object that holds it.
+  Dl_info info{};
+  if (!dladdr(reinterpret_cast<const void*>(&make_grid), &info) || !info.dli_fname)
+    throw BadInput("cannot locate the delayspec library of this process (dladdr)");
+  return std::filesystem::canonical(info.dli_fname);
+}
+
+}  // namespace delayspec::cli

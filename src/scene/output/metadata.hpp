@@ -1,0 +1,56 @@
+#pragma once
+// Metadata carried by every output file of `delayspec run` (and of any command writing files
+// into --out): what was computed, with which parameters, by which version, in how long.
+//
+// JSON files get a "metadata" object:
+//     {"delayspec_version": "0.1.0", "source_revision": "b054d7f-dirty",
+//      "command": "floquet", "scene": "data/scenes/default.toml",
+//      "parameters": {"N": "200", "k": "0.2", ...},   // every key given (scene + --set), as text
+//      "defaults": {"solver": "spectra", ...},        // every other key the command read, with
+//                                                     // the default it used (Config::effective_defaults)
+//      "N": 200, "events": "on", "jacobian": "consistent",
+//      "wall_seconds": 1.23, "finished_utc": "2026-11-22T04:00:00Z"}
+// CSV files start with the same content as comment lines (gnuplot, numpy.loadtxt and
+// pandas.read_csv(comment='#') skip them):
+//     # delayspec 0.1.0
+//     # source_revision: b054d7f-dirty
+//     # command: floquet
+//     # scene: data/scenes/default.toml
+//     # N = 200                    (one line per key given)
+//     # default: solver = spectra  (one line per key read with its default)
+//     ...
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/keys/config.hpp"
+
+namespace delayspec::cli {
+
+struct OutputMetadata {
+  std::string command;
+  std::optional<std::string> scene;
+  std::map<std::string, std::string> parameters;  // Config::values()
+  std::map<std::string, std::string> defaults;    // Config::effective_defaults()
+  // Resolved discretisation: taken from the result (its "N", "events", "jacobian") when it has
+  // them, else from the parameters, else the defaults.
+  long N = 0;
+  std::string events;
+  std::string jacobian;
+  double wall_seconds = 0;
+};
+
+// Fills the metadata of `command` run with `config`, taking N/events/jacobian from `result`
+// when present.
+OutputMetadata make_metadata(const std::string& command, const std::optional<std::string>& scene, const Config& config,
+                             const nlohmann::json& result, double wall_seconds);
+
+nlohmann::json metadata_json(const OutputMetadata& metadata);
+// The "# ..." comment lines (each ends with a newline).
+std::string metadata_comment_lines(const OutputMetadata& metadata);
+
+// Current UTC time, ISO 8601 ("2026-11-22T04:00:00Z").
+std::string utc_now_iso8601();
+
+}  // namespace delayspec::cli

@@ -1,0 +1,120 @@
+#include "scene/points/point_files.hpp"
+
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+
+#include "scene/output/atomic_file.hpp"
+#include "delayspec/errors.hpp"
+
+namespace delayspec::cli {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// BadInput naming each key whose value differs between `settings` and `stored` (both values; a
+// missing key shows as null).
+[[noreturn]] void settings_differ(const json& settings, const json& stored, const std::string& command) {
+  std::string diff;
+  auto add = [&](const std::string& k) {
+    diff += (diff.empty() ? "`" : ", `") + k + "` (now " + settings.value(k, json()).dump() + ", the " + command +
+            "'s " + (stored.is_object() ? stored.value(k, json()) : json()).dump() + ")";
+  };
+  for (const auto& [k, v] : settings.items())
+    if (!stored.is_object() || !stored.contains(k) || stored[k] != v) add(k);
+  if (stored.is_object())
+    for (const auto& [k, v] : stored.items())
+      if (!settings.contains(k)) add(k);
+  throw BadInput("`--resume`: the settings differ from the interrupted " + command + " in " + diff);
+}
+
+std::string points_directory(const std::string& command) { return command == "sweep" ? "points" : command + "_points"; }
+
+}  // namespace
+
+// nlohmann::json keeps object keys sorted, so the text hashed is canonical.
+std::string settings_hash(const json& settings) {
+  std::uint64_t hash = 14695981039346656037ull;
+  for (const unsigned char c : settings.dump()) {
+    hash ^= c;
+    hash *= 1099511628211ull;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
+}
+
+json resume_settings(const Config& config, const std::vector<std::string>& per_point) {
+  json settings = json::object();
+  for (const auto& [k, v] : config.effective_values())
+    if (k != "threads" && k != "analyses" && k != "title") settings[k] = v;
+  for (const auto& key : per_point) settings[key] = nullptr;
+  return settings;
+}
+
+PointFiles::PointFiles(fs::path dir, std::string command, json settings)
+    : dir_(std::move(dir)),
+      command_(std::move(command)),
+      settings_(std::move(settings)),
+      hash_(settings_hash(settings_)) {}
+
+fs::path PointFiles::settings_path() const { return dir_ / (command_ + "_settings.json"); }
+
+fs::path PointFiles::point_path(long index) const {
+  char name[32];
+  std::snprintf(name, sizeof name, "point_%05ld.json", index);
+  return dir_ / points_directory(command_) / name;
+}
+
+void PointFiles::write(long index, json record) const {
+  record["settings_hash"] = hash_;
+  write_file_atomically(point_path(index), record.dump() + "\n", Flush::skip);  // see Flush
+}
+
+std::map<long, json> PointFiles::start(bool resume, long count) const {
+  if (!resume) {
+    if (fs::exists(settings_path()) || fs::exists(dir_ / points_directory(command_)))
+      throw BadInput("`--out " + dir_.string() + "` already holds a " + command_ +
+                     ": add --resume to complete it, or choose another directory");
+    write_file_atomically(settings_path(), settings_.dump(2) + "\n");
+    return {};
+  }
+  std::ifstream in(settings_path());
+  if (!in)
+    throw BadInput("`--resume`: `" + settings_path().string() + "` not found (no " + command_ + " to resume there)");
+  json stored;
+  try {
+    stored = json::parse(in);
+  } catch (const std::exception&) {
+    throw BadInput("`--resume`: `" + settings_path().string() + "` is not valid JSON");
+  }
+  if (stored != settings_) settings_differ(settings_, stored, command_);
+
+  std::map<long, json> finished;
+  for (long index = 0; index < count; ++index) {
+    const fs::path path = point_path(index);
+    std::ifstream pin(path);
+    if (!pin) continue;
+    json record;
+    try {
+      record = json::parse(pin);
+    } catch (const std::exception&) {
+      continue;  // unreadable point file: recompute the point
+    }
+    // A point of another run (other settings) is never merged into this one.
+    const json stored_hash = record.is_object() ? record.value("settings_hash", json()) : json();
+    if (stored_hash != hash_)
+      throw BadInput("`--resume`: `" + path.string() + "` belongs to a " + command_ +
+                     " with other settings (settings_hash " +
+                     (stored_hash.is_string() ? stored_hash.get<std::string>() : std::string("missing")) + ", this " +
+                     command_ + " " + hash_ + ", settings in " + settings_path().string() +
+                     "): remove the file, or resume with the settings it was computed with");
+    const json stored_index = record.value("index", json());
+    if (stored_index.is_number_integer() && stored_index.get<long>() == index) finished[index] = record;
+  }
+  return finished;
+}
+
+}  // namespace delayspec::cli

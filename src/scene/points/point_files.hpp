@@ -1,0 +1,62 @@
+#pragma once
+// The point files of a run over many independent points (sweep, chart, basin) in `--out DIR`,
+// so that an interrupted run loses only the points in flight and `--resume` completes it, with
+// any number of threads or MPI ranks (docs/parallel.md):
+//   DIR/NAME_settings.json   the effective settings of the run (resume refuses other settings)
+//   DIR/POINTS/point_NNNNN.json  one file per finished point, written atomically by whichever
+//                            thread or rank computed it, with the settings_hash of its run
+//                            (resume refuses a point of another run)
+// where POINTS is `points` for sweep (its documented layout) and NAME_points otherwise, so that
+// the analyses of one `run` keep their points apart.
+//
+// Example (command_sweep.cpp):
+//     PointFiles files(dir, "sweep", resume_settings(config, {key}));
+//     for (auto& [index, record] : files.start(inv.resume, count)) ...;   // the lead, before the points
+//     files.write(index, record);                                  // as each point finishes
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/keys/config.hpp"
+
+namespace delayspec::cli {
+
+// The settings a resumed run must share with the interrupted one: the effective values (a key
+// stated at its default equals the key left out), except the thread count (results do not
+// depend on it), the scene-level keys of `run` (analyses, title), and the `per_point` keys
+// (null: their value is per point).
+nlohmann::json resume_settings(const Config& config, const std::vector<std::string>& per_point);
+
+// FNV-1a (64 bit) of the settings' JSON text, as 16 hex digits: a point record's label of the
+// run it belongs to.
+std::string settings_hash(const nlohmann::json& settings);
+
+class PointFiles {
+ public:
+  PointFiles(std::filesystem::path dir, std::string command, nlohmann::json settings);
+
+  // On the lead, before any point is computed. A new run: BadInput if DIR already holds a run
+  // of this command, else writes the settings. --resume: BadInput unless the stored settings
+  // equal these (naming each differing key with both values) or a point file belongs to other
+  // settings; returns the records of the finished points 0..count-1 by index (an unreadable file,
+  // or one without its index, is left out: its point is computed again).
+  std::map<long, nlohmann::json> start(bool resume, long count) const;
+
+  // Writes point `index`'s record, with this run's settings_hash added (atomically).
+  void write(long index, nlohmann::json record) const;
+
+  const std::string& hash() const { return hash_; }  // settings_hash of the settings
+  std::filesystem::path settings_path() const;
+  std::filesystem::path point_path(long index) const;
+
+ private:
+  std::filesystem::path dir_;
+  std::string command_;
+  nlohmann::json settings_;
+  std::string hash_;
+};
+
+}  // namespace delayspec::cli

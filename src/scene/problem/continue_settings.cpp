@@ -1,0 +1,56 @@
+#include "scene/problem/continue_settings.hpp"
+
+#include "delayspec/errors.hpp"
+#include "scene/problem/parameter_grid.hpp"
+
+namespace delayspec::cli {
+
+ContinueSettings read_continue_settings(Config& config) {
+  ContinueSettings s;
+  if (!config.has("continue_key"))
+    throw BadInput("missing key `continue_key` (the model parameter to continue, e.g. k)");
+  s.key = config.get_string("continue_key", "");
+  // Keys that are not a parameter of the model's equations: the discretisation, the model's name,
+  // and this command's own keys.
+  for (const char* reserved : {"model", "N", "orbit_period", "events", "jacobian", "contact_substeps", "nev", "solver",
+                               "ncv", "tol", "seed", "orbit", "x0", "v0"})
+    if (s.key == reserved)
+      throw BadInput("`continue_key = " + s.key + "`: not a model parameter that can be continued");
+  if (s.key.rfind("continue_", 0) == 0) throw BadInput("`continue_key = " + s.key + "`: not a model parameter");
+  ContinuationOptions& o = s.options;
+  o.from = config.require_double("continue_from");
+  o.to = config.require_double("continue_to");
+  if (o.from == o.to) throw BadInput("`continue_from = continue_to = " + format_number(o.from) + "`: an empty range");
+  require_finite_width("`continue_from = " + format_number(o.from) + "`, `continue_to = " + format_number(o.to) + "`",
+                       o.from, o.to);
+  // 0: the defaults relative to the range (continuation.hpp)
+  o.step = config.get_double("continue_step", 0);
+  o.step_min = config.get_double("continue_step_min", 0);
+  o.step_max = config.get_double("continue_step_max", 0);
+  for (const auto& [name, value] : {std::pair{"continue_step", o.step}, std::pair{"continue_step_min", o.step_min},
+                                    std::pair{"continue_step_max", o.step_max}})
+    if (!(value >= 0) || !std::isfinite(value))
+      throw BadInput("`" + std::string(name) + " = " + format_number(value) + "`: must be > 0 (or 0 for the default)");
+  if (o.step_min > 0 && o.step_max > 0 && o.step_min > o.step_max)
+    throw BadInput("`continue_step_min = " + format_number(o.step_min) +
+                   "` exceeds `continue_step_max = " + format_number(o.step_max) + "`");
+  o.max_points = static_cast<int>(config.get_int_in_range("continue_max_points", 500, 2, 10'000'000));
+  o.tolerance = config.get_double("continue_tolerance", 0);
+  if (!(o.tolerance >= 0) || !std::isfinite(o.tolerance))
+    throw BadInput("`continue_tolerance = " + format_number(o.tolerance) +
+                   "`: must be > 0 (or 0 for 1e-10 |to - from|)");
+  if (config.has("continue_Ns")) {
+    for (long N : config.get_int_list("continue_Ns", {})) {
+      if (N < 1 || N > 10'000'000)
+        throw BadInput("`continue_Ns`: N = " + std::to_string(N) + " must be between 1 and 1e7");
+      if (!s.Ns.empty() && N <= s.Ns.back())
+        throw BadInput("`continue_Ns`: must be increasing (" + std::to_string(s.Ns.back()) + ", " + std::to_string(N) +
+                       ")");
+      s.Ns.push_back(static_cast<int>(N));
+    }
+  }
+  s.switch_period_doubling = config.get_choice("continue_switch", "false", {"false", "true"}) == "true";
+  return s;
+}
+
+}  // namespace delayspec::cli

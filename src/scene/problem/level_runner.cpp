@@ -1,0 +1,194 @@
+#include "scene/problem/level_runner.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <sstream>
+
+#include "delayspec/errors.hpp"
+#include "delayspec/lambert_w.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+// Whether the problem's grid can be made at N (make_grid: a delay/period ratio may need multiples).
+bool valid_grid(const Problem& problem, long N) {
+  try {
+    Problem at_N = problem;
+    at_N.N = static_cast<int>(N);
+    at_N.grid();
+    return true;
+  } catch (const BadInput&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+std::vector<int> read_N_list(Config& config, const Problem& problem, int default_min, int default_max) {
+  std::vector<int> Ns;
+  const bool has_list = config.has("Ns");
+  const bool has_range = config.has("N_min") || config.has("N_max");
+  if (has_list && has_range) throw BadInput("`Ns` and `N_min`/`N_max` are both given: give one of them");
+  std::string what = "`Ns`";
+  if (has_list) {
+    what = "`Ns = " + config.get_string("Ns", "") + "`";
+    for (long N : config.get_int_list("Ns", {})) {
+      if (N < 1 || N > INT_MAX) throw BadInput(what + ": `" + std::to_string(N) + "` is not an integer >= 1");
+      Ns.push_back(static_cast<int>(N));
+    }
+  } else {
+    long lo = config.get_int_in_range("N_min", default_min, 1, INT_MAX);
+    long hi = config.get_int_in_range("N_max", default_max, lo, INT_MAX);  // lo = N_min
+    if (!has_range) {
+      // The defaults, on a grid that needs multiples (tau/T = 2 needs even N): the first valid N
+      // from default_min on, doubled as often as the defaults are (26, 52, ... for 25, 50, ...).
+      long first = lo;
+      while (first < 2 * lo && !valid_grid(problem, first)) ++first;
+      if (valid_grid(problem, first)) {
+        hi = first * (hi / lo);
+        lo = first;
+      }
+    }
+    for (long N = lo; N <= hi; N *= 2) Ns.push_back(static_cast<int>(N));
+  }
+  for (size_t i = 1; i < Ns.size(); ++i)
+    if (Ns[i] <= Ns[i - 1])
+      throw BadInput(what + ": must be strictly increasing (" + std::to_string(Ns[i - 1]) + " then " +
+                     std::to_string(Ns[i]) + ")");
+  for (int N : Ns) {  // fail fast on an N the grid cannot take
+    Problem at_N = problem;
+    at_N.N = N;
+    at_N.grid();
+  }
+  return Ns;
+}
+
+std::vector<std::string> read_word_list(Config& config, const std::string& key, const std::string& fallback,
+                                        const std::vector<std::string>& allowed) {
+  const std::string text = config.get_string(key, fallback);
+  std::vector<std::string> words;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const auto b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+    item = b == std::string::npos ? "" : item.substr(b, e - b + 1);
+    bool ok = false;
+    for (const auto& a : allowed) ok = ok || a == item;
+    if (!ok) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      throw BadInput("`" + key + " = " + text + "`: `" + item + "` is not one of " + list);
+    }
+    for (const auto& w : words)
+      if (w == item) throw BadInput("`" + key + " = " + text + "`: `" + item + "` is listed twice");
+    words.push_back(item);
+  }
+  if (words.empty()) throw BadInput("`" + key + " = " + text + "`: empty list");
+  return words;
+}
+
+std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count) {
+  if (const auto* linear = problem.model ? std::get_if<LinearModel>(&*problem.model) : nullptr) {
+    const LinearParameters& p = linear->parameters();
+    if (p.b == 0) return {};  // no delay term: Lambert W form does not apply
+    return linear_dde_multipliers(p.a, p.b, p.tau, p.period, count);
+  }
+  return {};
+}
+
+LevelResult level_result(const FloquetResult& result, long n, long K) {
+  LevelResult r;
+  r.multipliers = result.multipliers;
+  r.operator_applications = result.operator_applications;
+  const double radius = result.multipliers.empty() ? 0.0 : std::abs(result.multipliers.front());
+  for (size_t k = 0; k < result.multipliers.size(); ++k)
+    r.accuracy.push_back(multiplier_accuracy(result.multipliers[k],
+                                             k < result.residuals.size() ? result.residuals[k] : NAN, n, K, radius));
+  return r;
+}
+
+RichardsonOptions error_expansion(const Problem& problem) {
+  RichardsonOptions options;
+  const bool first_order = problem.switching() && problem.events == EventMode::off;
+  options.order = first_order ? 1 : 2;
+  options.order_step = first_order ? 1 : 2;
+  return options;
+}
+
+LevelResult StudyLevels::run(int N, int count, const Eigen::VectorXd* guess, int from_N) {
+  LevelResult r;
+  const auto start = std::chrono::steady_clock::now();
+  bool orbit_found = false;
+  Eigen::VectorXd sequence;
+  Problem level = problem_;
+  level.N = N;
+  const long K = level.grid().K;
+  try {
+    with_monodromy(problem_, events_, orbit_, N,
+                   [&](const LinearOperator& op, const LinearisedOrbit& at_orbit, double) {
+                     sequence = at_orbit.sequence;
+                     orbit_found = true;
+                     FloquetOptions fo = solver_;
+                     fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
+                     r = level_result(floquet_multipliers(op, fo), op.rows(), K);
+                   },
+                   {guess, true});
+    if (sequence.size() > 0) sequences_[N] = std::move(sequence);
+    if (guess) r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);
+  } catch (const NumericalFailure& e) {
+    r = {};
+    r.failure = e.what();
+    if (!orbit_found) orbit_failed_.insert(N);
+    failed_[N] = r.failure;
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (progress_) progress_->add();
+  return r;
+}
+
+ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
+                             const LevelResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  constexpr int kExtra = 2;  // candidates beyond nev for the matching (convergence.hpp)
+  FloquetOptions coarse = solver;
+  coarse.ncv = 0;  // the automatic subspace: a user's ncv may exceed a coarse level's dimension
+  coarse.nev = solver.nev + kExtra;
+  // A valid grid on which the solver's options hold, with more than the candidates (a proper
+  // sub-spectrum).
+  auto valid = [&](int N) {
+    if (!valid_grid(problem, N)) return false;
+    Problem at = problem;
+    at.N = N;
+    const long n = at.dimension();
+    FloquetOptions checked = coarse;
+    checked.nev = static_cast<int>(std::min<long>(coarse.nev, n));
+    try {
+      validate_floquet_options(checked, n);
+    } catch (const BadInput&) {
+      return false;
+    }
+    return n > coarse.nev;
+  };
+  std::vector<int> Ns = coarser_levels(problem.N, valid);
+  StudyLevels levels(problem, problem.events, orbit, coarse);
+  std::vector<LevelResult> results;
+  for (int N : Ns) results.push_back(levels.level(N, coarse.nev));
+  if (orbit_at_N.size() > 0) {
+    levels.keep_orbit(problem.N, std::move(orbit_at_N));
+    for (size_t i = 0; i < Ns.size(); ++i)
+      if (!results[i].failure.empty())
+        if (std::optional<LevelResult> again = levels.retry(Ns[i], coarse.nev, problem.N)) {
+          const std::string first = results[i].failure;
+          results[i] = std::move(*again);
+          if (!results[i].failure.empty()) results[i].failure = first + "; retried: " + results[i].failure;
+        }
+  }
+  Ns.push_back(problem.N);
+  results.push_back(at_N);
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return error_bars(Ns, results, error_expansion(problem));
+}
+
+}  // namespace delayspec::cli

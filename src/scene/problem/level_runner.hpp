@@ -1,0 +1,101 @@
+#pragma once
+// Shared by the commands that solve at several resolutions (converge, bench, floquet's error
+// bars): the problem at another resolution N, its periodic orbit and monodromy, a level of a
+// study, and the key lists they read (Ns / N_min..N_max).
+#include <chrono>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "scene/keys/config.hpp"
+#include "delayspec/convergence.hpp"
+#include "delayspec/error_bars.hpp"
+#include "delayspec/floquet.hpp"
+#include "delayspec/periodic_orbit.hpp"
+#include "scene/problem/orbit_settings.hpp"
+#include "scene/problem/problem.hpp"
+#include "scene/output/progress.hpp"
+
+namespace delayspec::cli {
+
+// `Ns` (comma list), or `N_min` .. `N_max` doubling (N_min, 2 N_min, ... <= N_max); defaults
+// when neither is given (moved up to the first valid N when the grid needs multiples: 26, 52, ...
+// for tau/T = 2). Validated: each N >= 1, strictly increasing, and a valid grid for the
+// problem (make_grid names N when the delay/period ratio needs a multiple).
+std::vector<int> read_N_list(Config& config, const Problem& problem, int default_min, int default_max);
+
+// A comma-separated list of words, each one of `allowed` (BadInput naming the key and the word).
+std::vector<std::string> read_word_list(Config& config, const std::string& key, const std::string& fallback,
+                                        const std::vector<std::string>& allowed);
+
+// The exact leading multipliers when the model has them (linear: Lambert W), else empty.
+std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count);
+
+// Builds the problem at resolution N with the given events mode, finds its periodic orbit (as
+// `request` says: from another level's orbit by Newton, and whether to keep the sequence) and
+// calls fn(monodromy, linearised_orbit, setup_seconds).
+template <class Fn>
+void with_monodromy(const Problem& problem, EventMode events, const OrbitSettings& orbit_settings, int N, Fn&& fn,
+                    const OrbitRequest& request = {}) {
+  const auto start = std::chrono::steady_clock::now();
+  Problem p = problem;
+  p.events = events;
+  p.N = N;
+  const LinearisedOrbit at_orbit = p.analyses->linearised_orbit(p.map_settings(), orbit_settings, request);
+  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  fn(static_cast<const LinearOperator&>(*at_orbit.monodromy), at_orbit, setup);
+}
+
+// A level's multipliers with their accuracy (multiplier_accuracy, convergence.hpp), from one
+// solve of a monodromy of dimension n over K steps.
+LevelResult level_result(const FloquetResult& result, long n, long K);
+
+// The Richardson expansion of the problem's discretisation error: h^2, h^4, ... (the trapezoid,
+// smooth or with events located), or h, h^2, ... for a switching model with events = off (a
+// step across the switching surface is first order, design 1.5).
+RichardsonOptions error_expansion(const Problem& problem);
+
+// A level of a study: orbit, monodromy, multipliers and their accuracy (convergence.hpp). The
+// orbits of the levels that succeeded are kept (states of one map, a few MB at most) so that a
+// level whose orbit failed can be retried with Newton from its nearest neighbour's.
+class StudyLevels {
+ public:
+  StudyLevels(const Problem& problem, EventMode events, const OrbitSettings& orbit, const FloquetOptions& solver,
+              Progress* progress = nullptr)
+      : problem_(problem), events_(events), orbit_(orbit), solver_(solver), progress_(progress) {}
+
+  LevelResult level(int N, int count) { return run(N, count, nullptr); }
+
+  // Only a level whose orbit failed is worth a second try; any other failure stands.
+  std::optional<LevelResult> retry(int N, int count, int from_N) {
+    if (!orbit_failed_.count(N) || !sequences_.count(from_N)) return std::nullopt;
+    return run(N, count, &sequences_.at(from_N), from_N);
+  }
+
+  // A level computed elsewhere (the solve at N itself): its orbit, for the retries of the others.
+  void keep_orbit(int N, Eigen::VectorXd sequence) { sequences_[N] = std::move(sequence); }
+
+ private:
+  LevelResult run(int N, int count, const Eigen::VectorXd* guess, int from_N = 0);
+
+  const Problem& problem_;
+  EventMode events_;
+  const OrbitSettings& orbit_;
+  const FloquetOptions& solver_;
+  Progress* progress_;
+  std::map<int, Eigen::VectorXd> sequences_;  // N -> orbit states of one map, levels that succeeded
+  std::set<int> orbit_failed_;                // N whose orbit (not the eigen-solve) failed
+  std::map<int, std::string> failed_;         // N -> why it failed
+};
+
+// floquet's error bars (delayspec/error_bars.hpp) for the multipliers `at_N` of the problem at
+// its N (level_result of its solve): the coarser levels (N/16 and N/4, valid grids on which the solver's options hold), each
+// solved as a study level with nev + 2 candidates (a level whose orbit failed is retried by Newton
+// from `orbit_at_N`, the orbit's states at N, when given), then analysed. `seconds` receives what
+// the coarser levels cost.
+ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
+                             const LevelResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds);
+
+}  // namespace delayspec::cli

@@ -1,0 +1,89 @@
+#pragma once
+// Problem: what every command needs to know about the system being studied: the model, the
+// resolution N and the discretisation options; the grid and the dimensions follow from them.
+// Read from a Config; every key it reads is documented in the CLI contract.
+//
+// The model's analyses (delayspec/model_analyses.hpp) are the one hand-off from a problem to the
+// engine, for the built-in models and for a model written as equations in the scene alike.
+// with_map() is kept for what only the built-in models offer (continuation, the classic
+// discretisations, simulate's control switch).
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "scene/keys/config.hpp"
+#include "delayspec/grid.hpp"
+#include "delayspec/model_impact.hpp"
+#include "delayspec/model_linear.hpp"
+#include "delayspec/model_mackey_glass.hpp"
+#include "delayspec/model_mathieu.hpp"
+#include "delayspec/model_analyses.hpp"
+#include "delayspec/model_milling.hpp"
+#include "delayspec/stepper.hpp"
+#include "delayspec/stroboscopic_map.hpp"
+
+namespace delayspec::cli {
+
+using AnyModel = std::variant<ImpactModel, LinearModel, MathieuModel, MackeyGlassModel, MillingModel>;
+
+struct Problem {
+  std::string model_name;
+  std::optional<AnyModel> model;                  // the built-in model; empty for model = equations
+  std::shared_ptr<const ModelAnalyses> analyses;  // every model
+  std::vector<std::string> state_names;           // the state's components: "x", "v" (output columns)
+  int N = 100;
+  int orbit_period = 1;
+  EventMode events = EventMode::on;
+  JacobianMode jacobian = JacobianMode::consistent;
+  int contact_substeps = StepOptions{}.contact_substeps;  // trapezoid sub-steps per contact piece
+
+  // The grid of this problem: a function of (model, N, orbit_period), never a stored copy.
+  HistoryGrid grid() const;
+  // d: the model's state dimension.
+  int state_dimension() const;
+  // n = d (M + 1): the dimension of the map's history vector (and of the monodromy).
+  long dimension() const { return grid().dimension(state_dimension()); }
+  // N, orbit_period and the step options, as the analyses take them.
+  MapSettings map_settings() const;
+  // Whether the model switches, in its state (impact) or in time (milling).
+  bool switching() const { return analyses->switches_in_state() || analyses->switches_in_time(); }
+};
+
+// The stepper options (events, jacobian, contact sub-steps) the problem asks for.
+StepOptions step_options(const Problem& problem);
+
+// The problem as a map, in one place: builds the problem's stepper and stroboscopic map and
+// returns fn(model, map) (fn is generic in the model; every alternative must return one type).
+// Built-in models only: BadInput for model = equations, naming `what` needs a built-in model.
+template <class Fn>
+decltype(auto) with_map(const Problem& problem, Fn&& fn, const std::string& what) {
+  if (!problem.model) throw BadInput(what + " takes the built-in models only, not model = equations");
+  return std::visit(
+      [&](const auto& model) -> decltype(auto) {
+        using Model = std::decay_t<decltype(model)>;
+        const StroboscopicMap<Model> map(TrapezoidStepper<Model>(model, step_options(problem)), problem.grid());
+        return fn(model, map);
+      },
+      *problem.model);
+}
+
+// The built-in models, the default first.
+const std::vector<std::string>& model_names();
+// The values of the key `model`: the built-in models and "equations" (a model written in the
+// scene's [equations] table, equation_model.hpp).
+const std::vector<std::string>& model_choices();
+
+// The key values of `events` and `jacobian` (the JSON and text edge): "on", "linear", "off";
+// "consistent", "frozen". parse_* throw BadInput naming `key` for any other text.
+std::string to_string(EventMode mode);
+std::string to_string(JacobianMode mode);
+EventMode parse_event_mode(const std::string& text, const std::string& key = "events");
+const std::vector<std::string>& event_mode_names();
+
+// Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps.
+// default_N is used when the key N is absent.
+Problem read_problem(Config& config, int default_N = 100);
+
+}  // namespace delayspec::cli

@@ -1,0 +1,163 @@
+// The run-time compilation of a model (equation_plugin.hpp), on a struct written here by hand in
+// the form the equation printer emits: x' = a x + b x(t - tau), the built-in linear model. What
+// is checked: the loaded analyses give the built-in model's multipliers; a second load is a
+// cache hit (counted compilations, not a clock); two threads loading a new model at once compile
+// it once; a missing compiler, a compile error and an unwritable cache are BadInput.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "delayspec/builtin_analyses.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec/floquet.hpp"
+#include "scene/equations/equation_plugin.hpp"
+
+namespace delayspec::cli {
+namespace {
+
+// What equation_model_source prints for state x, parameters (a, b), period 1, delay 1, rhs
+// a*x + b*x_tau, history x = 1.
+const char* kLinearCode = R"(struct EquationModel {
+  static constexpr int d = 1;
+  static constexpr int parameter_count = 2;
+  static constexpr bool has_switching = false;
+  static constexpr bool has_time_switches = false;
+  static constexpr bool affine_in_state = true;
+  static constexpr bool is_linear = true;
+  using Vector = delayspec::Vec<d>;
+  using Matrix = delayspec::Mat<d>;
+  std::array<double, parameter_count> p{};
+  double tau_ = 0, period_ = 0;
+  Vector history_ = Vector::Zero();
+  static double period_of(const double*) { return 1.0; }
+  static double delay_of(const double*) { return 1.0; }
+  static Vector history_of(const double*) { return Vector(1.0); }
+  double tau() const { return tau_; }
+  double period() const { return period_; }
+  Vector initial_state() const { return history_; }
+  Vector f(int, double, const Vector& y, const Vector& z) const { return Vector(p[0] * y[0] + p[1] * z[0]); }
+  Matrix A(int, double, const Vector&, const Vector&) const { return Matrix::Constant(p[0]); }
+  Matrix B(int, double, const Vector&, const Vector&) const { return Matrix::Constant(p[1]); }
+  Vector f_t(int, double, const Vector&, const Vector&) const { return Vector::Zero(); }
+  Vector f_tt(int, double, const Vector&, const Vector&) const { return Vector::Zero(); }
+};)";
+
+class EquationPluginTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cache_ = std::filesystem::temp_directory_path() / ("delayspec-plugin-test-" + std::to_string(::getpid()) + "-" +
+                                                       ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(cache_);
+  }
+  void TearDown() override { std::filesystem::remove_all(cache_); }
+  std::filesystem::path cache_;
+};
+
+std::vector<std::complex<double>> leading(const ModelAnalyses& analyses, int N) {
+  MapSettings map;
+  map.N = N;
+  const LinearisedOrbit at = analyses.linearised_orbit(map, OrbitSettings{});
+  FloquetOptions options;
+  options.nev = 4;
+  options.solver = FloquetSolver::dense_lapack;
+  return floquet_multipliers(*at.monodromy, options).multipliers;
+}
+
+TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInAndASecondLoadIsACacheHit) {
+  const long before = equation_plugin_compilations();
+  const EquationPlugin plugin = load_equation_plugin(kLinearCode, cache_);
+  EXPECT_EQ(equation_plugin_compilations(), before + 1);
+  const double p[2] = {-1.0, 0.5};
+  EXPECT_EQ(plugin.period(p), 1.0);
+  EXPECT_EQ(plugin.delay(p), 1.0);
+  double y0 = 0;
+  plugin.history(p, &y0);
+  EXPECT_EQ(y0, 1.0);
+  const std::unique_ptr<ModelAnalyses> loaded(plugin.analyses(p, 1.0, 1.0, &y0));
+  EXPECT_EQ(loaded->state_dimension(), 1);
+  EXPECT_TRUE(loaded->is_linear());
+  LinearParameters lp;
+  lp.a = -1;
+  lp.b = 0.5;
+  const auto builtin = builtin_analyses(LinearModel(lp));
+  const auto a = leading(*loaded, 64), b = leading(*builtin, 64);
+  ASSERT_EQ(a.size(), b.size());
+  // The same arithmetic in the same order: the two monodromies are the same matrix, and LAPACK
+  // gives the same eigenvalues to rounding (1e-14 relative allows for a different code path of
+  // the compiled expressions, a few ulp per entry).
+  for (size_t k = 0; k < a.size(); ++k) EXPECT_LE(std::abs(a[k] - b[k]), 1e-14 * std::abs(b[0])) << k;
+
+  const EquationPlugin again = load_equation_plugin(kLinearCode, cache_);
+  EXPECT_EQ(equation_plugin_compilations(), before + 1);  // the cached object, not a compilation
+  EXPECT_EQ(again.object, plugin.object);
+}
+
+TEST_F(EquationPluginTest, ConcurrentFirstLoadsCompileOnce) {
+  // Another source (a comment differs) than the other tests: a new cache entry.
+  const std::string code = std::string("// concurrent\n") + kLinearCode;
+  const long before = equation_plugin_compilations();
+  EquationPlugin first, second;
+  std::thread t1([&] { first = load_equation_plugin(code, cache_); });
+  std::thread t2([&] { second = load_equation_plugin(code, cache_); });
+  t1.join();
+  t2.join();
+  EXPECT_EQ(equation_plugin_compilations(), before + 1);
+  EXPECT_EQ(first.object, second.object);
+  const double p[2] = {-1.0, 0.5}, y0 = 1;
+  EXPECT_EQ(std::unique_ptr<ModelAnalyses>(second.analyses(p, 1, 1, &y0))->state_dimension(), 1);
+}
+
+TEST_F(EquationPluginTest, TwoModelsInOneProcessAreTwoObjects) {
+  // Objects are opened through the descriptor whose bytes were checked (/proc/self/fd/N); the
+  // dynamic loader matches objects by that name, so a second model must not reuse the first's N
+  // and get the first model's code (it did, with the descriptor closed after loading).
+  std::string other = kLinearCode;
+  const std::string period = "static double period_of(const double*) { return 1.0; }";
+  other.replace(other.find(period), period.size(), "static double period_of(const double*) { return 2.0; }");
+  const EquationPlugin first = load_equation_plugin(kLinearCode, cache_);
+  const EquationPlugin second = load_equation_plugin(other, cache_);
+  const double p[2] = {-1.0, 0.5};
+  EXPECT_EQ(first.period(p), 1.0);
+  EXPECT_EQ(second.period(p), 2.0);
+  EXPECT_NE(first.object, second.object);
+}
+
+TEST_F(EquationPluginTest, ACompileErrorIsBadInputWithTheCompilersFirstLines) {
+  try {
+    load_equation_plugin("struct EquationModel { this is not C++ };", cache_);
+    FAIL() << "no BadInput";
+  } catch (const BadInput& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("did not compile"), std::string::npos) << what;
+    EXPECT_NE(what.find("error"), std::string::npos) << what;  // the compiler's own line
+  }
+}
+
+TEST_F(EquationPluginTest, NoCompilerIsBadInputNamingThePackage) {
+  const char* old = std::getenv("DELAYSPEC_CXX");
+  const std::string saved = old ? old : "";
+  ::setenv("DELAYSPEC_CXX", "/nonexistent/g++", 1);
+  try {
+    load_equation_plugin(kLinearCode, cache_);
+    ADD_FAILURE() << "no BadInput";
+  } catch (const BadInput& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("/nonexistent/g++"), std::string::npos) << what;
+    EXPECT_NE(what.find("Debian package g++"), std::string::npos) << what;
+  }
+  if (old) ::setenv("DELAYSPEC_CXX", saved.c_str(), 1);
+  else ::unsetenv("DELAYSPEC_CXX");
+}
+
+TEST_F(EquationPluginTest, AnUnusableCacheDirectoryIsBadInput) {
+  std::filesystem::create_directories(cache_);
+  const std::filesystem::path file = cache_ / "a-file";
+  { std::ofstream(file) << "x"; }
+  EXPECT_THROW(load_equation_plugin(kLinearCode, file / "cache"), BadInput);
+}
+
+}  // namespace
+}  // namespace delayspec::cli
