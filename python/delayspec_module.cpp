@@ -210,7 +210,7 @@ py::object to_python(const nlohmann::json& j) {
 // 0, or 3 for failures recorded in a complete result, what the command wrote to stderr).
 py::tuple run(const std::string& command, const py::object& scene, const py::dict& keys,
               const std::optional<std::string>& out, bool resume) {
-  delayspec::cli::require_known_command(command);
+  delayspec::cli::command_spec(command);  // BadInput naming the commands when it is none
   std::optional<std::string> scene_path;
   Config config = make_config(scene, keys, scene_path);
   delayspec::cli::check_output_flags(command, out.has_value(), out.value_or(""), resume);
@@ -256,6 +256,22 @@ PYBIND11_MODULE(_delayspec, m) {
   py::register_exception<NumericalFailure>(m, "NumericalFailure", PyExc_RuntimeError);
   m.def("run", &run, py::arg("command"), py::arg("scene"), py::arg("keys"), py::arg("out"), py::arg("resume"),
         "Runs a command as `delayspec COMMAND --json`: (result, arrays, status, stderr text).");
+  m.def(
+      "commands",
+      [] {
+        py::list rows;
+        for (const auto& spec : delayspec::cli::command_table()) {
+          py::dict row;
+          row["name"] = spec.name;
+          row["summary"] = spec.summary;
+          row["writes_out"] = spec.out == delayspec::cli::OutDirUse::written;
+          row["resume"] = spec.resume;
+          rows.append(row);
+        }
+        return rows;
+      },
+      "The command table: name, summary (the first line of `delayspec COMMAND --help`), whether the command "
+      "writes files into out= and resumes with resume=True.");
   m.def(
       "keys_help", [](const std::string& command) { return delayspec::cli::command_keys_help(command); },
       py::arg("command"), "The keys COMMAND reads, with their defaults (the tail of `delayspec COMMAND --help`).");

@@ -285,12 +285,12 @@ def sweep(scene=None, *, out=None, resume=False, **keys):
     return _run("sweep", SweepResult, scene, keys, out, resume)
 
 
-def chart(scene=None, *, out=None, **keys):
-    return _run("chart", GridResult, scene, keys, out)
+def chart(scene=None, *, out=None, resume=False, **keys):
+    return _run("chart", GridResult, scene, keys, out, resume)
 
 
-def basin(scene=None, *, out=None, **keys):
-    return _run("basin", GridResult, scene, keys, out)
+def basin(scene=None, *, out=None, resume=False, **keys):
+    return _run("basin", GridResult, scene, keys, out, resume)
 
 
 def continue_(scene=None, *, out=None, **keys):
@@ -302,30 +302,22 @@ def keys_help(command):
     return _delayspec.keys_help(command)
 
 
-_SUMMARIES = {
-    floquet: ("floquet", "The leading Floquet multipliers of the periodic orbit.", FloquetResult),
-    lyapunov: ("lyapunov", "The leading Lyapunov exponents of the attractor reached from the constant "
-                           "initial history (fields exponents_per_period, standard_error_per_period, ...).", Result),
-    converge: ("converge", "A convergence study of the multipliers over a list of N (key Ns), with "
-                           "Richardson extrapolation.", ConvergeResult),
-    simulate: ("simulate", "A trajectory, its Poincare points and impacts from the constant initial history.",
-               SimulateResult),
-    sweep: ("sweep", "Lyapunov exponents and a Poincare section at each value of one key (sweep_key "
-                     "from sweep_from to sweep_to in sweep_points).", SweepResult),
-    chart: ("chart", "The spectral radius over a grid of two keys (chart_x, chart_y).", GridResult),
-    basin: ("basin", "The attractor reached from each initial history of a grid.", GridResult),
-    continue_: ("continue", "Pseudo-arclength continuation of the multipliers in one key.", ContinueResult),
-}
+_RESULT_TYPES = {floquet: FloquetResult, lyapunov: Result, converge: ConvergeResult, simulate: SimulateResult,
+                 sweep: SweepResult, chart: GridResult, basin: GridResult, continue_: ContinueResult}
 
 
 def _document():
-    for function, (command, summary, result_type) in _SUMMARIES.items():
-        extra = {"converge": ", out=None", "simulate": ", out=None", "chart": ", out=None", "basin": ", out=None",
-                 "continue": ", out=None", "sweep": ", out=None, resume=False"}.get(command, "")
+    """Each function's docstring from the command table (_delayspec.commands(), the program's own)."""
+    specs = {row["name"]: row for row in _delayspec.commands()}
+    for function, result_type in _RESULT_TYPES.items():
+        spec = specs[function.__name__.rstrip("_")]
+        command = spec["name"]
+        extra = (", out=None" if spec["writes_out"] else "") + (", resume=False" if spec["resume"] else "")
+        summary = spec["summary"].split(": ", 1)[1]  # after the usage "delayspec COMMAND [SCENE]"
         function.__doc__ = (
             f"{summary}\n\n"
             f"delayspec.{function.__name__}(scene=None{extra}, **keys) runs `delayspec {command} [SCENE] "
-            f"--set KEY=VALUE... --json{' [--out OUT]' if extra else ''}`; scene: a TOML file or a dict.\n\n"
+            f"--set KEY=VALUE... --json{' [--out OUT]' if spec['writes_out'] else ''}`; scene: a TOML file or a dict.\n\n"
             f"Returns {result_type.__name__}: {inspect.cleandoc(result_type.__doc__ or '')}\n\n"
             f"Raises BadInput (ValueError) for bad keys or values, NumericalFailure (RuntimeError) when a "
             f"method fails; KeyboardInterrupt on Ctrl-C.\n\n"

@@ -4,6 +4,7 @@ run the same command code; the numpy views hold the same numbers with the docume
 shapes; errors are the CLI's, with its messages; Ctrl-C stops a long run; threads are safe.
 Small N throughout: a few seconds in all."""
 import os
+import inspect
 import pathlib
 import signal
 import subprocess
@@ -429,6 +430,24 @@ def test_docstrings_list_the_keys():
     for function, key in [(delayspec.floquet, "nev = 6"), (delayspec.lyapunov, "exponents"),
                           (delayspec.sweep, "sweep_key"), (delayspec.chart, "chart_x")]:
         assert key in function.__doc__, function.__name__
+
+
+def test_signatures_follow_the_command_table():
+    # out= where the command writes files, resume=True where it resumes (chart and basin, as the
+    # program's --resume): from the one table, not a list kept here.
+    for row in _delayspec_commands():
+        function = getattr(delayspec, row["name"] + ("_" if row["name"] == "continue" else ""), None)
+        if function is None:
+            continue  # run, plot, bench: the program's only
+        parameters = inspect.signature(function).parameters
+        assert ("out" in parameters) == row["writes_out"], row["name"]
+        assert ("resume" in parameters) == row["resume"], row["name"]
+        assert row["summary"].split(": ", 1)[1] in function.__doc__
+
+
+def _delayspec_commands():
+    from delayspec import _delayspec
+    return _delayspec.commands()
 
 
 def test_a_missing_extension_says_how_to_build_it(tmp_path):

@@ -5,7 +5,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "scene/commands/commands.hpp"
+#include "cli/run_cli.hpp"
 #include "cli/freed_memory.hpp"
 #include "scene/points/ranks.hpp"
 

@@ -47,7 +47,8 @@ TEST(CommandHelp, ListsTheKeysTheCommandReadsWithDefaults) {
 TEST(CommandHelp, EveryCommandStartsWithWhatItDoes) {
   // Each command of the table, the first line: "delayspec COMMAND ...: <a sentence>." (issue 37
   // item 4), so that a command added without its sentence fails here.
-  for (const auto& [command, function] : delayspec::cli::command_table()) {
+  for (const auto& spec : delayspec::cli::command_table()) {
+    const std::string& command = spec.name;
     const CliResult r = run({command, "--help"});
     ASSERT_EQ(r.status, 0) << command << ": " << r.err;
     const std::string first = r.out.substr(0, r.out.find('\n'));

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "scene/commands/commands.hpp"
+#include "cli/run_cli.hpp"
 
 namespace delayspec::testing {
 

@@ -51,7 +51,7 @@ std::vector<std::string> split_list(const std::string& text) {
 // then names the key.
 std::string inferred_analysis(const Config& config) {
   for (const char* name : {"floquet", "lyapunov", "converge", "simulate", "sweep", "chart", "basin", "bench"}) {
-    if (!command_table().count(name)) continue;
+    if (!is_command(name)) continue;
     std::set<std::string> read = {"analyses", "title"};
     for (const auto& r : probe_command(name, config).reads) read.insert(r.key);
     if (std::all_of(config.values().begin(), config.values().end(),
@@ -68,16 +68,16 @@ std::vector<std::string> read_analyses(Config& config) {
   if (names.empty())
     throw BadInput("`analyses` is empty: list what to run, e.g. analyses = [\"floquet\"] in the scene");
   std::vector<std::string> available;
-  for (const auto& [name, fn] : command_table())
-    if (name != "run" && name != "plot") available.push_back(name);
+  for (const auto& spec : command_table())
+    if (spec.analysis) available.push_back(spec.name);
   std::string available_list;
   for (const auto& a : available) available_list += (available_list.empty() ? "" : ", ") + a;
   std::set<std::string> seen;
   for (const auto& name : names) {
     if (!seen.insert(name).second) throw BadInput("`analyses = " + text + "`: `" + name + "` is listed twice");
-    if (name == "run" || name == "plot")
+    if (is_command(name) && !command_spec(name).analysis)
       throw BadInput("`analyses = " + text + "`: `" + name + "` is a command, not an analysis");
-    if (command_table().count(name)) continue;
+    if (is_command(name)) continue;
     const std::string suggestion = closest_key(name, available);
     throw BadInput("`analyses = " + text + "`: unknown analysis `" + name + "`" +
                    (suggestion.empty() ? "" : "; did you mean `" + suggestion + "`?") +
@@ -109,11 +109,11 @@ Invocation analysis_invocation(const std::string& name, const Invocation& inv, s
 // have them (distributed_points.hpp), in the lead's order, and writes nothing but point files.
 int run_worker_analyses(const Config& config, const Invocation& inv, const RunPlan& plan) {
   for (const auto& name : plan.analyses) {
-    if (!distributes_points(name)) continue;
+    if (!command_spec(name).distributes) continue;
     Config worker_config = config_of_analysis(config, plan.known_keys);
     const Invocation analysis = analysis_invocation(name, inv, inv.out);
     try {
-      command_table().at(name)(worker_config, analysis);
+      command_spec(name).run(worker_config, analysis);
     } catch (const WorkerPointsDone&) {
       // this rank's points of the analysis are with the lead
     }
@@ -151,7 +151,7 @@ int command_run(Config& config, const Invocation& inv) {
   const fs::path dir = *inv.out_dir;
 
   bool resumable = false;
-  for (const auto& name : analyses) resumable = resumable || output_use(name).resume;
+  for (const auto& name : analyses) resumable = resumable || command_spec(name).resume;
   if (inv.resume && !resumable)
     throw BadInput("`--resume`: no analysis of this scene has anything to resume (only sweep, chart and basin do)");
 
@@ -173,7 +173,7 @@ int command_run(Config& config, const Invocation& inv) {
     std::ostringstream json_out;
     const Invocation analysis = analysis_invocation(name, inv, json_out);
     const auto start = std::chrono::steady_clock::now();
-    const int status = command_table().at(name)(analysis_config, analysis);
+    const int status = command_spec(name).run(analysis_config, analysis);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // Exit 3 from an analysis means failures recorded in its (complete) result, as sweep, chart
     // and basin do with failing points: keep it, run the other analyses, and exit 3 at the end.

@@ -3,7 +3,7 @@
 // A command reads its keys from the Config, calls config.check_all_used() before any heavy
 // work (so a typo fails fast, exit 2), computes, and writes one result: text on `out`, or with
 // --json exactly one JSON object on `out`. Progress and warnings go to `err`.
-// Exceptions: BadInput -> exit 2, NumericalFailure -> exit 3 (handled in run_cli).
+// Exceptions: BadInput -> exit 2, NumericalFailure -> exit 3 (handled by the front end: run_cli).
 #include <map>
 #include <optional>
 #include <ostream>
@@ -39,25 +39,36 @@ struct RunPlan {
 };
 RunPlan plan_run(Config& config);
 
-// The command table (name -> function); `run` dispatches a scene's analyses through it.
-const std::map<std::string, CommandFunction>& command_table();
-// What a command does, in one sentence that starts with its usage ("delayspec plot DIR: ..."):
-// the first line of `delayspec COMMAND --help`. Empty for an unknown command.
-const std::string& command_summary(const std::string& command);
-
-// BadInput "unknown command `NAME` (commands: ...)" unless `command` is in the table: the one
-// check of a command's name, for the program, `keys_help` and the Python module alike.
-void require_known_command(const std::string& command);
-
-// What a command does with `--out DIR`: nothing, writes its files there (run_cli then holds the
-// directory's lock, output_directory.hpp), or reads results from there (plot); and whether it
-// continues an interrupted run with `--resume`. run_cli refuses a flag the command ignores.
+// What a command does with `--out DIR`: nothing, writes its files there (run_command then holds
+// the directory's lock, output_directory.hpp), or reads results from there (plot).
 enum class OutDirUse { ignored, written, read };
-struct OutputUse {
+
+// Everything the front ends know of one command: one row of the command table, read by the
+// program (dispatch, --help, the --out and --resume checks), MPI (which commands the worker
+// ranks run), the key registry (its probes) and the Python module (delayspec._delayspec.commands).
+struct CommandSpec {
+  std::string name;
+  CommandFunction run = nullptr;
+  // What it does, in one sentence that starts with its usage ("delayspec plot DIR: ..."): the
+  // first line of `delayspec COMMAND --help`.
+  std::string summary;
   OutDirUse out = OutDirUse::ignored;
-  bool resume = false;
+  bool resume = false;       // continues an interrupted run in --out with --resume
+  bool distributes = false;  // its points are spread over MPI ranks (the workers run it too)
+  bool analysis = false;     // may be listed in a scene's `analyses` (not run, not plot)
+  // Keys it requires (no default), with the placeholder the key registry's probe gives them so
+  // that the command reaches its other reads; the swept key's placeholder is a name no model reads.
+  std::map<std::string, std::string> placeholders;
 };
-OutputUse output_use(const std::string& command);
+
+// The command table, in name order; `run` dispatches a scene's analyses through it.
+const std::vector<CommandSpec>& command_table();
+bool is_command(const std::string& name);
+// The row of `name`; BadInput "unknown command `NAME` (commands: ...)" when it is none: the one
+// check of a command's name, for the program, `keys_help` and the Python module alike.
+const CommandSpec& command_spec(const std::string& name);
+// "basin, bench, ...": the names of the table.
+std::string command_list();
 
 // Bad input in `--out DIR` / `--resume` for `command` (BadInput naming the flag and the command):
 // `out_given` whether an output directory was given at all, `out_dir` its name.
@@ -69,8 +80,5 @@ void check_output_flags(const std::string& command, bool out_given, const std::s
 // in a complete result); throws BadInput and NumericalFailure. The one entry of the CLI and the
 // Python module.
 int run_command(Config& config, const Invocation& inv);
-
-// Runs the program: parses argv, dispatches, maps errors to exit codes. Never throws.
-int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 
 }  // namespace delayspec::cli

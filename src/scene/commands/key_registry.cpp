@@ -13,20 +13,10 @@ namespace delayspec::cli {
 
 namespace {
 
-// Keys a command requires (no default): the probe gives them a placeholder so that the command
-// reaches its other reads. The swept key's placeholder is a name no model reads.
-const std::map<std::string, std::map<std::string, std::string>>& required_placeholders() {
-  static const std::map<std::string, std::map<std::string, std::string>> keys = {
-      {"sweep", {{"sweep_key", "(swept)"}, {"sweep_from", "0"}, {"sweep_to", "1"}}},
-      {"continue", {{"continue_key", "(continued)"}, {"continue_from", "0"}, {"continue_to", "1"}}}};
-  return keys;
-}
-
 Config probe_config(const std::string& command, const std::string& model) {
   Config config;
   if (model != model_names().front()) config.set("model", model, "--help");
-  if (auto it = required_placeholders().find(command); it != required_placeholders().end())
-    for (const auto& [key, value] : it->second) config.set(key, value, "--help");
+  for (const auto& [key, value] : command_spec(command).placeholders) config.set(key, value, "--help");
   return config;
 }
 
@@ -35,17 +25,16 @@ using Probes = std::map<std::string, std::map<std::string, std::vector<Config::R
 const Probes& all_probes() {
   static const Probes probes = [] {
     Probes p;
-    for (const auto& [command, fn] : command_table())
+    for (const auto& spec : command_table())
       for (const auto& model : model_names())
-        p[command][model] = probe_command(command, probe_config(command, model)).reads;
+        p[spec.name][model] = probe_command(spec.name, probe_config(spec.name, model)).reads;
     return p;
   }();
   return probes;
 }
 
 std::string default_text(const std::string& command, const Config::Read& r) {
-  if (auto it = required_placeholders().find(command); it != required_placeholders().end() && it->second.count(r.key))
-    return "(required)";
+  if (command_spec(command).placeholders.count(r.key)) return "(required)";
   return r.fallback ? (r.fallback->empty() ? "\"\"" : *r.fallback) : "-";
 }
 
@@ -63,7 +52,7 @@ Probe probe_command(const std::string& command, Config config, OnBadInput on_bad
                  .out = sink_out,
                  .err = sink_err};
   try {
-    command_table().at(command)(config, dry);
+    command_spec(command).run(config, dry);
   } catch (const KeysCollected&) {
     // the keys it carries are config.used_keys()
   } catch (const BadInput&) {
@@ -212,7 +201,7 @@ const std::map<std::string, std::string>& key_meanings() {
 }
 
 std::string command_keys_help(const std::string& command) {
-  require_known_command(command);  // (the probes hold every command of the table)
+  command_spec(command);  // BadInput for an unknown command (the probes hold every command of the table)
   const auto probes = all_probes().find(command);
   const auto& by_model = probes->second;
   // Keys every model reads (in the default model's reading order), then each model's own keys.

@@ -40,7 +40,7 @@ const std::map<std::string, std::string>& key_meanings();
 
 // The keys `command` reads, its defaults and their meanings (the tail of `COMMAND --help`):
 // keys every model shares first, then the keys of each model. BadInput naming the command and
-// listing the commands when it is not one (require_known_command).
+// listing the commands when it is not one (command_spec).
 std::string command_keys_help(const std::string& command);
 
 }  // namespace delayspec::cli

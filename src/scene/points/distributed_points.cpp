@@ -44,10 +44,6 @@ class KillHook {
 
 }  // namespace
 
-bool distributes_points(const std::string& command) {
-  return command == "sweep" || command == "chart" || command == "basin" || command == "run";
-}
-
 void distributed_points(const std::vector<long>& todo, int threads, const PointTasks& tasks) {
   KillHook hook;
 #ifdef DELAYSPEC_MPI

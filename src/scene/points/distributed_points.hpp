@@ -25,8 +25,4 @@ namespace delayspec::cli {
 // Computes every index of `todo` (the lead's list; ignored on the workers) once.
 void distributed_points(const std::vector<long>& todo, int threads, const PointTasks& tasks);
 
-// Commands whose points distributed_points spreads over the ranks (and `run`, which calls
-// them); under mpirun the worker ranks skip every other command.
-bool distributes_points(const std::string& command);
-
 }  // namespace delayspec::cli
