@@ -75,17 +75,6 @@ class PythonSignals final : public delayspec::CancellationCheck {
   std::optional<py::error_already_set> raised_;
 };
 
-// The CLI layer tracks the open output directory per process (output_directory.hpp: run_cli runs
-// one command at a time), so calls that write files (out=DIR) take turns; a call waiting for its
-// turn stays interruptible.
-std::timed_mutex output_turn;
-
-std::unique_lock<std::timed_mutex> wait_for_output_turn() {
-  std::unique_lock<std::timed_mutex> turn(output_turn, std::defer_lock);
-  while (!turn.try_lock_for(std::chrono::milliseconds(50))) delayspec::throw_if_cancelled();
-  return turn;
-}
-
 bool on_main_thread() {
   static const unsigned long main_ident =
       py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
@@ -232,8 +221,6 @@ py::tuple run(const std::string& command, const py::object& scene, const py::dic
                                          .err = err,
                                          .arrays = &arrays};
     try {
-      std::unique_lock<std::timed_mutex> turn;
-      if (out) turn = wait_for_output_turn();
       status = delayspec::cli::run_command(config, inv);
       result = nlohmann::json::parse(json_text.str());
     } catch (const delayspec::Cancelled&) {

@@ -5,6 +5,7 @@ shapes; errors are the CLI's, with its messages; Ctrl-C stops a long run; thread
 Small N throughout: a few seconds in all."""
 import os
 import inspect
+import json
 import pathlib
 import signal
 import subprocess
@@ -395,6 +396,38 @@ def test_threads_calling_floquet_at_once_give_the_sequential_results():
     for t in threads:
         t.join()
     assert results == expected
+
+
+def test_threads_writing_files_at_once_each_complete_their_own_directory(tmp_path):
+    """Calls with out= run at once (each invocation carries its own output directory): each
+    directory gets the files and the complete.json of its own call, as a call alone writes them."""
+    keys = dict(N=40, t_end=200, sample_every=4)
+    alone = tmp_path / "alone"
+    delayspec.simulate(out=alone, **keys)
+    barrier = threading.Barrier(3)
+    errors = []
+
+    def work(i):
+        barrier.wait()
+        try:
+            delayspec.simulate(out=tmp_path / f"thread{i}", **keys)
+        except Exception as e:  # noqa: BLE001 (reported below)
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    for i in range(3):
+        mine = tmp_path / f"thread{i}"
+        marker = json.loads((mine / "complete.json").read_text())
+        assert marker["command"] == "simulate" and marker["exit_status"] == 0
+        assert sorted(marker["files"]) == sorted(json.loads((alone / "complete.json").read_text())["files"])
+        for name in ("trajectory.csv", "poincare.csv", "impacts.csv"):
+            body = lambda d: [l for l in (d / name).read_text().splitlines() if not l.startswith("#")]
+            assert body(mine) == body(alone), name
 
 
 def test_gil_is_released_during_a_run():

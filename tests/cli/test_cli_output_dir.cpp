@@ -129,9 +129,10 @@ TEST(OutputDirectory, SecondRunWhileTheLockIsHeldExitsTwo) {
 // or already finished), this run writes nothing there.
 TEST(OutputDirectory, DirectoryCreatedLaterBelongsToTheRunThatCreatedIt) {
   const fs::path dir = fresh_dir("outdir_later");
-  auto write_fails = [&](const fs::path& target) {
+  // A write through the run's directory (as a command's, through inv.output).
+  auto write_fails = [&](delayspec::cli::OutputDirectory& run, const fs::path& target) {
     try {
-      delayspec::cli::write_file_atomically(target, "x\n");
+      run.write(target, "x\n");
     } catch (const delayspec::BadInput& e) {
       return contains(e.what(), "`--out " + dir.string() + "`: another delayspec run");
     }
@@ -142,20 +143,20 @@ TEST(OutputDirectory, DirectoryCreatedLaterBelongsToTheRunThatCreatedIt) {
     EXPECT_FALSE(fs::exists(dir));
     HeldLock other(dir);  // another run got there first and is running
     ASSERT_TRUE(other.held());
-    EXPECT_TRUE(write_fails(dir / "a.csv"));
+    EXPECT_TRUE(write_fails(mine, dir / "a.csv"));
     EXPECT_FALSE(fs::exists(dir / "a.csv"));
   }
   fs::remove_all(dir);
   {
     delayspec::cli::OutputDirectory mine(dir);
     fs::create_directories(dir);  // another run came and went
-    EXPECT_TRUE(write_fails(dir / "a.csv"));
+    EXPECT_TRUE(write_fails(mine, dir / "a.csv"));
     EXPECT_FALSE(fs::exists(dir / "a.csv"));
   }
   fs::remove_all(dir);
   {
     delayspec::cli::OutputDirectory mine(dir / "sub");
-    delayspec::cli::write_file_atomically(dir / "sub" / "a.csv", "x\n");  // nobody else: created and locked
+    mine.write(dir / "sub" / "a.csv", "x\n");  // nobody else: created and locked
     EXPECT_TRUE(fs::exists(dir / "sub" / "a.csv"));
     EXPECT_FALSE(lock_is_free(dir / "sub"));
   }

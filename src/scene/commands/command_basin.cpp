@@ -24,7 +24,7 @@
 #include <map>
 #include <sstream>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 #include "scene/output/metadata.hpp"
@@ -139,7 +139,7 @@ int command_basin(Config& config, const Invocation& inv) {
                              {"seconds", seconds},
                              {"rows", rows}});
   if (inv.out_dir) {
-    AtomicFile csv(std::filesystem::path(*inv.out_dir) / "basin.csv");
+    OutputFile csv(inv, std::filesystem::path(*inv.out_dir) / "basin.csv");
     csv.stream() << metadata_comment_lines(make_metadata("basin", inv.scene, config, json, seconds));
     csv.stream() << x.name << "," << y.name << ",period,max_section_x\n";
     csv.stream().precision(12);

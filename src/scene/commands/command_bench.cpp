@@ -25,7 +25,7 @@
 #include <filesystem>
 #include <optional>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "delayspec/classic_discretisation.hpp"
 #include "delayspec/convergence.hpp"
@@ -325,9 +325,9 @@ void score_rows(std::vector<BenchRow>& rows, const BenchReference& reference) {
   }
 }
 
-void write_bench_csv(const std::filesystem::path& path, const std::string& metadata_header, const BenchSettings& s,
-                     const std::vector<BenchRow>& rows, const BenchReference& reference) {
-  AtomicFile csv(path);
+void write_bench_csv(const Invocation& inv, const std::filesystem::path& path, const std::string& metadata_header,
+                     const BenchSettings& s, const std::vector<BenchRow>& rows, const BenchReference& reference) {
+  OutputFile csv(inv, path);
   csv.stream() << metadata_header;
   csv.stream() << "# delayspec bench: model " << s.problem.model_name << ", nev " << s.base.nev << ", reference "
                << reference.used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
@@ -418,7 +418,7 @@ int command_bench(Config& config, const Invocation& inv) {
   if (inv.out_dir) {  // report
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count();
     write_bench_csv(
-        std::filesystem::path(*inv.out_dir) / "bench.csv",
+        inv, std::filesystem::path(*inv.out_dir) / "bench.csv",
         metadata_comment_lines(make_metadata("bench", inv.scene, config, nlohmann::json::object(), seconds)), settings,
         rows, reference);
   }

@@ -21,7 +21,7 @@
 #include <sstream>
 #include <thread>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/stroboscopic_map.hpp"
@@ -131,7 +131,7 @@ int command_chart(Config& config, const Invocation& inv) {
                              {"rows", rows}});
 
   if (inv.out_dir) {
-    AtomicFile csv(std::filesystem::path(*inv.out_dir) / "chart.csv");
+    OutputFile csv(inv, std::filesystem::path(*inv.out_dir) / "chart.csv");
     csv.stream() << metadata_comment_lines(make_metadata("chart", inv.scene, config, json, seconds));
     csv.stream() << x.name << "," << y.name << ",spectral_radius" << (with_error_bars ? ",error_estimate,undecided" : "")
                  << "\n";

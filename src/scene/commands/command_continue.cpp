@@ -22,7 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "scene/problem/continue_settings.hpp"
 #include "delayspec/continuation.hpp"
@@ -278,11 +278,11 @@ int command_continue(Config& config, const Invocation& inv) {
         bifs << (i ? ";" : "") << e.Ns[i] << ":" << format_number(e.parameters[i]);
       bifs << "\n";
     }
-    write_file_atomically(dir / "branch.csv", rows.str());
-    write_file_atomically(dir / "bifurcations.csv", bifs.str());
+    write_output(inv, dir / "branch.csv", rows.str());
+    write_output(inv, dir / "bifurcations.csv", bifs.str());
     json file = j;
     file["metadata"] = metadata_json(metadata);
-    write_file_atomically(dir / "continue.json", file.dump(2) + "\n");
+    write_output(inv, dir / "continue.json", file.dump(2) + "\n");
   }
 
   if (!failures.empty()) {

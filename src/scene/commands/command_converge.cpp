@@ -20,7 +20,7 @@
 #include <map>
 #include <set>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "delayspec/convergence.hpp"
 #include "delayspec/errors.hpp"
@@ -293,7 +293,7 @@ int command_converge(Config& config, const Invocation& inv) {
     const std::string header = metadata_comment_lines(
         make_metadata("converge", inv.scene, config, nlohmann::json::object(),
                       std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
-    AtomicFile rows(dir / "converge.csv");
+    OutputFile rows(inv, dir / "converge.csv");
     rows.stream() << header << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver)
                   << "\n";
     for (size_t v = 0; v < studies.size(); ++v)  // failed levels have no multipliers: named here
@@ -302,7 +302,7 @@ int command_converge(Config& config, const Invocation& inv) {
           rows.stream() << "# events " << events[v] << ", N = " << r.N << " failed: " << one_line(r.failure) << "\n";
     rows.stream() << "events,N,track,re,im,abs,error,correct_digits,seconds,operator_applications\n";
     rows.stream().precision(17);
-    AtomicFile rich(dir / "converge_richardson.csv");
+    OutputFile rich(inv, dir / "converge_richardson.csv");
     rich.stream()
         << header
         << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";

@@ -17,7 +17,7 @@
 #include <set>
 #include <sstream>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "delayspec/errors.hpp"
 #include "scene/points/distributed_points.hpp"
@@ -102,7 +102,8 @@ Invocation analysis_invocation(const std::string& name, const Invocation& inv, s
                     .quiet = inv.quiet,
                     .resume = inv.resume,
                     .out = out,
-                    .err = inv.err};
+                    .err = inv.err,
+                    .output = inv.output};
 }
 
 // Under mpirun, a worker rank (ranks.hpp): it takes part in the point loops of the analyses that
@@ -186,7 +187,7 @@ int command_run(Config& config, const Invocation& inv) {
     }
     result["metadata"] = metadata_json(make_metadata(name, inv.scene, analysis_config, result, seconds));
     const fs::path file = dir / (name + ".json");
-    write_file_atomically(file, result.dump(2) + "\n");
+    write_output(inv, file, result.dump(2) + "\n");
     manifest["analyses"].push_back(
         {{"name", name}, {"file", file.filename().string()}, {"seconds", seconds}, {"exit_status", status}});
     if (!inv.json) inv.out << name << ": wrote " << file.string() << " (" << format_duration(seconds) << ")\n";
@@ -195,7 +196,7 @@ int command_run(Config& config, const Invocation& inv) {
   progress.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   manifest["metadata"] = metadata_json(make_metadata("run", inv.scene, config, nlohmann::json::object(), wall));
-  write_file_atomically(dir / "run.json", manifest.dump(2) + "\n");
+  write_output(inv, dir / "run.json", manifest.dump(2) + "\n");
   if (inv.json) {
     manifest["out"] = dir.string();
     inv.out << manifest.dump(2) << "\n";

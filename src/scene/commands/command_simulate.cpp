@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "delayspec/builtin_analyses.hpp"
 #include "delayspec/simulation.hpp"
@@ -104,15 +104,15 @@ int command_simulate(Config& config, const Invocation& inv) {
     const std::string header = metadata_comment_lines(make_metadata(
         "simulate", inv.scene, config,
         {{"N", problem.N}, {"events", to_string(problem.events)}, {"jacobian", to_string(problem.jacobian)}}, seconds));
-    AtomicFile traj(dir / "trajectory.csv");
+    OutputFile traj(inv, dir / "trajectory.csv");
     traj.stream() << header;
     write_points(traj.stream(), columns(problem), rec.t, rec.y);
     traj.commit();
-    AtomicFile poincare(dir / "poincare.csv");
+    OutputFile poincare(inv, dir / "poincare.csv");
     poincare.stream() << header;
     write_points(poincare.stream(), columns(problem), rec.poincare_t, rec.poincare_y);
     poincare.commit();
-    AtomicFile impacts(dir / "impacts.csv");
+    OutputFile impacts(inv, dir / "impacts.csv");
     impacts.stream() << header << std::setprecision(std::numeric_limits<double>::max_digits10) << "t,count\n";
     for (size_t i = 0; i < rec.impact_times.size(); ++i)
       impacts.stream() << rec.impact_times[i] << "," << i + 1 << "\n";

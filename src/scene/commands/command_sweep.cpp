@@ -26,7 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "scene/problem/lyapunov_settings.hpp"
 #include "scene/output/metadata.hpp"
@@ -214,9 +214,9 @@ int command_sweep(Config& config, const Invocation& inv) {
     OutputMetadata metadata = make_metadata("sweep", inv.scene, config, summary, seconds);
     metadata.parameters.erase(s.key);
     const std::string header = metadata_comment_lines(metadata);
-    write_file_atomically(dir / "exponents.csv", header + tables.exponents_csv);
-    write_file_atomically(dir / "section.csv", header + tables.section_csv);
-    write_file_atomically(dir / "sweep.json", summary.dump(1) + "\n");
+    write_output(inv, dir / "exponents.csv", header + tables.exponents_csv);
+    write_output(inv, dir / "section.csv", header + tables.section_csv);
+    write_output(inv, dir / "sweep.json", summary.dump(1) + "\n");
   }
 
   if (inv.json) {

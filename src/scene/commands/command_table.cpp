@@ -154,9 +154,11 @@ int run_command(Config& config, const Invocation& inv) {
   if (!is_lead_rank() && !spec.distributes) return 0;
   if (!inv.out_dir || spec.out != OutDirUse::written || !is_lead_rank()) return spec.run(config, inv);
   OutputDirectory directory(*inv.out_dir);  // held until the command returns: one run per DIR
+  Invocation writing = inv;
+  writing.output = &directory;
   int status = 0;
   try {
-    status = spec.run(config, inv);
+    status = spec.run(config, writing);
   } catch (const BadInput&) {
     directory.abandon();  // a run stopped by bad input leaves nothing behind (output_directory.hpp)
     throw;

@@ -6,12 +6,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
 
 #include "delayspec/errors.hpp"
+#include "scene/output/atomic_file.hpp"
 
 namespace delayspec::cli {
 
@@ -42,7 +42,6 @@ std::string owner_and_mode(const struct stat& st) {
   return "owner uid " + std::to_string(st.st_uid) + ", mode " + mode + "; this is uid " + std::to_string(::geteuid());
 }
 
-std::atomic<unsigned> temporaries{0};
 
 // An entry just opened (`fd`, or -1 with errno set) must be a regular file of this user's that
 // nobody else can write; BadInput naming it otherwise.
@@ -106,22 +105,14 @@ UniqueFd ModelCacheDir::create_entry(const std::string& name) const {
 }
 
 void ModelCacheDir::write_entry(const std::string& name, const std::string& text) const {
-  const std::string tmp = name + ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(temporaries++);
-  {
-    UniqueFd fd(::openat(dir_.get(), tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600));
-    if (!fd) throw BadInput("`model_cache`: cannot write " + entry_path(tmp).string() + " (" + reason() + ")");
-    for (size_t done = 0; done < text.size();) {
-      const ssize_t wrote = ::write(fd.get(), text.data() + done, text.size() - done);
-      if (wrote < 0 && errno == EINTR) continue;
-      if (wrote <= 0) {
-        const std::string why = reason();
-        remove_entry(tmp);
-        throw BadInput("`model_cache`: cannot write " + entry_path(tmp).string() + " (" + why + ")");
-      }
-      done += static_cast<size_t>(wrote);
-    }
+  // Not flushed to disk (as the cache's writes never were): an entry lost in a machine crash is
+  // missing or fails its checksum when loaded (equation_plugin.cpp) and is compiled again.
+  try {
+    write_atomically_at(dir_.get(), name, text, 0600, Flush::skip);
+  } catch (const AtomicWriteFailed& e) {
+    throw BadInput("`model_cache`: cannot write " + entry_path(name).string() + " (" + e.step + ": " +
+                   std::strerror(e.error) + ")");
   }
-  rename_entry(tmp, name);
 }
 
 void ModelCacheDir::make_private(const std::string& name) const {

@@ -10,7 +10,6 @@
 #include <system_error>
 
 #include "delayspec/errors.hpp"
-#include "scene/output/output_directory.hpp"
 
 namespace delayspec::cli {
 
@@ -20,27 +19,22 @@ namespace {
   throw BadInput("cannot write `" + path.string() + "`: " + what + ": " + std::strerror(error));
 }
 
-std::filesystem::path temporary_name(const std::filesystem::path& target) {
+std::string temporary_name(const std::string& name) {
   static std::atomic<unsigned long> sequence{0};
-  std::string name(".");  // (append, not operator+: GCC 12 warns falsely on "." + string)
-  name.append(target.filename().string()).append(".tmp-").append(std::to_string(::getpid()));
-  name.append("-").append(std::to_string(sequence.fetch_add(1)));
-  return target.parent_path() / name;
+  std::string temp(".");  // (append, not operator+: GCC 12 warns falsely on "." + string)
+  temp.append(name).append(".tmp-").append(std::to_string(::getpid()));
+  temp.append("-").append(std::to_string(sequence.fetch_add(1)));
+  return temp;
 }
 
 }  // namespace
 
-void write_file_atomically(const std::filesystem::path& target, const std::string& contents, Flush flush) {
-  if (target.filename().empty()) throw BadInput("cannot write `" + target.string() + "`: not a file name");
-  before_output_write(target);  // the lock and the completeness marker of --out DIR
-  const std::filesystem::path parent = target.parent_path().empty() ? "." : target.parent_path();
-  std::error_code ec;
-  std::filesystem::create_directories(parent, ec);
-  if (ec) fail(target, "cannot create directory `" + parent.string() + "`", ec.value());
-
-  const std::filesystem::path temp = temporary_name(parent / target.filename());
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) fail(target, "cannot create `" + temp.string() + "`", errno);
+void write_atomically_at(int dir_fd, const std::string& name, const std::string& contents, unsigned mode,
+                         Flush flush) {
+  const std::string temp = temporary_name(name);
+  const int fd = ::openat(dir_fd, temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC,
+                          static_cast<mode_t>(mode));
+  if (fd < 0) throw AtomicWriteFailed{"cannot create `" + temp + "`", errno};
   size_t written = 0;
   while (written < contents.size()) {
     const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
@@ -48,8 +42,8 @@ void write_file_atomically(const std::filesystem::path& target, const std::strin
     if (n < 0) {
       const int error = errno;
       ::close(fd);
-      ::unlink(temp.c_str());
-      fail(target, "write failed", error);
+      ::unlinkat(dir_fd, temp.c_str(), 0);
+      throw AtomicWriteFailed{"write failed", error};
     }
     written += static_cast<size_t>(n);
   }
@@ -57,14 +51,31 @@ void write_file_atomically(const std::filesystem::path& target, const std::strin
   int error = flush == Flush::skip || ::fsync(fd) == 0 ? 0 : errno;
   if (::close(fd) != 0 && error == 0) error = errno;
   if (error != 0) {
-    ::unlink(temp.c_str());
-    fail(target, "flush failed", error);
+    ::unlinkat(dir_fd, temp.c_str(), 0);
+    throw AtomicWriteFailed{"flush failed", error};
   }
-  if (std::rename(temp.c_str(), target.c_str()) != 0) {
+  if (::renameat(dir_fd, temp.c_str(), dir_fd, name.c_str()) != 0) {
     error = errno;
-    ::unlink(temp.c_str());
-    fail(target, "rename failed", error);
+    ::unlinkat(dir_fd, temp.c_str(), 0);
+    throw AtomicWriteFailed{"rename failed", error};
   }
+}
+
+void write_file_atomically(const std::filesystem::path& target, const std::string& contents, Flush flush) {
+  if (target.filename().empty()) throw BadInput("cannot write `" + target.string() + "`: not a file name");
+  const std::filesystem::path parent = target.parent_path().empty() ? "." : target.parent_path();
+  std::error_code ec;
+  std::filesystem::create_directories(parent, ec);
+  if (ec) fail(target, "cannot create directory `" + parent.string() + "`", ec.value());
+  const int dir_fd = ::open(parent.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd < 0) fail(target, "cannot open directory `" + parent.string() + "`", errno);
+  try {
+    write_atomically_at(dir_fd, target.filename().string(), contents, 0644, flush);
+  } catch (const AtomicWriteFailed& e) {
+    ::close(dir_fd);
+    fail(target, e.step, e.error);
+  }
+  ::close(dir_fd);
 }
 
 void AtomicFile::commit() {

@@ -6,8 +6,9 @@
 // complete; at worst a hidden `.NAME.tmp-*` file remains.
 // Errors (directory missing and not creatable, disk full, permission) throw BadInput naming the
 // path and the system's reason: the user asked for an output location that cannot be written.
-// A write into the `--out` directory of the running command is first reported to its
-// OutputDirectory (output_directory.hpp: lock, completeness marker).
+// A pure function of its arguments: a command's results go through its OutputDirectory
+// (output_directory.hpp: lock, completeness marker), which calls this; the model cache
+// (model_cache.hpp) calls write_atomically_at in its own directory.
 //
 // Example:
 //     AtomicFile file(out_dir / "exponents.csv");
@@ -25,7 +26,19 @@ namespace delayspec::cli {
 // fsync per point doubles the cost of a chart point (0.3 ms) and loads a cluster file system.
 enum class Flush { to_disk, skip };
 
-// Writes `contents` to `target` atomically (see above). Creates the parent directory if needed.
+// The write itself, in the directory open as `dir_fd`: `name` gets `contents` through a temporary
+// `.NAME.tmp-PID-SEQ` made with `mode` (O_EXCL | O_NOFOLLOW: never through a link), flushed as
+// `flush` says, renamed onto `name` (renameat replaces a link named `name`, never follows it).
+// On failure the temporary is removed and AtomicWriteFailed says which step and why.
+struct AtomicWriteFailed {
+  std::string step;       // "cannot create `TEMPORARY`", "write failed", "flush failed", "rename failed"
+  int error = 0;          // errno
+};
+void write_atomically_at(int dir_fd, const std::string& name, const std::string& contents, unsigned mode,
+                         Flush flush);
+
+// Writes `contents` to `target` atomically (see above), mode 0644. Creates the parent directory if
+// needed. BadInput "cannot write `target`: STEP: REASON".
 void write_file_atomically(const std::filesystem::path& target, const std::string& contents,
                            Flush flush = Flush::to_disk);
 

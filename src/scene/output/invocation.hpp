@@ -10,6 +10,8 @@
 
 namespace delayspec::cli {
 
+class OutputDirectory;  // output_directory.hpp
+
 struct Invocation {
   std::string command;
   std::optional<std::string> scene;
@@ -22,6 +24,9 @@ struct Invocation {
   // Bulk results the JSON leaves to --out files, for a front end that takes values (the Python
   // module): when set, `simulate` puts its trajectory rows here under "trajectory".
   nlohmann::json* arrays = nullptr;
+  // The --out directory's lock and completeness marker, held by run_command while the command
+  // writes there (output_directory.hpp); null when the command writes no files or runs alone.
+  OutputDirectory* output = nullptr;
 };
 
 }  // namespace delayspec::cli

@@ -4,7 +4,6 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <system_error>
@@ -22,9 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The directory of the running command (run_cli opens one at a time).
-std::atomic<OutputDirectory*> open_directory{nullptr};
-
 fs::path normal_directory(const fs::path& dir) {
   fs::path normal = dir.lexically_normal();
   return normal.has_filename() ? normal : normal.parent_path();  // "out/x/" -> "out/x"
@@ -36,11 +32,9 @@ OutputDirectory::OutputDirectory(fs::path dir) : dir_(normal_directory(dir)) {
   std::error_code ec;
   existed_ = fs::is_directory(dir_, ec);
   if (existed_) acquire();
-  previous_ = open_directory.exchange(this);
 }
 
 OutputDirectory::~OutputDirectory() {
-  open_directory.store(previous_);
   if (lock_fd_ >= 0) ::close(lock_fd_);  // closing the last descriptor releases the flock
 }
 
@@ -113,7 +107,7 @@ void OutputDirectory::finish(const std::string& command, int exit_status) {
                                  {"files", files},
                                  {"delayspec_version", DELAYSPEC_VERSION},
                                  {"finished_utc", utc_now_iso8601()}};
-  write_file_atomically(dir_ / marker_name, marker.dump(2) + "\n");
+  write(dir_ / marker_name, marker.dump(2) + "\n");  // takes the lock if nothing else did
 }
 
 void OutputDirectory::abandon() noexcept {
@@ -134,8 +128,20 @@ void OutputDirectory::abandon() noexcept {
     if (is_new) fs::remove_all(dir_ / name, ec);
 }
 
-void before_output_write(const fs::path& target) {
-  if (OutputDirectory* directory = open_directory.load()) directory->note_write(target);
+void OutputDirectory::write(const fs::path& target, const std::string& contents, Flush flush) {
+  note_write(target);
+  write_file_atomically(target, contents, flush);
+}
+
+void write_output(const Invocation& inv, const fs::path& target, const std::string& contents, Flush flush) {
+  if (inv.output) inv.output->write(target, contents, flush);
+  else write_file_atomically(target, contents, flush);
+}
+
+void OutputFile::commit() {
+  if (committed_) return;
+  write_output(inv_, target_, buffer_.str());
+  committed_ = true;
 }
 
 }  // namespace delayspec::cli

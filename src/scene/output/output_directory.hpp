@@ -1,8 +1,8 @@
 #pragma once
 // One run per output directory, and a marker that says when the run's files are complete.
-// run_cli opens an OutputDirectory for every command that writes into `--out DIR` and keeps it
-// for the whole command; the commands themselves know nothing of it (their writes go through
-// write_file_atomically, which reports each one here).
+// run_command opens an OutputDirectory for every command that writes into `--out DIR`, keeps it
+// for the whole command and hands it to the command in its Invocation (`inv.output`): the
+// command's files go through write_output / OutputFile, which tell the directory before each write.
 //
 // Lock: `DIR/.delayspec-lock`, an flock(2) taken without waiting and held until the command
 // returns (the kernel drops it when the process dies, so a killed run leaves no stale lock). It is
@@ -22,15 +22,20 @@
 // recorded in the files). It lists the files this run wrote directly in DIR. No complete.json:
 // the directory holds an interrupted or failed run, or one still in progress.
 //
-// Example (run_cli):
+// Example (run_command):
 //     OutputDirectory out(dir);                 // BadInput if another run holds DIR
-//     const int status = command(config, inv);  // writes DIR/... through write_file_atomically
+//     inv.output = &out;
+//     const int status = command(config, inv);  // writes DIR/... through write_output(inv, ...)
 //     out.finish("sweep", status);              // DIR/complete.json
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <string>
+
+#include "scene/output/atomic_file.hpp"
+#include "scene/output/invocation.hpp"
 
 namespace delayspec::cli {
 
@@ -45,6 +50,11 @@ class OutputDirectory {
   // Writes DIR/complete.json: {"command", "exit_status", "files", "delayspec_version", "finished_utc"}.
   void finish(const std::string& command, int exit_status);
 
+  // Writes `target` atomically (write_file_atomically) after telling the directory: when target
+  // lies in DIR, takes the lock if not yet held, removes complete.json on the first write and
+  // records the file. Thread-safe (sweep's worker threads write point files).
+  void write(const std::filesystem::path& target, const std::string& contents, Flush flush = Flush::to_disk);
+
   // After bad input: removes what this run created (see above). Never throws (it runs while a
   // BadInput propagates); what cannot be removed stays, and DIR still has no complete.json.
   void abandon() noexcept;
@@ -53,7 +63,6 @@ class OutputDirectory {
   static constexpr const char* marker_name = "complete.json";
 
  private:
-  friend void before_output_write(const std::filesystem::path& target);
   void acquire();  // creates DIR if needed and takes the lock (BadInput if held); idempotent
   void note_write(const std::filesystem::path& target);
 
@@ -68,12 +77,31 @@ class OutputDirectory {
   // whether it was new: decided at its first write, before any byte of this run lands there.
   std::map<std::string, bool> entries_;
   std::mutex mutex_;             // writes come from the worker threads of sweep
-  OutputDirectory* previous_ = nullptr;
 };
 
-// Called by write_file_atomically before it writes `target`: when target lies in the open
-// OutputDirectory, takes the lock if not yet held, removes complete.json on the first write and
-// records the file. Does nothing when no OutputDirectory is open (e.g. the library's tests).
-void before_output_write(const std::filesystem::path& target);
+// A command's result file: through the run's OutputDirectory when it has one (inv.output), else
+// (a worker rank's point files, a command called without run_command) written atomically alone.
+void write_output(const Invocation& inv, const std::filesystem::path& target, const std::string& contents,
+                  Flush flush = Flush::to_disk);
+
+// A result file built in memory and written by commit() through write_output. Output files of
+// delayspec are small (tables, JSON): buffering them whole keeps the write a single step.
+//     OutputFile csv(inv, dir / "chart.csv");
+//     csv.stream() << header << rows;
+//     csv.commit();             // without commit(), nothing is written
+class OutputFile {
+ public:
+  OutputFile(const Invocation& inv, std::filesystem::path target) : inv_(inv), target_(std::move(target)) {}
+  std::ostream& stream() { return buffer_; }
+  const std::filesystem::path& path() const { return target_; }
+  // Writes the file; a second commit() is a no-op.
+  void commit();
+
+ private:
+  const Invocation& inv_;
+  std::filesystem::path target_;
+  std::ostringstream buffer_;
+  bool committed_ = false;
+};
 
 }  // namespace delayspec::cli

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <fstream>
 
-#include "scene/output/atomic_file.hpp"
+#include "scene/output/output_directory.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec::cli {
@@ -54,8 +54,9 @@ json resume_settings(const Config& config, const std::vector<std::string>& per_p
   return settings;
 }
 
-PointFiles::PointFiles(fs::path dir, std::string command, json settings)
-    : dir_(std::move(dir)),
+PointFiles::PointFiles(const Invocation& inv, std::string command, json settings)
+    : inv_(inv),
+      dir_(inv.out_dir.value()),
       command_(std::move(command)),
       settings_(std::move(settings)),
       hash_(settings_hash(settings_)) {}
@@ -70,7 +71,7 @@ fs::path PointFiles::point_path(long index) const {
 
 void PointFiles::write(long index, json record) const {
   record["settings_hash"] = hash_;
-  write_file_atomically(point_path(index), record.dump() + "\n", Flush::skip);  // see Flush
+  write_output(inv_, point_path(index), record.dump() + "\n", Flush::skip);  // see Flush
 }
 
 std::map<long, json> PointFiles::start(bool resume, long count) const {
@@ -78,7 +79,7 @@ std::map<long, json> PointFiles::start(bool resume, long count) const {
     if (fs::exists(settings_path()) || fs::exists(dir_ / points_directory(command_)))
       throw BadInput("`--out " + dir_.string() + "` already holds a " + command_ +
                      ": add --resume to complete it, or choose another directory");
-    write_file_atomically(settings_path(), settings_.dump(2) + "\n");
+    write_output(inv_, settings_path(), settings_.dump(2) + "\n");
     return {};
   }
   std::ifstream in(settings_path());

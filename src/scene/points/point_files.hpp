@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/keys/config.hpp"
+#include "scene/output/invocation.hpp"
 
 namespace delayspec::cli {
 
@@ -36,7 +37,9 @@ std::string settings_hash(const nlohmann::json& settings);
 
 class PointFiles {
  public:
-  PointFiles(std::filesystem::path dir, std::string command, nlohmann::json settings);
+  // The files of `command` in the run's --out directory (inv.out_dir), written through its
+  // OutputDirectory (inv.output) where it has one.
+  PointFiles(const Invocation& inv, std::string command, nlohmann::json settings);
 
   // On the lead, before any point is computed. A new run: BadInput if DIR already holds a run
   // of this command, else writes the settings. --resume: BadInput unless the stored settings
@@ -53,6 +56,7 @@ class PointFiles {
   std::filesystem::path point_path(long index) const;
 
  private:
+  const Invocation& inv_;
   std::filesystem::path dir_;
   std::string command_;
   nlohmann::json settings_;

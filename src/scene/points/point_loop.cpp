@@ -39,7 +39,7 @@ std::vector<long> points_to_do(const std::optional<PointFiles>& files, bool resu
 
 long run_point_loop(const PointLoop& loop, const Config& config, const Invocation& inv) {
   std::optional<PointFiles> files;
-  if (inv.out_dir) files.emplace(*inv.out_dir, loop.command, resume_settings(config, loop.per_point_keys));
+  if (inv.out_dir) files.emplace(inv, loop.command, resume_settings(config, loop.per_point_keys));
   const std::vector<long> todo = points_to_do(files, inv.resume, loop.count, loop.take);
   const long todo_count = static_cast<long>(todo.size());
   if (!inv.quiet && inv.resume)
