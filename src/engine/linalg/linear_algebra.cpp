@@ -1,11 +1,10 @@
 #include "engine/linalg/linear_algebra.hpp"
 
-#include <dlfcn.h>
-
 #include <string>
 
 #include "delayspec/errors.hpp"
 #include "delayspec/linear_algebra_libraries.hpp"
+#include "engine/loading/shared_object.hpp"
 
 // The libraries' shared-object names (SONAMEs), found at configure time from the libraries CMake
 // found (CMakeLists.txt): the same libraries a link would have recorded.
@@ -18,24 +17,22 @@ namespace delayspec {
 
 namespace {
 
-// dlopen by SONAME, as the loader would have found a linked library. RTLD_LAZY, as at start-up:
-// RTLD_NOW binds every call of LAPACK's thousands of routines at once and made the load 3 ms
-// instead of 2 (measured at N = 2000, docs/benchmarks.md "Eighth sitting"). RTLD_LOCAL: their
-// symbols stay out of the process's global scope (a Python process may hold another BLAS).
-void* open_library(const char* soname, const char* what, std::string& error) {
-  void* handle = dlopen(soname, RTLD_LAZY | RTLD_LOCAL);
-  if (!handle && error.empty()) {
-    const char* reason = dlerror();
-    error = std::string("cannot load ") + soname + " (" + what + "): " + (reason ? reason : "unknown reason") +
+// By SONAME, as the loader would have found a linked library. Bound lazily, as at start-up:
+// binding every call of LAPACK's thousands of routines at once made the load 3 ms instead of 2
+// (measured at N = 2000, docs/benchmarks.md "Eighth sitting").
+detail::SharedObject open_library(const char* soname, const char* what, std::string& error) {
+  detail::SharedObject library(soname, detail::Binding::lazy);
+  if (!library.is_open() && error.empty())
+    error = std::string("cannot load ") + soname + " (" + what + "): " + library.error() +
             "; scripts/setup-debian.sh installs it";
-  }
-  return handle;
+  return library;
 }
 
 template <class F>
-void find_function(void* handle, const char* soname, const char* name, F*& function, std::string& error) {
-  if (!handle) return;
-  function = reinterpret_cast<F*>(dlsym(handle, name));
+void find_function(const detail::SharedObject& library, const char* soname, const char* name, F*& function,
+                   std::string& error) {
+  if (!library.is_open()) return;
+  function = library.function<F>(name);
   if (!function && error.empty()) error = std::string(soname) + " has no function " + name;
 }
 
@@ -61,9 +58,9 @@ const Table& loaded_once(Fill fill) {
 
 const detail::Lapack& detail::lapack() {
   return loaded_once<Lapack>([](Lapack& f, std::string& error) {
-    void* blas = open_library(DELAYSPEC_BLAS_SONAME, "BLAS", error);
+    const auto blas = open_library(DELAYSPEC_BLAS_SONAME, "BLAS", error);
     find_function(blas, DELAYSPEC_BLAS_SONAME, "dgemm_", f.dgemm, error);
-    void* lapack = open_library(DELAYSPEC_LAPACK_SONAME, "LAPACK", error);
+    const auto lapack = open_library(DELAYSPEC_LAPACK_SONAME, "LAPACK", error);
     find_function(lapack, DELAYSPEC_LAPACK_SONAME, "dgeev_", f.dgeev, error);
     find_function(lapack, DELAYSPEC_LAPACK_SONAME, "dgees_", f.dgees, error);
   });
@@ -71,7 +68,7 @@ const detail::Lapack& detail::lapack() {
 
 const detail::Arpack& detail::arpack() {
   return loaded_once<Arpack>([](Arpack& f, std::string& error) {
-    void* arpack = open_library(DELAYSPEC_ARPACK_SONAME, "ARPACK-ng", error);
+    const auto arpack = open_library(DELAYSPEC_ARPACK_SONAME, "ARPACK-ng", error);
     find_function(arpack, DELAYSPEC_ARPACK_SONAME, "dnaupd_c", f.dnaupd_c, error);
     find_function(arpack, DELAYSPEC_ARPACK_SONAME, "dneupd_c", f.dneupd_c, error);
   });
@@ -80,7 +77,7 @@ const detail::Arpack& detail::arpack() {
 const detail::Umfpack& detail::umfpack() {
   return loaded_once<Umfpack>([](Umfpack& f, std::string& error) {
     const char* so = DELAYSPEC_UMFPACK_SONAME;
-    void* umfpack = open_library(so, "SuiteSparse UMFPACK", error);
+    const auto umfpack = open_library(so, "SuiteSparse UMFPACK", error);
     find_function(umfpack, so, "umfpack_di_defaults", f.di_defaults, error);
     find_function(umfpack, so, "umfpack_di_symbolic", f.di_symbolic, error);
     find_function(umfpack, so, "umfpack_di_numeric", f.di_numeric, error);

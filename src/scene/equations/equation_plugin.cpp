@@ -1,6 +1,5 @@
 #include "scene/equations/equation_plugin.hpp"
 
-#include <dlfcn.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -21,6 +20,7 @@
 
 #include "delayspec/errors.hpp"
 #include "delayspec/version.hpp"
+#include "engine/loading/shared_object.hpp"
 #include "scene/equations/child_process.hpp"
 #include "equation_toolchain.hpp"
 #include "scene/equations/model_cache.hpp"
@@ -240,10 +240,10 @@ std::string first_lines(const std::string& text, int count) {
 }
 
 template <class F>
-F symbol(void* handle, const char* name, const std::filesystem::path& object) {
-  void* p = dlsym(handle, name);
+F* symbol(const detail::SharedObject& model, const char* name, const std::filesystem::path& object) {
+  F* p = model.function<F>(name);
   if (!p) throw BadInput("equations: the compiled model " + object.string() + " lacks `" + name + "`");
-  return reinterpret_cast<F>(p);
+  return p;
 }
 
 // dlopen of the file behind an open descriptor (the one whose bytes were checked), not of a path
@@ -252,25 +252,23 @@ F symbol(void* handle, const char* name, const std::filesystem::path& object) {
 // the name /proc/self/fd/N and returns an object already loaded under that name, so N must never
 // name another object (measured: with the descriptor closed, the next model got N again and the
 // first model's code).
-void* open_checked_object(UniqueFd& fd, std::string& error) {
-  const std::string through_fd = "/proc/self/fd/" + std::to_string(fd.get());
-  void* handle = dlopen(through_fd.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (!handle) error = dlerror();
-  else fd.release();
-  return handle;
+detail::SharedObject open_checked_object(UniqueFd& fd) {
+  detail::SharedObject model("/proc/self/fd/" + std::to_string(fd.get()), detail::Binding::now);
+  if (model.is_open()) fd.release();
+  return model;
 }
 
-EquationPlugin plugin_of(void* handle, const std::filesystem::path& object) {
-  const std::string version = symbol<const char* (*)()>(handle, "delayspec_equation_version", object)();
-  const std::string expected = std::string(DELAYSPEC_VERSION) + " " + DELAYSPEC_REVISION;
+EquationPlugin plugin_of(const detail::SharedObject& model, const std::filesystem::path& object) {
+  const std::string version = symbol<const char*()>(model, "delayspec_equation_version", object)();
+  const std::string expected = detail::this_build();
   if (version != expected)
     throw BadInput("equations: the compiled model " + object.string() + " is of delayspec " + version + ", this is " +
                    expected + ": delete it");
   EquationPlugin plugin;
-  plugin.analyses = symbol<decltype(plugin.analyses)>(handle, "delayspec_equation_analyses", object);
-  plugin.period = symbol<decltype(plugin.period)>(handle, "delayspec_equation_period", object);
-  plugin.delay = symbol<decltype(plugin.delay)>(handle, "delayspec_equation_delay", object);
-  plugin.history = symbol<decltype(plugin.history)>(handle, "delayspec_equation_history", object);
+  plugin.analyses = symbol<std::remove_pointer_t<decltype(plugin.analyses)>>(model, "delayspec_equation_analyses", object);
+  plugin.period = symbol<std::remove_pointer_t<decltype(plugin.period)>>(model, "delayspec_equation_period", object);
+  plugin.delay = symbol<std::remove_pointer_t<decltype(plugin.delay)>>(model, "delayspec_equation_delay", object);
+  plugin.history = symbol<std::remove_pointer_t<decltype(plugin.history)>>(model, "delayspec_equation_history", object);
   plugin.object = object;
   return plugin;
 }
@@ -287,12 +285,11 @@ std::optional<EquationPlugin> cached_plugin(const ModelCacheDir& cache, const st
   UniqueFd object = cache.open_entry(name + ".so");
   if (!object) return std::nullopt;
   if (object_checksum(read_fd(object.get())) != *recorded) return std::nullopt;
-  std::string error;
-  void* handle = open_checked_object(object, error);
-  if (!handle)
+  const detail::SharedObject model = open_checked_object(object);
+  if (!model.is_open())
     throw BadInput("equations: the cached model " + cache.entry_path(name + ".so").string() +
-                   " cannot be loaded (" + error + "): delete it");
-  return plugin_of(handle, cache.entry_path(name + ".so"));
+                   " cannot be loaded (" + model.error() + "): delete it");
+  return plugin_of(model, cache.entry_path(name + ".so"));
 }
 
 // The time a compile may take: DELAYSPEC_COMPILE_TIMEOUT seconds, default 600 (a large model
@@ -354,16 +351,20 @@ EquationPlugin compile_plugin(const Toolchain& tc, const ModelCacheDir& cache, c
   UniqueFd object = cache.open_entry(tmp);
   if (!object) throw BadInput("equations: the compiler exited 0 but wrote no object" + where);
   const std::string bytes = read_fd(object.get());
-  std::string error;
-  void* handle = bytes.compare(0, 4, "\x7f" "ELF") == 0 ? open_checked_object(object, error) : nullptr;
-  if (!handle) {
+  if (bytes.compare(0, 4, "\x7f" "ELF") != 0) {
     cache.remove_entry(tmp);
-    throw BadInput("equations: the compiler's output is not a loadable shared object (" +
-                   (error.empty() ? std::string("no ELF header") : error) + ")" + where + "; nothing was cached");
+    throw BadInput("equations: the compiler's output is not a loadable shared object (no ELF header)" + where +
+                   "; nothing was cached");
+  }
+  const detail::SharedObject model = open_checked_object(object);
+  if (!model.is_open()) {
+    cache.remove_entry(tmp);
+    throw BadInput("equations: the compiler's output is not a loadable shared object (" + model.error() + ")" +
+                   where + "; nothing was cached");
   }
   EquationPlugin plugin;
   try {
-    plugin = plugin_of(handle, cache.entry_path(name + ".so"));
+    plugin = plugin_of(model, cache.entry_path(name + ".so"));
   } catch (const BadInput&) {  // an object, but not this program's model: nothing is cached
     cache.remove_entry(tmp);
     throw;
