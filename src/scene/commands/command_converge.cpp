@@ -219,13 +219,10 @@ int command_converge(Config& config, const Invocation& inv) {
   const auto command_start = std::chrono::steady_clock::now();
   // events may be a list here (side by side); the problem reads the first of them.
   // Models that switch (the impact wall, milling's cutting windows): located and not, side by side.
-  const std::string model_name = config.get_string("model", "impact");
-  bool switching_default = model_name == "impact" || model_name == "milling";
-  if (model_name == "equations") {  // known once the equations are read
-    Config first = config;
-    first.set("events", "on", "converge");
-    switching_default = read_problem(first, 100).switching();
-  }
+  // Whether the model switches is the model's own (its analyses); `events` is read after it.
+  Config first = config;
+  first.set("events", "on", "converge");
+  const bool switching_default = read_problem(first, 100).switching();
   const std::vector<std::string> events =
       read_word_list(config, "events", switching_default ? "on,off" : "on", event_mode_names());
   config.set("events", events.front(), "converge");

@@ -118,8 +118,25 @@ EventMode parse_event_mode(const std::string& text, const std::string& key) {
   throw BadInput("`" + key + " = " + text + "`: must be one of on, linear, off");
 }
 
+const std::vector<BuiltinModel>& builtin_models() {
+  // The default first. Forced: a periodic forcing sets the map's period (orbit_period counts its
+  // periods); linear and mackey-glass are autonomous, their map's period is the key `period`.
+  static const std::vector<BuiltinModel> table = {
+      {"impact", [](Config& c) -> AnyModel { return read_impact(c); }, true, {"x", "v"}},
+      {"linear", [](Config& c) -> AnyModel { return read_linear(c); }, false, {"x"}},
+      {"mathieu", [](Config& c) -> AnyModel { return read_mathieu(c); }, true, {"x", "v"}},
+      {"mackey-glass", [](Config& c) -> AnyModel { return read_mackey_glass(c); }, false, {"x"}},
+      {"milling", [](Config& c) -> AnyModel { return read_milling(c); }, true, {"x", "v"}},
+  };
+  return table;
+}
+
 const std::vector<std::string>& model_names() {
-  static const std::vector<std::string> names = {"impact", "linear", "mathieu", "mackey-glass", "milling"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all;
+    for (const auto& model : builtin_models()) all.push_back(model.name);
+    return all;
+  }();
   return names;
 }
 
@@ -135,15 +152,14 @@ const std::vector<std::string>& model_choices() {
 Problem read_problem(Config& config, int default_N) {
   Problem problem;
   problem.model_name = config.get_choice("model", model_names().front(), model_choices());
-  if (problem.model_name == "impact") problem.model = read_impact(config);
-  if (problem.model_name == "linear") problem.model = read_linear(config);
-  if (problem.model_name == "mathieu") problem.model = read_mathieu(config);
-  if (problem.model_name == "mackey-glass") problem.model = read_mackey_glass(config);
-  if (problem.model_name == "milling") problem.model = read_milling(config);
-  if (problem.model) {
+  const BuiltinModel* builtin = nullptr;
+  for (const auto& model : builtin_models())
+    if (model.name == problem.model_name) builtin = &model;
+  if (builtin) {
+    problem.model = builtin->read(config);
     problem.analyses = std::visit([](const auto& model) { return builtin_analyses(model); }, *problem.model);
-    problem.state_names =
-        problem.state_dimension() == 2 ? std::vector<std::string>{"x", "v"} : std::vector<std::string>{"x"};
+    problem.state_names = builtin->state_names;
+    problem.forced = builtin->forced;
   } else {
     EquationModel equations = read_equation_model(config, [&](double tau, double period) {
       make_grid(tau, period, static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000)),
@@ -156,7 +172,7 @@ Problem read_problem(Config& config, int default_N) {
   // multiply the work per step or per period, 1000 is far beyond any use.
   problem.N = static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000));
   problem.orbit_period = static_cast<int>(config.get_int_in_range("orbit_period", 1, 1, 1000));
-  if (problem.orbit_period != 1 && (problem.model_name == "linear" || problem.model_name == "mackey-glass"))
+  if (problem.orbit_period != 1 && !problem.forced)
     throw BadInput("`orbit_period = " + std::to_string(problem.orbit_period) +
                    "`: only for forced models (impact, mathieu, milling); for linear and mackey-glass set `period`");
   problem.events = parse_event_mode(config.get_choice("events", "on", event_mode_names()));

@@ -33,6 +33,9 @@ struct Problem {
   std::optional<AnyModel> model;                  // the built-in model; empty for model = equations
   std::shared_ptr<const ModelAnalyses> analyses;  // every model
   std::vector<std::string> state_names;           // the state's components: "x", "v" (output columns)
+  // Whether a periodic forcing sets the map's period (orbit_period counts forcing periods); an
+  // equation model's period is its own, so it may take several.
+  bool forced = true;
   int N = 100;
   int orbit_period = 1;
   EventMode events = EventMode::on;
@@ -69,7 +72,16 @@ decltype(auto) with_map(const Problem& problem, Fn&& fn, const std::string& what
       *problem.model);
 }
 
-// The built-in models, the default first.
+// The one table of the built-in models, the default first: the name (the key `model`), how the
+// keys make the model, and the traits the scene layer needs beside its analyses.
+struct BuiltinModel {
+  std::string name;
+  AnyModel (*read)(Config& config);
+  bool forced;                           // Problem::forced
+  std::vector<std::string> state_names;  // Problem::state_names
+};
+const std::vector<BuiltinModel>& builtin_models();
+// Their names, the default first.
 const std::vector<std::string>& model_names();
 // The values of the key `model`: the built-in models and "equations" (a model written in the
 // scene's [equations] table, equation_model.hpp).
