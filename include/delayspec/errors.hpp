@@ -55,6 +55,9 @@ std::string describe_point(const ModelPoint& point);
 // Formats a double with the fewest digits that read back as the same double (messages,
 // metadata, values passed on as text).
 std::string format_number(double value);
+// Formats a double with `significant_digits` digits (printf's %g): a tolerance in a message
+// (3), a coordinate in a plot script (10). The one home of number formatting with format_number.
+std::string format_number(double value, int significant_digits);
 
 // Throws BadInput("`name = value`: must be finite") when value is NaN or infinite.
 void require_finite(const char* name, double value);

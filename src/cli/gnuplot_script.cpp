@@ -19,12 +19,7 @@ namespace delayspec::cli {
 
 namespace fs = std::filesystem;
 
-std::string gnuplot_number(double value) {
-  if (!std::isfinite(value)) return "NaN";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", value);
-  return buf;
-}
+std::string gnuplot_number(double value) { return std::isfinite(value) ? format_number(value, 10) : "NaN"; }
 
 std::string gnuplot_string(const std::string& text) {
   std::string out = "'";

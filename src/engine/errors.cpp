@@ -21,6 +21,12 @@ std::string format_number(double value) {
   return best;
 }
 
+std::string format_number(double value, int significant_digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*g", significant_digits, value);
+  return buffer;
+}
+
 NonFiniteStep::NonFiniteStep(const std::string& what, std::vector<ModelPoint> points)
     : NumericalFailure(what), points_(std::move(points)) {}
 

@@ -131,12 +131,6 @@ double largest_relative_estimate(const std::vector<std::complex<double>>& theta,
   return worst;
 }
 
-std::string short_number(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.3g", value);
-  return buffer;
-}
-
 }  // namespace krylov
 
 namespace {
@@ -281,7 +275,7 @@ std::string residual_gate_message(double size, const FloquetResult& r, const std
                         " of nev = " + std::to_string(r.multipliers.size()) + ", mu = " + format_number(mu.real()) +
                         (mu.imag() < 0 ? " - " : " + ") + format_number(std::abs(mu.imag())) +
                         "i, fails its residual check: |M v - mu v| / (|mu| |v|) = " + format_number(r.residuals[k]) +
-                        " > bound " + krylov::short_number(bound) + " (ncv = " + std::to_string(first_ncv) +
+                        " > bound " + format_number(bound, 3) + " (ncv = " + std::to_string(first_ncv) +
                         (last_ncv != first_ncv ? ", retried with ncv = " + std::to_string(last_ncv) : "") + ")";
   const double round_off = std::numeric_limits<double>::epsilon() * size;
   if (std::abs(mu) <= 1e3 * round_off)

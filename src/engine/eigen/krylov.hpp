@@ -55,7 +55,4 @@ RitzPairs ritz_pairs_in_basis(const std::vector<std::complex<double>>& theta, co
 double largest_relative_estimate(const std::vector<std::complex<double>>& theta, const std::vector<double>& estimate,
                                  int nev);
 
-// A tolerance for messages: "1e-12", not "9.9999999999999998e-13".
-std::string short_number(double value);
-
 }  // namespace delayspec::krylov

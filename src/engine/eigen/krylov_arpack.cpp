@@ -105,7 +105,7 @@ RitzPairs arpack_ritz_pairs(const LinearOperator& op, const Settings& s, const E
         " Ritz values converged after " + std::to_string(pairs.iterations) + " Arnoldi iterations (max_iterations = " +
         std::to_string(s.max_iterations) + " = 1 + max_restarts, ncv = " + std::to_string(ncv) +
         "), largest relative residual estimate " + format_number(largest_relative_estimate(theta, est, nev)) +
-        " > tol " + short_number(s.tolerance) + " (dnaupd info = " + std::to_string(info) + ")");
+        " > tol " + format_number(s.tolerance, 3) + " (dnaupd info = " + std::to_string(info) + ")");
   }
   if (info != 0)
     throw NumericalFailure("Krylov (arpack): dnaupd info = " + std::to_string(info) + ": " + dnaupd_error(info) +

@@ -313,7 +313,7 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
           " Ritz values converged after " + std::to_string(iteration) +
           " iterations (max_iterations = " + std::to_string(s.max_iterations) + " = 1 + max_restarts, basis " +
           std::to_string(m) + ", block " + std::to_string(b) + "), largest relative residual estimate " +
-          format_number(largest_relative_estimate(values, estimates, nev)) + " > tol " + short_number(s.tolerance));
+          format_number(largest_relative_estimate(values, estimates, nev)) + " > tol " + format_number(s.tolerance, 3));
 
     // Restart: ordered real Schur form, the `keep` largest moduli first. dgees selects by modulus;
     // ties (exact zeros of a rank-deficient monodromy, round-off-level values of a strongly

@@ -114,7 +114,7 @@ RitzPairs spectra_ritz_pairs(const LinearOperator& op, const Settings& s, const 
         " Ritz values converged after " + std::to_string(pairs.iterations) +
         " Arnoldi iterations (max_iterations = " + std::to_string(s.max_iterations) +
         " = 1 + max_restarts, ncv = " + std::to_string(s.ncv) + "), largest relative residual estimate " +
-        format_number(solver.largest_estimate()) + " > tol " + short_number(s.tolerance));
+        format_number(solver.largest_estimate()) + " > tol " + format_number(s.tolerance, 3));
 
   std::vector<std::complex<double>> theta;
   std::vector<Eigen::VectorXcd> y;

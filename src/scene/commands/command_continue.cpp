@@ -108,7 +108,6 @@ json measures_json(const OrbitMeasures& m) {
   return j;
 }
 
-std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : "nan"; }
 
 json points_json(const std::vector<ContinuationPoint>& points) {
   json list = json::array();

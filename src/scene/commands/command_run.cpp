@@ -32,15 +32,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The analyses listed, empty items dropped ("floquet,,lyapunov" lists two).
 std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    const auto b = item.find_first_not_of(" \t");
-    const auto e = item.find_last_not_of(" \t");
-    if (b != std::string::npos) out.push_back(item.substr(b, e - b + 1));
-  }
+  std::vector<std::string> out = split_items(text);
+  std::erase(out, std::string());
   return out;
 }
 

@@ -50,7 +50,6 @@ struct SweepPoint {
   json result;  // the point's record (also its file)
 };
 
-std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : "nan"; }
 
 double number_or_nan(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
 

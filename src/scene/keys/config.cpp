@@ -330,6 +330,14 @@ std::string Config::get_choice(const std::string& key, const std::string& fallba
   throw BadInput("`" + key + " = " + value + "`: must be one of " + list);
 }
 
+std::vector<std::string> split_items(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) items.push_back(trim(item));
+  return items;
+}
+
 std::vector<long> Config::get_int_list(const std::string& key, const std::vector<long>& fallback) {
   auto join = [](const std::vector<long>& list) {
     std::string out;
@@ -344,10 +352,7 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
     return fallback;
   }
   std::vector<long> out;
-  std::stringstream ss(*text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    item = trim(item);
+  for (const std::string& item : split_items(*text)) {
     errno = 0;
     char* end = nullptr;
     const long value = std::strtol(item.c_str(), &end, 10);

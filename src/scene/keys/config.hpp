@@ -124,6 +124,10 @@ class Config {
   const KeyIndex* key_index_ = nullptr;
 };
 
+// "a, b,,c" -> {"a", "b", "", "c"}: a list value's items, split at commas and trimmed of blanks
+// (empty items kept: each reader says what it makes of them). The one splitting of a list key.
+std::vector<std::string> split_items(const std::string& text);
+
 // Thrown by check_all_used() in key-collection mode (not an error: not derived from
 // std::exception so that no error handler mistakes it for one).
 struct KeysCollected {

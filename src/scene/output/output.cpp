@@ -10,6 +10,8 @@ namespace delayspec::cli {
 
 nlohmann::json number_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
+std::string csv_number(double x) { return std::isfinite(x) ? format_number(x) : "nan"; }
+
 nlohmann::json lyapunov_json(const LyapunovResult& r) {
   nlohmann::json j;
   j["exponents_per_period"] = r.per_period;

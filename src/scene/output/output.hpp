@@ -16,6 +16,8 @@ namespace delayspec::cli {
 
 // A number, or null when it is not finite (JSON has no nan or inf).
 nlohmann::json number_or_null(double x);
+// A CSV cell: the shortest exact text of x (format_number), "nan" when x is not finite.
+std::string csv_number(double x);
 
 // The exponents and their errors, the fields `lyapunov --json` and each `sweep` point share:
 // exponents_per_period, standard_error_per_period (= error_per_period, the historical key),

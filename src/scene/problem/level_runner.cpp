@@ -69,11 +69,7 @@ std::vector<std::string> read_word_list(Config& config, const std::string& key, 
                                         const std::vector<std::string>& allowed) {
   const std::string text = config.get_string(key, fallback);
   std::vector<std::string> words;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    const auto b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
-    item = b == std::string::npos ? "" : item.substr(b, e - b + 1);
+  for (const std::string& item : split_items(text)) {
     bool ok = false;
     for (const auto& a : allowed) ok = ok || a == item;
     if (!ok) {
