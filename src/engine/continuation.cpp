@@ -1,7 +1,10 @@
-// The non-template parts of continuation.hpp: detection counts, test functions, the Hermite
-// maximum, and the extrapolation of bifurcation points across N.
+// The non-template parts of continuation.hpp and its detail headers: the checked options,
+// detection counts, test functions, the Hermite maximum, and the extrapolation of bifurcation
+// points across N.
 #include "delayspec/continuation.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <set>
 
 namespace delayspec {
@@ -17,6 +20,28 @@ std::string to_string(BifurcationType type) {
 }
 
 namespace continuation_detail {
+
+ContinuationOptions checked_options(const ContinuationOptions& options) {
+  ContinuationOptions o = options;
+  require_finite("continue_from", o.from);
+  require_finite("continue_to", o.to);
+  if (o.from == o.to) throw BadInput("`continue_from = continue_to = " + format_number(o.from) + "`: an empty range");
+  const double range = std::abs(o.to - o.from);
+  if (o.step == 0) o.step = range / 50;
+  if (o.step_min == 0) o.step_min = 1e-6 * range;
+  if (o.step_max == 0) o.step_max = range / 10;
+  if (o.tolerance == 0) o.tolerance = 1e-10 * range;
+  require_positive("continue_step", o.step);
+  require_positive("continue_step_min", o.step_min);
+  require_positive("continue_step_max", o.step_max);
+  require_positive("continue_tolerance", o.tolerance);
+  if (o.step_min > o.step_max)
+    throw BadInput("`continue_step_min = " + format_number(o.step_min) +
+                   "` exceeds `continue_step_max = " + format_number(o.step_max) + "`");
+  o.step = std::clamp(o.step, o.step_min, o.step_max);
+  if (o.max_points < 2) throw BadInput("`continue_max_points = " + std::to_string(o.max_points) + "`: must be >= 2");
+  return o;
+}
 
 bool is_real(std::complex<double> mu) { return std::abs(mu.imag()) <= 1e-10 * std::abs(mu); }
 
