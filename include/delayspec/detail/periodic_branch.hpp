@@ -286,19 +286,20 @@ class PeriodicBranch {
   // Switching models: over each step [t, t + h] of the orbit, max H from the cubic Hermite
   // interpolant of H(y(t)) with the slopes dH/dt = grad H . f at both nodes (H affine,
   // model.hpp), and the time in region 1 from the step's events (none with events off: the
-  // node's region).
+  // node's region). The delayed states from HistoryGrid::delay_tap, the orbit repeated
+  // periodically into the past: slot M + l of the history is u_{l mod K}.
   void switching_measures(const Map& map, const States& states, OrbitMeasures& m) const {
     const HistoryGrid& g = map.grid();
     const Model& model = map.stepper().model();
-    const double theta = g.theta, c0 = 1 - theta, h = g.h;
+    const double h = g.h;
+    const long M = g.M;
     auto u = [&](long l) { return V(states.col(((l % K_) + K_) % K_)); };
+    auto slot = [&](long i) { return u(i - M); };
     m.max_H = -INFINITY;
     m.contact_time = 0;
     StepMap<D> scratch;
     for (long l = 0; l < K_; ++l) {
-      const V w0 = theta == 0 ? u(l - g.m) : V(c0 * u(l - g.m) + theta * u(l - g.m - 1));
-      const V w1 = theta == 0 ? u(l - g.m + 1) : V(c0 * u(l - g.m + 1) + theta * u(l - g.m));
-      const double t = static_cast<double>(l % g.steps_per_period) * h;
+      const auto [w0, w1, t] = g.delay_tap<V>(l, slot);
       const V a = u(l), b = u(l + 1);
       const int ja = region_of(model, a), jb = region_of(model, b);
       const V grad = model.grad_H(a);
