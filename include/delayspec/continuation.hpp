@@ -161,11 +161,21 @@ struct ContinuationOptions {
   std::function<void(const ContinuationPoint&)> on_point;
 };
 
+// Where a branch ended.
+enum class BranchEnd {
+  to,          // at `to`
+  from,        // back at `from` (turned back past the start)
+  max_points,  // after max_points points
+  failure      // it could not go on: ContinuationResult::failure says where and why
+};
+// "to", "from", "max_points", "failure".
+std::string to_string(BranchEnd end);
+
 struct ContinuationResult {
   std::vector<ContinuationPoint> points;
   std::vector<Bifurcation> bifurcations;  // by segment along the branch (within one: multiplier types first)
-  std::string end;                        // "to", "from" (turned back past the start), "max_points", or "failure"
-  std::string failure;                    // when end == "failure": the point reached and the reason
+  BranchEnd end = BranchEnd::max_points;
+  std::string failure;  // when end == failure: the point reached and the reason
   // Cost: corrector iterations (each one linearisation + one sparse LU) and Krylov solves.
   long newton_iterations = 0;
   long krylov_solves = 0;

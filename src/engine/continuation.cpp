@@ -19,6 +19,16 @@ std::string to_string(BifurcationType type) {
   return "?";
 }
 
+std::string to_string(BranchEnd end) {
+  switch (end) {
+    case BranchEnd::to: return "to";
+    case BranchEnd::from: return "from";
+    case BranchEnd::max_points: return "max_points";
+    case BranchEnd::failure: return "failure";
+  }
+  return "?";
+}
+
 namespace continuation_detail {
 
 ContinuationOptions checked_options(const ContinuationOptions& options) {

@@ -50,7 +50,7 @@ class BranchTracer {
     zero_row_ = Eigen::VectorXd::Zero(n);
     start(guess);
     ds_ = o_.step;
-    result_.end = "max_points";
+    result_.end = BranchEnd::max_points;
     while (static_cast<long>(result_.points.size()) < o_.max_points)
       if (!advance()) break;
     return std::move(result_);
@@ -112,7 +112,7 @@ class BranchTracer {
     try {
       point = branch_.evaluate(*next, result_.krylov_seconds);
     } catch (const NumericalFailure& e) {
-      result_.end = "failure";
+      result_.end = BranchEnd::failure;
       result_.failure = "multipliers at parameter " + format_number(next->p) + " (after point " +
                         std::to_string(result_.points.size() - 1) + "): " + e.what();
       return false;
@@ -173,7 +173,7 @@ class BranchTracer {
     ds_ *= 0.5;
     if (!(ds_ < o_.step_min)) return true;
     const ContinuationPoint& last = result_.points.back();
-    result_.end = "failure";
+    result_.end = BranchEnd::failure;
     result_.failure = "step below continue_step_min = " + format_number(o_.step_min) + " after point " +
                       std::to_string(result_.points.size() - 1) + " at parameter " + format_number(last.parameter) +
                       " (" + reason + ")";
@@ -195,7 +195,7 @@ class BranchTracer {
       s_b = branch_.dot(current_->tx, current_->tp, end->x - current_->x, end->p - current_->p);
       next = std::move(end);
     }
-    result_.end = past_to >= 0 ? "to" : "from";
+    result_.end = past_to >= 0 ? BranchEnd::to : BranchEnd::from;
     return true;
   }
 
