@@ -33,23 +33,26 @@ namespace continuation_detail {
 
 ContinuationOptions checked_options(const ContinuationOptions& options) {
   ContinuationOptions o = options;
-  require_finite("continue_from", o.from);
-  require_finite("continue_to", o.to);
-  if (o.from == o.to) throw BadInput("`continue_from = continue_to = " + format_number(o.from) + "`: an empty range");
+  // Named by the options' fields: the scene layer checks its keys before (continue_settings.cpp).
+  require_finite("ContinuationOptions::from", o.from);
+  require_finite("ContinuationOptions::to", o.to);
+  if (o.from == o.to)
+    throw BadInput("`ContinuationOptions::from = to = " + format_number(o.from) + "`: an empty range");
   const double range = std::abs(o.to - o.from);
   if (o.step == 0) o.step = range / 50;
   if (o.step_min == 0) o.step_min = 1e-6 * range;
   if (o.step_max == 0) o.step_max = range / 10;
   if (o.tolerance == 0) o.tolerance = 1e-10 * range;
-  require_positive("continue_step", o.step);
-  require_positive("continue_step_min", o.step_min);
-  require_positive("continue_step_max", o.step_max);
-  require_positive("continue_tolerance", o.tolerance);
+  require_positive("ContinuationOptions::step", o.step);
+  require_positive("ContinuationOptions::step_min", o.step_min);
+  require_positive("ContinuationOptions::step_max", o.step_max);
+  require_positive("ContinuationOptions::tolerance", o.tolerance);
   if (o.step_min > o.step_max)
-    throw BadInput("`continue_step_min = " + format_number(o.step_min) +
-                   "` exceeds `continue_step_max = " + format_number(o.step_max) + "`");
+    throw BadInput("`ContinuationOptions::step_min = " + format_number(o.step_min) + "` exceeds `step_max = " +
+                   format_number(o.step_max) + "`" + (options.step_max == 0 ? " (its default, |to - from| / 10)" : ""));
   o.step = std::clamp(o.step, o.step_min, o.step_max);
-  if (o.max_points < 2) throw BadInput("`continue_max_points = " + std::to_string(o.max_points) + "`: must be >= 2");
+  if (o.max_points < 2)
+    throw BadInput("`ContinuationOptions::max_points = " + std::to_string(o.max_points) + "`: must be >= 2");
   return o;
 }
 
@@ -141,8 +144,8 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
   if (Ns.empty()) return {};
   for (size_t i = 1; i < Ns.size(); ++i)
     if (Ns[i] <= Ns[i - 1])
-      throw BadInput("`continue_Ns`: must be increasing (" + std::to_string(Ns[i - 1]) + ", " + std::to_string(Ns[i]) +
-                     ")");
+      throw BadInput("extrapolate_bifurcations: the Ns must be increasing (" + std::to_string(Ns[i - 1]) + ", " +
+                     std::to_string(Ns[i]) + ")");
   std::vector<BifurcationEstimate> estimates;
   const size_t finest = Ns.size() - 1;
   std::vector<std::set<size_t>> used(Ns.size());
