@@ -69,7 +69,7 @@ void report(benchmark::State& state, const FloquetResult& r, long n) {
   state.counters["basis_MB"] = static_cast<double>(n) * r.ncv * 8 / 1048576.0;
   state.counters["mu1"] = std::abs(r.multipliers[0]);
   state.counters["mu20"] = std::abs(r.multipliers.back());
-  state.SetLabel(r.solver);
+  state.SetLabel(to_string(r.solver));
 }
 
 void BM_KrylovTop20(benchmark::State& state) {

@@ -88,10 +88,11 @@ struct FloquetOptions {
 
 struct FloquetResult {
   std::vector<std::complex<double>> multipliers;  // sorted by modulus, largest first (sort_by_modulus)
-  std::string solver;                             // backend that produced them
-  long operator_applications = 0;                 // single-vector applications of the operator (all of them)
-  double seconds = 0;                             // wall time of the eigen-solve (incl. assembly / residuals)
-  std::string note;                               // e.g. why a Krylov request went dense
+  // The backend that produced them (never automatic).
+  FloquetSolver solver = FloquetSolver::automatic;
+  long operator_applications = 0;  // single-vector applications of the operator (all of them)
+  double seconds = 0;              // wall time of the eigen-solve (incl. assembly / residuals)
+  std::string note;                // e.g. why a Krylov request went dense
   // Krylov only (dense: converged = nev, the rest 0 / empty):
   int ncv = 0;                    // subspace dimension used
   int converged = 0;              // Ritz values the backend reports converged (ARPACK iparam(5)), >= nev

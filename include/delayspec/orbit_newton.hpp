@@ -149,7 +149,7 @@ PeriodicOrbit orbit_by_newton(const Map& map, Eigen::VectorXd x, const OrbitByNe
   if (!x.allFinite()) throw NumericalFailure("orbit by Newton: the guess is not finite (did the simulation diverge?)");
 
   PeriodicOrbit orbit;
-  orbit.method = "newton";
+  orbit.method = OrbitFoundBy::newton;
   Eigen::SparseMatrix<double> J;
   Eigen::VectorXd F = problem.residual(x, &J);
   double r = F.lpNorm<Eigen::Infinity>();

@@ -22,8 +22,21 @@
 
 namespace delayspec {
 
+// How find_orbit looks for the orbit (the header's list).
+enum class OrbitMethod { automatic, shooting, simulate, newton };
+// "auto", "shooting", "simulate", "newton".
+inline std::string to_string(OrbitMethod method) {
+  switch (method) {
+    case OrbitMethod::automatic: return "auto";
+    case OrbitMethod::shooting: return "shooting";
+    case OrbitMethod::simulate: return "simulate";
+    case OrbitMethod::newton: return "newton";
+  }
+  return "?";
+}
+
 struct OrbitSettings {
-  std::string method = "auto";  // auto | shooting | simulate | newton
+  OrbitMethod method = OrbitMethod::automatic;
   OrbitBySimulationOptions simulation;
   OrbitByNewtonOptions newton;
   OrbitByShootingOptions shooting;
@@ -46,20 +59,21 @@ PeriodicOrbit find_orbit(const Model& model, const Map& map, const OrbitSettings
     PeriodicOrbit zero;
     zero.history = Eigen::VectorXd::Zero(map.dimension());
     zero.residual = 0;
-    zero.method = "zero";
+    zero.method = OrbitFoundBy::zero;
     return linearise(std::move(zero));
   } else {
-    if (settings.method == "auto" || settings.method == "shooting") {
+    if (settings.method == OrbitMethod::automatic || settings.method == OrbitMethod::shooting) {
       NestedShootingOptions o;
       o.shooting = settings.shooting;
       o.newton = settings.newton;
-      o.coarse_method = settings.method == "auto" ? CoarseOrbitMethod::automatic : CoarseOrbitMethod::shooting;
+      o.coarse_method =
+          settings.method == OrbitMethod::automatic ? CoarseOrbitMethod::automatic : CoarseOrbitMethod::shooting;
       o.guess_periods = settings.guess_periods;
       o.coarse_N = settings.coarse_N;
       return orbit_by_nested_shooting(map, model.initial_state(), o, at_orbit);
     }
     Eigen::VectorXd U = map.constant_history(model.initial_state());
-    if (settings.method == "simulate") {
+    if (settings.method == OrbitMethod::simulate) {
       try {
         return linearise(orbit_by_simulation(map, U, settings.simulation));
       } catch (const NumericalFailure& e) {
@@ -71,6 +85,7 @@ PeriodicOrbit find_orbit(const Model& model, const Map& map, const OrbitSettings
                                "(x0, v0 for impact), or a scene that has one, e.g. data/scenes/default.toml");
       }
     }
+    // OrbitMethod::newton
     for (long i = 1; i <= settings.guess_periods; ++i) {
       U = map.apply(U);
       if (!U.allFinite())

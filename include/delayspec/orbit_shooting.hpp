@@ -82,7 +82,7 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
   if (!U.allFinite()) throw NumericalFailure("orbit by shooting: the starting history is not finite");
 
   PeriodicOrbit orbit;
-  orbit.method = "shooting";
+  orbit.method = OrbitFoundBy::shooting;
   OrbitLinearisation<D> lin;
   // G = P(X) - X with the step maps and states of this evaluation in `lin`; false when the
   // stepper cannot step from X or the result is not finite.

@@ -9,11 +9,18 @@
 
 namespace delayspec {
 
+// How an orbit was found: by simulation (orbit_simulation.hpp), by sparse-LU Newton on the
+// discrete periodic problem (orbit_newton.hpp), by Newton-Krylov shooting (orbit_shooting.hpp),
+// or it is the zero orbit of a linear model.
+enum class OrbitFoundBy { simulate, newton, shooting, zero };
+// "simulate", "newton", "shooting", "zero".
+std::string to_string(OrbitFoundBy method);
+
 struct PeriodicOrbit {
-  Eigen::VectorXd history;          // U with P(U) ~ U (the history the Monodromy is taken at)
-  double residual = NAN;            // |P(U) - U|_inf, one application of the stroboscopic map
-  long maps = 0;                    // stroboscopic maps simulated (simulate: to settle; newton: for the guess)
-  std::string method = "simulate";  // "simulate" | "newton" | "zero" (linear models)
+  Eigen::VectorXd history;  // U with P(U) ~ U (the history the Monodromy is taken at)
+  double residual = NAN;    // |P(U) - U|_inf, one application of the stroboscopic map
+  long maps = 0;            // stroboscopic maps simulated (simulate: to settle; newton: for the guess)
+  OrbitFoundBy method = OrbitFoundBy::simulate;
 
   // Newton only (empty / zero otherwise).
   int newton_iterations = 0;                   // linear solves performed
@@ -26,8 +33,8 @@ struct PeriodicOrbit {
   // Shooting only (orbit_shooting.hpp; empty / zero otherwise).
   long linear_iterations = 0;  // GMRES iterations (applications of M - I), all levels
   struct Level {
-    int N = 0;           // steps per delay at this level
-    std::string method;  // "newton" (sparse LU, the coarsest level) or "shooting"
+    int N = 0;                                     // steps per delay at this level
+    OrbitFoundBy method = OrbitFoundBy::shooting;  // newton (sparse LU) only at the coarsest level
     int newton_iterations = 0;
     long linear_iterations = 0;
     double residual = NAN;  // |P(U) - U|_inf at the level's orbit

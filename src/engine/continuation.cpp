@@ -1,7 +1,10 @@
-// The non-template parts of continuation.hpp: detection counts, test functions, the Hermite
-// maximum, and the extrapolation of bifurcation points across N.
+// The non-template parts of continuation.hpp and its detail headers: the checked options,
+// detection counts, test functions, the Hermite maximum, and the extrapolation of bifurcation
+// points across N.
 #include "delayspec/continuation.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <set>
 
 namespace delayspec {
@@ -16,7 +19,42 @@ std::string to_string(BifurcationType type) {
   return "?";
 }
 
+std::string to_string(BranchEnd end) {
+  switch (end) {
+    case BranchEnd::to: return "to";
+    case BranchEnd::from: return "from";
+    case BranchEnd::max_points: return "max_points";
+    case BranchEnd::failure: return "failure";
+  }
+  return "?";
+}
+
 namespace continuation_detail {
+
+ContinuationOptions checked_options(const ContinuationOptions& options) {
+  ContinuationOptions o = options;
+  // Named by the options' fields: the scene layer checks its keys before (continue_settings.cpp).
+  require_finite("ContinuationOptions::from", o.from);
+  require_finite("ContinuationOptions::to", o.to);
+  if (o.from == o.to)
+    throw BadInput("`ContinuationOptions::from = to = " + format_number(o.from) + "`: an empty range");
+  const double range = std::abs(o.to - o.from);
+  if (o.step == 0) o.step = range / 50;
+  if (o.step_min == 0) o.step_min = 1e-6 * range;
+  if (o.step_max == 0) o.step_max = range / 10;
+  if (o.tolerance == 0) o.tolerance = 1e-10 * range;
+  require_positive("ContinuationOptions::step", o.step);
+  require_positive("ContinuationOptions::step_min", o.step_min);
+  require_positive("ContinuationOptions::step_max", o.step_max);
+  require_positive("ContinuationOptions::tolerance", o.tolerance);
+  if (o.step_min > o.step_max)
+    throw BadInput("`ContinuationOptions::step_min = " + format_number(o.step_min) + "` exceeds `step_max = " +
+                   format_number(o.step_max) + "`" + (options.step_max == 0 ? " (its default, |to - from| / 10)" : ""));
+  o.step = std::clamp(o.step, o.step_min, o.step_max);
+  if (o.max_points < 2)
+    throw BadInput("`ContinuationOptions::max_points = " + std::to_string(o.max_points) + "`: must be >= 2");
+  return o;
+}
 
 bool is_real(std::complex<double> mu) { return std::abs(mu.imag()) <= 1e-10 * std::abs(mu); }
 
@@ -106,8 +144,8 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
   if (Ns.empty()) return {};
   for (size_t i = 1; i < Ns.size(); ++i)
     if (Ns[i] <= Ns[i - 1])
-      throw BadInput("`continue_Ns`: must be increasing (" + std::to_string(Ns[i - 1]) + ", " + std::to_string(Ns[i]) +
-                     ")");
+      throw BadInput("extrapolate_bifurcations: the Ns must be increasing (" + std::to_string(Ns[i - 1]) + ", " +
+                     std::to_string(Ns[i]) + ")");
   std::vector<BifurcationEstimate> estimates;
   const size_t finest = Ns.size() - 1;
   std::vector<std::set<size_t>> used(Ns.size());

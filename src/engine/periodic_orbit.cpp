@@ -7,6 +7,16 @@
 
 namespace delayspec {
 
+std::string to_string(OrbitFoundBy method) {
+  switch (method) {
+    case OrbitFoundBy::simulate: return "simulate";
+    case OrbitFoundBy::newton: return "newton";
+    case OrbitFoundBy::shooting: return "shooting";
+    case OrbitFoundBy::zero: return "zero";
+  }
+  return "?";
+}
+
 Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, long K_to) {
   if (d < 1 || K_to < 1 || x.size() == 0 || x.size() % d != 0)
     throw BadInput("prolong_periodic_sequence: " + std::to_string(x.size()) + " entries of dimension " +

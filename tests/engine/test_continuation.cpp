@@ -88,7 +88,7 @@ TEST(Continuation, NeimarkSackerOfLinearDdeAtExactBoundary) {
   std::vector<std::vector<Bifurcation>> by_N;
   for (int N : Ns) {
     const ContinuationResult r = linear_branch(N, 1e-13);
-    ASSERT_EQ(r.end, "to") << r.failure;
+    ASSERT_EQ(r.end, BranchEnd::to) << r.failure;
     ASSERT_EQ(r.bifurcations.size(), 1u) << "N = " << N;
     const Bifurcation& b = r.bifurcations[0];
     EXPECT_EQ(b.type, BifurcationType::neimark_sacker);
@@ -123,7 +123,7 @@ TEST(Continuation, PassesTheFoldOfAnExactEquilibriumBranch) {
   o.tolerance = 1e-12;
   auto model_at = [](double p) { return SaddleNodeDelayModel{p, 0.5}; };
   const ContinuationResult r = continue_orbit<SaddleNodeDelayModel>(model_at, Eigen::VectorXd::Constant(40, 1.0), o);
-  ASSERT_EQ(r.end, "from") << r.failure;
+  ASSERT_EQ(r.end, BranchEnd::from) << r.failure;
   ASSERT_EQ(r.bifurcations.size(), 1u);
   const Bifurcation& fold = r.bifurcations[0];
   EXPECT_EQ(fold.type, BifurcationType::fold);
@@ -175,7 +175,7 @@ TEST(Continuation, GrazingOfImpactOrbitAtFreeAmplitude) {
       guess[2 * l + 1] = A * w * std::cos(w * l * h - phi);
     }
     const ContinuationResult r = continue_orbit<ImpactModel>(model_at, guess, o);
-    ASSERT_EQ(r.end, "to") << r.failure;
+    ASSERT_EQ(r.end, BranchEnd::to) << r.failure;
     // the branch also loses stability in contact (a Neimark-Sacker point near e = 1.256 with k = 0.5);
     // the grazing point is the one known exactly
     std::vector<Bifurcation> grazing;
@@ -210,7 +210,7 @@ TEST(Continuation, PeriodDoublingOfDelayedMathieuAtMultiplierMinusOne) {
     o.tolerance = 1e-12;
     auto model_at = [](double b) { return MathieuModel({0.1, 2, 1, b}); };
     const ContinuationResult r = continue_orbit<MathieuModel>(model_at, Eigen::VectorXd::Zero(2 * N), o);
-    ASSERT_EQ(r.end, "to") << r.failure;
+    ASSERT_EQ(r.end, BranchEnd::to) << r.failure;
     ASSERT_EQ(r.bifurcations.size(), 1u) << "N = " << N;
     const Bifurcation& pd = r.bifurcations[0];
     EXPECT_EQ(pd.type, BifurcationType::period_doubling);
@@ -238,7 +238,7 @@ TEST(Continuation, StepThatCannotBeReducedEndsTheBranchWithThePointReached) {
   };
   const ContinuationResult r =
       continue_orbit<SaddleNodeDelayModel>(model_at, Eigen::VectorXd::Constant(20, std::sqrt(0.1)), o);
-  EXPECT_EQ(r.end, "failure");
+  EXPECT_EQ(r.end, BranchEnd::failure);
   ASSERT_GE(r.points.size(), 2u);
   EXPECT_LE(r.points.back().parameter, 0.5);
   // the branch went as far as the edge allows: beyond 0.4 (its steps are at most 0.09)

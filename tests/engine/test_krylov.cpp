@@ -64,8 +64,8 @@ void expect_backends_agree(const auto& op, int nev) {
   const double scale = std::abs(dense.multipliers[0]);
   for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     const FloquetResult r = solve(op, solver, nev);
-    SCOPED_TRACE(r.solver);
-    EXPECT_EQ(r.solver, to_string(solver));
+    SCOPED_TRACE(to_string(r.solver));
+    EXPECT_EQ(r.solver, solver);
     ASSERT_EQ(r.multipliers.size(), static_cast<size_t>(nev));
     ASSERT_EQ(r.residuals.size(), static_cast<size_t>(nev));
     EXPECT_GE(r.converged, nev);
@@ -159,7 +159,7 @@ TEST(KrylovBlock, BlockSizesAgreeWithDenseAndArpack) {
       o.solver = FloquetSolver::block;
       o.block_size = b;
       const FloquetResult r = floquet_multipliers(op, o);
-      EXPECT_EQ(r.solver, "block");
+      EXPECT_EQ(r.solver, FloquetSolver::block);
       ASSERT_EQ(r.multipliers.size(), static_cast<size_t>(nev));
       for (int k = 0; k < nev; ++k) {
         EXPECT_LE(std::abs(r.multipliers[k] - dense.multipliers[k]), 1e-10 * scale) << k;
@@ -203,7 +203,7 @@ TEST(Krylov, AutoPicksByDimension) {
   EXPECT_EQ(choose_floquet_solver(3000), FloquetSolver::block);
   EXPECT_EQ(choose_floquet_solver(200000), FloquetSolver::block);
   const auto op = zero_orbit_monodromy(LinearModel({.a = -1, .b = -2, .tau = 1, .period = 1}), 3000);
-  EXPECT_EQ(solve(op, FloquetSolver::automatic, 2).solver, "block");
+  EXPECT_EQ(solve(op, FloquetSolver::automatic, 2).solver, FloquetSolver::block);
 }
 
 // An operator that returns NaN from its fifth product on (an overflowing model, a bug): every
@@ -279,12 +279,12 @@ TEST(Krylov, NevAboveDimensionMinusTwoRoutesToDense) {
   const auto dense = solve(op, FloquetSolver::dense_lapack, 5).multipliers;
   for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {
     const FloquetResult r = solve(op, solver, 5);
-    EXPECT_EQ(r.solver, "dense-lapack");
+    EXPECT_EQ(r.solver, FloquetSolver::dense_lapack);
     EXPECT_NE(r.note.find("nev = 5 > n - 2 = 4"), std::string::npos) << r.note;
     EXPECT_EQ(r.multipliers, dense);
   }
   // nev = n - 2 still runs Krylov
-  EXPECT_EQ(solve(op, FloquetSolver::arpack, 4).solver, "arpack");
+  EXPECT_EQ(solve(op, FloquetSolver::arpack, 4).solver, FloquetSolver::arpack);
 }
 
 // The message validate_floquet_options throws for `o` at dimension n ("" when it accepts them).

@@ -167,8 +167,8 @@ TEST(OrbitShooting, StableAlignedOrbitEqualsSparseNewtonAndSimulation) {
   const PeriodicOrbit shot = orbit_by_nested_shooting(s.map, s.model.initial_state(), o, &at_orbit);
   ASSERT_EQ(shot.levels.size(), 2u);
   EXPECT_EQ(shot.levels[0].N, 100);
-  EXPECT_EQ(shot.levels[0].method, "shooting");  // automatic: shooting, which converges here
-  EXPECT_EQ(shot.method, "shooting");
+  EXPECT_EQ(shot.levels[0].method, OrbitFoundBy::shooting);  // automatic: shooting, which converges here
+  EXPECT_EQ(shot.method, OrbitFoundBy::shooting);
   EXPECT_LE(shot.newton_iterations, 4);
   EXPECT_GT(shot.linear_iterations, 0);
   EXPECT_LE(shot.residual, 1e-12 * (1 + shot.history.lpNorm<Eigen::Infinity>()));
@@ -203,7 +203,7 @@ TEST(OrbitShooting, FractionalDelayPeriodTwoEqualsSparseNewton) {
   o.guess_periods = 10;
   const PeriodicOrbit shot = orbit_by_nested_shooting(s.map, s.model.initial_state(), o);
   ASSERT_EQ(shot.levels.size(), 2u);
-  EXPECT_EQ(shot.levels[0].method, "shooting");
+  EXPECT_EQ(shot.levels[0].method, OrbitFoundBy::shooting);
   EXPECT_LE(shot.levels[1].newton_iterations, 3);
   const PeriodicOrbit newton = sparse_newton(s, 10);
   EXPECT_LT(relative_distance(shot.history, newton.history), 1e-10);
@@ -242,7 +242,7 @@ TEST(OrbitShooting, AutomaticCoarseLevelFallsBackToSparseNewton) {
   o.shooting.max_iterations = 1;
   const PeriodicOrbit orbit = orbit_by_nested_shooting(s.map, s.model.initial_state(), o);
   ASSERT_EQ(orbit.levels.size(), 1u);
-  EXPECT_EQ(orbit.levels[0].method, "newton");
+  EXPECT_EQ(orbit.levels[0].method, OrbitFoundBy::newton);
   EXPECT_GE(orbit.newton_iterations, 2);
   EXPECT_LT(relative_distance(orbit.history, sparse_newton(s, 100).history), 1e-10);
 

@@ -424,7 +424,7 @@ FloquetResult floquet_multipliers(const LinearOperator& op, const FloquetOptions
       break;
     }
   }
-  result.solver = to_string(solver);
+  result.solver = solver;
   result.operator_applications = op.applications() - applications_before;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -182,7 +182,7 @@ int command_continue(Config& config, const Invocation& inv) {
   j["Ns"] = Ns;
   j["events"] = to_string(problem.events);
   j["jacobian"] = to_string(problem.jacobian);
-  j["end"] = branch.end;
+  j["end"] = to_string(branch.end);
   if (!failures.empty()) j["failure"] = failures;
   j["points"] = points_json(branch.points);
   j["bifurcations"] = json::array();
@@ -211,7 +211,7 @@ int command_continue(Config& config, const Invocation& inv) {
       sj["from_parameter"] = switched_from[i];
       sj["orbit_period"] = 2 * problem.orbit_period;
       sj["N"] = Ns.back();
-      sj["end"] = switched[i].end;
+      sj["end"] = to_string(switched[i].end);
       sj["points"] = points_json(switched[i].points);
       sj["bifurcations"] = json::array();
       for (const Bifurcation& b : switched[i].bifurcations)
@@ -297,8 +297,8 @@ int command_continue(Config& config, const Invocation& inv) {
   inv.out << "delayspec continue: model " << problem.model_name << ", " << settings.key << " from "
           << format_number(options.from) << " to " << format_number(options.to) << ", N = ";
   for (size_t i = 0; i < Ns.size(); ++i) inv.out << (i ? "," : "") << Ns[i];
-  inv.out << "\nbranch (N = " << Ns.back() << "): " << branch.points.size() << " points, ended at `" << branch.end
-          << "`\n";
+  inv.out << "\nbranch (N = " << Ns.back() << "): " << branch.points.size() << " points, ended at `"
+          << to_string(branch.end) << "`\n";
   std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s\n", settings.key.c_str(), "|mu_1|", "unstable", "max y1");
   inv.out << line;
   for (const auto& p : branch.points) {

@@ -55,7 +55,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["model"] = problem.model_name;
     json["N"] = problem.N;
     json["dimension"] = n;
-    json["solver"] = result.solver;
+    json["solver"] = to_string(result.solver);
     json["multipliers"] = multipliers_json(result.multipliers);
     add_resolution_json(json["multipliers"], result.multipliers, accuracy);
     if (bars) {
@@ -89,7 +89,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     inv.out << "delayspec floquet: model " << problem.model_name << ", " << problem.grid().describe() << ", n = " << n
             << "\n";
     print_orbit(inv.out, orbit, contacts);
-    inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << result.solver << ", "
+    inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << to_string(result.solver) << ", "
             << result.operator_applications << " operator applications):\n";
     print_multipliers(inv.out, result.multipliers, accuracy);
     if (bars) print_error_bars(inv.out, result.multipliers, *bars);

@@ -125,28 +125,28 @@ void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>
 
 nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& contacts) {
   nlohmann::json j;
-  j["method"] = orbit.method;
+  j["method"] = to_string(orbit.method);
   j["residual"] = orbit.residual;
   j["periods"] = orbit.maps;
   j["contacts"] = contacts.contacts;
   j["nodes_in_contact"] = contacts.nodes_in_contact;
   j["max_H"] = contacts.max_H;  // NaN (models without switching) is written as null
-  if (orbit.method == "newton" || orbit.method == "shooting") {
+  if (orbit.method == OrbitFoundBy::newton || orbit.method == OrbitFoundBy::shooting) {
     j["newton_iterations"] = orbit.newton_iterations;
     j["newton_residuals"] = orbit.newton_residuals;
     j["newton_step_fractions"] = orbit.newton_step_fractions;
   }
-  if (orbit.method == "newton") {
+  if (orbit.method == OrbitFoundBy::newton) {
     j["jacobian_reciprocal_condition"] = orbit.jacobian_reciprocal_condition;
     j["jacobian_nonzeros"] = orbit.jacobian_nonzeros;
     j["factor_nonzeros"] = orbit.factor_nonzeros;
   }
-  if (orbit.method == "shooting") j["linear_iterations"] = orbit.linear_iterations;
+  if (orbit.method == OrbitFoundBy::shooting) j["linear_iterations"] = orbit.linear_iterations;
   if (!orbit.levels.empty()) {
     nlohmann::json levels = nlohmann::json::array();
     for (const PeriodicOrbit::Level& l : orbit.levels)
       levels.push_back({{"N", l.N},
-                        {"method", l.method},
+                        {"method", to_string(l.method)},
                         {"newton_iterations", l.newton_iterations},
                         {"linear_iterations", l.linear_iterations},
                         {"residual", l.residual},
@@ -157,29 +157,29 @@ nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& cont
 }
 
 void print_orbit(std::ostream& out, const PeriodicOrbit& orbit, const ContactSummary& contacts) {
-  if (orbit.method == "zero") {
+  if (orbit.method == OrbitFoundBy::zero) {
     out << "periodic orbit: the zero orbit (linear model)\n";
     return;
   }
-  out << "periodic orbit (" << orbit.method << "): |P(U) - U| = " << orbit.residual;
-  if (orbit.method == "newton" || orbit.method == "shooting")
+  out << "periodic orbit (" << to_string(orbit.method) << "): |P(U) - U| = " << orbit.residual;
+  if (orbit.method == OrbitFoundBy::newton || orbit.method == OrbitFoundBy::shooting)
     out << " after " << orbit.newton_iterations << " Newton iterations";
   if (orbit.levels.size() > 1)
     out << " at N = " << orbit.levels.back().N << ", from the orbit at N = " << orbit.levels[orbit.levels.size() - 2].N;
-  if (orbit.method == "newton" || orbit.method == "shooting")
+  if (orbit.method == OrbitFoundBy::newton || orbit.method == OrbitFoundBy::shooting)
     out << " (first guess simulated for " << orbit.maps << " periods"
         << (orbit.levels.size() > 1 ? " at N = " + std::to_string(orbit.levels.front().N) : std::string()) << ")";
   else out << " after " << orbit.maps << " periods";
   out << "\n";
-  if (orbit.method == "newton" || orbit.method == "shooting") {
-    out << "  Newton " << (orbit.method == "newton" ? "|F|_inf" : "|P(U) - U|_inf") << ":";
+  if (orbit.method == OrbitFoundBy::newton || orbit.method == OrbitFoundBy::shooting) {
+    out << "  Newton " << (orbit.method == OrbitFoundBy::newton ? "|F|_inf" : "|P(U) - U|_inf") << ":";
     for (double r : orbit.newton_residuals) out << " " << r;
     out << "\n";
   }
   if (orbit.levels.size() > 1) {
     out << "  levels (N: method, Newton steps, GMRES products, seconds):";
     for (const PeriodicOrbit::Level& l : orbit.levels)
-      out << " " << l.N << ": " << l.method << " " << l.newton_iterations << " " << l.linear_iterations << " "
+      out << " " << l.N << ": " << to_string(l.method) << " " << l.newton_iterations << " " << l.linear_iterations << " "
           << l.seconds << ";";
     out << "\n";
   }

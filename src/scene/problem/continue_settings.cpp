@@ -1,5 +1,7 @@
 #include "scene/problem/continue_settings.hpp"
 
+#include <cmath>
+
 #include "delayspec/errors.hpp"
 #include "scene/problem/parameter_grid.hpp"
 
@@ -31,9 +33,13 @@ ContinueSettings read_continue_settings(Config& config) {
                                     std::pair{"continue_step_max", o.step_max}})
     if (!(value >= 0) || !std::isfinite(value))
       throw BadInput("`" + std::string(name) + " = " + format_number(value) + "`: must be > 0 (or 0 for the default)");
-  if (o.step_min > 0 && o.step_max > 0 && o.step_min > o.step_max)
-    throw BadInput("`continue_step_min = " + format_number(o.step_min) +
-                   "` exceeds `continue_step_max = " + format_number(o.step_max) + "`");
+  // The library's defaults for 0 (continuation.hpp), so that a step_min above step_max is named by the keys
+  const double range = std::abs(o.to - o.from);
+  const double step_min = o.step_min > 0 ? o.step_min : 1e-6 * range,
+               step_max = o.step_max > 0 ? o.step_max : range / 10;
+  if (step_min > step_max)
+    throw BadInput("`continue_step_min = " + format_number(step_min) +
+                   "` exceeds `continue_step_max = " + format_number(step_max) + "`");
   o.max_points = static_cast<int>(config.get_int_in_range("continue_max_points", 500, 2, 10'000'000));
   o.tolerance = config.get_double("continue_tolerance", 0);
   if (!(o.tolerance >= 0) || !std::isfinite(o.tolerance))

@@ -4,7 +4,10 @@ namespace delayspec::cli {
 
 OrbitSettings read_orbit_settings(Config& config) {
   OrbitSettings s;
-  s.method = config.get_choice("orbit", s.method, {"auto", "shooting", "simulate", "newton"});
+  const std::string method =
+      config.get_choice("orbit", to_string(s.method), {"auto", "shooting", "simulate", "newton"});
+  for (OrbitMethod m : {OrbitMethod::automatic, OrbitMethod::shooting, OrbitMethod::simulate, OrbitMethod::newton})
+    if (to_string(m) == method) s.method = m;
   s.simulation.tolerance = config.get_double("orbit_tolerance", s.simulation.tolerance);
   require_positive("orbit_tolerance", s.simulation.tolerance);
   s.newton.tolerance = s.simulation.tolerance;

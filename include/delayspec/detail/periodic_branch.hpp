@@ -1,0 +1,338 @@
+#pragma once
+// The discrete periodic problem of continuation.hpp at one parameter value, and what the branch
+// tracer (continuation_branch.hpp) and the bifurcation locator (bifurcation_locator.hpp) ask of
+// it: the bordered Newton corrector, F_x and F_p, the multipliers and the measures of a point.
+// Part of continuation.hpp's implementation (its header states the mathematics), included by
+// it; not an interface.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "delayspec/continuation.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec/floquet.hpp"
+#include "delayspec/grid.hpp"
+#include "delayspec/orbit_newton.hpp"
+#include "delayspec/detail/sparse_lu.hpp"
+#include "delayspec/stepper.hpp"
+#include "delayspec/stroboscopic_map.hpp"
+
+namespace delayspec::continuation_detail {
+
+// The continued key changed the size of the discrete problem (e.g. a period that changes K): bad
+// input, not a point outside the model's domain (which ends the branch).
+class ProblemSizeChanged : public BadInput {
+ public:
+  using BadInput::BadInput;
+};
+
+// The maximum of the cubic Hermite interpolant on [0, h] of values g0, g1 and slopes s0, s1.
+double hermite_maximum(double g0, double g1, double s0, double s1, double h);
+
+// The problem F(x, p) = 0 of one model factory and one discretisation (the options' N,
+// periods_per_map, step options), with the weighted inner product of continuation.hpp.
+template <class Model, class ModelAt>
+class PeriodicBranch {
+ public:
+  static constexpr int D = Model::d;
+  using V = Vec<D>;
+  using Map = StroboscopicMap<Model>;
+
+  // A corrected point with the tangent there.
+  struct State {
+    Eigen::VectorXd x;
+    double p = 0;
+    Eigen::VectorXd tx;  // unit tangent (weighted norm)
+    double tp = 0;
+    int iterations = 0;
+    double residual = 0;
+  };
+
+  // `o` with its defaults filled in (the tracer's checked options): the corrector reads newton from it.
+  PeriodicBranch(const ModelAt& model_at, const ContinuationOptions& o) : model_at_(model_at), o_(o) {
+    const HistoryGrid g = grid_at(o.from);
+    K_ = g.K;
+    M_ = g.M;
+    weight_ = 1.0 / static_cast<double>(K_);
+    range_ = std::abs(o.to - o.from);
+  }
+
+  long unknowns() const { return static_cast<long>(D) * K_; }
+
+  Map map_at(double p) const {
+    const Model model = model_at_(p);
+    const HistoryGrid g = grid_at_model(model, p);
+    return Map(TrapezoidStepper<Model>(model, o_.step_options), g);
+  }
+
+  // Newton from (x, p) on F = 0 and  row_x . x + row_p p = target:
+  //   [ F_x    F_p   ] [dx]     [ F ]
+  //   [ row_x  row_p ] [dp] = - [ g ],   g = row_x . x + row_p p - target,
+  // one sparse LU per iteration. Converged when |F|_inf <= tolerance (1 + |x|_inf) and g is at
+  // its rounding level; then the tangent solves the same matrix with e_{n+1} (oriented by the
+  // row: row . t > 0), normalised in the weighted norm. Returns nullopt and the reason on
+  // failure (not converged in max_iterations, diverging, singular, a parameter the model rejects).
+  std::optional<State> correct(Eigen::VectorXd x, double p, const Eigen::VectorXd& row_x, double row_p, double target,
+                               int max_iterations, std::string& why, double& seconds) const {
+    const auto start = std::chrono::steady_clock::now();
+    struct Timer {
+      std::chrono::steady_clock::time_point start;
+      double& seconds;
+      ~Timer() { seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+    } timer{start, seconds};
+    const long n = unknowns();
+    double first = INFINITY;
+    for (int it = 0;; ++it) {
+      Eigen::VectorXd F, Fp;
+      Eigen::SparseMatrix<double> Fx;
+      if (!linearise_or_reason(x, p, F, Fx, Fp, why)) return std::nullopt;
+      const double r = F.lpNorm<Eigen::Infinity>();
+      const double g = row_x.dot(x) + row_p * p - target;
+      if (!std::isfinite(r)) {
+        why = "non-finite residual, |F|_inf = " + format_number(r) + " at parameter " + format_number(p);
+        return std::nullopt;
+      }
+      // g is linear: after one Newton step it is at its rounding level, eps times the size of its terms
+      const double g_scale = row_x.cwiseAbs().dot(x.cwiseAbs()) + std::abs(row_p * p) + std::abs(target);
+      const bool converged =
+          r <= o_.newton.tolerance * (1 + x.lpNorm<Eigen::Infinity>()) && std::abs(g) <= 1e-12 * (1 + g_scale);
+      // Diverging: the residual 1e3 times above the one after the first step (not any growth: near
+      // grazing the discrete problem is only piecewise smooth and an iterate may raise |F| before
+      // converging; the start may have |F| = 0 with the constraint violated).
+      if (it == 1) first = r;
+      if (!converged && (it >= max_iterations || r > 1e3 * first)) {
+        why = (it >= max_iterations ? "not converged in " + std::to_string(it) + " iterations"
+                                    : "residual diverging at iteration " + std::to_string(it)) +
+              ", |F|_inf = " + format_number(r) + " at parameter " + format_number(p);
+        return std::nullopt;
+      }
+      std::optional<SparseLU> lu;
+      try {
+        lu.emplace(bordered_matrix(Fx, Fp, row_x, row_p));
+      } catch (const NumericalFailure& e) {
+        why = std::string("bordered matrix singular at parameter ") + format_number(p) + " (" + e.what() + ")";
+        return std::nullopt;
+      }
+      if (converged) return tangent_state(*lu, std::move(x), p, it, r);
+      Eigen::VectorXd rhs(n + 1);
+      rhs.head(n) = -F;
+      rhs[n] = -g;
+      const Eigen::VectorXd step = lu->solve(rhs);
+      x += step.head(n);
+      p += step[n];
+    }
+  }
+
+  // The corrected point at arclength s from `base` along its tangent: the predictor
+  // X_pred = X_base + s t_base, corrected on the hyperplane <t_base, X - X_pred>_w = 0.
+  std::optional<State> point_along(const State& base, double s, std::string& reason, double& seconds) const {
+    const Eigen::VectorXd pred_x = base.x + s * base.tx;
+    const double pred_p = base.p + s * base.tp;
+    const Eigen::VectorXd row_x = weight_ * base.tx;
+    return correct(pred_x, pred_p, row_x, base.tp, row_x.dot(pred_x) + base.tp * pred_p, o_.newton.max_iterations,
+                   reason, seconds);
+  }
+
+  // F(x, p), F_x and F_p. F_p by the central difference (F(x, p + delta) - F(x, p - delta)) /
+  // (2 delta), delta = eps^(1/3) max(|p|, |to - from|) (continuation.hpp: why that is enough).
+  void linearise(const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
+                 Eigen::VectorXd& Fp) const {
+    const Map map = map_at(p);
+    F = PeriodicOrbitProblem<Map>(map).residual(x, &Fx);
+    const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max({std::abs(p), range_, 1e-300});
+    const double up = p + delta, down = p - delta;
+    // At a bound of the key's range (milling's depth from 0: p - delta = -6e-9 is rejected) the
+    // one-sided second-order stencil on the side the model accepts, (-3 F(p) + 4 F(p + s) -
+    // F(p + 2 s)) / (2 s), s = +-delta: the same order, and truncation 2x the central one's.
+    auto map_if_accepted = [&](double q) -> std::optional<Map> {
+      try {
+        return map_at(q);
+      } catch (const BadInput&) {
+        return std::nullopt;
+      }
+    };
+    auto residual = [&](const Map& m) { return PeriodicOrbitProblem<Map>(m).residual(x); };
+    const std::optional<Map> map_up = map_if_accepted(up), map_down = map_if_accepted(down);
+    if (map_up && map_down) {
+      Fp = (residual(*map_up) - residual(*map_down)) / (up - down);
+      return;
+    }
+    if (!map_up && !map_down) map_at(down);  // neither side: the model's reason (BadInput)
+    const double side = map_up ? delta : -delta;
+    const double s1 = (p + side) - p, s2 = (p + 2 * side) - p;  // the steps as represented
+    const Eigen::VectorXd F1 = residual(map_up ? *map_up : *map_down), F2 = residual(map_at(p + 2 * side));
+    // Quadratic through (0, F), (s1, F1), (s2, F2), differentiated at 0.
+    Fp = (-(s1 + s2) / (s1 * s2)) * F + (s2 / (s1 * (s2 - s1))) * F1 - (s1 / (s2 * (s2 - s1))) * F2;
+  }
+
+  // Weighted inner product of the state parts plus the parameters' product.
+  double dot(const Eigen::VectorXd& ax, double ap, const Eigen::VectorXd& bx, double bp) const {
+    return weight_ * ax.dot(bx) + ap * bp;
+  }
+  double weight() const { return weight_; }
+
+  // Multipliers and measures of the orbit x at p.
+  ContinuationPoint evaluate(const State& s, double& krylov_seconds) const {
+    ContinuationPoint point;
+    point.parameter = s.p;
+    point.newton_iterations = s.iterations;
+    point.residual = s.residual;
+    point.tangent_p = s.tp;
+    const Map map = map_at(s.p);
+    PeriodicOrbitProblem<Map> problem(map);
+    const auto start = std::chrono::steady_clock::now();
+    const auto monodromy = map.monodromy(problem.history(s.x));
+    // A pair failing the residual gate is nearly always one of the smallest requested (|mu| ~ 1e-7
+    // on a nearly rank-deficient monodromy, far below anything that crosses the circle): retried
+    // with one multiplier fewer, down to one; the point has then fewer multipliers.
+    FloquetOptions floquet = o_.floquet;
+    FloquetResult r;
+    for (;;) {
+      try {
+        r = floquet_multipliers(monodromy, floquet);
+        break;
+      } catch (const NumericalFailure&) {
+        if (floquet.nev <= 1) throw;
+        --floquet.nev;
+      }
+    }
+    krylov_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    point.multipliers = r.multipliers;
+    for (const auto& mu : r.multipliers) point.unstable += std::abs(mu) > 1;
+    point.measures = measures(map, s.x);
+    return point;
+  }
+
+  // The orbit's extremes per component; for a switching model also max H between the nodes and
+  // the contact time (OrbitMeasures).
+  OrbitMeasures measures(const Map& map, const Eigen::VectorXd& x) const {
+    OrbitMeasures m;
+    const Eigen::Map<const Eigen::Matrix<double, D, Eigen::Dynamic>> states(x.data(), D, K_);
+    for (int i = 0; i < D; ++i) {
+      m.max.push_back(states.row(i).maxCoeff());
+      m.min.push_back(states.row(i).minCoeff());
+    }
+    if constexpr (Model::has_switching) switching_measures(map, states, m);
+    return m;
+  }
+
+  const ContinuationOptions& options() const { return o_; }
+
+ private:
+  using States = Eigen::Map<const Eigen::Matrix<double, D, Eigen::Dynamic>>;
+
+  // F, F_x, F_p at (x, p), or false and the reason: a residual the stepper cannot compute, or a
+  // parameter (p or p +- delta) outside the model's domain. A change of the problem's size is bad
+  // input and passes through.
+  bool linearise_or_reason(const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
+                           Eigen::VectorXd& Fp, std::string& why) const {
+    try {
+      linearise(x, p, F, Fx, Fp);
+      return true;
+    } catch (const NumericalFailure& e) {
+      why = std::string("residual not computable at ") + format_number(p) + " (" + e.what() + ")";
+    } catch (const ProblemSizeChanged&) {
+      throw;
+    } catch (const BadInput& e) {  // p (or p +- delta) outside the model's domain
+      why = std::string("the model rejects parameter ") + format_number(p) + " (" + e.what() + ")";
+    }
+    return false;
+  }
+
+  // The bordered matrix [F_x F_p; row_x^T row_p] (n + 1 square), compressed for the LU.
+  Eigen::SparseMatrix<double> bordered_matrix(const Eigen::SparseMatrix<double>& Fx, const Eigen::VectorXd& Fp,
+                                              const Eigen::VectorXd& row_x, double row_p) const {
+    const long n = unknowns();
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(static_cast<size_t>(Fx.nonZeros() + 2 * n + 1));
+    for (int k = 0; k < Fx.outerSize(); ++k)
+      for (Eigen::SparseMatrix<double>::InnerIterator e(Fx, k); e; ++e)
+        triplets.emplace_back(static_cast<int>(e.row()), static_cast<int>(e.col()), e.value());
+    for (long i = 0; i < n; ++i) {
+      if (Fp[i] != 0) triplets.emplace_back(static_cast<int>(i), static_cast<int>(n), Fp[i]);
+      if (row_x[i] != 0) triplets.emplace_back(static_cast<int>(n), static_cast<int>(i), row_x[i]);
+    }
+    triplets.emplace_back(static_cast<int>(n), static_cast<int>(n), row_p);
+    Eigen::SparseMatrix<double> A(n + 1, n + 1);
+    A.setFromTriplets(triplets.begin(), triplets.end());
+    A.makeCompressed();
+    return A;
+  }
+
+  // The converged point with its tangent z: [F_x F_p; row] z = e_{n+1}, z / |z|_w.
+  State tangent_state(const SparseLU& lu, Eigen::VectorXd x, double p, int iterations, double residual) const {
+    const long n = unknowns();
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + 1);
+    rhs[n] = 1;
+    const Eigen::VectorXd z = lu.solve(rhs);
+    const double norm = std::sqrt(weight_ * z.head(n).squaredNorm() + z[n] * z[n]);
+    State s;
+    s.x = std::move(x);
+    s.p = p;
+    s.tx = z.head(n) / norm;
+    s.tp = z[n] / norm;
+    s.iterations = iterations;
+    s.residual = residual;
+    return s;
+  }
+
+  // Switching models: over each step [t, t + h] of the orbit, max H from the cubic Hermite
+  // interpolant of H(y(t)) with the slopes dH/dt = grad H . f at both nodes (H affine,
+  // model.hpp), and the time in region 1 from the step's events (none with events off: the
+  // node's region). The delayed states from HistoryGrid::delay_tap, the orbit repeated
+  // periodically into the past: slot M + l of the history is u_{l mod K}.
+  void switching_measures(const Map& map, const States& states, OrbitMeasures& m) const {
+    const HistoryGrid& g = map.grid();
+    const Model& model = map.stepper().model();
+    const double h = g.h;
+    const long M = g.M;
+    auto u = [&](long l) { return V(states.col(((l % K_) + K_) % K_)); };
+    auto slot = [&](long i) { return u(i - M); };
+    m.max_H = -INFINITY;
+    m.contact_time = 0;
+    StepMap<D> scratch;
+    for (long l = 0; l < K_; ++l) {
+      const auto [w0, w1, t] = g.delay_tap<V>(l, slot);
+      const V a = u(l), b = u(l + 1);
+      const int ja = region_of(model, a), jb = region_of(model, b);
+      const V grad = model.grad_H(a);
+      m.max_H = std::max(m.max_H, hermite_maximum(model.H(a), model.H(b), grad.dot(model.f(ja, t, a, w0)),
+                                                  grad.dot(model.f(jb, t + h, b, w1)), h));
+      StepEvents events;
+      map.stepper().step(t, h, a, w0, w1, scratch, &events);
+      int region = ja;
+      double position = 0;
+      for (int e = 0; e < events.count; ++e) {
+        if (region == 1) m.contact_time += events.offset[e] - position;
+        position = events.offset[e];
+        region = events.new_region[e];
+      }
+      if (region == 1) m.contact_time += h - position;
+    }
+  }
+
+  HistoryGrid grid_at(double p) const { return grid_at_model(model_at_(p), p); }
+  HistoryGrid grid_at_model(const Model& model, double p) const {
+    const HistoryGrid g = make_grid(model.tau(), model.period(), o_.N, o_.periods_per_map);
+    if (K_ != 0 && (g.K != K_ || g.M != M_))
+      throw ProblemSizeChanged("continuation: at parameter " + format_number(p) +
+                               " the grid has K = " + std::to_string(g.K) + ", M = " + std::to_string(g.M) +
+                               " (at the start K = " + std::to_string(K_) + ", M = " + std::to_string(M_) +
+                               "): the continued key must not change the size of the discrete problem");
+    return g;
+  }
+
+  const ModelAt& model_at_;
+  ContinuationOptions o_;
+  long K_ = 0, M_ = 0;
+  double weight_ = 1, range_ = 1;
+};
+
+}  // namespace delayspec::continuation_detail
