@@ -1,6 +1,6 @@
 #pragma once
 // The analyses of the built-in models (model_analyses.hpp), compiled once in the library
-// (src/analyses_<model>.cpp): builtin_analyses(model) wraps a model in them.
+// (src/engine/analyses_<model>.cpp): builtin_analyses(model) wraps a model in them.
 #include <memory>
 
 #include "delayspec/model_analyses.hpp"

@@ -86,11 +86,7 @@ PeriodicOrbit find_orbit(const Model& model, const Map& map, const OrbitSettings
       }
     }
     // OrbitMethod::newton
-    for (long i = 1; i <= settings.guess_periods; ++i) {
-      U = map.apply(U);
-      if (!U.allFinite())
-        throw NumericalFailure("orbit = newton: the simulated guess diverged after " + std::to_string(i) + " periods");
-    }
+    U = simulated_guess(map, std::move(U), settings.guess_periods, "orbit = newton");
     PeriodicOrbitProblem<Map> problem(map);
     PeriodicOrbit orbit = orbit_by_newton(map, problem.sequence_from_history(U), settings.newton);
     orbit.maps = settings.guess_periods;

@@ -43,6 +43,7 @@
 #include "delayspec/gmres.hpp"
 #include "delayspec/monodromy.hpp"
 #include "delayspec/orbit_newton.hpp"
+#include "delayspec/orbit_simulation.hpp"
 #include "delayspec/periodic_orbit.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
@@ -201,13 +202,8 @@ PeriodicOrbit orbit_by_nested_shooting(const StroboscopicMap<Model, Stepper>& ma
   // Coarsest level: simulated guess, then Newton.
   auto t0 = clock();
   const Map coarse = level_map(Ns.front());
-  Eigen::VectorXd U = coarse.constant_history(y0);
-  for (long i = 1; i <= opt.guess_periods; ++i) {
-    U = coarse.apply(U);
-    if (!U.allFinite())
-      throw NumericalFailure("orbit (N = " + std::to_string(Ns.front()) + "): the simulated guess diverged after " +
-                             std::to_string(i) + " periods");
-  }
+  const Eigen::VectorXd U = simulated_guess(coarse, coarse.constant_history(y0), opt.guess_periods,
+                                            "orbit (N = " + std::to_string(Ns.front()) + ")");
   OrbitLinearisation<Model::d> lin;
   PeriodicOrbit orbit;
   long linear_iterations = 0;

@@ -16,6 +16,19 @@ struct OrbitBySimulationOptions {
   long max_maps = 20000;     // applications of the stroboscopic map before giving up
 };
 
+// The guess Newton starts from: U after `periods` maps. NumericalFailure "WHO: the simulated guess
+// diverged after i periods" at the first map whose result is not finite (an attractor at infinity,
+// or the impact model's chaotic transient blown up by a large step).
+template <class Map>
+Eigen::VectorXd simulated_guess(const Map& map, Eigen::VectorXd U, long periods, const std::string& who) {
+  for (long i = 1; i <= periods; ++i) {
+    U = map.apply(U);
+    if (!U.allFinite())
+      throw NumericalFailure(who + ": the simulated guess diverged after " + std::to_string(i) + " periods");
+  }
+  return U;
+}
+
 template <class Map>
 PeriodicOrbit orbit_by_simulation(const Map& map, Eigen::VectorXd U, const OrbitBySimulationOptions& opt = {}) {
   if (!(opt.tolerance > 0)) throw BadInput("`orbit_tolerance = " + format_number(opt.tolerance) + "`: must be > 0");

@@ -2,6 +2,7 @@
 // detection counts, test functions, the Hermite maximum, and the extrapolation of bifurcation
 // points across N.
 #include "delayspec/continuation.hpp"
+#include "delayspec/detail/cubic_hermite.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -108,27 +109,13 @@ double multiplier_test(BifurcationType type, const std::vector<std::complex<doub
 }
 
 double hermite_maximum(double g0, double g1, double s0, double s1, double h) {
-  // g(u) = a + b u + c u^2 + d u^3 on u in [0, 1], slopes in u: h s0, h s1
-  const double a = g0, b = h * s0, c = 3 * (g1 - g0) - h * (2 * s0 + s1), d = 2 * (g0 - g1) + h * (s0 + s1);
+  // g(u) on u in [0, 1], slopes in u: h s0, h s1; its largest value at an end or a turning point.
+  const detail::CubicHermite g(g0, g1, h * s0, h * s1);
   double best = std::max(g0, g1);
-  auto consider = [&](double u) {
-    if (u > 0 && u < 1) best = std::max(best, a + u * (b + u * (c + u * d)));
-  };
-  // g'(u) = b + 2 c u + 3 d u^2 = 0
-  if (d == 0) {
-    if (c != 0) consider(-b / (2 * c));
-  } else {
-    const double disc = c * c - 3 * b * d;
-    if (disc >= 0) {
-      const double q = -(c + std::copysign(std::sqrt(disc), c));  // stable roots: q / (3 d), b / q
-      if (q != 0) {
-        consider(q / (3 * d));
-        consider(b / q);
-      } else {
-        consider(0);
-      }
-    }
-  }
+  double roots[2];
+  const int n = g.turning_points(roots);
+  for (int i = 0; i < n; ++i)
+    if (roots[i] > 0 && roots[i] < 1) best = std::max(best, g(roots[i]));
   return best;
 }
 

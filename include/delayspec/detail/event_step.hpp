@@ -64,6 +64,7 @@
 
 #include <Eigen/LU>
 
+#include "delayspec/detail/cubic_hermite.hpp"
 #include "delayspec/detail/small_solve.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
@@ -100,27 +101,14 @@ inline bool hermite_extremum_within(double ga, double gL, double d0, double d1, 
   const double chord_deviation = 0.25 * std::max(std::abs(d0 - (gL - ga)), std::abs(d1 - (gL - ga)));
   const double slack = 1e-12 * (std::abs(ga) + std::abs(gL) + std::abs(d0) + std::abs(d1));
   if (std::min(into * ga, into * gL) - chord_deviation > margin + slack) return false;
-  const double c1 = d0, c2 = -3 * ga - 2 * d0 + 3 * gL - d1, c3 = 2 * ga + d0 - 2 * gL + d1;
-  // p'(tau) = c1 + 2 c2 tau + 3 c3 tau^2
-  const double qa = 3 * c3, qb = 2 * c2, qc = c1;
+  const CubicHermite p(ga, gL, d0, d1);
   double roots[2];
-  int n = 0;
-  if (std::abs(qa) <= 1e-14 * (std::abs(qb) + std::abs(qc))) {
-    if (qb != 0) roots[n++] = -qc / qb;
-  } else {
-    const double disc = qb * qb - 4 * qa * qc;
-    if (disc >= 0) {
-      const double q = -0.5 * (qb + std::copysign(std::sqrt(disc), qb));
-      if (q != 0) roots[n++] = q / qa;
-      roots[n++] = q != 0 ? qc / q : -qb / (2 * qa);
-    }
-  }
+  const int n = p.turning_points(roots);
   for (int i = 0; i < n; ++i) {
     const double tau = roots[i];
     if (!(tau > 0 && tau < 1)) continue;
-    if (minima_only && into * (c2 + 3 * c3 * tau) < 0) continue;  // p''(tau) / 2: a maximum of into p
-    const double p = ga + tau * (c1 + tau * (c2 + tau * c3));
-    if (into * p < margin) return true;
+    if (minima_only && into * p.half_curvature(tau) < 0) continue;  // a maximum of into p
+    if (into * p(tau) < margin) return true;
   }
   return false;
 }
