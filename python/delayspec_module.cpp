@@ -18,6 +18,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <streambuf>
 #include <string>
 #include <thread>
 
@@ -194,17 +195,69 @@ py::object to_python(const nlohmann::json& j) {
   }
 }
 
-// Runs `command` as `delayspec COMMAND [SCENE] --set KEY=VALUE... --json --quiet [--out OUT]`.
+// The stderr of a call with progress=True: each piece the command flushes (a progress line every
+// few seconds, a warning) is written to Python's sys.stderr as it comes, so that it shows where
+// the user looks (a terminal, a notebook's cell), and kept for the result. Written from the
+// computing threads: a mutex orders the pieces and the GIL is taken for each write.
+class LiveStderr : public std::streambuf {
+ public:
+  std::string text() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return all_;
+  }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (c != traits_type::eof()) {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      pending_ += traits_type::to_char_type(c);
+    }
+    return c;
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    pending_.append(s, static_cast<size_t>(n));
+    return n;
+  }
+  int sync() override {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (pending_.empty()) return 0;
+    {
+      py::gil_scoped_acquire gil;
+      try {
+        const py::object stderr_ = py::module_::import("sys").attr("stderr");
+        stderr_.attr("write")(pending_);
+        stderr_.attr("flush")();
+      } catch (const py::error_already_set&) {
+        // no usable sys.stderr (closed, replaced by None): the text is still in the result
+      }
+    }
+    all_ += pending_;
+    pending_.clear();
+    return 0;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::string pending_;
+  std::string all_;
+};
+
+// Runs `command` as `delayspec COMMAND [SCENE] --set KEY=VALUE... --json --quiet [--out OUT]`
+// (without --quiet when `progress`: its stderr then goes to sys.stderr as it comes, LiveStderr).
 // Returns (the JSON result, the bulk arrays the JSON leaves to --out files, the exit status:
 // 0, or 3 for failures recorded in a complete result, what the command wrote to stderr).
 py::tuple run(const std::string& command, const py::object& scene, const py::dict& keys,
-              const std::optional<std::string>& out, bool resume) {
+              const std::optional<std::string>& out, bool resume, bool progress) {
   delayspec::cli::command_spec(command);  // BadInput naming the commands when it is none
   std::optional<std::string> scene_path;
   Config config = make_config(scene, keys, scene_path);
   delayspec::cli::check_output_flags(command, out.has_value(), out.value_or(""), resume);
   PythonSignals signals(on_main_thread());
-  std::ostringstream json_text, err;
+  std::ostringstream json_text, quiet_err;
+  LiveStderr live;
+  std::ostream live_err(&live);
+  std::ostream& err = progress ? live_err : quiet_err;
   nlohmann::json result, arrays = nlohmann::json::object();
   int status = 0;
   bool cancelled = false;
@@ -215,13 +268,14 @@ py::tuple run(const std::string& command, const py::object& scene, const py::dic
                                          .scene = scene_path,
                                          .json = true,
                                          .out_dir = out,
-                                         .quiet = true,
+                                         .quiet = !progress,
                                          .resume = resume,
                                          .out = json_text,
                                          .err = err,
                                          .arrays = &arrays};
     try {
       status = delayspec::cli::run_command(config, inv);
+      err.flush();
       result = nlohmann::json::parse(json_text.str());
     } catch (const delayspec::Cancelled&) {
       cancelled = true;
@@ -231,7 +285,7 @@ py::tuple run(const std::string& command, const py::object& scene, const py::dic
     }
   }
   if (cancelled) signals.rethrow();
-  return py::make_tuple(to_python(result), to_python(arrays), status, err.str());
+  return py::make_tuple(to_python(result), to_python(arrays), status, progress ? live.text() : quiet_err.str());
 }
 
 }  // namespace
@@ -242,7 +296,9 @@ PYBIND11_MODULE(_delayspec, m) {
   py::register_exception<BadInput>(m, "BadInput", PyExc_ValueError);
   py::register_exception<NumericalFailure>(m, "NumericalFailure", PyExc_RuntimeError);
   m.def("run", &run, py::arg("command"), py::arg("scene"), py::arg("keys"), py::arg("out"), py::arg("resume"),
-        "Runs a command as `delayspec COMMAND --json`: (result, arrays, status, stderr text).");
+        py::arg("progress") = false,
+        "Runs a command as `delayspec COMMAND --json`: (result, arrays, status, stderr text). With progress, its "
+        "stderr (progress lines, warnings) is written to sys.stderr as it comes.");
   m.def(
       "commands",
       [] {

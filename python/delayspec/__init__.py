@@ -256,45 +256,46 @@ class ContinueResult(SweepResult):
     docs/continuation.md)."""
 
 
-def _run(command, result_type, scene, keys, out=None, resume=False):
-    data, arrays, status, stderr = _delayspec.run(command, scene, keys, None if out is None else str(out), resume)
+def _run(command, result_type, scene, keys, out=None, resume=False, progress=False):
+    data, arrays, status, stderr = _delayspec.run(command, scene, keys, None if out is None else str(out), resume,
+                                                  bool(progress))
     if status != 0:
         warnings.warn(stderr.strip() or f"delayspec {command}: exit status {status}", RuntimeWarning, stacklevel=3)
-    elif stderr:
+    elif stderr and not progress:  # with progress it was written as it came
         sys.stderr.write(stderr)
     return result_type(command, data, arrays, status)
 
 
-def floquet(scene=None, **keys):
-    return _run("floquet", FloquetResult, scene, keys)
+def floquet(scene=None, *, progress=False, **keys):
+    return _run("floquet", FloquetResult, scene, keys, progress=progress)
 
 
-def lyapunov(scene=None, **keys):
-    return _run("lyapunov", Result, scene, keys)
+def lyapunov(scene=None, *, progress=False, **keys):
+    return _run("lyapunov", Result, scene, keys, progress=progress)
 
 
-def converge(scene=None, *, out=None, **keys):
-    return _run("converge", ConvergeResult, scene, keys, out)
+def converge(scene=None, *, out=None, progress=False, **keys):
+    return _run("converge", ConvergeResult, scene, keys, out, progress=progress)
 
 
-def simulate(scene=None, *, out=None, **keys):
-    return _run("simulate", SimulateResult, scene, keys, out)
+def simulate(scene=None, *, out=None, progress=False, **keys):
+    return _run("simulate", SimulateResult, scene, keys, out, progress=progress)
 
 
-def sweep(scene=None, *, out=None, resume=False, **keys):
-    return _run("sweep", SweepResult, scene, keys, out, resume)
+def sweep(scene=None, *, out=None, resume=False, progress=False, **keys):
+    return _run("sweep", SweepResult, scene, keys, out, resume, progress)
 
 
-def chart(scene=None, *, out=None, resume=False, **keys):
-    return _run("chart", GridResult, scene, keys, out, resume)
+def chart(scene=None, *, out=None, resume=False, progress=False, **keys):
+    return _run("chart", GridResult, scene, keys, out, resume, progress)
 
 
-def basin(scene=None, *, out=None, resume=False, **keys):
-    return _run("basin", GridResult, scene, keys, out, resume)
+def basin(scene=None, *, out=None, resume=False, progress=False, **keys):
+    return _run("basin", GridResult, scene, keys, out, resume, progress)
 
 
-def continue_(scene=None, *, out=None, **keys):
-    return _run("continue", ContinueResult, scene, keys, out)
+def continue_(scene=None, *, out=None, progress=False, **keys):
+    return _run("continue", ContinueResult, scene, keys, out, progress=progress)
 
 
 def keys_help(command):
@@ -312,13 +313,16 @@ def _document():
     for function, result_type in _RESULT_TYPES.items():
         spec = specs[function.__name__.rstrip("_")]
         command = spec["name"]
-        extra = (", out=None" if spec["writes_out"] else "") + (", resume=False" if spec["resume"] else "")
+        extra = (", out=None" if spec["writes_out"] else "") + (", resume=False" if spec["resume"] else "") + \
+            ", progress=False"
         summary = spec["summary"].split(": ", 1)[1]  # after the usage "delayspec COMMAND [SCENE]"
         function.__doc__ = (
             f"{summary}\n\n"
             f"delayspec.{function.__name__}(scene=None{extra}, **keys) runs `delayspec {command} [SCENE] "
             f"--set KEY=VALUE... --json{' [--out OUT]' if spec['writes_out'] else ''}`; scene: a TOML file or a dict.\n\n"
             f"Returns {result_type.__name__}: {inspect.cleandoc(result_type.__doc__ or '')}\n\n"
+            f"progress=True reports the progress of long work (as the program's progress lines) on sys.stderr "
+            f"as it comes.\n\n"
             f"Raises BadInput (ValueError) for bad keys or values, NumericalFailure (RuntimeError) when a "
             f"method fails; KeyboardInterrupt on Ctrl-C.\n\n"
             f"Keys (KEY = default):\n{keys_help(command)}")

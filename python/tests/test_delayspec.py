@@ -430,6 +430,32 @@ def test_threads_writing_files_at_once_each_complete_their_own_directory(tmp_pat
             assert body(mine) == body(alone), name
 
 
+def test_progress_is_written_to_sys_stderr_while_the_call_runs(capsys):
+    """progress=True: the program's progress lines (one every 5 s) reach sys.stderr while the call
+    still runs, where a notebook shows them; without it the call is silent. A sweep of ~7 s."""
+    keys = dict(N=20, sweep_key="k", sweep_from=0, sweep_to=1.4, sweep_points=160, transient=0, periods=8000,
+                threads=1, section_points=2)  # ~0.04-0.05 s per point: a report is due after 5 s
+    seen_during = []
+    real_write = sys.stderr.write
+
+    def spy(text):  # records what arrives before the call has returned
+        seen_during.append(text)
+        return real_write(text)
+
+    sys.stderr.write = spy
+    try:
+        r = delayspec.sweep(progress=True, **keys)
+    finally:
+        sys.stderr.write = real_write
+    assert r.status == 0
+    lines = "".join(seen_during)
+    assert "sweep: " in lines and "/160 (" in lines, lines  # a report while running: "sweep: k/160 (p%), ..."
+    assert "done in" in lines, lines
+    capsys.readouterr()  # what the call above wrote
+    delayspec.sweep(**dict(keys, sweep_points=2))
+    assert "sweep" not in capsys.readouterr().err
+
+
 def test_gil_is_released_during_a_run():
     """A Python thread keeps running while another computes."""
     ticks = []
