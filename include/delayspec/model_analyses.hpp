@@ -9,11 +9,13 @@
 // model written as equations in a scene, inside the object compiled from those equations at run
 // time (docs/models.md): the per-step work is always compiled for the model, never interpreted,
 // and one virtual call per analysis is all the front ends add.
+#include <functional>
 #include <memory>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "delayspec/continuation.hpp"
 #include "delayspec/grid.hpp"
 #include "delayspec/linear_operator.hpp"
 #include "delayspec/lyapunov.hpp"
@@ -51,6 +53,12 @@ struct LinearisedOrbit {
   Eigen::VectorXd sequence;                   // u_0 .. u_{K-1} when requested (empty for linear models)
 };
 
+class ModelAnalyses;
+// The analyses of one model with one parameter set to p (continuation's family of models): for
+// the built-in models the scene's keys with the continued one changed, for an equation model its
+// compiled code with other constants. Must give analyses of the same model type as the caller.
+using AnalysesAt = std::function<std::shared_ptr<const ModelAnalyses>(double p)>;
+
 class ModelAnalyses {
  public:
   virtual ~ModelAnalyses() = default;
@@ -78,6 +86,15 @@ class ModelAnalyses {
   virtual SimulationRecord<Eigen::Dynamic> simulate(const MapSettings& before_map, const MapSettings& map,
                                                     const SimulationOptions& options,
                                                     const ModelAnalyses* before = nullptr) const = 0;
+  // The branch of periodic orbits through this model's orbit (found as `orbit` says, on the
+  // grid of options.N and options.periods_per_map), continued in p over the family `at`
+  // (continuation.hpp: continue_orbit; this model is the one at options.from).
+  virtual ContinuationResult continue_orbit(const AnalysesAt& at, const OrbitSettings& orbit,
+                                            const ContinuationOptions& options) const = 0;
+  // The period-2 branch born at the period doubling `at_pd` of such a branch
+  // (continuation.hpp: continue_period_doubled).
+  virtual ContinuationResult continue_period_doubled(const AnalysesAt& at, const Bifurcation& at_pd,
+                                                     const ContinuationOptions& options) const = 0;
 
  protected:
   ModelAnalyses() = default;
@@ -168,7 +185,32 @@ class ModelAnalysesFor final : public ModelAnalyses {
     return out;
   }
 
+  ContinuationResult continue_orbit(const AnalysesAt& at, const OrbitSettings& settings,
+                                    const ContinuationOptions& options) const override {
+    const StroboscopicMap<Model> map(TrapezoidStepper<Model>(model_, options.step_options),
+                                     make_grid(model_.tau(), model_.period(), options.N, options.periods_per_map));
+    const PeriodicOrbit orbit = find_orbit(model_, map, settings);
+    const Eigen::VectorXd guess =
+        PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
+    return delayspec::continue_orbit<Model>(model_at(at), guess, options);
+  }
+
+  ContinuationResult continue_period_doubled(const AnalysesAt& at, const Bifurcation& at_pd,
+                                             const ContinuationOptions& options) const override {
+    return delayspec::continue_period_doubled<Model>(model_at(at), at_pd, options);
+  }
+
  private:
+  // The family `at` as continuation takes it: p -> the Model at p.
+  static std::function<Model(double)> model_at(const AnalysesAt& at) {
+    return [at](double p) {
+      const std::shared_ptr<const ModelAnalyses> analyses = at(p);
+      const auto* typed = dynamic_cast<const ModelAnalysesFor*>(analyses.get());
+      if (!typed) throw std::logic_error("continuation: the model at another parameter is of another type");
+      return typed->model_;
+    };
+  }
+
   static bool all_finite(const OrbitLinearisation<D>& at) {
     for (const StepMap<D>& m : at.maps)
       if (!m.P.allFinite() || !m.Q.allFinite() || !m.R.allFinite()) return false;

@@ -7,10 +7,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
+#include <cmath>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_test_support.hpp"
+#include "delayspec/errors.hpp"
 #include "delayspec_test_paths.hpp"
 
 namespace {
@@ -114,10 +117,39 @@ TEST_F(EquationsCli, RunComputesTheScenesAnalyses) {
   EXPECT_TRUE(std::filesystem::exists(out / "lyapunov.json"));
 }
 
-TEST_F(EquationsCli, ContinuationRefusesItWithExitTwo) {
-  const CliResult r = command("continue", {"continue_key=b", "continue_from=0", "continue_to=0.4", "N=20"});
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_TRUE(contains(r.err, "built-in models only")) << r.err;
+TEST_F(EquationsCli, ContinuationEqualsTheBuiltInLinearModelsBranch) {
+  // x' = -x + b x(t - tau), tau = T = 2 pi / (3 sqrt 3): the Neimark-Sacker point at b = -2 exactly
+  // (test_cli_continue.cpp), continued as equations and as the built-in model. The same discrete
+  // problem at every point: the branches agree to the corrector's and the locator's tolerances
+  // (1e-13 on the parameter here), far below 1e-9.
+  const std::string scene = (dir_ / "continue.toml").string();
+  std::ofstream(scene) << "model = \"equations\"\n[equations]\nstate = [\"x\"]\n"
+                       << "parameters = { a = -1, b = -1.5 }\nperiod = \"2*pi/(3*sqrt(3))\"\n"
+                       << "delay = \"2*pi/(3*sqrt(3))\"\nrhs = [\"a*x + b*x_tau\"]\n";
+  const std::vector<std::string> sets = {"continue_key=b", "continue_from=-1.5", "continue_to=-2.5",
+                                         "continue_Ns=50,100,200", "continue_tolerance=1e-13"};
+  const CliResult eq = command("continue", sets, scene);
+  ASSERT_EQ(eq.status, 0) << eq.err;
+  std::vector<std::string> builtin_sets = sets;
+  for (const char* s : {"model=linear", "a=-1"}) builtin_sets.push_back(s);
+  builtin_sets.push_back("tau=" + delayspec::format_number(2 * std::numbers::pi / (3 * std::sqrt(3.0))));
+  const CliResult builtin = run(with_sets({"continue", "--json"}, builtin_sets));
+  ASSERT_EQ(builtin.status, 0) << builtin.err;
+  const auto a = nlohmann::json::parse(eq.out), b = nlohmann::json::parse(builtin.out);
+  EXPECT_EQ(a["model"], "equations");
+  ASSERT_EQ(a["points"].size(), b["points"].size());
+  for (size_t i = 0; i < a["points"].size(); ++i)
+    EXPECT_NEAR(a["points"][i]["parameter"].get<double>(), b["points"][i]["parameter"].get<double>(), 1e-9) << i;
+  ASSERT_EQ(a["bifurcations"].size(), 1u);
+  ASSERT_EQ(b["bifurcations"].size(), 1u);
+  const auto &ba = a["bifurcations"][0], &bb = b["bifurcations"][0];
+  EXPECT_EQ(ba["type"], "neimark-sacker");
+  EXPECT_EQ(bb["type"], "neimark-sacker");
+  for (size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(ba["by_N"][i]["parameter"].get<double>(), bb["by_N"][i]["parameter"].get<double>(), 1e-9) << i;
+  EXPECT_NEAR(ba["extrapolated"].get<double>(), bb["extrapolated"].get<double>(), 1e-9);
+  // and both at the exact boundary within their error bar
+  EXPECT_LE(std::abs(ba["extrapolated"].get<double>() + 2), ba["error_estimate"].get<double>());
 }
 
 TEST_F(EquationsCli, BadEquationsExitTwoNamingTheItem) {

@@ -39,17 +39,15 @@ namespace {
 
 using nlohmann::json;
 
-// The model of `base` with `key` set to p (the same validation as any scene value).
-template <class Model>
-struct ModelWithKey {
-  const Config& base;
-  const std::string& key;
-  Model operator()(double p) const {
+// The model's analyses with `key` set to p: the scene `base` read again with that value (the
+// same validation as any scene value; an equation model keeps its compiled code, new constants).
+AnalysesAt analyses_with_key(const Config& base, const std::string& key) {
+  return [&base, &key](double p) {
     Config c = base;
     c.set(key, format_number(p), "continue");
-    return std::get<Model>(*read_problem(c, 100).model);
-  }
-};
+    return read_problem(c, 100).analyses;
+  };
+}
 
 // One level N with the continued key at p: the scene the model factory reads (ModelWithKey keeps
 // a reference to `config`), its problem, and the options' discretisation taken from it.
@@ -75,28 +73,16 @@ ContinuationResult branch_at(const Config& config, const ContinueSettings& setti
                              const OrbitSettings& orbit_settings, ContinuationOptions options, int N,
                              Progress& progress) {
   const Level level = level_at(config, settings.key, options.from, N, options, progress);
-  return with_map(
-      level.problem,
-      [&](const auto& model, const auto& map) {
-        using Model = std::decay_t<decltype(model)>;
-        const PeriodicOrbit orbit = find_orbit(model, map, orbit_settings);
-        const Eigen::VectorXd guess =
-            PeriodicOrbitProblem<std::decay_t<decltype(map)>>(map).sequence_from_history(orbit.history);
-        return continue_orbit<Model>(ModelWithKey<Model>{level.config, settings.key}, guess, options);
-      },
-      "`continue`");
+  return level.problem.analyses->continue_orbit(analyses_with_key(level.config, settings.key), orbit_settings,
+                                                options);
 }
 
 // The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
 ContinuationResult switched_at(const Config& config, const ContinueSettings& settings, ContinuationOptions options,
                                int N, const Bifurcation& pd, Progress& progress) {
   const Level level = level_at(config, settings.key, pd.parameter, N, options, progress);
-  return std::visit(
-      [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        return continue_period_doubled<Model>(ModelWithKey<Model>{level.config, settings.key}, pd, options);
-      },
-      *level.problem.model);
+  return level.problem.analyses->continue_period_doubled(analyses_with_key(level.config, settings.key), pd,
+                                                         options);
 }
 
 json measures_json(const OrbitMeasures& m) {
@@ -139,7 +125,6 @@ int command_continue(Config& config, const Invocation& inv) {
   // it as used (a key no model reads is then reported as unknown).
   config.set(settings.key, format_number(options.from), "continue_from");
   const Problem problem = read_problem(config, 100);
-  if (!problem.model) throw BadInput("`continue` takes the built-in models only, not model = equations");
   config.check_all_used();
   const std::vector<int> Ns = settings.Ns.empty() ? std::vector<int>{problem.N} : settings.Ns;
   const bool switching = problem.analyses->switches_in_state();

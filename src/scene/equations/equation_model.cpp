@@ -88,8 +88,25 @@ class ExplainedAnalyses final : public ModelAnalyses {
     const ModelAnalyses* inner_before = explained_before ? explained_before->inner_.get() : before;
     return explained([&] { return inner_->simulate(before_map, map, options, inner_before); });
   }
+  ContinuationResult continue_orbit(const AnalysesAt& at, const OrbitSettings& orbit,
+                                    const ContinuationOptions& options) const override {
+    return explained([&] { return inner_->continue_orbit(unwrapped(at), orbit, options); });
+  }
+  ContinuationResult continue_period_doubled(const AnalysesAt& at, const Bifurcation& at_pd,
+                                             const ContinuationOptions& options) const override {
+    return explained([&] { return inner_->continue_period_doubled(unwrapped(at), at_pd, options); });
+  }
 
  private:
+  // The family `at` gives explained analyses; the plugin's own continuation takes its own.
+  static AnalysesAt unwrapped(const AnalysesAt& at) {
+    return [at](double p) -> std::shared_ptr<const ModelAnalyses> {
+      std::shared_ptr<const ModelAnalyses> analyses = at(p);
+      if (const auto* explained = dynamic_cast<const ExplainedAnalyses*>(analyses.get())) return explained->inner_;
+      return analyses;
+    };
+  }
+
   template <class Analysis>
   auto explained(const Analysis& analysis) const -> decltype(analysis()) {
     try {

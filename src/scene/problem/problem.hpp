@@ -5,7 +5,7 @@
 //
 // The model's analyses (delayspec/model_analyses.hpp) are the one hand-off from a problem to the
 // engine, for the built-in models and for a model written as equations in the scene alike.
-// with_map() is kept for what only the built-in models offer (continuation, the classic
+// with_map() is kept for what only the built-in models offer (the classic
 // discretisations, simulate's control switch).
 #include <memory>
 #include <optional>
