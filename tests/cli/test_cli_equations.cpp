@@ -152,6 +152,44 @@ TEST_F(EquationsCli, ContinuationEqualsTheBuiltInLinearModelsBranch) {
   EXPECT_LE(std::abs(ba["extrapolated"].get<double>() + 2), ba["error_estimate"].get<double>());
 }
 
+TEST_F(EquationsCli, ContinuationOfTheImpactModelAsEquationsLocatesTheBuiltInGrazingAndPeriodDoubling) {
+  // data/scenes/continue_grazing_e.toml (the impact orbit at tau = T, k = 0, continued in the gap
+  // e) and the same system written as equations: a switch, events, grazing. The same discrete
+  // problem: the located points agree to the locator's tolerance (1e-10 |to - from| = 1e-11), not
+  // merely to the discretisation error (~1e-3 between N = 100 and 200).
+  const std::string scene = (dir_ / "grazing.toml").string();
+  std::ofstream(scene) << R"toml(model = "equations"
+tau_over_T = 1
+nev = 4
+orbit = "newton"
+[equations]
+state = ["x", "v"]
+parameters = { zeta = 0.01, e = 1.26, a = 0.7, beta = 28, omega = 0.802, k = 0 }
+period = "2*pi/omega"
+rhs = ["v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x"]
+switch = "x - e"
+rhs_switched = ["v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x - beta*(x - e)"]
+)toml";
+  const std::vector<std::string> sets = {"continue_key=e", "continue_from=1.3", "continue_to=1.2",
+                                         "continue_Ns=50,100", "N=100"};
+  const CliResult eq = command("continue", sets, scene);
+  ASSERT_EQ(eq.status, 0) << eq.err;
+  const CliResult builtin =
+      run(with_sets({"continue", DELAYSPEC_SOURCE_DIR "/data/scenes/continue_grazing_e.toml", "--json"}, sets));
+  ASSERT_EQ(builtin.status, 0) << builtin.err;
+  const auto a = nlohmann::json::parse(eq.out), b = nlohmann::json::parse(builtin.out);
+  ASSERT_EQ(a["bifurcations"].size(), b["bifurcations"].size());
+  ASSERT_GE(a["bifurcations"].size(), 2u);  // grazing, then the period doubling
+  EXPECT_EQ(a["bifurcations"][0]["type"], "grazing");
+  for (size_t i = 0; i < a["bifurcations"].size(); ++i) {
+    EXPECT_EQ(a["bifurcations"][i]["type"], b["bifurcations"][i]["type"]) << i;
+    for (size_t n = 0; n < 2; ++n)
+      EXPECT_NEAR(a["bifurcations"][i]["by_N"][n]["parameter"].get<double>(),
+                  b["bifurcations"][i]["by_N"][n]["parameter"].get<double>(), 1e-9)
+          << i << " " << n;
+  }
+}
+
 TEST_F(EquationsCli, BadEquationsExitTwoNamingTheItem) {
   struct Case {
     std::string from, to, expected;
