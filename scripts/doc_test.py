@@ -12,9 +12,10 @@ continuations and dropping a trailing `# comment`) that starts with `build/delay
 expected output), is run with the built program, no shell involved: the line is split with
 shlex and passed as arguments. Every other line (git, sudo bash scripts/..., cmake) is shown
 to the reader only. `cp -r SRC DST && build/delayspec ...` is supported (the copy is done here,
-inside the scratch directory). Commands run in order, one document after the other, each
-document in a fresh scratch directory (a reader at the repository root) holding `data/` and
-`docs/` of the source tree (read-only use) and the `out/` directories the commands write.
+inside the scratch directory). Commands run in order, one document after the other, all in one
+fresh scratch directory (a reader at the repository root,
+one clone: a page that reuses another page's output folder fails) holding `data/` and `docs/` of
+the source tree (read-only use) and the `out/` directories the commands write.
 
 Markers (HTML comments, invisible on the rendered page), on the lines before a block:
 
@@ -226,7 +227,7 @@ def main():
     parser.add_argument("--update", action="store_true",
                         help="rewrite the help blocks (docs/cli.md) from the program, run nothing")
     parser.add_argument("--keep", metavar="DIR",
-                        help="copy each document's scratch directory (the files its commands wrote) to DIR/DOC")
+                        help="copy the scratch directory (the files the documents' commands wrote) to DIR")
     parser.add_argument("docs", nargs="*", default=["README.md", "docs/tutorial.md", "docs/cli.md"])
     a = parser.parse_args()
     program = os.path.abspath(a.delayspec)
@@ -240,10 +241,12 @@ def main():
             log.append(f"{doc}: {len(helps)} key lists compared with --help")
     if a.update:
         return 0
-    for doc in a.docs:
-        with tempfile.TemporaryDirectory(prefix="delayspec_doc_test_") as scratch:
-            for sub in ("data", "docs"):
-                os.symlink(os.path.join(os.path.abspath(a.source), sub), os.path.join(scratch, sub))
+    # One scratch directory for every document, in the order given (a reader at the repository
+    # root, one clone): a page that reuses another page's output folder fails here.
+    with tempfile.TemporaryDirectory(prefix="delayspec_doc_test_") as scratch:
+        for sub in ("data", "docs"):
+            os.symlink(os.path.join(os.path.abspath(a.source), sub), os.path.join(scratch, sub))
+        for doc in a.docs:
             where = os.path.join(a.source, doc)
             log.append(f"{doc}:")
             for kind, line, item in parse(where):
@@ -276,9 +279,9 @@ def main():
                         if want not in output:
                             failures.append(f"{doc}:{line}: output lacks the documented line `{want}`;"
                                             f" got: {output.strip()[-600:]}")
-            if a.keep:  # what the commands wrote, not the source tree's data/ and docs/ linked in
-                shutil.copytree(scratch, os.path.join(a.keep, doc), symlinks=True,
-                                ignore=lambda d, names: [n for n in names if os.path.islink(os.path.join(d, n))])
+        if a.keep:  # what the commands wrote, not the source tree's data/ and docs/ linked in
+            shutil.copytree(scratch, a.keep, symlinks=True,
+                            ignore=lambda d, names: [n for n in names if os.path.islink(os.path.join(d, n))])
     print("\n".join(log))
     if failures:
         print(f"\n{len(failures)} doc-test failure(s):\n" + "\n".join(failures))
