@@ -49,8 +49,8 @@ AnalysesAt analyses_with_key(const Config& base, const std::string& key) {
   };
 }
 
-// One level N with the continued key at p: the scene the model factory reads (ModelWithKey keeps
-// a reference to `config`), its problem, and the options' discretisation taken from it.
+// One level N with the continued key at p: the scene the family of models reads (analyses_with_key
+// keeps a reference to `config`), its problem, and the options' discretisation taken from it.
 struct Level {
   Config config;
   Problem problem;
@@ -94,7 +94,6 @@ json measures_json(const OrbitMeasures& m) {
   return j;
 }
 
-
 json points_json(const std::vector<ContinuationPoint>& points) {
   json list = json::array();
   for (const auto& p : points) {
@@ -111,66 +110,82 @@ json points_json(const std::vector<ContinuationPoint>& points) {
   return list;
 }
 
-}  // namespace
+// What the command reads and checks before any work; the keys are read in this order (--help lists them so).
+struct ContinueRun {
+  ContinueSettings settings;
+  OrbitSettings orbit_settings;
+  ContinuationOptions options;
+  Problem problem;         // at continue_from
+  std::vector<int> Ns;     // continue_Ns, or the one level N
+  bool switching = false;  // the model switches in the state (its extrapolation order)
+};
 
-int command_continue(Config& config, const Invocation& inv) {
-  const auto start = std::chrono::steady_clock::now();
-  const ContinueSettings settings = read_continue_settings(config);
-  const OrbitSettings orbit_settings = read_orbit_settings(config);
-  ContinuationOptions options = settings.options;
-  options.floquet = read_floquet_options(config);
-  options.newton.tolerance = orbit_settings.newton.tolerance;       // the corrector's relative residual
-  options.start_iterations = orbit_settings.newton.max_iterations;  // the first point's Newton
+// Reads the keys and the problem at the start value, and rejects what continue cannot take.
+ContinueRun read_continue_run(Config& config) {
+  ContinueRun run;
+  run.settings = read_continue_settings(config);
+  run.orbit_settings = read_orbit_settings(config);
+  run.options = run.settings.options;
+  run.options.floquet = read_floquet_options(config);
+  run.options.newton.tolerance = run.orbit_settings.newton.tolerance;       // the corrector's relative residual
+  run.options.start_iterations = run.orbit_settings.newton.max_iterations;  // the first point's Newton
   // The continued key takes the start value; reading the problem with it validates it and marks
   // it as used (a key no model reads is then reported as unknown).
-  config.set(settings.key, format_number(options.from), "continue_from");
-  const Problem problem = read_problem(config, 100);
+  config.set(run.settings.key, format_number(run.options.from), "continue_from");
+  run.problem = read_problem(config, 100);
   config.check_all_used();
-  const std::vector<int> Ns = settings.Ns.empty() ? std::vector<int>{problem.N} : settings.Ns;
-  const bool switching = problem.analyses->switches_in_state();
+  run.Ns = run.settings.Ns.empty() ? std::vector<int>{run.problem.N} : run.settings.Ns;
+  run.switching = run.problem.analyses->switches_in_state();
+  return run;
+}
 
+// The computed branches: one per N, the period-2 branches of the finest one, the extrapolated
+// bifurcations, and every failure named on one line (empty: none).
+struct ContinueOutcome {
+  std::vector<ContinuationResult> levels;  // by N; the reported branch is the last
+  std::vector<BifurcationEstimate> estimates;
+  std::vector<ContinuationResult> switched;
+  std::vector<double> switched_from;  // each switched branch's period doubling
+  std::string failures;
+  const ContinuationResult& branch() const { return levels.back(); }
+};
+
+// Computes the branch at every N, extrapolates its bifurcations, and (continue_switch) the
+// period-2 branches from the finest branch's period doublings.
+ContinueOutcome compute_continue(const Config& config, const ContinueRun& run, const Invocation& inv) {
+  const ContinuationOptions& options = run.options;
+  ContinueOutcome out;
   Progress progress(inv.err, "continue", 0, inv.quiet);
-  std::vector<ContinuationResult> levels;
-  for (int N : Ns) levels.push_back(branch_at(config, settings, orbit_settings, options, N, progress));
-  const ContinuationResult& branch = levels.back();
+  for (int N : run.Ns) out.levels.push_back(branch_at(config, run.settings, run.orbit_settings, options, N, progress));
   std::vector<std::vector<Bifurcation>> by_N;
-  for (const auto& r : levels) by_N.push_back(r.bifurcations);
+  for (const auto& r : out.levels) by_N.push_back(r.bifurcations);
   const double tolerance = options.tolerance > 0 ? options.tolerance : 1e-10 * std::abs(options.to - options.from);
   RichardsonOptions richardson;
-  if (switching && problem.events == EventMode::off) richardson.order = richardson.order_step = 1;  // design.md 1.5
-  const std::vector<BifurcationEstimate> estimates = extrapolate_bifurcations(Ns, by_N, tolerance, richardson);
+  if (run.switching && run.problem.events == EventMode::off)
+    richardson.order = richardson.order_step = 1;  // design.md 1.5
+  out.estimates = extrapolate_bifurcations(run.Ns, by_N, tolerance, richardson);
   // continue_switch: the period-2 branch of every period doubling on the finest branch.
-  std::vector<ContinuationResult> switched;
-  std::vector<double> switched_from;
-  if (settings.switch_period_doubling)
-    for (const Bifurcation& b : branch.bifurcations)
+  if (run.settings.switch_period_doubling)
+    for (const Bifurcation& b : out.branch().bifurcations)
       if (b.type == BifurcationType::period_doubling) {
-        switched.push_back(switched_at(config, settings, options, Ns.back(), b, progress));
-        switched_from.push_back(b.parameter);
+        out.switched.push_back(switched_at(config, run.settings, options, run.Ns.back(), b, progress));
+        out.switched_from.push_back(b.parameter);
       }
   progress.finish();
-  std::string failures;
-  for (size_t i = 0; i < switched.size(); ++i)
-    if (!switched[i].failure.empty())
-      failures += (failures.empty() ? "" : "; ") + std::string("period-2 branch from ") +
-                  format_number(switched_from[i]) + ": " + switched[i].failure;
-  for (size_t i = 0; i < levels.size(); ++i)
-    if (!levels[i].failure.empty())
-      failures +=
-          (failures.empty() ? "" : "; ") + std::string("N = ") + std::to_string(Ns[i]) + ": " + levels[i].failure;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (size_t i = 0; i < out.switched.size(); ++i)
+    if (!out.switched[i].failure.empty())
+      out.failures += (out.failures.empty() ? "" : "; ") + std::string("period-2 branch from ") +
+                      format_number(out.switched_from[i]) + ": " + out.switched[i].failure;
+  for (size_t i = 0; i < out.levels.size(); ++i)
+    if (!out.levels[i].failure.empty())
+      out.failures += (out.failures.empty() ? "" : "; ") + std::string("N = ") + std::to_string(run.Ns[i]) + ": " +
+                      out.levels[i].failure;
+  return out;
+}
 
-  json j;
-  j["model"] = problem.model_name;
-  j["continue_key"] = settings.key;
-  j["N"] = Ns.back();
-  j["Ns"] = Ns;
-  j["events"] = to_string(problem.events);
-  j["jacobian"] = to_string(problem.jacobian);
-  j["end"] = to_string(branch.end);
-  if (!failures.empty()) j["failure"] = failures;
-  j["points"] = points_json(branch.points);
-  j["bifurcations"] = json::array();
+// The extrapolated bifurcations, each with the finest branch's multipliers, measures and note.
+json bifurcations_json(const std::vector<BifurcationEstimate>& estimates, const ContinuationResult& branch) {
+  json list = json::array();
   for (size_t b = 0; b < estimates.size(); ++b) {
     const BifurcationEstimate& e = estimates[b];
     const Bifurcation& finest = branch.bifurcations[b];
@@ -187,27 +202,48 @@ int command_continue(Config& config, const Invocation& inv) {
     bj["observed_order"] = e.observed_order;
     bj["bracket"] = finest.bracket;
     if (!e.note.empty() || !finest.note.empty()) bj["note"] = finest.note + (finest.note.empty() ? "" : "; ") + e.note;
-    j["bifurcations"].push_back(bj);
+    list.push_back(bj);
   }
-  if (settings.switch_period_doubling) {
-    j["switched"] = json::array();
-    for (size_t i = 0; i < switched.size(); ++i) {
-      json sj;
-      sj["from_parameter"] = switched_from[i];
-      sj["orbit_period"] = 2 * problem.orbit_period;
-      sj["N"] = Ns.back();
-      sj["end"] = to_string(switched[i].end);
-      sj["points"] = points_json(switched[i].points);
-      sj["bifurcations"] = json::array();
-      for (const Bifurcation& b : switched[i].bifurcations)
-        sj["bifurcations"].push_back({{"type", to_string(b.type)},
-                                      {"parameter", b.parameter},
-                                      {"angle", b.angle},
-                                      {"multipliers", multipliers_json(b.multipliers)},
-                                      {"note", b.note}});
-      j["switched"].push_back(sj);
-    }
+  return list;
+}
+
+// The period-2 branches (continue_switch), at the finest N.
+json switched_json(const ContinueRun& run, const ContinueOutcome& out) {
+  json list = json::array();
+  for (size_t i = 0; i < out.switched.size(); ++i) {
+    json sj;
+    sj["from_parameter"] = out.switched_from[i];
+    sj["orbit_period"] = 2 * run.problem.orbit_period;
+    sj["N"] = run.Ns.back();
+    sj["end"] = to_string(out.switched[i].end);
+    sj["points"] = points_json(out.switched[i].points);
+    sj["bifurcations"] = json::array();
+    for (const Bifurcation& b : out.switched[i].bifurcations)
+      sj["bifurcations"].push_back({{"type", to_string(b.type)},
+                                    {"parameter", b.parameter},
+                                    {"angle", b.angle},
+                                    {"multipliers", multipliers_json(b.multipliers)},
+                                    {"note", b.note}});
+    list.push_back(sj);
   }
+  return list;
+}
+
+// The --json result (also continue.json's body).
+json continue_json(const ContinueRun& run, const ContinueOutcome& out, double seconds) {
+  const ContinuationResult& branch = out.branch();
+  json j;
+  j["model"] = run.problem.model_name;
+  j["continue_key"] = run.settings.key;
+  j["N"] = run.Ns.back();
+  j["Ns"] = run.Ns;
+  j["events"] = to_string(run.problem.events);
+  j["jacobian"] = to_string(run.problem.jacobian);
+  j["end"] = to_string(branch.end);
+  if (!out.failures.empty()) j["failure"] = out.failures;
+  j["points"] = points_json(branch.points);
+  j["bifurcations"] = bifurcations_json(out.estimates, branch);
+  if (run.settings.switch_period_doubling) j["switched"] = switched_json(run, out);
   json cost;
   cost["points"] = branch.points.size();
   cost["newton_iterations"] = branch.newton_iterations;
@@ -218,59 +254,114 @@ int command_continue(Config& config, const Invocation& inv) {
   cost["branch_seconds"] = branch.seconds;
   j["cost_finest_N"] = cost;
   j["seconds"] = seconds;
+  return j;
+}
 
-  if (inv.out_dir) {
-    const std::filesystem::path dir(*inv.out_dir);
-    OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
-    metadata.parameters.erase(settings.key);  // per row (plot labels the x axis with continue_key)
-    std::string header = metadata_comment_lines(metadata);
-    if (!failures.empty()) header += "# INCOMPLETE: the branch ended in a failure: " + failures + "\n";
-    std::ostringstream rows;
-    rows << header << "parameter,stable,unstable,abs_mu1";
-    const size_t d = branch.points.front().measures.max.size();
-    for (size_t c = 0; c < d; ++c) rows << ",max_y" << c + 1;
-    for (size_t c = 0; c < d; ++c) rows << ",min_y" << c + 1;
-    rows << ",max_H,contact_time,newton_iterations";
-    for (int k = 0; k < options.floquet.nev; ++k) rows << ",mu" << k + 1 << "_re,mu" << k + 1 << "_im";
+// branch.csv after `header`: one row per point, with the first `nev` multipliers.
+std::string branch_csv(const std::string& header, const ContinuationResult& branch, int nev) {
+  std::ostringstream rows;
+  rows << header << "parameter,stable,unstable,abs_mu1";
+  const size_t d = branch.points.front().measures.max.size();
+  for (size_t c = 0; c < d; ++c) rows << ",max_y" << c + 1;
+  for (size_t c = 0; c < d; ++c) rows << ",min_y" << c + 1;
+  rows << ",max_H,contact_time,newton_iterations";
+  for (int k = 0; k < nev; ++k) rows << ",mu" << k + 1 << "_re,mu" << k + 1 << "_im";
+  rows << "\n";
+  for (const auto& p : branch.points) {
+    rows << csv_number(p.parameter) << "," << (p.stable() ? 1 : 0) << "," << p.unstable << ","
+         << csv_number(p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]));
+    for (double v : p.measures.max) rows << "," << csv_number(v);
+    for (double v : p.measures.min) rows << "," << csv_number(v);
+    rows << "," << csv_number(p.measures.max_H) << "," << csv_number(p.measures.contact_time) << ","
+         << p.newton_iterations;
+    for (int k = 0; k < nev; ++k) {
+      const bool has = static_cast<size_t>(k) < p.multipliers.size();
+      rows << "," << csv_number(has ? p.multipliers[k].real() : NAN) << ","
+           << csv_number(has ? p.multipliers[k].imag() : NAN);
+    }
     rows << "\n";
-    for (const auto& p : branch.points) {
-      rows << csv_number(p.parameter) << "," << (p.stable() ? 1 : 0) << "," << p.unstable << ","
-           << csv_number(p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]));
-      for (double v : p.measures.max) rows << "," << csv_number(v);
-      for (double v : p.measures.min) rows << "," << csv_number(v);
-      rows << "," << csv_number(p.measures.max_H) << "," << csv_number(p.measures.contact_time) << ","
-           << p.newton_iterations;
-      for (int k = 0; k < options.floquet.nev; ++k) {
-        const bool has = static_cast<size_t>(k) < p.multipliers.size();
-        rows << "," << csv_number(has ? p.multipliers[k].real() : NAN) << ","
-             << csv_number(has ? p.multipliers[k].imag() : NAN);
-      }
-      rows << "\n";
-    }
-    std::ostringstream bifs;
-    bifs << header << "type,parameter,extrapolated,error_estimate,observed_order,angle,abs_mu,by_N\n";
-    for (size_t b = 0; b < estimates.size(); ++b) {
-      const BifurcationEstimate& e = estimates[b];
-      std::complex<double> critical;
-      const double g = e.type == BifurcationType::grazing ? NAN
-                                                          : continuation_detail::multiplier_test(
-                                                                e.type, branch.bifurcations[b].multipliers, &critical);
-      bifs << to_string(e.type) << "," << csv_number(e.parameter) << "," << csv_number(e.extrapolated) << ","
-           << csv_number(e.error_estimate) << "," << csv_number(e.observed_order) << "," << csv_number(e.angle) << ","
-           << csv_number(std::isfinite(g) ? std::abs(critical) : NAN) << ",";
-      for (size_t i = 0; i < e.Ns.size(); ++i)
-        bifs << (i ? ";" : "") << e.Ns[i] << ":" << format_number(e.parameters[i]);
-      bifs << "\n";
-    }
-    write_output(inv, dir / "branch.csv", rows.str());
-    write_output(inv, dir / "bifurcations.csv", bifs.str());
-    json file = j;
-    file["metadata"] = metadata_json(metadata);
-    write_output(inv, dir / "continue.json", file.dump(2) + "\n");
   }
+  return rows.str();
+}
 
-  if (!failures.empty()) {
-    inv.err << "delayspec continue: numerical failure: " << failures
+// bifurcations.csv after `header`: one row per bifurcation, |mu| the critical multiplier's.
+std::string bifurcations_csv(const std::string& header, const std::vector<BifurcationEstimate>& estimates,
+                             const ContinuationResult& branch) {
+  std::ostringstream bifs;
+  bifs << header << "type,parameter,extrapolated,error_estimate,observed_order,angle,abs_mu,by_N\n";
+  for (size_t b = 0; b < estimates.size(); ++b) {
+    const BifurcationEstimate& e = estimates[b];
+    std::complex<double> critical;
+    const double g = e.type == BifurcationType::grazing
+                         ? NAN
+                         : continuation_detail::multiplier_test(e.type, branch.bifurcations[b].multipliers, &critical);
+    bifs << to_string(e.type) << "," << csv_number(e.parameter) << "," << csv_number(e.extrapolated) << ","
+         << csv_number(e.error_estimate) << "," << csv_number(e.observed_order) << "," << csv_number(e.angle) << ","
+         << csv_number(std::isfinite(g) ? std::abs(critical) : NAN) << ",";
+    for (size_t i = 0; i < e.Ns.size(); ++i) bifs << (i ? ";" : "") << e.Ns[i] << ":" << format_number(e.parameters[i]);
+    bifs << "\n";
+  }
+  return bifs.str();
+}
+
+// --out DIR: branch.csv, bifurcations.csv and continue.json, marked incomplete after a failure.
+void write_continue_files(const Invocation& inv, const Config& config, const ContinueRun& run,
+                          const ContinueOutcome& out, const json& j, double seconds) {
+  const std::filesystem::path dir(*inv.out_dir);
+  OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
+  metadata.parameters.erase(run.settings.key);  // per row (plot labels the x axis with continue_key)
+  std::string header = metadata_comment_lines(metadata);
+  if (!out.failures.empty()) header += "# INCOMPLETE: the branch ended in a failure: " + out.failures + "\n";
+  write_output(inv, dir / "branch.csv", branch_csv(header, out.branch(), run.options.floquet.nev));
+  write_output(inv, dir / "bifurcations.csv", bifurcations_csv(header, out.estimates, out.branch()));
+  json file = j;
+  file["metadata"] = metadata_json(metadata);
+  write_output(inv, dir / "continue.json", file.dump(2) + "\n");
+}
+
+// The text report: the branch's points, the bifurcations, the time.
+void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutcome& out, double seconds) {
+  const ContinuationResult& branch = out.branch();
+  const std::string& key = run.settings.key;
+  char line[256];
+  os << "delayspec continue: model " << run.problem.model_name << ", " << key << " from "
+     << format_number(run.options.from) << " to " << format_number(run.options.to) << ", N = ";
+  for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
+  os << "\nbranch (N = " << run.Ns.back() << "): " << branch.points.size() << " points, ended at `"
+     << to_string(branch.end) << "`\n";
+  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s\n", key.c_str(), "|mu_1|", "unstable", "max y1");
+  os << line;
+  for (const auto& p : branch.points) {
+    std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g\n", p.parameter,
+                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0]);
+    os << line;
+  }
+  os << "bifurcations: " << out.estimates.size() << "\n";
+  for (size_t b = 0; b < out.estimates.size(); ++b) {
+    const BifurcationEstimate& e = out.estimates[b];
+    os << "  " << to_string(e.type) << " at " << key << " = " << format_number(e.parameter);
+    if (e.type != BifurcationType::grazing) os << ", angle " << e.angle << " (" << e.angle / std::numbers::pi << " pi)";
+    if (e.Ns.size() > 1)
+      os << "; extrapolated " << format_number(e.extrapolated) << " +- " << e.error_estimate << " (order "
+         << e.observed_order << ")";
+    os << "\n";
+    if (!branch.bifurcations[b].note.empty()) os << "    note: " << branch.bifurcations[b].note << "\n";
+  }
+  os << "time: " << seconds << " s (finest N: Newton " << branch.newton_seconds << " s, Krylov "
+     << branch.krylov_seconds << " s)\n";
+}
+
+}  // namespace
+
+int command_continue(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  const ContinueRun run = read_continue_run(config);
+  const ContinueOutcome out = compute_continue(config, run, inv);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const json j = continue_json(run, out, seconds);
+  if (inv.out_dir) write_continue_files(inv, config, run, out, j, seconds);
+  if (!out.failures.empty()) {
+    inv.err << "delayspec continue: numerical failure: " << out.failures
             << (inv.out_dir ? "; the branch so far is in " + *inv.out_dir : std::string()) << "\n";
     return 3;
   }
@@ -278,33 +369,7 @@ int command_continue(Config& config, const Invocation& inv) {
     inv.out << j.dump(2) << "\n";
     return 0;
   }
-  char line[256];
-  inv.out << "delayspec continue: model " << problem.model_name << ", " << settings.key << " from "
-          << format_number(options.from) << " to " << format_number(options.to) << ", N = ";
-  for (size_t i = 0; i < Ns.size(); ++i) inv.out << (i ? "," : "") << Ns[i];
-  inv.out << "\nbranch (N = " << Ns.back() << "): " << branch.points.size() << " points, ended at `"
-          << to_string(branch.end) << "`\n";
-  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s\n", settings.key.c_str(), "|mu_1|", "unstable", "max y1");
-  inv.out << line;
-  for (const auto& p : branch.points) {
-    std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g\n", p.parameter,
-                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0]);
-    inv.out << line;
-  }
-  inv.out << "bifurcations: " << estimates.size() << "\n";
-  for (size_t b = 0; b < estimates.size(); ++b) {
-    const BifurcationEstimate& e = estimates[b];
-    inv.out << "  " << to_string(e.type) << " at " << settings.key << " = " << format_number(e.parameter);
-    if (e.type != BifurcationType::grazing)
-      inv.out << ", angle " << e.angle << " (" << e.angle / std::numbers::pi << " pi)";
-    if (e.Ns.size() > 1)
-      inv.out << "; extrapolated " << format_number(e.extrapolated) << " +- " << e.error_estimate << " (order "
-              << e.observed_order << ")";
-    inv.out << "\n";
-    if (!branch.bifurcations[b].note.empty()) inv.out << "    note: " << branch.bifurcations[b].note << "\n";
-  }
-  inv.out << "time: " << seconds << " s (finest N: Newton " << branch.newton_seconds << " s, Krylov "
-          << branch.krylov_seconds << " s)\n";
+  print_continue(inv.out, run, out, seconds);
   return 0;
 }
 

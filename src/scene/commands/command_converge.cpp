@@ -213,35 +213,45 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
   if (!s.stop_note.empty()) out << "stopped: " << s.stop_note << "\n";
 }
 
-}  // namespace
+// What the command reads and checks before any work; the keys are read in this order (--help lists them so).
+struct ConvergeSettings {
+  std::vector<std::string> events;  // the variants, side by side; the problem has the first
+  Problem problem;
+  bool switching = false;
+  OrbitSettings orbit_settings;
+  ConvergenceOptions base;  // the options of every variant but the Richardson orders
+  FloquetOptions solver_options;
+  bool order_given = false, step_given = false;  // else each variant's own expansion (error_expansion)
+  double x_order = 2, x_step = 2;
+};
 
-int command_converge(Config& config, const Invocation& inv) {
-  const auto command_start = std::chrono::steady_clock::now();
+// Reads and checks the keys, the levels and the reference (the exact multipliers where a model has them).
+ConvergeSettings read_converge_settings(Config& config) {
+  ConvergeSettings s;
   // events may be a list here (side by side); the problem reads the first of them.
   // Models that switch (the impact wall, milling's cutting windows): located and not, side by side.
   // Whether the model switches is the model's own (its analyses); `events` is read after it.
   Config first = config;
   first.set("events", "on", "converge");
   const bool switching_default = read_problem(first, 100).switching();
-  const std::vector<std::string> events =
-      read_word_list(config, "events", switching_default ? "on,off" : "on", event_mode_names());
-  config.set("events", events.front(), "converge");
-  Problem problem = read_problem(config, 100);
-  const bool switching = problem.switching();
-  const OrbitSettings orbit_settings = read_orbit_settings(config);
-  ConvergenceOptions base;
-  base.Ns = read_N_list(config, problem, 25, 400);
-  const FloquetOptions solver_options = read_floquet_options(config, 2);  // nev, solver, ncv, tol, ...
-  const FloquetSolver solver = solver_options.solver;
-  base.nev = solver_options.nev;
+  s.events = read_word_list(config, "events", switching_default ? "on,off" : "on", event_mode_names());
+  config.set("events", s.events.front(), "converge");
+  s.problem = read_problem(config, 100);
+  s.switching = s.problem.switching();
+  s.orbit_settings = read_orbit_settings(config);
+  ConvergenceOptions& base = s.base;
+  base.Ns = read_N_list(config, s.problem, 25, 400);
+  s.solver_options = read_floquet_options(config, 2);  // nev, solver, ncv, tol, ...
+  base.nev = s.solver_options.nev;
   base.extra = std::max(2, base.nev / 2);
   base.reference =
       parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
-  const bool order_given = config.has("extrapolation_order"), step_given = config.has("extrapolation_order_step");
-  const double x_order = config.get_double("extrapolation_order", 2);
-  const double x_step = config.get_double("extrapolation_order_step", 2);
-  require_positive("extrapolation_order", x_order);
-  require_positive("extrapolation_order_step", x_step);
+  s.order_given = config.has("extrapolation_order");
+  s.step_given = config.has("extrapolation_order_step");
+  s.x_order = config.get_double("extrapolation_order", 2);
+  s.x_step = config.get_double("extrapolation_order_step", 2);
+  require_positive("extrapolation_order", s.x_order);
+  require_positive("extrapolation_order_step", s.x_step);
   // More columns than levels is harmless (the table stops at the levels); the bound keeps the cast exact.
   base.richardson.max_columns = static_cast<int>(config.get_int_in_range("extrapolation_levels", 4, 1, 1000));
   base.target = config.get_double("converge_target", 0);
@@ -259,110 +269,136 @@ int command_converge(Config& config, const Invocation& inv) {
                    "`: must be > 0 and at most 1e7");
   config.check_all_used();
 
-  Problem coarsest = problem;
+  Problem coarsest = s.problem;
   coarsest.N = base.Ns.front();
   const long n_min = coarsest.dimension();
-  validate_floquet_options(solver_options, n_min);  // at the coarsest N, the smallest n
-  base.exact = exact_multipliers(problem, base.nev + base.extra);
+  validate_floquet_options(s.solver_options, n_min);  // at the coarsest N, the smallest n
+  base.exact = exact_multipliers(s.problem, base.nev + base.extra);
   if (base.reference == ReferenceKind::exact && base.exact.empty())
-    throw BadInput("`reference = exact`: model `" + problem.model_name +
+    throw BadInput("`reference = exact`: model `" + s.problem.model_name +
                    "` has no exact multipliers (use extrapolated or finest)");
+  return s;
+}
 
+// One convergence study per events variant, each with its own Richardson orders.
+std::vector<ConvergenceStudy> run_studies(const ConvergeSettings& s, const Invocation& inv) {
   std::vector<ConvergenceStudy> studies;
-  Progress progress(inv.err, "converge", base.target > 0 ? 0 : static_cast<long>(base.Ns.size() * events.size()),
+  Progress progress(inv.err, "converge", s.base.target > 0 ? 0 : static_cast<long>(s.base.Ns.size() * s.events.size()),
                     inv.quiet);
-  for (const std::string& ev : events) {
-    ConvergenceOptions options = base;
-    Problem with_events = problem;
+  for (const std::string& ev : s.events) {
+    ConvergenceOptions options = s.base;
+    Problem with_events = s.problem;
     with_events.events = parse_event_mode(ev);
     const RichardsonOptions expansion = error_expansion(with_events);  // h, h^2 with events = off
-    options.richardson.order = order_given ? x_order : expansion.order;
-    options.richardson.order_step = step_given ? x_step : expansion.order_step;
-    StudyLevels levels(problem, with_events.events, orbit_settings, solver_options, &progress);
+    options.richardson.order = s.order_given ? s.x_order : expansion.order;
+    options.richardson.order_step = s.step_given ? s.x_step : expansion.order_step;
+    StudyLevels levels(s.problem, with_events.events, s.orbit_settings, s.solver_options, &progress);
     studies.push_back(
         run_convergence_study([&](int N, int count) { return levels.level(N, count); }, options,
                               [&](int N, int count, int from_N) { return levels.retry(N, count, from_N); }));
   }
   progress.finish();
+  return studies;
+}
 
-  if (inv.out_dir) {
-    const std::filesystem::path dir(*inv.out_dir);
-    const std::string header = metadata_comment_lines(
-        make_metadata("converge", inv.scene, config, nlohmann::json::object(),
-                      std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count()));
-    OutputFile rows(inv, dir / "converge.csv");
-    rows.stream() << header << "# delayspec converge: model " << problem.model_name << ", solver " << to_string(solver)
-                  << "\n";
-    for (size_t v = 0; v < studies.size(); ++v)  // failed levels have no multipliers: named here
-      for (const auto& r : studies[v].rows)
-        if (!r.failure.empty())
-          rows.stream() << "# events " << events[v] << ", N = " << r.N << " failed: " << one_line(r.failure) << "\n";
-    rows.stream() << "events,N,track,re,im,abs,error,correct_digits,seconds,operator_applications\n";
-    rows.stream().precision(17);
-    OutputFile rich(inv, dir / "converge_richardson.csv");
-    rich.stream()
-        << header
-        << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";
-    rich.stream().precision(17);
-    for (size_t v = 0; v < studies.size(); ++v) {
-      const auto& s = studies[v];
-      for (const auto& r : s.rows)
-        for (size_t k = 0; k < r.multipliers.size(); ++k)
-          rows.stream() << events[v] << "," << r.N << "," << k + 1 << "," << r.multipliers[k].real() << ","
-                        << r.multipliers[k].imag() << "," << std::abs(r.multipliers[k]) << "," << r.errors[k] << ","
-                        << r.correct_digits[k] << "," << r.seconds << "," << r.operator_applications << "\n";
-      for (size_t c = 0; c < s.richardson.columns.size(); ++c)
-        for (size_t i = 0; i < s.richardson.columns[c].size(); ++i) {
-          const auto x = s.richardson.columns[c][i];
-          rich.stream() << events[v] << "," << s.richardson.Ns[i + c] << "," << c + 1 << "," << x.real() << ","
-                        << x.imag() << "," << std::abs(x) << "," << s.richardson.errors[c][i] << "\n";
-        }
-    }
-    rows.commit();
-    rich.commit();
+// --out DIR: converge.csv (every level's multipliers) and converge_richardson.csv (mu_1's columns).
+void write_converge_files(const Invocation& inv, const Config& config, const ConvergeSettings& s,
+                          const std::vector<ConvergenceStudy>& studies, double seconds) {
+  const std::filesystem::path dir(*inv.out_dir);
+  const std::string header =
+      metadata_comment_lines(make_metadata("converge", inv.scene, config, nlohmann::json::object(), seconds));
+  OutputFile rows(inv, dir / "converge.csv");
+  rows.stream() << header << "# delayspec converge: model " << s.problem.model_name << ", solver "
+                << to_string(s.solver_options.solver) << "\n";
+  for (size_t v = 0; v < studies.size(); ++v)  // failed levels have no multipliers: named here
+    for (const auto& r : studies[v].rows)
+      if (!r.failure.empty())
+        rows.stream() << "# events " << s.events[v] << ", N = " << r.N << " failed: " << one_line(r.failure) << "\n";
+  rows.stream() << "events,N,track,re,im,abs,error,correct_digits,seconds,operator_applications\n";
+  rows.stream().precision(17);
+  OutputFile rich(inv, dir / "converge_richardson.csv");
+  rich.stream()
+      << header
+      << "# delayspec converge: Richardson columns of mu_1 (levels combined)\nevents,N,levels,re,im,abs,error\n";
+  rich.stream().precision(17);
+  for (size_t v = 0; v < studies.size(); ++v) {
+    const auto& st = studies[v];
+    const std::string& ev = s.events[v];
+    for (const auto& r : st.rows)
+      for (size_t k = 0; k < r.multipliers.size(); ++k)
+        rows.stream() << ev << "," << r.N << "," << k + 1 << "," << r.multipliers[k].real() << ","
+                      << r.multipliers[k].imag() << "," << std::abs(r.multipliers[k]) << "," << r.errors[k] << ","
+                      << r.correct_digits[k] << "," << r.seconds << "," << r.operator_applications << "\n";
+    for (size_t c = 0; c < st.richardson.columns.size(); ++c)
+      for (size_t i = 0; i < st.richardson.columns[c].size(); ++i) {
+        const auto x = st.richardson.columns[c][i];
+        rich.stream() << ev << "," << st.richardson.Ns[i + c] << "," << c + 1 << "," << x.real() << "," << x.imag()
+                      << "," << std::abs(x) << "," << st.richardson.errors[c][i] << "\n";
+      }
   }
+  rows.commit();
+  rich.commit();
+}
 
-  if (inv.json) {
-    nlohmann::json j = study_json(studies.front(), events.front());
-    j["model"] = problem.model_name;
-    j["solver"] = to_string(solver);
-    j["nev"] = base.nev;
-    if (studies.size() > 1) {
-      j["by_events"] = nlohmann::json::array();
-      for (size_t v = 0; v < studies.size(); ++v) j["by_events"].push_back(study_json(studies[v], events[v]));
+// The --json result: the first variant's study at the top level, every variant's under by_events.
+nlohmann::json converge_json(const ConvergeSettings& s, const std::vector<ConvergenceStudy>& studies) {
+  nlohmann::json j = study_json(studies.front(), s.events.front());
+  j["model"] = s.problem.model_name;
+  j["solver"] = to_string(s.solver_options.solver);
+  j["nev"] = s.base.nev;
+  if (studies.size() > 1) {
+    j["by_events"] = nlohmann::json::array();
+    for (size_t v = 0; v < studies.size(); ++v) j["by_events"].push_back(study_json(studies[v], s.events[v]));
+  }
+  return j;
+}
+
+// The variants side by side: mu_1's relative error at every N any of them reached.
+void print_side_by_side(std::ostream& out, const std::vector<ConvergenceStudy>& studies,
+                        const std::vector<std::string>& events) {
+  char line[200];
+  out << "\nside by side: relative error of mu_1 (correct digits)\n  " << std::string(6, ' ');
+  for (const auto& ev : events) {
+    std::snprintf(line, sizeof line, "  %22s", ("events = " + ev).c_str());
+    out << line;
+  }
+  out << "\n";
+  std::set<int> all_N;  // with a target the variants may end at different N
+  for (const auto& s : studies)
+    for (const auto& r : s.rows) all_N.insert(r.N);
+  for (int N : all_N) {
+    std::snprintf(line, sizeof line, "  %6d", N);
+    out << line;
+    for (const auto& s : studies) {
+      const auto r = std::find_if(s.rows.begin(), s.rows.end(), [&](const ConvergenceRow& x) { return x.N == N; });
+      if (r == s.rows.end()) std::snprintf(line, sizeof line, "  %22s", "-");
+      else if (!r->failure.empty()) std::snprintf(line, sizeof line, "  %22s", "failed");
+      else std::snprintf(line, sizeof line, "  %13.3e (%5.2f)", r->error, r->correct_digits[0]);
+      out << line;
     }
-    inv.out << j.dump(2) << "\n";
+    out << "\n";
+  }
+}
+
+}  // namespace
+
+int command_converge(Config& config, const Invocation& inv) {
+  const auto command_start = std::chrono::steady_clock::now();
+  const ConvergeSettings s = read_converge_settings(config);
+  const std::vector<ConvergenceStudy> studies = run_studies(s, inv);
+  if (inv.out_dir)
+    write_converge_files(inv, config, s, studies,
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count());
+  if (inv.json) {
+    inv.out << converge_json(s, studies).dump(2) << "\n";
     return 0;
   }
-  inv.out << "delayspec converge: model " << problem.model_name << ", solver " << to_string(solver) << ", nev "
-          << base.nev << ", N = ";
-  for (size_t i = 0; i < base.Ns.size(); ++i) inv.out << (i ? "," : "") << base.Ns[i];
+  inv.out << "delayspec converge: model " << s.problem.model_name << ", solver " << to_string(s.solver_options.solver)
+          << ", nev " << s.base.nev << ", N = ";
+  for (size_t i = 0; i < s.base.Ns.size(); ++i) inv.out << (i ? "," : "") << s.base.Ns[i];
   inv.out << "\n";
-  for (size_t v = 0; v < studies.size(); ++v) print_study(inv.out, studies[v], events[v], switching);
-  if (studies.size() > 1) {
-    char line[200];
-    inv.out << "\nside by side: relative error of mu_1 (correct digits)\n  " << std::string(6, ' ');
-    for (const auto& ev : events) {
-      std::snprintf(line, sizeof line, "  %22s", ("events = " + ev).c_str());
-      inv.out << line;
-    }
-    inv.out << "\n";
-    std::set<int> all_N;  // with a target the variants may end at different N
-    for (const auto& s : studies)
-      for (const auto& r : s.rows) all_N.insert(r.N);
-    for (int N : all_N) {
-      std::snprintf(line, sizeof line, "  %6d", N);
-      inv.out << line;
-      for (const auto& s : studies) {
-        const auto r = std::find_if(s.rows.begin(), s.rows.end(), [&](const ConvergenceRow& x) { return x.N == N; });
-        if (r == s.rows.end()) std::snprintf(line, sizeof line, "  %22s", "-");
-        else if (!r->failure.empty()) std::snprintf(line, sizeof line, "  %22s", "failed");
-        else std::snprintf(line, sizeof line, "  %13.3e (%5.2f)", r->error, r->correct_digits[0]);
-        inv.out << line;
-      }
-      inv.out << "\n";
-    }
-  }
+  for (size_t v = 0; v < studies.size(); ++v) print_study(inv.out, studies[v], s.events[v], s.switching);
+  if (studies.size() > 1) print_side_by_side(inv.out, studies, s.events);
   return 0;
 }
 
