@@ -187,10 +187,11 @@ TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 points
   const std::string section = without_metadata(read(dir / "section.csv"));
   EXPECT_EQ(std::count(section.begin(), section.end(), '\n'), 1 + 3 * 4);
-  // the same directory again without --resume is refused
+  // the same directory again is refused: it holds a finished sweep (test_cli_output_dir.cpp has
+  // the interrupted case, which advises --resume)
   CliResult again = run(args);
   EXPECT_EQ(again.status, 2);
-  EXPECT_NE(again.err.find("--resume"), std::string::npos) << again.err;
+  EXPECT_NE(again.err.find("already holds a finished sweep"), std::string::npos) << again.err;
   fs::remove_all(dir);
 }
 

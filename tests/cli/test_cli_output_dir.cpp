@@ -321,6 +321,12 @@ TEST(OutputDirectory, ChartAndBasinResumeToTheSameTable) {
       EXPECT_TRUE(fs::exists(dir / (name + "_points/point_0000" + std::to_string(i) + ".json")));
     CliResult again = run(with(args, {"--out", dir.string()}));
     EXPECT_EQ(again.status, 2) << name;
+    // finished: nothing to resume, so no --resume advice (a new run with other keys would fail it)
+    EXPECT_TRUE(contains(again.err, "already holds a finished " + name + " (complete.json)")) << again.err;
+    EXPECT_FALSE(contains(again.err, "--resume")) << again.err;
+    fs::remove(dir / "complete.json");  // as an interrupted run leaves it
+    again = run(with(args, {"--out", dir.string()}));
+    EXPECT_EQ(again.status, 2) << name;
     EXPECT_TRUE(contains(again.err, "already holds a " + name + ": add --resume")) << again.err;
 
     fs::remove(dir / (name + ".csv"));

@@ -76,9 +76,15 @@ void PointFiles::write(long index, json record) const {
 
 std::map<long, json> PointFiles::start(bool resume, long count) const {
   if (!resume) {
-    if (fs::exists(settings_path()) || fs::exists(dir_ / points_directory(command_)))
+    if (fs::exists(settings_path()) || fs::exists(dir_ / points_directory(command_))) {
+      // A finished run (its complete.json, output_directory.hpp) has nothing to resume: a new
+      // run, with other keys say, needs a directory of its own.
+      if (fs::exists(dir_ / OutputDirectory::marker_name))
+        throw BadInput("`--out " + dir_.string() + "` already holds a finished " + command_ +
+                       " (complete.json): choose another directory for this one");
       throw BadInput("`--out " + dir_.string() + "` already holds a " + command_ +
                      ": add --resume to complete it, or choose another directory");
+    }
     write_output(inv_, settings_path(), settings_.dump(2) + "\n");
     return {};
   }
