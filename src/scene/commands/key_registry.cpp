@@ -74,7 +74,11 @@ const KeyIndex& key_index() {
   return index;
 }
 
-const std::map<std::string, std::string>& key_meanings() {
+namespace {
+
+// The one-line meaning of each key, in two tables for length: the problem and the analyses of
+// one orbit, then the grids, continuation and the commands that run others.
+const std::map<std::string, std::string>& problem_and_analysis_meanings() {
   static const std::map<std::string, std::string> meanings = {
       // the problem (problem.cpp)
       {"model", "the system: impact, linear, mathieu, mackey-glass, milling, equations (the scene's [equations])"},
@@ -163,6 +167,12 @@ const std::map<std::string, std::string>& key_meanings() {
       {"sample_every", "grid points between trajectory samples"},
       {"control_on_at", "impact: k = 0 before this time, the given k from it on (paper Fig. 6.3)"},
       {"events_before_control", "events mode before control_on_at (default: = events)"},
+  };
+  return meanings;
+}
+
+const std::map<std::string, std::string>& grid_and_continuation_meanings() {
+  static const std::map<std::string, std::string> meanings = {
       // chart, basin (command_chart.cpp, command_basin.cpp, parameter_grid.cpp)
       {"chart_x", "chart: parameter on the x axis (a numeric model key)"},
       {"chart_y", "chart: parameter on the y axis"},
@@ -197,6 +207,17 @@ const std::map<std::string, std::string>& key_meanings() {
       {"analyses", "run: the analyses (command names) to run, in order (default: the command reading every key)"},
       {"title", "run: a title for the manifest"},
   };
+  return meanings;
+}
+
+}  // namespace
+
+const std::map<std::string, std::string>& key_meanings() {
+  static const std::map<std::string, std::string> meanings = [] {
+    std::map<std::string, std::string> all = problem_and_analysis_meanings();
+    all.insert(grid_and_continuation_meanings().begin(), grid_and_continuation_meanings().end());
+    return all;
+  }();
   return meanings;
 }
 
