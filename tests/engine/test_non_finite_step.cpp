@@ -10,6 +10,7 @@
 #include <string>
 
 #include "delayspec/model_analyses.hpp"
+#include "delayspec/model_analyses_continuation.hpp"
 
 namespace {
 

@@ -1,0 +1,44 @@
+#pragma once
+// ModelAnalysesFor's continuation (model_analyses.hpp), defined apart from the other analyses:
+// included where it is instantiated, src/engine/analyses_continuation.cpp for the built-in models
+// and the object compiled from a scene's equations (equation_plugin.cpp), never into the unit of
+// the stepper's analyses, whose inlining it would share.
+#include <functional>
+#include <memory>
+#include <stdexcept>
+
+#include "delayspec/continuation.hpp"
+#include "delayspec/model_analyses.hpp"
+
+namespace delayspec {
+
+namespace detail {
+// The family `at` as continuation takes it: p -> the Model at p.
+template <class Model>
+std::function<Model(double)> model_at(const AnalysesAt& at) {
+  return [at](double p) {
+    const std::shared_ptr<const ModelAnalyses> analyses = at(p);
+    const auto* typed = dynamic_cast<const ModelAnalysesFor<Model>*>(analyses.get());
+    if (!typed) throw std::logic_error("continuation: the model at another parameter is of another type");
+    return typed->model();
+  };
+}
+}  // namespace detail
+
+template <class Model>
+ContinuationResult ModelAnalysesFor<Model>::continue_orbit(const AnalysesAt& at, const OrbitSettings& settings,
+                                                           const ContinuationOptions& options) const {
+  const StroboscopicMap<Model> map(TrapezoidStepper<Model>(model_, options.step_options),
+                                   make_grid(model_.tau(), model_.period(), options.N, options.periods_per_map));
+  const PeriodicOrbit orbit = find_orbit(model_, map, settings);
+  const Eigen::VectorXd guess = PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
+  return delayspec::continue_orbit<Model>(detail::model_at<Model>(at), guess, options);
+}
+
+template <class Model>
+ContinuationResult ModelAnalysesFor<Model>::continue_period_doubled(const AnalysesAt& at, const Bifurcation& at_pd,
+                                                                    const ContinuationOptions& options) const {
+  return delayspec::continue_period_doubled<Model>(detail::model_at<Model>(at), at_pd, options);
+}
+
+}  // namespace delayspec
