@@ -242,9 +242,9 @@ ContinuationResult continue_period_doubled(const ModelAt& model_at, const Bifurc
   const Model model = model_at(at.parameter);
   const StepOptions& so = options.step_options;
   const Map map1(TrapezoidStepper<Model>(model, so),
-                 make_grid(model.tau(), model.period(), options.N, options.periods_per_map));
+                 make_grid(delays_of(model), model.period(), options.N, options.periods_per_map));
   const Map map2(TrapezoidStepper<Model>(model, so),
-                 make_grid(model.tau(), model.period(), options.N, 2 * options.periods_per_map));
+                 make_grid(delays_of(model), model.period(), options.N, 2 * options.periods_per_map));
   const PeriodicOrbitProblem<Map> problem1(map1);
   if (at.orbit.size() != problem1.unknowns())
     throw BadInput("continue_period_doubled: the orbit has " + std::to_string(at.orbit.size()) + " entries, expected " +

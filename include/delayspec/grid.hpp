@@ -16,6 +16,7 @@
 // and at its end (1 - theta) u_{m-1} + theta u_m (the terms with theta = 0 are absent):
 // HistoryGrid::delay_tap, the one statement of this rule.
 #include <string>
+#include <vector>
 
 namespace delayspec {
 
@@ -56,13 +57,56 @@ struct HistoryGrid {
   template <class V, class Slot>
   DelayTap<V> delay_tap(long l, const Slot& b) const {
     const long j = delayed_slot(l);
-    // l mod K_1 without a division where l < K_1 (every step of a one-period map): a 64-bit
-    // idiv sat at the head of the step's dependency chain (t -> forcing -> S -> ...)
-    const double t = static_cast<double>(l < steps_per_period ? l : l % steps_per_period) * h;
+    const double t = time_in_period(l);
     if (theta == 0) return {V(b(j)), V(b(j + 1)), t};
     const double c0 = 1 - theta;
     return {V(c0 * b(j) + theta * b(j - 1)), V(c0 * b(j + 1) + theta * b(j)), t};
   }
+  // The start of step l within the forcing period, (l mod K_1) h. l mod K_1 without a division
+  // where l < K_1 (every step of a one-period map): a 64-bit idiv sat at the head of the step's
+  // dependency chain (t -> forcing -> S -> ...)
+  double time_in_period(long l) const {
+    return static_cast<double>(l < steps_per_period ? l : l % steps_per_period) * h;
+  }
+
+  // Several delays (model.hpp): `delays` holds each delay's position, tau_i = (m_i + theta_i) h,
+  // in the model's order; the longest is the grid's own tau, m, theta. Empty for one delay.
+  struct DelayPosition {
+    double tau = 0;
+    int m = 0;
+    double theta = 0;
+  };
+  std::vector<DelayPosition> delays;
+
+  // The taps of a state of dimension D: delay_tap for a model with one delay (W = Vec<D>);
+  // with several, W = Vec<D n> stacks each delay's delay_tap, delay i in rows i D .. i D + D - 1,
+  // by the same formula with its own m_i and theta_i.
+  template <int D, class W, class Slot>
+  DelayTap<W> delay_taps(long l, const Slot& b) const {
+    if constexpr (W::RowsAtCompileTime == D) {
+      return delay_tap<W>(l, b);
+    } else {
+      DelayTap<W> tap;
+      tap.t = time_in_period(l);
+      for (size_t i = 0; i < delays.size(); ++i) {
+        const long j = M + l - delays[i].m;
+        const double th = delays[i].theta, c0 = 1 - th;
+        const long row = static_cast<long>(i) * D;
+        if (th == 0) {
+          tap.w0.template segment<D>(row) = b(j);
+          tap.w1.template segment<D>(row) = b(j + 1);
+        } else {
+          tap.w0.template segment<D>(row) = c0 * b(j) + th * b(j - 1);
+          tap.w1.template segment<D>(row) = c0 * b(j + 1) + th * b(j);
+        }
+      }
+      return tap;
+    }
+  }
+
+  // The values of the delays: {tau} for one, else each of `delays`.
+  std::vector<double> delay_values() const;
+
   // Dimension of the history vector for state dimension d.
   long dimension(int d) const { return static_cast<long>(d) * (M + 1); }
   std::string describe() const;
@@ -72,5 +116,11 @@ struct HistoryGrid {
 // (N < 1, non-positive or non-finite times, a rational ratio with incompatible N, a delay
 // shorter than one step).
 HistoryGrid make_grid(double tau, double period, int N, int periods_per_map = 1);
+
+// Several delays (taus in the model's order; one entry is make_grid above): N steps per the
+// longest, laid as make_grid lays it, each other delay at its (m_i, theta_i). Throws BadInput
+// naming the delay (by its place, "delay 2 of 3") when it is not positive and finite or shorter
+// than one step.
+HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map = 1);
 
 }  // namespace delayspec

@@ -150,7 +150,9 @@ template <class Model, class Stepper>
 LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, const Eigen::VectorXd& U0,
                                   const LyapunovOptions& options) {
   constexpr int D = Model::d;
+  constexpr int DW = delayed_rows<Model>;  // D, or D n with n delays (model.hpp)
   using V = Vec<D>;
+  using W = DelayedVec<Model>;
   const HistoryGrid& grid = map.grid();
   const long n = map.dimension();
   validate_lyapunov_options(options, n);
@@ -200,13 +202,16 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
     double* const b = block.data();
     auto slot = [u](long i) -> const V& { return u[i]; };
     for (long l = 0; l < K; ++l) {
-      const DelayTap<V> tap = g.delay_tap<V>(l, slot);
-      StepLinearisation<D> step_linearisation;  // a local: kept in registers where the step inlines
+      const DelayTap<W> tap = g.template delay_taps<D, W>(l, slot);
+      StepLinearisation<D, DW> step_linearisation;  // a local: kept in registers where the step inlines
       u[M + l + 1] = stepper.step(tap.t, g.h, u[M + l], tap.w0, tap.w1, step_linearisation);
       // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same
       // tap), P, Q, R not formed where the step is one sub-step (apply_step_linearisation)
-      apply_step_linearisation<D, KC>(step_linearisation, b + (M + l) * stride, b + g.delayed_slot(l) * stride, k,
-                                      g.theta, b + (M + l + 1) * stride);
+      if constexpr (DW != D)
+        multi_delay_step<D, DW>(step_linearisation, b, M + l, g.delays, k, b + (M + l + 1) * stride);
+      else
+        apply_step_linearisation<D, KC>(step_linearisation, b + (M + l) * stride, b + g.delayed_slot(l) * stride, k,
+                                        g.theta, b + (M + l + 1) * stride);
       if (record && section_count < options.section_points && (l + 1) % spp == 0)  // (no division unless recording)
         result.section.row(section_count++) = u[M + l + 1].transpose();
     }

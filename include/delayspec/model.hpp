@@ -39,7 +39,18 @@
 // switches (time_switch_step.hpp); with events = off it is the plain grid trapezoid, each node
 // evaluated in the branch of its own time (first order across a jump). Such a model has no
 // state switching (has_switching = false): the two kinds are not combined.
+//
+// Several delays. A model with n > 1 discrete delays declares
+//   static constexpr int delay_count = n;
+//   std::array<double, n> delays() const;    // tau_1 .. tau_n, each > 0 (any order)
+// and tau() returns the longest (the history's length: N steps per the longest delay). Its
+// delayed argument is then the n delayed states stacked, Vec<d n> (rows i d .. i d + d - 1 hold
+// y(t - tau_{i+1})), and B = df / d(that stack) is d x d n (DelayedVec, DelayedMat). A model
+// without delay_count has the one delay tau(). Several delays with switching or time switches
+// are not supported (the event steps take one delayed value).
+#include <array>
 #include <concepts>
+#include <vector>
 
 #include "delayspec/types.hpp"
 
@@ -52,6 +63,31 @@ concept TimeSwitchedModel = requires {
   requires Model::has_time_switches;
 };
 
+// The number of delays of Model (1 unless it declares delay_count).
+template <class Model>
+constexpr int delay_count_of() {
+  if constexpr (requires { Model::delay_count; }) return Model::delay_count;
+  else return 1;
+}
+// The rows of a model's delayed argument, and its types (see above).
+template <class Model>
+inline constexpr int delayed_rows = Model::d * delay_count_of<Model>();
+template <class Model>
+using DelayedVec = Vec<delayed_rows<Model>>;
+template <class Model>
+using DelayedMat = RectMat<Model::d, delayed_rows<Model>>;
+
+// The delays of a model, in its order: {tau()} for a model with one delay.
+template <class Model>
+std::vector<double> delays_of(const Model& model) {
+  if constexpr (delay_count_of<Model>() > 1) {
+    const auto taus = model.delays();
+    return std::vector<double>(taus.begin(), taus.end());
+  } else {
+    return {model.tau()};
+  }
+}
+
 // The contract above as a concept, checked where a stepper is made (stepper.hpp): the members
 // every model has, the switching members (H, grad_H, f_t, f_tt) only when has_switching, the
 // time-switch members only when has_time_switches.
@@ -63,11 +99,16 @@ concept DelayModel = requires(const Model& m, const Vec<Model::d>& y, double t, 
   { Model::is_linear } -> std::convertible_to<bool>;
   { m.tau() } -> std::convertible_to<double>;
   { m.period() } -> std::convertible_to<double>;
-  { m.f(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
-  { m.A(j, t, y, y) } -> std::convertible_to<Mat<Model::d>>;
-  { m.B(j, t, y, y) } -> std::convertible_to<Mat<Model::d>>;
+  { m.f(j, t, y, DelayedVec<Model>()) } -> std::convertible_to<Vec<Model::d>>;
+  { m.A(j, t, y, DelayedVec<Model>()) } -> std::convertible_to<Mat<Model::d>>;
+  { m.B(j, t, y, DelayedVec<Model>()) } -> std::convertible_to<DelayedMat<Model>>;
   { m.initial_state() } -> std::convertible_to<Vec<Model::d>>;
 }
+&&(delay_count_of<Model>() == 1 || requires(const Model& m) {
+     requires delay_count_of<Model>() >= 2;
+     requires !Model::has_switching && !TimeSwitchedModel<Model>;
+     { m.delays() } -> std::convertible_to<std::array<double, delay_count_of<Model>()>>;
+   })
 &&(!Model::has_switching ||
    requires(const Model& m, const Vec<Model::d>& y, double t, int j) {
      { m.H(y) } -> std::convertible_to<double>;

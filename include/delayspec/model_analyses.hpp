@@ -67,9 +67,11 @@ class ModelAnalyses {
   virtual bool switches_in_state() const = 0;  // H(y) with events (has_switching)
   virtual bool switches_in_time() const = 0;   // cutting windows (has_time_switches)
   virtual bool is_linear() const = 0;          // the monodromy does not depend on the orbit
-  virtual double tau() const = 0;
+  virtual double tau() const = 0;  // the longest delay
+  // Every delay, in the model's order ({tau()} for one delay; model.hpp).
+  virtual std::vector<double> delays() const = 0;
   virtual double period() const = 0;
-  HistoryGrid grid(const MapSettings& s) const { return make_grid(tau(), period(), s.N, s.orbit_period); }
+  HistoryGrid grid(const MapSettings& s) const { return make_grid(delays(), period(), s.N, s.orbit_period); }
 
   // The periodic orbit (orbit_search.hpp; the zero orbit of a linear model) and its monodromy.
   virtual LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
@@ -106,6 +108,7 @@ template <class Model>
 class ModelAnalysesFor final : public ModelAnalyses {
  public:
   static constexpr int D = Model::d;
+  static constexpr int DW = delayed_rows<Model>;  // D, or D n with n delays (model.hpp)
   explicit ModelAnalysesFor(Model model) : model_(std::move(model)) {}
   const Model& model() const { return model_; }
 
@@ -114,6 +117,7 @@ class ModelAnalysesFor final : public ModelAnalyses {
   bool switches_in_time() const override { return TimeSwitchedModel<Model>; }
   bool is_linear() const override { return Model::is_linear; }
   double tau() const override { return model_.tau(); }
+  std::vector<double> delays() const override { return delays_of(model_); }
   double period() const override { return model_.period(); }
 
   LinearisedOrbit linearised_orbit(const MapSettings& s, const OrbitSettings& settings,
@@ -121,7 +125,7 @@ class ModelAnalysesFor final : public ModelAnalyses {
     const StroboscopicMap<Model> map = make_map(s);
     const long K = map.grid().K;
     LinearisedOrbit out;
-    OrbitLinearisation<D> at_orbit;  // step maps and states of one map at the orbit
+    OrbitLinearisation<D, DW> at_orbit;  // step maps and states of one map at the orbit
     if (request.newton_guess && !Model::is_linear) {
       const Eigen::VectorXd guess = prolong_periodic_sequence(*request.newton_guess, D, K);
       out.orbit = orbit_by_newton(map, guess, settings.newton);
@@ -137,7 +141,7 @@ class ModelAnalysesFor final : public ModelAnalyses {
     // no eigensolver can use: say at which step, once here (a pass over K small matrices).
     if (!all_finite(at_orbit)) map.throw_first_non_finite_step(out.orbit.history, 1, "the map at the periodic orbit");
     out.contacts = orbit_contacts(model_, std::move(at_orbit.states));
-    out.monodromy = std::make_unique<Monodromy<D>>(map.grid(), std::move(at_orbit.maps));
+    out.monodromy = std::make_unique<Monodromy<D, DW>>(map.grid(), std::move(at_orbit.maps));
     return out;
   }
 
@@ -195,8 +199,8 @@ class ModelAnalysesFor final : public ModelAnalyses {
                                              const ContinuationOptions& options) const override;
 
  private:
-  static bool all_finite(const OrbitLinearisation<D>& at) {
-    for (const StepMap<D>& m : at.maps)
+  static bool all_finite(const OrbitLinearisation<D, DW>& at) {
+    for (const StepMap<D, DW>& m : at.maps)
       if (!m.P.allFinite() || !m.Q.allFinite() || !m.R.allFinite()) return false;
     for (const Vec<D>& y : at.states)
       if (!y.allFinite()) return false;

@@ -24,6 +24,9 @@
 // Thread safety: the work buffers are owned by the operator (no allocation per application),
 // so one Monodromy must not be applied from two threads at once. Copy it instead.
 //
+// Several delays (model.hpp): DW = D n rows of delayed values, D x DW blocks Q and R; the steps
+// run through block_kernel.hpp's multi_delay_steps on the linear layout (portable code).
+//
 // A LinearOperator (linear_operator.hpp): the eigensolvers take it for any d. The bodies are
 // here, so a model of any d instantiates them; d = 1 and 2 are compiled once in the library.
 #include <algorithm>
@@ -43,21 +46,21 @@
 
 namespace delayspec {
 
-template <int D>
+template <int D, int DW = D>
 class Monodromy final : public LinearOperator {
  public:
   using Scalar = double;
 
   // maps.size() must equal grid.K (BadInput otherwise).
-  Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps);
+  Monodromy(const HistoryGrid& grid, std::vector<StepMap<D, DW>> maps);
 
   Eigen::Index rows() const override { return n_; }
   Eigen::Index cols() const { return n_; }
   const HistoryGrid& grid() const { return grid_; }
-  const std::vector<StepMap<D>>& step_maps() const { return maps_; }
+  const std::vector<StepMap<D, DW>>& step_maps() const { return maps_; }
   // Hands the step maps back (the operator is empty afterwards): a caller that evaluates the map
   // again, as Newton does, refills the same storage instead of allocating and faulting it in anew.
-  std::vector<StepMap<D>> take_step_maps() && { return std::move(maps_); }
+  std::vector<StepMap<D, DW>> take_step_maps() && { return std::move(maps_); }
 
   // y = M x. Checks sizes (BadInput naming both) then calls the unchecked kernel.
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
@@ -77,7 +80,8 @@ class Monodromy final : public LinearOperator {
 
   // The widest path compiled in the library for D: the AVX-512 kernel is d = 2's streaming one,
   // AVX2 + FMA code exists for D = 1, 2; another D (compiled outside the library) is portable.
-  static constexpr KernelPath kWidestPath = D == 2   ? KernelPath::avx512
+  static constexpr KernelPath kWidestPath = DW != D   ? KernelPath::baseline
+                                            : D == 2 ? KernelPath::avx512
                                             : D == 1 ? KernelPath::avx2
                                                      : KernelPath::baseline;
   static constexpr bool kHasAvx2Kernel = kWidestPath != KernelPath::baseline;
@@ -103,7 +107,7 @@ class Monodromy final : public LinearOperator {
   void from_slots(const double* b, long rows, long k, double* Y, long ldy) const;
 
   HistoryGrid grid_;
-  std::vector<StepMap<D>> maps_;
+  std::vector<StepMap<D, DW>> maps_;
   Eigen::Index n_ = 0;
   mutable std::vector<double> work_;        // (M + 1 + K) d, single vector
   mutable std::vector<double> block_work_;  // (M + 1 + K) d k, interleaved
@@ -112,8 +116,8 @@ class Monodromy final : public LinearOperator {
   KernelPath path_ = KernelPath::baseline;
 };
 
-template <int D>
-Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
+template <int D, int DW>
+Monodromy<D, DW>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D, DW>> maps)
     : grid_(grid), maps_(std::move(maps)), n_(grid.dimension(D)), path_(choose_kernel_path(kWidestPath)) {
   if (static_cast<long>(maps_.size()) != grid_.K)
     throw BadInput("Monodromy: " + std::to_string(maps_.size()) +
@@ -121,21 +125,22 @@ Monodromy<D>::Monodromy(const HistoryGrid& grid, std::vector<StepMap<D>> maps)
   work_.assign(static_cast<size_t>(grid_.M + 1 + grid_.K) * D, 0.0);
 }
 
-template <int D>
-void Monodromy<D>::perform_op(const double* x, double* y) const {
+template <int D, int DW>
+void Monodromy<D, DW>::perform_op(const double* x, double* y) const {
   throw_if_cancelled();  // one application = one period: the front end may stop here
   const long M = grid_.M, K = grid_.K;
   double* b = work_.data();
   std::copy(x, x + n_, b);
   // b[M+l+1] = P b[M+l] + Q y_tau(t) + R y_tau(t+h), the tap of grid.delay_tap (block_kernel.hpp).
   // Portable code on every path: latency-bound (block_kernel_avx2.cpp).
-  single_steps<D>(maps_.data(), K, M, grid_.delayed_slot(0), grid_.theta, b);
+  if constexpr (DW != D) multi_delay_steps<D, DW>(maps_.data(), K, M, grid_.delays, b, 1);
+  else single_steps<D>(maps_.data(), K, M, grid_.delayed_slot(0), grid_.theta, b);
   std::copy(b + K * D, b + K * D + n_, y);
   ++applications_;
 }
 
-template <int D>
-void Monodromy<D>::run_block_steps(long l0, long count, double* u, const double* delayed, long k) const {
+template <int D, int DW>
+void Monodromy<D, DW>::run_block_steps(long l0, long count, double* u, const double* delayed, long k) const {
   if constexpr (kHasAvx2Kernel) {
     if (runs_avx2_code(path_)) {
       detail::block_steps_avx2(maps_.data() + l0, count, u, delayed, grid_.theta, k);
@@ -145,8 +150,8 @@ void Monodromy<D>::run_block_steps(long l0, long count, double* u, const double*
   block_steps<D>(maps_.data() + l0, count, u, delayed, grid_.theta, k);
 }
 
-template <int D>
-void Monodromy<D>::to_slots(const double* X, long ldx, long rows, long k, double* b) const {
+template <int D, int DW>
+void Monodromy<D, DW>::to_slots(const double* X, long ldx, long rows, long k, double* b) const {
   if constexpr (kHasAvx2Kernel) {
     if (runs_avx2_code(path_)) {
       detail::transpose_avx2(X, ldx, k, rows, b, k);
@@ -156,8 +161,8 @@ void Monodromy<D>::to_slots(const double* X, long ldx, long rows, long k, double
   interleave(X, ldx, rows, k, b);
 }
 
-template <int D>
-void Monodromy<D>::from_slots(const double* b, long rows, long k, double* Y, long ldy) const {
+template <int D, int DW>
+void Monodromy<D, DW>::from_slots(const double* b, long rows, long k, double* Y, long ldy) const {
   if constexpr (kHasAvx2Kernel) {
     if (runs_avx2_code(path_)) {
       detail::transpose_avx2(b, k, rows, k, Y, ldy);
@@ -167,8 +172,8 @@ void Monodromy<D>::from_slots(const double* b, long rows, long k, double* Y, lon
   deinterleave(b, rows, k, Y, ldy);
 }
 
-template <int D>
-void Monodromy<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+template <int D, int DW>
+void Monodromy<D, DW>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   if (x.size() != n_)
     throw BadInput("Monodromy::apply: x has " + std::to_string(x.size()) + " entries, the operator is " +
                    std::to_string(n_) + " x " + std::to_string(n_));
@@ -176,8 +181,8 @@ void Monodromy<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   perform_op(x.data(), y.data());
 }
 
-template <int D>
-void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const {
+template <int D, int DW>
+void Monodromy<D, DW>::apply_block_raw(const double* X, long ldx, long k, double* Y, long ldy) const {
   // One vector: interleaving is a copy, which perform_op makes with its own (smaller) buffer; the
   // AVX2 transposes would move it element by element (measured slower than the baseline path).
   if (k == 1) {
@@ -192,16 +197,21 @@ void Monodromy<D>::apply_block_raw(const double* X, long ldx, long k, double* Y,
   // part of the result (K <= M + 1): the history need not be stored.
   // Streaming writes Y while it still reads X: only when they do not overlap (apply_block(X, X)
   // takes the linear layout, which reads all of X first).
-  const long first_read = grid_.delayed_slot(0) - (grid_.theta == 0 ? 0 : 1);
-  const bool disjoint = std::less<>()(X + (k - 1) * ldx + n_ - 1, Y) || std::less<>()(Y + (k - 1) * ldy + n_ - 1, X);
-  if (disjoint && first_read >= 0 && grid_.delayed_slot(0) + grid_.K <= grid_.M)
-    apply_block_streaming(X, ldx, k, Y, ldy);
-  else apply_block_linear(X, ldx, k, Y, ldy);
+  if constexpr (DW != D) {  // several delays: the linear layout
+    apply_block_linear(X, ldx, k, Y, ldy);
+  } else {
+    const long first_read = grid_.delayed_slot(0) - (grid_.theta == 0 ? 0 : 1);
+    const bool disjoint =
+        std::less<>()(X + (k - 1) * ldx + n_ - 1, Y) || std::less<>()(Y + (k - 1) * ldy + n_ - 1, X);
+    if (disjoint && first_read >= 0 && grid_.delayed_slot(0) + grid_.K <= grid_.M)
+      apply_block_streaming(X, ldx, k, Y, ldy);
+    else apply_block_linear(X, ldx, k, Y, ldy);
+  }
   applications_ += k;
 }
 
-template <int D>
-void Monodromy<D>::apply_block_linear(const double* X, long ldx, long k, double* Y, long ldy) const {
+template <int D, int DW>
+void Monodromy<D, DW>::apply_block_linear(const double* X, long ldx, long k, double* Y, long ldy) const {
   last_layout_ = BlockLayout::linear;
   const long M = grid_.M, K = grid_.K, stride = D * k;
   const size_t need = static_cast<size_t>(M + 1 + K) * stride;
@@ -209,12 +219,13 @@ void Monodromy<D>::apply_block_linear(const double* X, long ldx, long k, double*
   double* b = block_work_.data();
   // b[(j D + r) k + v] = X(j D + r, v); K steps; the result (slots K .. K + M) back into Y
   to_slots(X, ldx, n_, k, b);
-  run_block_steps(0, K, b + M * stride, b + grid_.delayed_slot(0) * stride, k);
+  if constexpr (DW != D) multi_delay_steps<D, DW>(maps_.data(), K, M, grid_.delays, b, k);
+  else run_block_steps(0, K, b + M * stride, b + grid_.delayed_slot(0) * stride, k);
   from_slots(b + K * stride, n_, k, Y, ldy);
 }
 
-template <int D>
-void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, double* Y, long ldy) const {
+template <int D, int DW>
+void Monodromy<D, DW>::apply_block_streaming(const double* X, long ldx, long k, double* Y, long ldy) const {
   // d = 2, k even: the fused kernels read X and write Y themselves (no buffer, no copies;
   // AVX2 4 vectors at a time, portable 2; bench_apply, docs/benchmarks.md: per vector 1.6-2.7x
   // faster than the staged loop below on AVX2 for k = 8..32, 1.05-1.8x portable). Otherwise:
@@ -267,8 +278,8 @@ void Monodromy<D>::apply_block_streaming(const double* X, long ldx, long k, doub
   copy_x_slots();
 }
 
-template <int D>
-void Monodromy<D>::apply_block(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const {
+template <int D, int DW>
+void Monodromy<D, DW>::apply_block(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) const {
   if (X.rows() != n_)
     throw BadInput("Monodromy::apply_block: X has " + std::to_string(X.rows()) + " rows, the operator is " +
                    std::to_string(n_) + " x " + std::to_string(n_));
@@ -277,8 +288,8 @@ void Monodromy<D>::apply_block(const Eigen::MatrixXd& X, Eigen::MatrixXd& Y) con
   apply_block_raw(X.data(), X.rows(), X.cols(), Y.data(), Y.rows());
 }
 
-template <int D>
-Eigen::MatrixXd Monodromy<D>::to_dense() const {
+template <int D, int DW>
+Eigen::MatrixXd Monodromy<D, DW>::to_dense() const {
   Eigen::MatrixXd dense(n_, n_);
   constexpr long kChunk = 32;
   Eigen::MatrixXd I = Eigen::MatrixXd::Zero(n_, kChunk);

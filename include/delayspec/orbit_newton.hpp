@@ -52,7 +52,9 @@ template <class Map>
 class PeriodicOrbitProblem {
  public:
   static constexpr int D = Map::D;
+  static constexpr int DW = Map::DW;  // D, or D n with n delays (model.hpp)
   using V = Vec<D>;
+  using W = Vec<DW>;
 
   explicit PeriodicOrbitProblem(const Map& map) : map_(map), grid_(map.grid()) {}
 
@@ -62,26 +64,33 @@ class PeriodicOrbitProblem {
   // F(x); when jacobian is non-null it receives dF/dx (unknowns() x unknowns(), compressed).
   Eigen::VectorXd residual(const Eigen::VectorXd& x, Eigen::SparseMatrix<double>* jacobian = nullptr) const {
     check_size(x);
-    const long K = grid_.K, m = grid_.m, M = grid_.M;
-    const double theta = grid_.theta, c0 = 1 - theta;
+    const long K = grid_.K, M = grid_.M;
     auto u = [&](long l) { return x.segment<D>(D * wrap(l)); };
     auto slot = [&](long i) { return u(i - M); };  // delay_tap's numbering: slot M + l = u_l
+    // Each delay's position (m_i, theta_i) and its column block of Q and R: one, or grid.delays.
+    std::vector<HistoryGrid::DelayPosition> taps = grid_.delays;
+    if (taps.empty()) taps.push_back({grid_.tau, grid_.m, grid_.theta});
     Eigen::VectorXd F(unknowns());
     std::vector<Eigen::Triplet<double>> triplets;
-    if (jacobian) triplets.reserve(static_cast<size_t>(K) * D * D * (theta == 0 ? 4 : 6) + K * D);
-    StepMap<D> map;
+    if (jacobian) triplets.reserve(static_cast<size_t>(K) * D * D * (1 + 6 * taps.size()) + K * D);
+    StepMap<D, DW> map;
     for (long l = 0; l < K; ++l) {
-      const DelayTap<V> tap = grid_.delay_tap<V>(l, slot);
+      const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
       const V next = map_.stepper().step(tap.t, grid_.h, V(u(l)), tap.w0, tap.w1, map);
       F.segment<D>(D * l) = u(l + 1) - next;  // F_l = u_{l+1} - S_l(u_l, w0_l, w1_l)
-      if (jacobian) {
-        add_block(triplets, l, l + 1, Mat<D>::Identity());
-        add_block(triplets, l, l, -map.P);
-        add_block(triplets, l, l - m, -c0 * map.Q);
-        add_block(triplets, l, l - m + 1, -c0 * map.R);
+      if (!jacobian) continue;
+      add_block(triplets, l, l + 1, Mat<D>::Identity());
+      add_block(triplets, l, l, -map.P);
+      for (size_t i = 0; i < taps.size(); ++i) {  // w0_i = (1 - theta_i) u_{l-m_i} + theta_i u_{l-m_i-1}, w1_i one later
+        const long m = taps[i].m;
+        const double theta = taps[i].theta, c0 = 1 - theta;
+        const Mat<D> Q = map.Q.template middleCols<D>(static_cast<long>(i) * D);
+        const Mat<D> R = map.R.template middleCols<D>(static_cast<long>(i) * D);
+        add_block(triplets, l, l - m, -c0 * Q);
+        add_block(triplets, l, l - m + 1, -c0 * R);
         if (theta != 0) {
-          add_block(triplets, l, l - m - 1, -theta * map.Q);
-          add_block(triplets, l, l - m, -theta * map.R);
+          add_block(triplets, l, l - m - 1, -theta * Q);
+          add_block(triplets, l, l - m, -theta * R);
         }
       }
     }

@@ -50,7 +50,7 @@ struct OrbitSettings {
 // the orbit), from the orbit search's own last evaluation where it has one.
 template <class Model, class Map>
 PeriodicOrbit find_orbit(const Model& model, const Map& map, const OrbitSettings& settings,
-                         OrbitLinearisation<Model::d>* at_orbit = nullptr) {
+                         OrbitLinearisation<Model::d, delayed_rows<Model>>* at_orbit = nullptr) {
   auto linearise = [&](PeriodicOrbit orbit) {
     if (at_orbit) map.apply(orbit.history, &at_orbit->maps, &at_orbit->states);
     return orbit;

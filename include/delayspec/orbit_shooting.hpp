@@ -59,9 +59,9 @@ struct OrbitByShootingOptions {
 
 // What the last map evaluation of a solve saw: the step maps (the monodromy at the orbit) and
 // the K + 1 states u_0 at t = 0, h, ..., K h.
-template <int D>
+template <int D, int DW = D>
 struct OrbitLinearisation {
-  std::vector<StepMap<D>> maps;
+  std::vector<StepMap<D, DW>> maps;
   std::vector<Vec<D>> states;
 };
 
@@ -69,7 +69,7 @@ struct OrbitLinearisation {
 // and states of the map at the returned history.
 template <class Map>
 PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitByShootingOptions& opt,
-                                OrbitLinearisation<Map::D>* at_orbit = nullptr) {
+                                OrbitLinearisation<Map::D, Map::DW>* at_orbit = nullptr) {
   constexpr int D = Map::D;
   if (!(opt.tolerance > 0) || !std::isfinite(opt.tolerance))
     throw BadInput("`orbit_tolerance = " + format_number(opt.tolerance) + "`: must be > 0 and finite");
@@ -84,7 +84,7 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
 
   PeriodicOrbit orbit;
   orbit.method = OrbitFoundBy::shooting;
-  OrbitLinearisation<D> lin;
+  OrbitLinearisation<D, Map::DW> lin;
   // G = P(X) - X with the step maps and states of this evaluation in `lin`; false when the
   // stepper cannot step from X or the result is not finite.
   auto evaluate = [&](const Eigen::VectorXd& X, Eigen::VectorXd& G) {
@@ -122,7 +122,7 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
     eta = std::max(eta, 1e-13);                   // GMRES' own rounding floor
     // (M - I) s = -G with M the monodromy at U (the step maps of the evaluation of G); the maps'
     // storage goes back to `lin` for the next evaluation, the Krylov basis stays in `basis`.
-    Monodromy<D> monodromy(map.grid(), std::move(lin.maps));
+    Monodromy<D, Map::DW> monodromy(map.grid(), std::move(lin.maps));
     const GmresResult step = gmres(
         [&](const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::VectorXd& y) {
           monodromy.perform_op(x.data(), y.data());
@@ -187,14 +187,14 @@ std::vector<int> shooting_levels(const HistoryGrid& grid, int coarse_N, int refi
 template <class Model, class Stepper>
 PeriodicOrbit orbit_by_nested_shooting(const StroboscopicMap<Model, Stepper>& map, const Vec<Model::d>& y0,
                                        const NestedShootingOptions& opt,
-                                       OrbitLinearisation<Model::d>* at_orbit = nullptr) {
+                                       OrbitLinearisation<Model::d, delayed_rows<Model>>* at_orbit = nullptr) {
   using Map = StroboscopicMap<Model, Stepper>;
   if (opt.guess_periods < 0)
     throw BadInput("`orbit_guess_periods = " + std::to_string(opt.guess_periods) + "`: must be >= 0");
   const HistoryGrid& fine = map.grid();
   const std::vector<int> Ns = shooting_levels(fine, opt.coarse_N, opt.refinement);
   auto level_map = [&](int N) {
-    return N == fine.N ? map : Map(map.stepper(), make_grid(fine.tau, fine.period, N, fine.periods_per_map));
+    return N == fine.N ? map : Map(map.stepper(), make_grid(fine.delay_values(), fine.period, N, fine.periods_per_map));
   };
   auto clock = [] { return std::chrono::steady_clock::now(); };
   auto since = [](auto t0) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };

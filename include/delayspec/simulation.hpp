@@ -90,12 +90,12 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
     if constexpr (Model::has_switching) rec.max_H = std::max(rec.max_H, before.model().H(y));
   };
   record_point(0, slot(M));
-  StepMap<D> scratch;
+  StepMap<D, delayed_rows<Model>> scratch;
   StepEvents events;
   for (long l = 0; l < steps; ++l) {
     // Between periods a front end may stop the run (cancellation.hpp).
     if (l % grid.steps_per_period == 0) throw_if_cancelled();
-    const DelayTap<V> tap = grid.delay_tap<V>(l, slot);  // tap.t: the time in the period, as StroboscopicMap
+    const DelayTap<DelayedVec<Model>> tap = grid.template delay_taps<D, DelayedVec<Model>>(l, slot);  // tap.t: the time in the period, as StroboscopicMap
     const double t_abs = static_cast<double>(l) * h;
     const TrapezoidStepper<Model>& stepper = t_abs >= options.switch_time ? after : before;
     const V u = slot(M + l);

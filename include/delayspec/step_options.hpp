@@ -43,12 +43,12 @@ struct StepEvents {
 // (found together with z1: the plain, unsplit trapezoid rule).
 inline constexpr int kRegionOfEndpoint = 0;
 
-template <int D>
+template <int D, int DW = D>
 struct SubStepResult {
   Vec<D> z1;
-  Mat<D> dz0;  // dz1 / dz0
-  Mat<D> dw0;  // dz1 / dw0 (delayed value at the left node)
-  Mat<D> dw1;  // dz1 / dw1 (delayed value at the right node)
+  Mat<D> dz0;          // dz1 / dz0
+  RectMat<D, DW> dw0;  // dz1 / dw0 (delayed value at the left node)
+  RectMat<D, DW> dw1;  // dz1 / dw1 (delayed value at the right node)
   int right_region = 1;
 };
 

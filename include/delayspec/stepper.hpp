@@ -30,9 +30,11 @@
 namespace delayspec {
 
 // (t, y, y(t - tau)) as a NonFiniteStep reports it (errors.hpp).
-template <int D>
-ModelPoint model_point(double t, const Vec<D>& y, const Vec<D>& y_tau) {
-  return ModelPoint{t, std::vector<double>(y.data(), y.data() + D), std::vector<double>(y_tau.data(), y_tau.data() + D)};
+// With several delays y_tau is their stack (model.hpp), DW rows.
+template <int D, int DW = D>
+ModelPoint model_point(double t, const Vec<D>& y, const Vec<DW>& y_tau) {
+  return ModelPoint{t, std::vector<double>(y.data(), y.data() + D),
+                    std::vector<double>(y_tau.data(), y_tau.data() + DW)};
 }
 
 template <class Model>
@@ -41,7 +43,9 @@ class TrapezoidStepper {
 
  public:
   static constexpr int D = Model::d;
+  static constexpr int DW = delayed_rows<Model>;  // D, or D n with n delays (model.hpp)
   using V = Vec<D>;
+  using W = DelayedVec<Model>;  // the delayed argument
   using M = Mat<D>;
 
   // BadInput when options.contact_substeps < 1.
@@ -55,10 +59,10 @@ class TrapezoidStepper {
   // Throws NumericalFailure if the implicit equation cannot be solved. Always inlined, as the
   // solve inside it: for D <= 2 the whole step is ~100 flops, and a call returning the result
   // through memory cost the scalar Lyapunov step 4 of its 8 ns (bench_lyapunov).
-  [[gnu::always_inline]] inline SubStepResult<D> sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1,
+  [[gnu::always_inline]] inline SubStepResult<D, DW> sub_step(double t0, double dt, const V& z0, const W& w0, const W& w1,
                                                           int left_region, int right_region) const {
-    SubStepResult<D> r;
-    detail::SubStepDerivative<D> derivative;
+    SubStepResult<D, DW> r;
+    detail::SubStepDerivative<D, DW> derivative;
     r.z1 = factored_sub_step(t0, dt, z0, w0, w1, left_region, right_region, derivative, r.right_region);
     r.dz0 = derivative.dz0();
     r.dw0 = derivative.dw0();
@@ -69,9 +73,9 @@ class TrapezoidStepper {
   // The same sub-step with its derivative in factored form (sub_step_derivative.hpp: S^{-1}
   // and the three right-hand matrices, no product formed); right_region_out receives the right
   // node's region. Returns z1.
-  [[gnu::always_inline]] inline V factored_sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1,
+  [[gnu::always_inline]] inline V factored_sub_step(double t0, double dt, const V& z0, const W& w0, const W& w1,
                                                     int left_region, int right_region,
-                                                    detail::SubStepDerivative<D>& derivative,
+                                                    detail::SubStepDerivative<D, DW>& derivative,
                                                     int& right_region_out) const {
     const double t1 = t0 + dt;
     const V z1 = solve_sub_step(t0, dt, z0, w0, w1, left_region, right_region, right_region_out, derivative.s);
@@ -84,7 +88,7 @@ class TrapezoidStepper {
   }
 
   // z1 of the same sub-step without its derivatives (event location evaluates many of these).
-  V sub_step_state(double t0, double dt, const V& z0, const V& w0, const V& w1, int left_region,
+  V sub_step_state(double t0, double dt, const V& z0, const W& w0, const W& w1, int left_region,
                    int right_region) const {
     int jr;
     detail::SmallSolve<D> lu;
@@ -97,9 +101,9 @@ class TrapezoidStepper {
   // when given, receives them; otherwise (events off, or no switching) it is the plain
   // trapezoid, each node in the region of its own state.
   // Always inlined (a dispatch; the event and time-switch steps stay calls): see sub_step.
-  [[gnu::always_inline]] inline V step(double t, double h, const V& u0, const V& w0, const V& w1, StepMap<D>& map,
+  [[gnu::always_inline]] inline V step(double t, double h, const V& u0, const W& w0, const W& w1, StepMap<D, DW>& map,
                                        StepEvents* events = nullptr) const {
-    StepLinearisation<D> linearisation;
+    StepLinearisation<D, DW> linearisation;
     const V u1 = step(t, h, u0, w0, w1, linearisation, events);
     map = linearisation.formed();
     return u1;
@@ -108,8 +112,8 @@ class TrapezoidStepper {
   // The same step with its derivative as a StepLinearisation (step_map.hpp): factored when the
   // step is one sub-step (no event or time switch inside it), for a caller that applies it once
   // to a few tangent vectors (the Lyapunov loop) and need not form P, Q, R.
-  [[gnu::always_inline]] inline V step(double t, double h, const V& u0, const V& w0, const V& w1,
-                                       StepLinearisation<D>& linearisation, StepEvents* events = nullptr) const {
+  [[gnu::always_inline]] inline V step(double t, double h, const V& u0, const W& w0, const W& w1,
+                                       StepLinearisation<D, DW>& linearisation, StepEvents* events = nullptr) const {
     if constexpr (Model::has_switching) {
       if (options_.events != EventMode::off) return event_step(*this, t, h, u0, w0, w1, linearisation, events);
     }
@@ -123,15 +127,15 @@ class TrapezoidStepper {
 
   // The plain (unsplit) trapezoid step, whatever the options: each node in its own region (the
   // region of its state, or for time switches the branch in force at its time).
-  [[gnu::always_inline]] inline V plain_step(double t, double h, const V& u0, const V& w0, const V& w1,
-                                             StepMap<D>& map) const {
-    StepLinearisation<D> linearisation;
+  [[gnu::always_inline]] inline V plain_step(double t, double h, const V& u0, const W& w0, const W& w1,
+                                             StepMap<D, DW>& map) const {
+    StepLinearisation<D, DW> linearisation;
     const V u1 = plain_step(t, h, u0, w0, w1, linearisation);
     map = linearisation.formed();
     return u1;
   }
-  [[gnu::always_inline]] inline V plain_step(double t, double h, const V& u0, const V& w0, const V& w1,
-                                             StepLinearisation<D>& linearisation) const {
+  [[gnu::always_inline]] inline V plain_step(double t, double h, const V& u0, const W& w0, const W& w1,
+                                             StepLinearisation<D, DW>& linearisation) const {
     int left = region_of(model_, u0), right = kRegionOfEndpoint;
     if constexpr (TimeSwitchedModel<Model>) left = model_.time_segment(t), right = model_.time_segment(t + h);
     int right_region;
@@ -152,7 +156,7 @@ class TrapezoidStepper {
   // iterate at which f and A were evaluated, and returns a state that is not finite instead of
   // throwing; the instantiation every step runs does neither.
   template <bool kRecord = false>
-  [[gnu::always_inline]] inline V solve_sub_step(double t0, double dt, const V& z0, const V& w0, const V& w1,
+  [[gnu::always_inline]] inline V solve_sub_step(double t0, double dt, const V& z0, const W& w0, const W& w1,
                                                  int left_region, int right_region, int& jr,
                                                  detail::SmallSolve<D>& lu, V* last_finite = nullptr) const {
     const double t1 = t0 + dt;
@@ -205,8 +209,8 @@ class TrapezoidStepper {
   // the model, the left end and the last finite Newton iterate at the right end (where f or A is
   // not finite, when the model is: the caller may name the term). Newton is run again to find
   // that iterate, so that the steps that succeed keep nothing.
-  [[gnu::noinline, gnu::cold]] void throw_non_finite_sub_step(double t0, double dt, const V& z0, const V& w0,
-                                                             const V& w1, int left_region, int right_region,
+  [[gnu::noinline, gnu::cold]] void throw_non_finite_sub_step(double t0, double dt, const V& z0, const W& w0,
+                                                             const W& w1, int left_region, int right_region,
                                                              int region_changes) const {
     V last_finite = z0;
     int jr = 0;
@@ -215,7 +219,7 @@ class TrapezoidStepper {
     throw NonFiniteStep("trapezoid step at t = " + format_number(t0) + ", dt = " + format_number(dt) +
                             ": the new state is not finite (" + format_number(z[0]) + ", region changes " +
                             std::to_string(region_changes) + ")",
-                        {model_point<D>(t0, z0, w0), model_point<D>(t0 + dt, last_finite, w1)});
+                        {model_point<D, DW>(t0, z0, w0), model_point<D, DW>(t0 + dt, last_finite, w1)});
   }
 
   Model model_;

@@ -23,7 +23,9 @@ template <class Model, class Stepper = TrapezoidStepper<Model>>
 class StroboscopicMap {
  public:
   static constexpr int D = Model::d;
+  static constexpr int DW = delayed_rows<Model>;  // D, or D n with n delays (model.hpp)
   using V = Vec<D>;
+  using W = DelayedVec<Model>;
 
   StroboscopicMap(const Stepper& stepper, const HistoryGrid& grid) : stepper_(stepper), grid_(grid) {}
 
@@ -40,7 +42,7 @@ class StroboscopicMap {
 
   // P(U). When maps is non-null it receives the K step maps (the monodromy at U).
   // When trajectory is non-null it receives the K + 1 states u_0 at t = 0, h, ..., K h.
-  Eigen::VectorXd apply(const Eigen::VectorXd& U, std::vector<StepMap<D>>* maps = nullptr,
+  Eigen::VectorXd apply(const Eigen::VectorXd& U, std::vector<StepMap<D, DW>>* maps = nullptr,
                         std::vector<V>* trajectory = nullptr) const {
     if (U.size() != dimension())
       throw BadInput("StroboscopicMap: history has " + std::to_string(U.size()) + " entries, expected " +
@@ -55,10 +57,10 @@ class StroboscopicMap {
       trajectory->reserve(K + 1);
       trajectory->push_back(b[M]);
     }
-    StepMap<D> scratch;
+    StepMap<D, DW> scratch;
     auto slot = [&b](long i) -> const V& { return b[i]; };
     for (long l = 0; l < K; ++l) {
-      const DelayTap<V> tap = grid_.delay_tap<V>(l, slot);
+      const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
       b[M + l + 1] = stepper_.step(tap.t, grid_.h, b[M + l], tap.w0, tap.w1, maps ? (*maps)[l] : scratch);
       if (trajectory) trajectory->push_back(b[M + l + 1]);
     }
@@ -81,8 +83,8 @@ class StroboscopicMap {
       for (long j = 0; j <= M; ++j) b[j] = U.segment<D>(j * D);
       const std::string which = "map " + std::to_string(m + 1) + ", step ";
       for (long l = 0; l < K; ++l) {
-        const DelayTap<V> tap = grid_.delay_tap<V>(l, slot);
-        StepMap<D> step_map;
+        const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
+        StepMap<D, DW> step_map;
         try {
           b[M + l + 1] = stepper_.step(tap.t, grid_.h, b[M + l], tap.w0, tap.w1, step_map);
         } catch (const NonFiniteStep& e) {
@@ -94,18 +96,18 @@ class StroboscopicMap {
                                   format_number(tap.t) + " to " + format_number(tap.t + grid_.h) + " has a " +
                                   (b[M + l + 1].allFinite() ? "derivative (step map)" : "new state") +
                                   " that is not finite",
-                              {model_point<D>(tap.t, b[M + l], tap.w0),
-                               model_point<D>(tap.t + grid_.h, b[M + l + 1], tap.w1)});
+                              {model_point<D, DW>(tap.t, b[M + l], tap.w0),
+                               model_point<D, DW>(tap.t + grid_.h, b[M + l + 1], tap.w1)});
       }
       for (long j = 0; j <= M; ++j) U.segment<D>(j * D) = b[K + j];
     }
   }
 
   // The monodromy at U (the Jacobian of apply at U).
-  Monodromy<D> monodromy(const Eigen::VectorXd& U) const {
-    std::vector<StepMap<D>> maps;
+  Monodromy<D, DW> monodromy(const Eigen::VectorXd& U) const {
+    std::vector<StepMap<D, DW>> maps;
     apply(U, &maps);
-    return Monodromy<D>(grid_, std::move(maps));
+    return Monodromy<D, DW>(grid_, std::move(maps));
   }
 
  private:

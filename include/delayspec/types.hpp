@@ -9,5 +9,9 @@ template <int D>
 using Vec = Eigen::Matrix<double, D, 1>;
 template <int D>
 using Mat = Eigen::Matrix<double, D, D>;
+// D rows, DW columns: the derivative of a field by the delayed values of a model with several
+// delays (DW = D times their number; model.hpp).
+template <int D, int DW>
+using RectMat = Eigen::Matrix<double, D, DW>;
 
 }  // namespace delayspec

@@ -1,5 +1,6 @@
 #include "delayspec/grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -32,6 +33,43 @@ Ratio rational_approximation(double x) {
 std::string HistoryGrid::describe() const {
   return "N=" + std::to_string(N) + " h=" + format_number(h) + " K=" + std::to_string(K) + " M=" + std::to_string(M) +
          (aligned() ? " (aligned delay)" : " (fractional delay, theta=" + format_number(theta) + ")");
+}
+
+std::vector<double> HistoryGrid::delay_values() const {
+  if (delays.empty()) return {tau};
+  std::vector<double> out;
+  for (const DelayPosition& p : delays) out.push_back(p.tau);
+  return out;
+}
+
+HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map) {
+  if (taus.empty()) throw BadInput("make_grid: no delay given");
+  const std::string count = std::to_string(taus.size());
+  for (size_t i = 0; i < taus.size(); ++i)
+    if (!(std::isfinite(taus[i]) && taus[i] > 0))
+      throw BadInput("delay " + std::to_string(i + 1) + " of " + count + " is " + format_number(taus[i]) +
+                     ": a delay must be positive and finite");
+  const size_t longest = static_cast<size_t>(std::max_element(taus.begin(), taus.end()) - taus.begin());
+  HistoryGrid g = make_grid(taus[longest], period, N, periods_per_map);
+  if (taus.size() == 1) return g;
+  for (size_t i = 0; i < taus.size(); ++i) {
+    HistoryGrid::DelayPosition p{taus[i], g.m, g.theta};
+    if (i != longest) {
+      // tau_i = (m_i + theta_i) h, snapped to a whole number of steps as make_grid snaps tau
+      const double ratio = taus[i] / g.h;
+      double m = std::floor(ratio), theta = ratio - m;
+      if (theta > 1 - 1e-12) m += 1, theta = 0;
+      if (theta < 1e-12) theta = 0;
+      if (m < 1)
+        throw BadInput("`N = " + std::to_string(N) + "`: delay " + std::to_string(i + 1) + " of " + count + ", " +
+                       format_number(taus[i]) + ", is shorter than one step h = " + format_number(g.h) +
+                       " (N steps per the longest delay, " + format_number(taus[longest]) + "); increase N");
+      p.m = static_cast<int>(m);
+      p.theta = theta;
+    }
+    g.delays.push_back(p);
+  }
+  return g;
 }
 
 HistoryGrid make_grid(double tau, double period, int N, int periods_per_map) {

@@ -29,6 +29,7 @@
 // No allocation, no checks: the callers check sizes.
 #include <type_traits>
 
+#include "delayspec/grid.hpp"
 #include "delayspec/step_map.hpp"
 
 namespace delayspec {
@@ -235,6 +236,71 @@ inline void single_steps(const StepMap<D>* maps, long K, long M, long first_dela
     double* next = b + (M + l + 1) * D;
     for (int r = 0; r < D; ++r) next[r] = u[r] = out[r];
   }
+}
+
+// Several delays (model.hpp, grid.hpp's delay_taps). Step l of k interleaved vectors on one
+// linear history b (slot j at b + j D k, u0 in slot `current` = M + l):
+//
+//   out = P u0 + sum_i Q_i w0_i + R_i w1_i,   w0_i = (1 - theta_i) b[j_i] + theta_i b[j_i - 1],
+//                                             w1_i = (1 - theta_i) b[j_i + 1] + theta_i b[j_i],
+//
+// j_i = current - m_i, Q_i and R_i the D x D column blocks of delay i. Portable, one vector at a
+// time: the taps of n delays are gathered into the stacked W0, W1 (D n rows) and the step's
+// derivative applied to them, formed (step_block's sum over the blocks) or factored
+// (SubStepDerivative::apply). The single-delay kernels above are the fast paths; these serve
+// the models that declare several delays.
+template <int D, int DW>
+struct DelayedStack {
+  Vec<DW> w0, w1;
+  // Gathers vector v's taps around slot `current` of b (k interleaved vectors).
+  void gather(const double* b, long current, const std::vector<HistoryGrid::DelayPosition>& delays, long k, long v) {
+    const long stride = static_cast<long>(D) * k;
+    for (size_t i = 0; i < delays.size(); ++i) {
+      const double* d0 = b + (current - delays[i].m) * stride + v;
+      const double th = delays[i].theta, c0 = 1 - th;
+      for (int c = 0; c < D; ++c) {
+        const long row = static_cast<long>(i) * D + c;
+        w0[row] = th == 0 ? d0[c * k] : c0 * d0[c * k] + th * d0[c * k - stride];
+        w1[row] = th == 0 ? d0[stride + c * k] : c0 * d0[stride + c * k] + th * d0[c * k];
+      }
+    }
+  }
+};
+
+// One vector's step: through the formed blocks, or the factored derivative when the step kept it.
+template <int D, int DW>
+inline Vec<D> apply_multi_delay(const StepMap<D, DW>& s, const Vec<D>& u0, const DelayedStack<D, DW>& w) {
+  return s.Q * w.w0 + s.R * w.w1 + s.P * u0;
+}
+template <int D, int DW>
+inline Vec<D> apply_multi_delay(const StepLinearisation<D, DW>& s, const Vec<D>& u0, const DelayedStack<D, DW>& w) {
+  if (s.factored) return s.sub.apply(u0, w.w0, w.w1);
+  return apply_multi_delay(s.map, u0, w);
+}
+
+// Step `current` -> current + 1 of k interleaved vectors; Derivative: a StepMap or a
+// StepLinearisation of D x DW blocks.
+template <int D, int DW, class Derivative>
+inline void multi_delay_step(const Derivative& s, const double* b, long current,
+                             const std::vector<HistoryGrid::DelayPosition>& delays, long k, double* __restrict out) {
+  const long stride = static_cast<long>(D) * k;
+  DelayedStack<D, DW> w;
+  for (long v = 0; v < k; ++v) {
+    w.gather(b, current, delays, k, v);
+    Vec<D> u0;
+    for (int c = 0; c < D; ++c) u0[c] = b[current * stride + c * k + v];
+    const Vec<D> next = apply_multi_delay<D, DW>(s, u0, w);
+    for (int r = 0; r < D; ++r) out[r * k + v] = next[r];
+  }
+}
+
+// The K steps of one map (formed step maps) on k interleaved vectors of the linear history b:
+// step l reads slot M + l and the taps, writes slot M + l + 1.
+template <int D, int DW>
+inline void multi_delay_steps(const StepMap<D, DW>* maps, long K, long M,
+                              const std::vector<HistoryGrid::DelayPosition>& delays, double* b, long k) {
+  const long stride = static_cast<long>(D) * k;
+  for (long l = 0; l < K; ++l) multi_delay_step<D, DW>(maps[l], b, M + l, delays, k, b + (M + l + 1) * stride);
 }
 
 }  // namespace delayspec

@@ -297,9 +297,9 @@ class PeriodicBranch {
     auto slot = [&](long i) { return u(i - M); };
     m.max_H = -INFINITY;
     m.contact_time = 0;
-    StepMap<D> scratch;
+    StepMap<D, delayed_rows<Model>> scratch;
     for (long l = 0; l < K_; ++l) {
-      const auto [w0, w1, t] = g.delay_tap<V>(l, slot);
+      const auto [w0, w1, t] = g.template delay_taps<D, DelayedVec<Model>>(l, slot);
       const V a = u(l), b = u(l + 1);
       const int ja = region_of(model, a), jb = region_of(model, b);
       const V grad = model.grad_H(a);
@@ -320,7 +320,7 @@ class PeriodicBranch {
 
   HistoryGrid grid_at(double p) const { return grid_at_model(model_at_(p), p); }
   HistoryGrid grid_at_model(const Model& model, double p) const {
-    const HistoryGrid g = make_grid(model.tau(), model.period(), o_.N, o_.periods_per_map);
+    const HistoryGrid g = make_grid(delays_of(model), model.period(), o_.N, o_.periods_per_map);
     if (K_ != 0 && (g.K != K_ || g.M != M_))
       throw ProblemSizeChanged("continuation: at parameter " + format_number(p) +
                                " the grid has K = " + std::to_string(g.K) + ", M = " + std::to_string(g.M) +

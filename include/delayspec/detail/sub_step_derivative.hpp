@@ -22,23 +22,29 @@
 
 namespace delayspec::detail {
 
-template <int D>
+// DW: the rows of the delayed argument (D, or D n for n delays: Bl and Br are D x DW).
+template <int D, int DW = D>
 struct SubStepDerivative {
-  SmallSolve<D> s;  // S = I - dt/2 A_r, solved
-  Mat<D> left;      // L  = I + dt/2 A_l
-  Mat<D> bl;        // Bl = dt/2 B_l
-  Mat<D> br;        // Br = dt/2 B_r
+  SmallSolve<D> s;        // S = I - dt/2 A_r, solved
+  Mat<D> left;            // L  = I + dt/2 A_l
+  RectMat<D, DW> bl;      // Bl = dt/2 B_l
+  RectMat<D, DW> br;      // Br = dt/2 B_r
 
   // Fills L, Bl, Br from A_l, B_l, B_r (S is set by the caller, from its Newton solve).
   // Coefficient by coefficient, on purpose: the model has just built A and B with scalar stores
   // (Eigen's comma initializer), and GCC turns `c * B` into 16-byte loads of B's columns; a load
   // spanning two stores is not forwarded (AMD Zen: it waits for both to reach the cache), which
   // cost the impact model's Lyapunov step 10 ns (bench_lyapunov, perf annotate).
-  [[gnu::always_inline]] inline void set_blocks(double half_dt, const Mat<D>& a_left, const Mat<D>& b_left,
-                                                const Mat<D>& b_right) {
+  [[gnu::always_inline]] inline void set_blocks(double half_dt, const Mat<D>& a_left,
+                                                const RectMat<D, DW>& b_left, const RectMat<D, DW>& b_right) {
     for (int c = 0; c < D; ++c)
       for (int r = 0; r < D; ++r) {
         left(r, c) = (r == c ? 1.0 : 0.0) + half_dt * a_left(r, c);
+        bl(r, c) = half_dt * b_left(r, c);
+        br(r, c) = half_dt * b_right(r, c);
+      }
+    for (int c = D; c < DW; ++c)  // the other delays' columns (several delays only)
+      for (int r = 0; r < D; ++r) {
         bl(r, c) = half_dt * b_left(r, c);
         br(r, c) = half_dt * b_right(r, c);
       }
@@ -46,8 +52,8 @@ struct SubStepDerivative {
 
   // The blocks of the step map: dz1/dz0, dz1/dw0, dz1/dw1.
   Mat<D> dz0() const { return s.solve(left); }
-  Mat<D> dw0() const { return s.solve(bl); }
-  Mat<D> dw1() const { return s.solve(br); }
+  RectMat<D, DW> dw0() const { return s.solve(bl); }
+  RectMat<D, DW> dw1() const { return s.solve(br); }
 
   // dZ1 = S^{-1} (L dZ0 + Bl dW0 + Br dW1) for D x c blocks of tangent vectors (c columns),
   // written row by row: row r of a block holds component r of the c vectors, so each term is a
@@ -63,6 +69,7 @@ struct SubStepDerivative {
     for (int r = 0; r < D; ++r) {
       rhs.row(r) = left(r, 0) * dz0.row(0) + bl(r, 0) * dw0.row(0) + br(r, 0) * dw1.row(0);
       for (int c = 1; c < D; ++c) rhs.row(r) += left(r, c) * dz0.row(c) + bl(r, c) * dw0.row(c) + br(r, c) * dw1.row(c);
+      for (int c = D; c < DW; ++c) rhs.row(r) += bl(r, c) * dw0.row(c) + br(r, c) * dw1.row(c);  // other delays
     }
     if constexpr (requires { s.inverse(); }) {
       Block out;  // S^{-1} rhs through the stored inverse, row by row as above

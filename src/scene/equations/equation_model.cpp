@@ -70,6 +70,7 @@ class ExplainedAnalyses final : public ModelAnalyses {
   bool switches_in_time() const override { return inner_->switches_in_time(); }
   bool is_linear() const override { return inner_->is_linear(); }
   double tau() const override { return inner_->tau(); }
+  std::vector<double> delays() const override { return inner_->delays(); }
   double period() const override { return inner_->period(); }
   LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
                                    const OrbitRequest& request) const override {
