@@ -119,8 +119,9 @@ HistoryGrid make_grid(double tau, double period, int N, int periods_per_map = 1)
 
 // Several delays (taus in the model's order; one entry is make_grid above): N steps per the
 // longest, laid as make_grid lays it, each other delay at its (m_i, theta_i). Throws BadInput
-// naming the delay (by its place, "delay 2 of 3") when it is not positive and finite or shorter
-// than one step.
-HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map = 1);
+// naming the delay when it is not positive and finite or shorter than one step: by names[i] when
+// given (one per delay, e.g. "`equations.delays.tau1`"), else by its place ("delay 2 of 3").
+HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map = 1,
+                      const std::vector<std::string>& names = {});
 
 }  // namespace delayspec

@@ -42,13 +42,16 @@ std::vector<double> HistoryGrid::delay_values() const {
   return out;
 }
 
-HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map) {
+HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map,
+                      const std::vector<std::string>& names) {
   if (taus.empty()) throw BadInput("make_grid: no delay given");
-  const std::string count = std::to_string(taus.size());
+  const auto name = [&](size_t i) {
+    return names.size() == taus.size() ? names[i]
+                                       : "delay " + std::to_string(i + 1) + " of " + std::to_string(taus.size());
+  };
   for (size_t i = 0; i < taus.size(); ++i)
     if (!(std::isfinite(taus[i]) && taus[i] > 0))
-      throw BadInput("delay " + std::to_string(i + 1) + " of " + count + " is " + format_number(taus[i]) +
-                     ": a delay must be positive and finite");
+      throw BadInput(name(i) + " is " + format_number(taus[i]) + ": a delay must be positive and finite");
   const size_t longest = static_cast<size_t>(std::max_element(taus.begin(), taus.end()) - taus.begin());
   HistoryGrid g = make_grid(taus[longest], period, N, periods_per_map);
   if (taus.size() == 1) return g;
@@ -61,8 +64,8 @@ HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int
       if (theta > 1 - 1e-12) m += 1, theta = 0;
       if (theta < 1e-12) theta = 0;
       if (m < 1)
-        throw BadInput("`N = " + std::to_string(N) + "`: delay " + std::to_string(i + 1) + " of " + count + ", " +
-                       format_number(taus[i]) + ", is shorter than one step h = " + format_number(g.h) +
+        throw BadInput("`N = " + std::to_string(N) + "`: " + name(i) + " = " + format_number(taus[i]) +
+                       " is shorter than one step h = " + format_number(g.h) +
                        " (N steps per the longest delay, " + format_number(taus[longest]) + "); increase N");
       p.m = static_cast<int>(m);
       p.theta = theta;

@@ -28,11 +28,15 @@
 #include "delayspec/model_linear.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/stroboscopic_map.hpp"
+#include "characteristic_roots.hpp"
 
 namespace delayspec {
 namespace {
 
 using cd = std::complex<double>;
+using test::Characteristic;
+using test::exact_multipliers;
+using test::worst_distance;
 
 // x' = a x + b1 x(t - tau1) + b2 x(t - tau2) (+ forcing: a cos(2 pi t / T) term, for Newton)
 struct TwoDelayScalar {
@@ -76,9 +80,6 @@ static_assert(DelayModel<TwoDelayOscillator>);
 
 // The characteristic function of a linear model with constant coefficients, det(lambda I - A -
 // sum_i B_i exp(-lambda tau_i)), and its derivative, for d = 1 and d = 2.
-struct Characteristic {
-  std::function<cd(cd)> value, derivative;
-};
 Characteristic characteristic(const TwoDelayScalar& m) {
   return {[m](cd l) { return l - m.a - m.b1 * std::exp(-l * m.tau1) - m.b2 * std::exp(-l * m.tau2); },
           [m](cd l) { return 1.0 + m.b1 * m.tau1 * std::exp(-l * m.tau1) + m.b2 * m.tau2 * std::exp(-l * m.tau2); }};
@@ -95,27 +96,6 @@ Characteristic characteristic(const TwoDelayOscillator& m) {
           }};
 }
 
-// The distinct roots with Re > re_min found by Newton from starts on a grid of the rectangle
-// [re_min, 3] x [-im_max, im_max], as multipliers exp(lambda T), largest modulus first.
-std::vector<cd> exact_multipliers(const Characteristic& ch, double T, double re_min, double im_max) {
-  std::vector<cd> roots;
-  for (double re = re_min; re <= 3; re += 0.25)
-    for (double im = -im_max; im <= im_max; im += 0.25) {
-      cd l(re, im);
-      for (int it = 0; it < 60; ++it) {
-        const cd step = ch.value(l) / ch.derivative(l);
-        l -= step;
-        if (std::abs(step) < 1e-15 * (1 + std::abs(l))) break;
-      }
-      if (!(std::abs(ch.value(l)) < 1e-12 * (1 + std::abs(l))) || l.real() < re_min) continue;
-      if (std::none_of(roots.begin(), roots.end(), [&](cd r) { return std::abs(r - l) < 1e-8; })) roots.push_back(l);
-    }
-  std::vector<cd> mu;
-  for (cd l : roots) mu.push_back(std::exp(l * T));
-  std::sort(mu.begin(), mu.end(), [](cd x, cd y) { return std::abs(x) > std::abs(y); });
-  return mu;
-}
-
 template <class Model>
 StroboscopicMap<Model> map_of(const Model& model, int N) {
   return StroboscopicMap<Model>(TrapezoidStepper<Model>(model), make_grid(delays_of(model), model.period(), N));
@@ -128,18 +108,6 @@ Multipliers discrete_multipliers(const Model& model, int N, int nev, FloquetSolv
   o.nev = nev;
   o.solver = solver;
   return floquet_multipliers(map.monodromy(Eigen::VectorXd::Zero(map.dimension())), o).multipliers;
-}
-
-// The largest distance from each of `got` to the nearest of `exact` (a matching that ignores the
-// order of equal moduli: conjugate pairs).
-double worst_distance(const Multipliers& got, const std::vector<cd>& exact) {
-  double worst = 0;
-  for (const auto& m : got) {
-    double best = INFINITY;
-    for (cd e : exact) best = std::min(best, std::abs(m - e));
-    worst = std::max(worst, best);
-  }
-  return worst;
 }
 
 TEST(SeveralDelays, GridPlacesEachDelay) {

@@ -163,7 +163,8 @@ TEST(EquationModelSource, NoParametersGiveAnEmptyArray) {
   EXPECT_TRUE(contains(s.code, "std::array<double, parameter_count> p{};"));
   // delay defaults to the period
   const SymbolicEquationModel m = analyse_equations(table, kEngineKeys);
-  EXPECT_TRUE((m.delay - 2 * GiNaC::Pi).is_zero());
+  ASSERT_EQ(m.delays.size(), 1u);
+  EXPECT_TRUE((m.delays[0] - 2 * GiNaC::Pi).is_zero());
   EXPECT_TRUE(m.history[0].is_zero());
 }
 
@@ -242,7 +243,7 @@ std::vector<BadTable> bad_tables() {
   add("unknown entry, a prefix", impact_with("param", toml::table{}), {"`equations.param`", "did you mean `parameters`?"});
   add("unknown entry, longer", impact_with("switching", "x"), {"`equations.switching`", "did you mean `switch`?"});
   add("unknown entry, far", impact_with("initial", toml::table{}),
-      {"`equations.initial`", "the entries are state, parameters, period, delay, rhs, switch, rhs_switched, history"});
+      {"`equations.initial`", "the entries are state, parameters, period, delay, delays, rhs, switch, rhs_switched, history"});
   add("no state", impact_without("state"), {"`equations.state` is required"});
   add("state not an array", impact_with("state", "x"), {"`equations.state`", "array"});
   add("empty state", impact_with("state", toml::array{}), {"`equations.state`", "at least one"});

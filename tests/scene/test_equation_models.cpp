@@ -8,7 +8,10 @@
 // - a d = 3 system coupled through commuting matrices, A = S diag(a) S^-1, B = S diag(b) S^-1,
 //   whose multipliers are exactly those of the three scalar equations x' = a_i x + b_i x_tau
 //   (Lambert W): order 2 against them;
-// - a parameter given with --set reaches the compiled model without recompiling.
+// - a parameter given with --set reaches the compiled model without recompiling;
+// - several delays (`delays`): x' = a x + b1 x(t - tau1) + b2 x(t - tau2) converges with order 2
+//   to its exact characteristic roots (Newton in the test), a parameter a delay depends on
+//   re-taps the compiled model, and `delay = E` is `delays = { tau = E }` bit for bit.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,6 +24,7 @@
 #include "delayspec/lambert_w.hpp"
 #include "scene/equations/equation_plugin.hpp"
 #include "scene/problem/problem.hpp"
+#include "characteristic_roots.hpp"
 
 namespace delayspec::cli {
 namespace {
@@ -243,6 +247,94 @@ TEST(EquationModels, AParameterChangeReachesTheModelWithoutRecompiling) {
   // Second order at N = 400 (h = 1/400): the error is about 1e-6 (the order test above).
   EXPECT_LE(std::abs(mu[0] - exact[0]), 1e-5);
   EXPECT_NE(first.analyses.get(), other.analyses.get());
+}
+
+const char* kTwoDelayScene = R"scene(model = "equations"
+[equations]
+state = ["x"]
+parameters = { a = -1.0, b1 = 0.5, b2 = -0.7, s = 1 }
+period = "1"
+delays = { tau1 = "s", tau2 = "sqrt(2)" }
+rhs = ["a*x + b1*x_tau1 + b2*x_tau2"]
+history = { x = 1 }
+)scene";
+
+// The exact multipliers of kTwoDelayScene's equation at tau1 = s (T = 1).
+std::vector<std::complex<double>> two_delay_exact(double s) {
+  using cd = std::complex<double>;
+  const double a = -1, b1 = 0.5, b2 = -0.7, tau2 = std::sqrt(2.0);
+  const test::Characteristic ch{
+      [=](cd l) { return l - a - b1 * std::exp(-l * s) - b2 * std::exp(-l * tau2); },
+      [=](cd l) { return 1.0 + b1 * s * std::exp(-l * s) + b2 * tau2 * std::exp(-l * tau2); }};
+  return test::exact_multipliers(ch, 1, -12, 60);
+}
+
+TEST(EquationModels, TwoDelaysHaveOrderTwoAgainstTheExactRoots) {
+  const std::vector<std::complex<double>> exact = two_delay_exact(1);
+  std::vector<double> errors;
+  for (int N : {100, 200, 400, 800, 1600})
+    errors.push_back(test::worst_distance(spectrum(problem_from(kTwoDelayScene, {{"N", std::to_string(N)}}), 6).multipliers, exact));
+  // tau2 / h irrational: the interpolation weight changes with N, so the ratio of successive
+  // errors wanders; over the whole range 2.00 +- 0.05 (the issue's tolerance).
+  EXPECT_NEAR(std::log2(errors.front() / errors.back()) / 4, 2.0, 0.05) << errors.front() << " " << errors.back();
+}
+
+TEST(EquationModels, AParameterADelayDependsOnReTapsWithoutRecompiling) {
+  problem_from(kTwoDelayScene, {});
+  const long compiled = equation_plugin_compilations();
+  const auto mu = spectrum(problem_from(kTwoDelayScene, {{"s", "0.5"}, {"N", "400"}}), 4).multipliers;
+  EXPECT_EQ(equation_plugin_compilations(), compiled);
+  // Second order at N = 400: ~1e-5 (the order test above has 4.5e-6 at tau1 = 1); the multipliers
+  // at tau1 = 1 differ from these by more than 0.01.
+  EXPECT_LE(test::worst_distance(mu, two_delay_exact(0.5)), 3e-5);
+  EXPECT_GT(test::worst_distance(mu, two_delay_exact(1)), 1e-2);
+}
+
+TEST(EquationModels, OneDelayWrittenEitherWayIsBitIdentical) {
+  std::string with_table = kLinearScene;
+  with_table.replace(with_table.find("delay = \"1\""), 11, "delays = { tau = \"1\" }");
+  const Spectrum a = spectrum(problem_from(kLinearScene, {{"N", "120"}}), 4),
+                 b = spectrum(problem_from(with_table, {{"N", "120"}}), 4);
+  ASSERT_EQ(a.multipliers.size(), b.multipliers.size());
+  for (size_t k = 0; k < a.multipliers.size(); ++k) EXPECT_EQ(a.multipliers[k], b.multipliers[k]);
+  const LyapunovResult la = exponents(problem_from(kLinearScene, {{"N", "50"}}), 200),
+                       lb = exponents(problem_from(with_table, {{"N", "50"}}), 200);
+  EXPECT_EQ(la.per_period, lb.per_period);
+}
+
+// Bad input names the item: each case's message contains `expected`. None of these compiles.
+TEST(EquationModels, SeveralDelaysBadInputNamesTheDelay) {
+  const auto message = [](const std::string& scene, const std::vector<std::pair<std::string, std::string>>& sets) {
+    try {
+      problem_from(scene, sets);
+    } catch (const BadInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  const auto with = [](const std::string& from, const std::string& to) {
+    std::string scene = kTwoDelayScene;
+    scene.replace(scene.find(from), from.size(), to);
+    return scene;
+  };
+  struct Case {
+    std::string scene;
+    std::vector<std::pair<std::string, std::string>> sets;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {with("x_tau2", "x_tau3"), {}, "did you mean `x_tau"},
+      {kTwoDelayScene, {{"s", "0"}}, "`equations.delays.tau1` evaluates to 0"},
+      {kTwoDelayScene, {{"s", "-2"}}, "`equations.delays.tau1` evaluates to -2"},
+      {with("tau1 = \"s\"", "x = \"s\""), {}, "`equations.delays.x`: `x` is also a state"},
+      {with("tau1 = \"s\"", "a = \"s\""), {}, "`equations.delays.a`: `a` is also a parameter"},
+      {with("s = 1 }", "s = 1, x_tau1 = 2 }"), {}, "the delayed state `x_tau1` would be the parameter"},
+      {kTwoDelayScene, {{"s", "0.001"}, {"N", "100"}}, "`equations.delays.tau1` = 0.001 is shorter than one step"},
+      {with("period = \"1\"", "period = \"1\"\ndelay = \"1\""), {}, "are both given"},
+      {kTwoDelayScene, {{"tau_over_T", "1"}}, "this model has 2"},
+      {with("delays = { tau1 = \"s\", tau2 = \"sqrt(2)\" }", "delays = 3"), {}, "must be a table of named delays"},
+  };
+  for (const Case& c : cases) EXPECT_NE(message(c.scene, c.sets).find(c.expected), std::string::npos) << message(c.scene, c.sets);
 }
 
 }  // namespace

@@ -33,7 +33,8 @@ const char* kLinearCode = R"(struct EquationModel {
   double tau_ = 0, period_ = 0;
   Vector history_ = Vector::Zero();
   static double period_of(const double*) { return 1.0; }
-  static double delay_of(const double*) { return 1.0; }
+  static void delays_of(const double*, double* taus) { taus[0] = 1.0; }
+  void set_delays(const double* taus) { tau_ = taus[0]; }
   static Vector history_of(const double*) { return Vector(1.0); }
   double tau() const { return tau_; }
   double period() const { return period_; }
@@ -72,11 +73,13 @@ TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInAndASecondLoadIsACacheHit)
   EXPECT_EQ(equation_plugin_compilations(), before + 1);
   const double p[2] = {-1.0, 0.5};
   EXPECT_EQ(plugin.period(p), 1.0);
-  EXPECT_EQ(plugin.delay(p), 1.0);
+  double tau = 0;
+  plugin.delays(p, &tau);
+  EXPECT_EQ(tau, 1.0);
   double y0 = 0;
   plugin.history(p, &y0);
   EXPECT_EQ(y0, 1.0);
-  const std::unique_ptr<ModelAnalyses> loaded(plugin.analyses(p, 1.0, 1.0, &y0));
+  const std::unique_ptr<ModelAnalyses> loaded(plugin.analyses(p, &tau, 1.0, &y0));
   EXPECT_EQ(loaded->state_dimension(), 1);
   EXPECT_TRUE(loaded->is_linear());
   LinearParameters lp;
@@ -106,8 +109,8 @@ TEST_F(EquationPluginTest, ConcurrentFirstLoadsCompileOnce) {
   t2.join();
   EXPECT_EQ(equation_plugin_compilations(), before + 1);
   EXPECT_EQ(first.object, second.object);
-  const double p[2] = {-1.0, 0.5}, y0 = 1;
-  EXPECT_EQ(std::unique_ptr<ModelAnalyses>(second.analyses(p, 1, 1, &y0))->state_dimension(), 1);
+  const double p[2] = {-1.0, 0.5}, y0 = 1, tau = 1;
+  EXPECT_EQ(std::unique_ptr<ModelAnalyses>(second.analyses(p, &tau, 1, &y0))->state_dimension(), 1);
 }
 
 TEST_F(EquationPluginTest, TwoModelsInOneProcessAreTwoObjects) {

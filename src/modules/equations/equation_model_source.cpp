@@ -56,8 +56,9 @@ class ModelPrinter {
          << "  Vector history_ = Vector::Zero();\n"
          << "  double tau() const { return tau_; }\n"
          << "  double period() const { return period_; }\n"
-         << "  Vector initial_state() const { return history_; }\n"
-         << "  // The functions of the expressions, as <cmath>'s (the printed expressions call them unqualified).\n";
+         << "  Vector initial_state() const { return history_; }\n";
+    print_delays();
+    out_ << "  // The functions of the expressions, as <cmath>'s (the printed expressions call them unqualified).\n";
     // sin and cos through the per-thread memo of the built-in models (detail/remembered_trig.hpp,
     // the same values bit for bit): a forcing term sin(w t) is evaluated at one t by f, f_t,
     // f_tt, the event test and the next step's left node. Measured on the impact equations,
@@ -70,16 +71,16 @@ class ModelPrinter {
          << "  static constexpr double " << pi_.get_name() << " = "
          << "3.141592653589793238462643383279502884;\n";
     out_ << "  static double period_of([[maybe_unused]] const double* p) { return " << cxx(m_.period) << "; }\n"
-         << "  static double delay_of([[maybe_unused]] const double* p) { return " << cxx(m_.delay) << "; }\n"
+         << "  static void delays_of([[maybe_unused]] const double* p, double* taus) {\n";
+    for (int k = 0; k < m_.delay_count(); ++k) out_ << "    taus[" << k << "] = " << cxx(m_.delays[k]) << ";\n";
+    out_ << "  }\n"
          << "  static Vector history_of([[maybe_unused]] const double* p) {\n"
          << "    Vector r;\n";
     for (int i = 0; i < m_.d(); ++i) out_ << "    r[" << i << "] = " << cxx(m_.history[i]) << ";\n";
     out_ << "    return r;\n  }\n";
     print_field_vector("f", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f; });
-    print_field_matrix(
-        "A", [](const SymbolicField& f) -> const auto& { return f.A; });
-    print_field_matrix(
-        "B", [](const SymbolicField& f) -> const auto& { return f.B; });
+    print_field_matrix("Matrix", "A", [](const SymbolicField& f) -> const auto& { return f.A; });
+    print_field_matrix("DelayedMatrix", "B", [](const SymbolicField& f) -> const auto& { return f.B; });
     print_field_vector("f_t", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f_t; });
     print_field_vector("f_tt", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f_tt; });
     if (state_switch) print_state_switch();
@@ -114,7 +115,7 @@ class ModelPrinter {
 
   static std::string arguments() {
     return "([[maybe_unused]] int j, [[maybe_unused]] double t, [[maybe_unused]] const Vector& y, "
-           "[[maybe_unused]] const Vector& z) const {\n";
+           "[[maybe_unused]] const Delayed& z) const {\n";
   }
 
   // The body for each field: one field, or `if (j == 1) f_1 else f_2`.
@@ -139,8 +140,8 @@ class ModelPrinter {
     out_ << "    return r;\n  }\n";
   }
 
-  void print_field_matrix(const std::string& name, const Matrix& matrix) {
-    out_ << "  Matrix " << name << arguments() << "    Matrix r = Matrix::Zero();\n";
+  void print_field_matrix(const std::string& type, const std::string& name, const Matrix& matrix) {
+    out_ << "  " << type << " " << name << arguments() << "    " << type << " r = " << type << "::Zero();\n";
     per_field([&](const SymbolicField& field, const std::string& indent) {
       const auto& entries = matrix(field);
       for (size_t i = 0; i < entries.size(); ++i)
@@ -149,6 +150,28 @@ class ModelPrinter {
             out_ << indent << "r(" << i << ", " << a << ") = " << cxx(entries[i][a]) << ";\n";
     });
     out_ << "    return r;\n  }\n";
+  }
+
+  // The delays: one (tau_, set by the loader; Delayed is Vector), or n >= 2 (model.hpp's
+  // delay_count and delays(); tau_ the longest). set_delays takes the values in the order of
+  // the names (sorted).
+  void print_delays() {
+    const int n = m_.delay_count();
+    if (n == 1) {
+      out_ << "  using Delayed = Vector;\n"
+           << "  using DelayedMatrix = Matrix;\n"
+           << "  void set_delays(const double* taus) { tau_ = taus[0]; }\n";
+      return;
+    }
+    out_ << "  static constexpr int delay_count = " << n << ";\n"
+         << "  using Delayed = delayspec::Vec<d * delay_count>;\n"
+         << "  using DelayedMatrix = delayspec::RectMat<d, d * delay_count>;\n"
+         << "  std::array<double, delay_count> delays_{};\n"
+         << "  std::array<double, delay_count> delays() const { return delays_; }\n"
+         << "  void set_delays(const double* taus) {\n"
+         << "    tau_ = 0;\n"
+         << "    for (int k = 0; k < delay_count; ++k) delays_[k] = taus[k], tau_ = taus[k] > tau_ ? taus[k] : tau_;\n"
+         << "  }\n";
   }
 
   void print_state_switch() {
@@ -203,12 +226,16 @@ EquationModelSource generate_equation_model(const toml::table& equations,
   source.parameter_defaults = model.parameter_defaults;
   source.switches_in_state = model.switch_kind == SwitchKind::state;
   source.switches_in_time = model.switch_kind == SwitchKind::time;
+  source.delays = model.delay_names;
+  source.written_with_delays = equations.contains("delays");
+  for (size_t a = 0; a < model.z.size(); ++a) source.delayed.push_back(model.delayed_name(a));
   source.code = ModelPrinter(model).print();
   if (source.code.size() > kMaxModelCode)
     throw BadInput("`equations`: the model's derivatives print as " + std::to_string(source.code.size() / 1000) +
                    " kB of C++, more than the " + std::to_string(kMaxModelCode / 1000) +
                    " kB delayspec compiles (a model this large compiles for minutes): simplify it");
-  std::vector<GiNaC::ex> constants = {model.period, model.delay};
+  std::vector<GiNaC::ex> constants = {model.period};
+  constants.insert(constants.end(), model.delays.begin(), model.delays.end());
   constants.insert(constants.end(), model.history.begin(), model.history.end());
   source.constants = [constants, p = model.p](const std::vector<double>& values) {
     GiNaC::lst at;

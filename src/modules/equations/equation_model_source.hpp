@@ -18,11 +18,14 @@ struct EquationModelSource {
   std::vector<std::string> state;          // state names in order; d = state.size()
   std::vector<std::string> parameters;     // parameter names, sorted (the table's order)
   std::vector<double> parameter_defaults;  // their values in the table, same order
+  std::vector<std::string> delays;         // the delays' names (sorted; {"tau"} for one delay)
+  std::vector<std::string> delayed;        // the delayed states' names NAME_X, d per delay, delay by delay
+  bool written_with_delays = false;        // the `delays` table (else `delay` or none): for messages
   bool switches_in_state = false;          // `switch` given and depends on the state
   bool switches_in_time = false;           // `switch` given and depends on t only
   std::string code;                        // C++ text of `struct EquationModel {...};`
-  // The constant expressions at parameter values (in the order of `parameters`): period, delay,
-  // then the d history values, each GiNaC's evaluation of the exact expression (NaN where that is
+  // The constant expressions at parameter values (in the order of `parameters`): period, the
+  // delays (in the order of `delays`), then the d history values, each GiNaC's evaluation of the exact expression (NaN where that is
   // not a finite real number, e.g. 1/0). So that they are checked before the model is compiled
   // (seconds) rather than after. Not thread-safe (GiNaC).
   std::function<std::vector<double>(const std::vector<double>& p)> constants;
@@ -39,8 +42,9 @@ struct EquationModelSource {
 //
 // The code (after <array>, <cmath> and "delayspec/types.hpp") defines struct EquationModel with
 // d, parameter_count, the model flags, `std::array<double, parameter_count> p` (values in the
-// order of `parameters`), tau_, period_, history_ (set by the loader), the static period_of(p),
-// delay_of(p), history_of(p), and f, A, B, f_t, f_tt for j = 1 (rhs_switched, switch > 0) and
+// order of `parameters`), tau_, period_, history_ (set by the loader; set_delays(taus) sets the
+// delays), the types Delayed and DelayedMatrix of the delayed argument and of B, the static
+// period_of(p), delays_of(p, taus), history_of(p), and f, A, B, f_t, f_tt for j = 1 (rhs_switched, switch > 0) and
 // j = 2 (rhs), H and grad_H with a state switch, time_segment and next_time_switch with a time
 // switch: a delayspec::DelayModel (model.hpp).
 EquationModelSource generate_equation_model(const toml::table& equations,

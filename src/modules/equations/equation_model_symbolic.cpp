@@ -16,8 +16,8 @@ namespace delayspec::cli {
 namespace {
 
 const std::vector<std::string>& table_entries() {
-  static const std::vector<std::string> entries = {"state", "parameters", "period",       "delay",
-                                                   "rhs",   "switch",     "rhs_switched", "history"};
+  static const std::vector<std::string> entries = {"state",  "parameters", "period",       "delay",  "delays",
+                                                   "rhs",    "switch",     "rhs_switched", "history"};
   return entries;
 }
 
@@ -60,6 +60,7 @@ class EquationsReader {
     check_entries();
     read_state();
     read_parameters();
+    read_delay_names();
     make_scopes();
     read_constants();
     read_fields();
@@ -98,8 +99,45 @@ class EquationsReader {
         throw BadInput("`" + item_of("state", i) + "`: `" + name->get() + "` is named twice");
       m_.state.push_back(name->get());
       m_.y.emplace_back("y[" + std::to_string(i) + "]");
-      m_.z.emplace_back("z[" + std::to_string(i) + "]");
     }
+  }
+
+  // `delays = { X = "expr", ... }` (several delays, NAME_X) or `delay = "expr"` (one, NAME_tau;
+  // the same as delays = { tau = "expr" }), or neither (tau = period). A delay's name may not be
+  // a state's or a parameter's, nor make NAME_X one.
+  void read_delay_names() {
+    const toml::node* several = table_.get("delays");
+    if (several && table_.contains("delay"))
+      throw BadInput("`equations.delay` and `equations.delays` are both given: `delay = \"...\"` is the same as "
+                     "`delays = { tau = \"...\" }`; keep one");
+    if (!several) {
+      m_.delay_names = {"tau"};
+    } else {
+      const toml::table* delays = several->as_table();
+      if (!delays || delays->empty())
+        throw BadInput("`equations.delays`: must be a table of named delays, e.g. { tau1 = \"1\", tau2 = \"sqrt(2)\" }");
+      for (const auto& [key, value] : *delays) {  // sorted by name
+        const std::string name(key.str());
+        const std::string item = "equations.delays." + printable(name);
+        check_equation_name(item, name);
+        const auto named = [&](const std::vector<std::string>& names) {
+          return std::find(names.begin(), names.end(), name) != names.end();
+        };
+        if (named(m_.state)) throw BadInput("`" + item + "`: `" + name + "` is also a state");
+        if (named(m_.parameters)) throw BadInput("`" + item + "`: `" + name + "` is also a parameter");
+        m_.delay_names.push_back(name);
+      }
+    }
+    const size_t d = m_.state.size();
+    for (size_t k = 0; k < m_.delay_names.size(); ++k)
+      for (size_t i = 0; i < d; ++i) {
+        m_.z.emplace_back("z[" + std::to_string(k * d + i) + "]");
+        const std::string delayed = m_.delayed_name(k * d + i);
+        for (const auto* names : {&m_.state, &m_.parameters})
+          if (std::find(names->begin(), names->end(), delayed) != names->end())
+            throw BadInput("`equations.delays." + printable(m_.delay_names[k]) + "`: the delayed state `" + delayed +
+                           "` would be the " + (names == &m_.state ? "state" : "parameter") + " of that name");
+      }
   }
 
   void read_parameters() {
@@ -126,8 +164,8 @@ class EquationsReader {
     }
   }
 
-  // Constants (period, delay, history): the parameters and pi. Fields and switch: also t, the
-  // states and the delayed states NAME_tau.
+  // Constants (period, delays, history): the parameters and pi. Fields and switch: also t, the
+  // states and the delayed states NAME_X.
   void make_scopes() {
     for (size_t k = 0; k < m_.parameters.size(); ++k) constants_.names[m_.parameters[k]] = m_.p[k];
     constants_.names["pi"] = GiNaC::Pi;
@@ -137,9 +175,11 @@ class EquationsReader {
     constants_.elsewhere["t"] = "the time" + only;
     for (size_t i = 0; i < m_.state.size(); ++i) {
       fields_.names[m_.state[i]] = m_.y[i];
-      fields_.names[m_.state[i] + "_tau"] = m_.z[i];
       constants_.elsewhere[m_.state[i]] = "a state" + only;
-      constants_.elsewhere[m_.state[i] + "_tau"] = "a delayed state" + only;
+    }
+    for (size_t a = 0; a < m_.z.size(); ++a) {
+      fields_.names[m_.delayed_name(a)] = m_.z[a];
+      constants_.elsewhere[m_.delayed_name(a)] = "a delayed state" + only;
     }
   }
 
@@ -151,8 +191,13 @@ class EquationsReader {
     const toml::node* period = table_.get("period");
     if (!period) throw BadInput("`equations.period` is required (the forcing period T, e.g. \"2*pi/omega\")");
     m_.period = expression(*period, item_of("period"), constants_);
-    const toml::node* delay = table_.get("delay");
-    m_.delay = delay ? expression(*delay, item_of("delay"), constants_) : m_.period;  // tau = T by default
+    if (const toml::table* delays = table_.get("delays") ? table_.get("delays")->as_table() : nullptr) {
+      for (const auto& [key, value] : *delays)
+        m_.delays.push_back(expression(value, "equations.delays." + std::string(key.str()), constants_));
+    } else {
+      const toml::node* delay = table_.get("delay");
+      m_.delays = {delay ? expression(*delay, item_of("delay"), constants_) : m_.period};  // tau = T by default
+    }
     m_.history.assign(m_.state.size(), 0);
     const toml::node* history = table_.get("history");
     if (!history) return;
@@ -263,10 +308,8 @@ class EquationsReader {
       try {
         field.A.emplace_back();
         field.B.emplace_back();
-        for (size_t a = 0; a < f.size(); ++a) {
-          field.A[i].push_back(f[i].diff(m_.y[a]));
-          field.B[i].push_back(f[i].diff(m_.z[a]));
-        }
+        for (size_t a = 0; a < f.size(); ++a) field.A[i].push_back(f[i].diff(m_.y[a]));
+        for (const auto& za : m_.z) field.B[i].push_back(f[i].diff(za));
         field.f_t.push_back(f[i].diff(m_.t));
         field.f_tt.push_back(field.f_t[i].diff(m_.t));
       } catch (const std::exception& e) {
@@ -308,10 +351,8 @@ class EquationsReader {
 
 GiNaC::ex SymbolicEquationModel::display(const GiNaC::ex& e) const {
   GiNaC::exmap names;
-  for (size_t i = 0; i < state.size(); ++i) {
-    names[y[i]] = GiNaC::symbol(state[i]);
-    names[z[i]] = GiNaC::symbol(state[i] + "_tau");
-  }
+  for (size_t i = 0; i < state.size(); ++i) names[y[i]] = GiNaC::symbol(state[i]);
+  for (size_t a = 0; a < z.size(); ++a) names[z[a]] = GiNaC::symbol(delayed_name(a));
   for (size_t k = 0; k < parameters.size(); ++k) names[p[k]] = GiNaC::symbol(parameters[k]);
   return e.subs(names);
 }
@@ -319,10 +360,8 @@ GiNaC::ex SymbolicEquationModel::display(const GiNaC::ex& e) const {
 std::vector<std::string> terms_not_finite(const SymbolicEquationModel& model, double t, const std::vector<double>& y,
                                           const std::vector<double>& y_tau, const std::vector<double>& p) {
   GiNaC::lst at{model.t == GiNaC::numeric(t)};
-  for (size_t i = 0; i < model.y.size() && i < y.size() && i < y_tau.size(); ++i) {
-    at.append(model.y[i] == GiNaC::numeric(y[i]));
-    at.append(model.z[i] == GiNaC::numeric(y_tau[i]));
-  }
+  for (size_t i = 0; i < model.y.size() && i < y.size(); ++i) at.append(model.y[i] == GiNaC::numeric(y[i]));
+  for (size_t a = 0; a < model.z.size() && a < y_tau.size(); ++a) at.append(model.z[a] == GiNaC::numeric(y_tau[a]));
   for (size_t k = 0; k < model.p.size() && k < p.size(); ++k) at.append(model.p[k] == GiNaC::numeric(p[k]));
   // "" when e is a finite real number at the point, else what it is.
   auto not_finite = [&](const GiNaC::ex& e) -> std::string {
@@ -352,8 +391,9 @@ std::vector<std::string> terms_not_finite(const SymbolicEquationModel& model, do
         for (size_t a = 0; a < derivatives->at(i).size(); ++a) {
           const GiNaC::ex& e = derivatives->at(i)[a];
           if (const std::string why = not_finite(e); !why.empty())
-            found.push_back(item + ": its derivative by " + model.state[a] + (derivatives == &field.B ? "_tau" : "") +
-                            ", " + text_of(model.display(e)) + ", is " + why);
+            found.push_back(item + ": its derivative by " +
+                            (derivatives == &field.B ? model.delayed_name(a) : model.state[a]) + ", " +
+                            text_of(model.display(e)) + ", is " + why);
         }
     }
   }

@@ -3,8 +3,9 @@
 // model as symbolic expressions, before it is printed as C++ (equation_model_source.hpp).
 //
 // Every user name is replaced by a symbol with a generated name at parse time: state i is y[i],
-// its delayed value z[i], parameter k p[k], time t; pi stays GiNaC's exact constant Pi. Messages
-// show the user's names again (display()).
+// its value delayed by delay k z[k d + i] (the user's NAME_X for delay X; NAME_tau with one
+// delay), parameter k p[k], time t; pi stays GiNaC's exact constant Pi. Messages show the user's
+// names again (display()).
 #include <string>
 #include <vector>
 
@@ -20,7 +21,7 @@ struct SymbolicField {
   std::string entry;                         // "rhs" or "rhs_switched"
   std::vector<std::string> text;             // the entry's components as the scene wrote them (messages)
   std::vector<GiNaC::ex> f;                  // f_j, d components
-  std::vector<std::vector<GiNaC::ex>> A, B;  // A[i][a] = d f_i / d y_a, B[i][a] = d f_i / d z_a
+  std::vector<std::vector<GiNaC::ex>> A, B;  // A[i][a] = d f_i / d y_a, B[i][a] = d f_i / d z_a (d n of them)
   std::vector<GiNaC::ex> f_t, f_tt;          // d f / dt, d2 f / dt2 at fixed y, z
 };
 
@@ -28,9 +29,13 @@ struct SymbolicEquationModel {
   std::vector<std::string> state;       // user names, in order
   std::vector<std::string> parameters;  // user names, in the table's (sorted) order
   std::vector<double> parameter_defaults;
+  // The delays' names (the `delays` table's keys, sorted; {"tau"} for `delay` or none) and their
+  // expressions, in p and Pi only.
+  std::vector<std::string> delay_names;
+  std::vector<GiNaC::ex> delays;
   GiNaC::symbol t{"t"};
-  std::vector<GiNaC::symbol> y, z, p;  // printed y[i], z[i], p[k]
-  GiNaC::ex period, delay;             // in p and Pi only
+  std::vector<GiNaC::symbol> y, z, p;  // printed y[i], z[k d + i], p[k]
+  GiNaC::ex period;                    // in p and Pi only
   std::vector<GiNaC::ex> history;      // d entries, in p and Pi only
   SwitchKind switch_kind = SwitchKind::none;
   GiNaC::ex switch_function;      // H (0 without a switch): of t only, or affine in y
@@ -42,12 +47,15 @@ struct SymbolicEquationModel {
   bool is_linear = false;        // no state switch, every f_j affine in (y, z) jointly
 
   int d() const { return static_cast<int>(state.size()); }
+  int delay_count() const { return static_cast<int>(delays.size()); }
+  // The user's name of z[a]: NAME_X (state a mod d, delay a / d).
+  std::string delayed_name(size_t a) const { return state[a % state.size()] + "_" + delay_names[a / state.size()]; }
   // e with the user's names for the generated symbols, for messages.
   GiNaC::ex display(const GiNaC::ex& e) const;
 };
 
-// What of the model is not a finite real number at a point (t, y, y(t - tau)) and parameter
-// values p, evaluated by GiNaC from the exact expressions (not the compiled code): each component
+// What of the model is not a finite real number at a point (t, y, the delayed states z) and
+// parameter values p, evaluated by GiNaC from the exact expressions (not the compiled code): each component
 // of every field and its derivatives by y and y_tau, one line each, e.g. "`equations.rhs[1]` =
 // a*x^(1/3)+b*x_tau: its derivative by x, 1/3*a*x^(-2/3), is undefined (division by zero)".
 // Empty when all are finite. For messages about a step that failed. Not thread-safe (GiNaC).

@@ -132,8 +132,8 @@ class ExplainedAnalyses final : public ModelAnalyses {
       text += "; at t = " + format_number(point.t);
       for (size_t i = 0; i < source_.state.size() && i < point.y.size(); ++i)
         text += ", " + source_.state[i] + " = " + format_number(point.y[i]);
-      for (size_t i = 0; i < source_.state.size() && i < point.y_tau.size(); ++i)
-        text += ", " + source_.state[i] + "_tau = " + format_number(point.y_tau[i]);
+      for (size_t a = 0; a < source_.delayed.size() && a < point.y_tau.size(); ++a)
+        text += ", " + source_.delayed[a] + " = " + format_number(point.y_tau[a]);
       for (size_t i = 0; i < terms.size(); ++i) text += (i ? "; " : ": ") + terms[i];
       named = true;
       break;  // the first point the step evaluated where a term is not finite
@@ -151,6 +151,12 @@ class ExplainedAnalyses final : public ModelAnalyses {
   std::vector<double> p_;
 };
 
+// The item of delay k in messages: equations.delay for a model written with `delay`, else
+// equations.delays.NAME.
+std::string delay_item(const EquationModelSource& source, size_t k) {
+  return source.written_with_delays ? "equations.delays." + source.delays[k] : "equations.delay";
+}
+
 double positive_value(const std::string& item, double value) {
   if (!std::isfinite(value) || !(value > 0))
     throw BadInput("`" + item + "` evaluates to " + format_number(value) +
@@ -166,7 +172,8 @@ std::vector<std::string> engine_keys(const KeyIndex& index) {
   return keys;
 }
 
-EquationModel read_equation_model(Config& config, const std::function<void(double, double)>& check_grid) {
+EquationModel read_equation_model(Config& config,
+                                  const std::function<void(const std::vector<double>&, const std::vector<std::string>&, double)>& check_grid) {
   if (!config.has("equations"))
     throw BadInput("`model = equations`: the scene has no [equations] table (docs/models.md shows its format)");
   const std::string text = config.get_string("equations", "");
@@ -187,20 +194,37 @@ EquationModel read_equation_model(Config& config, const std::function<void(doubl
   // Everything that can be checked without the compiled model is checked before the compile
   // (seconds): the constant expressions, and the grid they give with N.
   const std::vector<double> constants = constants_at(src, p);
+  const size_t n = src.delays.size();
   const double period_exact = positive_value("equations.period", constants[0]);
   const bool delay_from_ratio = config.has("tau_over_T");
-  if (delay_from_ratio) require_positive("tau_over_T", config.get_double("tau_over_T", 1));
-  const double tau_exact = delay_from_ratio ? config.get_double("tau_over_T", 1) * period_exact
-                                            : positive_value("equations.delay", constants[1]);
+  if (delay_from_ratio) {
+    require_positive("tau_over_T", config.get_double("tau_over_T", 1));
+    if (n > 1)
+      throw BadInput("`tau_over_T`: sets the one delay of a model; this model has " + std::to_string(n) +
+                     " (equations.delays): set the parameters its delays depend on instead");
+  }
+  // The delays at these parameters, from `values` (the constants' GiNaC values, or the compiled
+  // model's): each > 0 and finite, named.
+  const auto delays_from = [&](std::vector<double> values, double period) {
+    if (delay_from_ratio) return std::vector<double>{config.get_double("tau_over_T", 1) * period};
+    for (size_t k = 0; k < n; ++k)
+      positive_value(delay_item(src, k), values[k]);
+    return values;
+  };
+  const std::vector<double> taus_exact =
+      delays_from(std::vector<double>(constants.begin() + 1, constants.begin() + 1 + static_cast<long>(n)), period_exact);
   for (size_t i = 0; i < src.state.size(); ++i)
-    if (!std::isfinite(constants[2 + i]))
+    if (!std::isfinite(constants[1 + n + i]))
       throw BadInput("`equations.history." + src.state[i] + "` is not a finite number at these parameters");
-  check_grid(tau_exact, period_exact);
+  std::vector<std::string> delay_items;
+  for (size_t k = 0; k < n; ++k) delay_items.push_back("`" + delay_item(src, k) + "`");
+  check_grid(taus_exact, delay_items, period_exact);
 
   const EquationPlugin& plugin = compiled(src, cache_dir);
   const double period = positive_value("equations.period", plugin.period(p.data()));
-  const double tau = delay_from_ratio ? config.get_double("tau_over_T", 1) * period
-                                      : positive_value("equations.delay", plugin.delay(p.data()));
+  std::vector<double> compiled_taus(n);
+  plugin.delays(p.data(), compiled_taus.data());
+  const std::vector<double> taus = delays_from(compiled_taus, period);
   std::vector<double> history(src.state.size());
   plugin.history(p.data(), history.data());
   for (size_t i = 0; i < history.size(); ++i)
@@ -211,7 +235,7 @@ EquationModel read_equation_model(Config& config, const std::function<void(doubl
   model.state = src.state;
   model.parameters = src.parameters;
   model.analyses = std::make_shared<const ExplainedAnalyses>(
-      std::unique_ptr<const ModelAnalyses>(plugin.analyses(p.data(), tau, period, history.data())), src, p);
+      std::unique_ptr<const ModelAnalyses>(plugin.analyses(p.data(), taus.data(), period, history.data())), src, p);
   return model;
 }
 

@@ -48,15 +48,16 @@ std::string plugin_source(const std::string& model_code) {
          "DELAYSPEC_EXPORT const char* delayspec_equation_version() {\n"
          "  return DELAYSPEC_VERSION \" \" DELAYSPEC_REVISION;\n}\n"
          "DELAYSPEC_EXPORT double delayspec_equation_period(const double* p) { return EquationModel::period_of(p); }\n"
-         "DELAYSPEC_EXPORT double delayspec_equation_delay(const double* p) { return EquationModel::delay_of(p); }\n"
+         "DELAYSPEC_EXPORT void delayspec_equation_delays(const double* p, double* taus) {\n"
+         "  EquationModel::delays_of(p, taus);\n}\n"
          "DELAYSPEC_EXPORT void delayspec_equation_history(const double* p, double* y) {\n"
          "  const EquationModel::Vector h = EquationModel::history_of(p);\n"
          "  for (int i = 0; i < EquationModel::d; ++i) y[i] = h[i];\n}\n"
-         "DELAYSPEC_EXPORT delayspec::ModelAnalyses* delayspec_equation_analyses(const double* p, double tau,\n"
+         "DELAYSPEC_EXPORT delayspec::ModelAnalyses* delayspec_equation_analyses(const double* p, const double* taus,\n"
          "    double period, const double* y) {\n"
          "  EquationModel m;\n"
          "  for (int k = 0; k < EquationModel::parameter_count; ++k) m.p[k] = p[k];\n"
-         "  m.tau_ = tau;\n  m.period_ = period;\n"
+         "  m.set_delays(taus);\n  m.period_ = period;\n"
          "  for (int i = 0; i < EquationModel::d; ++i) m.history_[i] = y[i];\n"
          "  return new delayspec::ModelAnalysesFor<EquationModel>(m);\n}\n";
 }
@@ -268,7 +269,7 @@ EquationPlugin plugin_of(const detail::SharedObject& model, const std::filesyste
   EquationPlugin plugin;
   plugin.analyses = symbol<std::remove_pointer_t<decltype(plugin.analyses)>>(model, "delayspec_equation_analyses", object);
   plugin.period = symbol<std::remove_pointer_t<decltype(plugin.period)>>(model, "delayspec_equation_period", object);
-  plugin.delay = symbol<std::remove_pointer_t<decltype(plugin.delay)>>(model, "delayspec_equation_delay", object);
+  plugin.delays = symbol<std::remove_pointer_t<decltype(plugin.delays)>>(model, "delayspec_equation_delays", object);
   plugin.history = symbol<std::remove_pointer_t<decltype(plugin.history)>>(model, "delayspec_equation_history", object);
   plugin.object = object;
   return plugin;

@@ -28,10 +28,12 @@ namespace delayspec::cli {
 
 struct EquationPlugin {
   // The analyses of the model at the given parameter values (in the order of the source's
-  // parameters), delay, period and constant initial history (d values). The caller owns it.
-  ModelAnalyses* (*analyses)(const double* parameters, double tau, double period, const double* history) = nullptr;
+  // parameters), delays (in the order of the source's delays), period and constant initial
+  // history (d values). The caller owns it.
+  ModelAnalyses* (*analyses)(const double* parameters, const double* delays, double period,
+                             const double* history) = nullptr;
   double (*period)(const double* parameters) = nullptr;                // the `period` expression
-  double (*delay)(const double* parameters) = nullptr;                 // the `delay` expression
+  void (*delays)(const double* parameters, double* delays) = nullptr;  // the `delay(s)` expressions
   void (*history)(const double* parameters, double* state) = nullptr;  // the `history` expressions
   std::filesystem::path object;                                        // the loaded shared object
 };

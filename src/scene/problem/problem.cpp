@@ -161,9 +161,10 @@ Problem read_problem(Config& config, int default_N) {
     problem.state_names = builtin->state_names;
     problem.forced = builtin->forced;
   } else {
-    EquationModel equations = read_equation_model(config, [&](double tau, double period) {
-      make_grid(tau, period, static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000)),
-                static_cast<int>(config.get_int_in_range("orbit_period", 1, 1, 1000)));
+    EquationModel equations = read_equation_model(
+        config, [&](const std::vector<double>& taus, const std::vector<std::string>& names, double period) {
+          make_grid(taus, period, static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000)),
+                    static_cast<int>(config.get_int_in_range("orbit_period", 1, 1, 1000)), names);
     });
     problem.analyses = std::move(equations.analyses);
     problem.state_names = std::move(equations.state);
