@@ -204,7 +204,7 @@ PeriodicOrbit orbit_by_nested_shooting(const StroboscopicMap<Model, Stepper>& ma
   const Map coarse = level_map(Ns.front());
   const Eigen::VectorXd U = simulated_guess(coarse, coarse.constant_history(y0), opt.guess_periods,
                                             "orbit (N = " + std::to_string(Ns.front()) + ")");
-  OrbitLinearisation<Model::d> lin;
+  OrbitLinearisation<Model::d, delayed_rows<Model>> lin;
   PeriodicOrbit orbit;
   long linear_iterations = 0;
   std::vector<PeriodicOrbit::Level> levels;

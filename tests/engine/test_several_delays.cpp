@@ -25,6 +25,8 @@
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/lyapunov.hpp"
+#include "delayspec/model_analyses.hpp"
+#include "delayspec/model_analyses_continuation.hpp"  // the analyses of a model the library does not instantiate
 #include "delayspec/model_linear.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/stroboscopic_map.hpp"
@@ -262,6 +264,89 @@ TEST(SeveralDelays, LyapunovExponentsAreTheRightmostRealParts) {
   for (cd m : mu) re.push_back(std::log(std::abs(m)));
   // the leading exponent to the discretisation error and the 1/periods convergence of the average
   EXPECT_NEAR(r.per_period[0], re[0], 2e-2) << re[0];
+}
+
+// A forced Duffing oscillator under two delayed loops (data/scenes/equations_two_delays.toml's
+// equation at its values): nonlinear, so Newton, shooting and the linearisation at the orbit run.
+struct TwoDelayDuffing {
+  static constexpr int d = 2;
+  static constexpr int delay_count = 2;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false;
+  double zeta = 0.1, alpha = 0.2, F = 0.4, Omega = 1.1, kp = 0.2, kv = 0.1, tp = 1, tv = std::sqrt(2.0);
+  std::array<double, 2> delays() const { return {tp, tv}; }
+  double tau() const { return std::max(tp, tv); }
+  double period() const { return 2 * M_PI / Omega; }
+  Vec<2> f(int, double t, const Vec<2>& y, const Vec<4>& z) const {
+    return Vec<2>(y[1], -2 * zeta * y[1] - y[0] - alpha * y[0] * y[0] * y[0] + F * std::cos(Omega * t) - kp * z[0] -
+                            kv * z[3]);
+  }
+  Mat<2> A(int, double, const Vec<2>& y, const Vec<4>&) const {
+    return (Mat<2>() << 0, 1, -1 - 3 * alpha * y[0] * y[0], -2 * zeta).finished();
+  }
+  RectMat<2, 4> B(int, double, const Vec<2>&, const Vec<4>&) const {
+    RectMat<2, 4> b = RectMat<2, 4>::Zero();
+    b(1, 0) = -kp;  // by x(t - tp)
+    b(1, 3) = -kv;  // by v(t - tv)
+    return b;
+  }
+  Vec<2> initial_state() const { return Vec<2>(0, 0); }
+};
+static_assert(DelayModel<TwoDelayDuffing>);
+
+// The orbit by Newton on the periodic problem and by shooting agree; its multipliers (the
+// operator's step maps, through the analyses every command uses) equal the eigenvalues of the
+// map's Jacobian formed by central differences of the nonlinear map at the orbit, which never
+// sees a step map: to 1e-7, the difference quotient's error (h^2 f''' ~ 1e-10 with h = 1e-5,
+// plus rounding eps / h ~ 1e-11, amplified by the eigenproblem's conditioning).
+TEST(SeveralDelays, NonlinearOrbitMultipliersEqualTheMapsFiniteDifferenceJacobian) {
+  const TwoDelayDuffing model;
+  const ModelAnalysesFor<TwoDelayDuffing> typed(model);
+  const ModelAnalyses& analyses = typed;
+  MapSettings settings;
+  settings.N = 40;
+  OrbitSettings by_newton, by_shooting;
+  by_newton.method = OrbitMethod::newton;
+  by_shooting.method = OrbitMethod::shooting;
+  const LinearisedOrbit newton = analyses.linearised_orbit(settings, by_newton);
+  const LinearisedOrbit shooting = analyses.linearised_orbit(settings, by_shooting);
+  EXPECT_LT((newton.orbit.history - shooting.orbit.history).cwiseAbs().maxCoeff(), 1e-9);
+  FloquetOptions o;
+  o.nev = 6;
+  o.solver = FloquetSolver::dense_lapack;
+  const Multipliers mu = floquet_multipliers(*newton.monodromy, o).multipliers;
+
+  const StroboscopicMap<TwoDelayDuffing> map(TrapezoidStepper<TwoDelayDuffing>(model), analyses.grid(settings));
+  const Eigen::VectorXd& U = newton.orbit.history;
+  const long n = U.size();
+  Eigen::MatrixXd J(n, n);
+  const double e = 1e-5;
+  for (long j = 0; j < n; ++j)
+    J.col(j) = (map.apply(U + e * Eigen::VectorXd::Unit(n, j)) - map.apply(U - e * Eigen::VectorXd::Unit(n, j))) / (2 * e);
+  const Eigen::VectorXcd ev = J.eigenvalues();
+  const std::vector<cd> fd(ev.data(), ev.data() + ev.size());
+  EXPECT_GT(std::abs(mu[0]), 0.5);  // a non-trivial leading pair
+  EXPECT_LT(worst_distance(mu, fd), 1e-7);
+}
+
+// The Lyapunov exponents of the stable forced orbit are log |mu| of its leading multipliers.
+TEST(SeveralDelays, NonlinearLyapunovExponentsAreTheOrbitsLeadingMultipliers) {
+  const TwoDelayDuffing model;
+  const ModelAnalysesFor<TwoDelayDuffing> typed(model);
+  const ModelAnalyses& analyses = typed;
+  MapSettings settings;
+  settings.N = 100;
+  const LinearisedOrbit at = analyses.linearised_orbit(settings, OrbitSettings{});
+  FloquetOptions o;
+  o.nev = 2;
+  const Multipliers mu = floquet_multipliers(*at.monodromy, o).multipliers;
+  LyapunovOptions l;
+  l.exponents = 2;
+  l.transient = 200;
+  l.periods = 400;
+  const LyapunovResult r = analyses.lyapunov(settings, l);
+  // a complex pair: both exponents are log |mu_1|, to the averages' error (reported)
+  EXPECT_NEAR(r.per_period[0], std::log(std::abs(mu[0])), 3 * r.error_per_period[0] + 1e-3);
+  EXPECT_NEAR(r.per_period[1], std::log(std::abs(mu[1])), 3 * r.error_per_period[1] + 1e-3);
 }
 
 }  // namespace
