@@ -88,9 +88,10 @@ struct HistoryGrid {
     } else {
       DelayTap<W> tap;
       tap.t = time_in_period(l);
-      for (size_t i = 0; i < delays.size(); ++i) {
-        const long j = M + l - delays[i].m;
-        const double th = delays[i].theta, c0 = 1 - th;
+      constexpr int kDelays = W::RowsAtCompileTime / D;  // == delays.size()
+      for (int i = 0; i < kDelays; ++i) {
+        const long j = M + l - delays[static_cast<size_t>(i)].m;
+        const double th = delays[static_cast<size_t>(i)].theta, c0 = 1 - th;
         const long row = static_cast<long>(i) * D;
         if (th == 0) {
           tap.w0.template segment<D>(row) = b(j);

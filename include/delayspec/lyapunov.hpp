@@ -198,6 +198,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
     // (through the captured references they were reloaded every step: a store of a double may
     // alias them)
     const HistoryGrid g = grid;
+    [[maybe_unused]] const DelayPlaces<DW / D> places(g.delays);  // several delays only
     V* const u = traj.data();
     double* const b = block.data();
     auto slot = [u](long i) -> const V& { return u[i]; };
@@ -208,7 +209,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
       // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same
       // tap), P, Q, R not formed where the step is one sub-step (apply_step_linearisation)
       if constexpr (DW != D)
-        multi_delay_step<D, DW>(step_linearisation, b, M + l, g.delays, k, b + (M + l + 1) * stride);
+        multi_delay_step<D, DW, KC>(step_linearisation, b, M + l, places, k, b + (M + l + 1) * stride);
       else
         apply_step_linearisation<D, KC>(step_linearisation, b + (M + l) * stride, b + g.delayed_slot(l) * stride, k,
                                         g.theta, b + (M + l + 1) * stride);

@@ -46,8 +46,8 @@
 // and tau() returns the longest (the history's length: N steps per the longest delay). Its
 // delayed argument is then the n delayed states stacked, Vec<d n> (rows i d .. i d + d - 1 hold
 // y(t - tau_{i+1})), and B = df / d(that stack) is d x d n (DelayedVec, DelayedMat). A model
-// without delay_count has the one delay tau(). Several delays with switching or time switches
-// are not supported (the event steps take one delayed value).
+// without delay_count has the one delay tau(). Several delays with time switches are supported,
+// with state switching (has_switching) not yet (the event step takes one delayed value).
 #include <array>
 #include <concepts>
 #include <vector>
@@ -106,7 +106,7 @@ concept DelayModel = requires(const Model& m, const Vec<Model::d>& y, double t, 
 }
 &&(delay_count_of<Model>() == 1 || requires(const Model& m) {
      requires delay_count_of<Model>() >= 2;
-     requires !Model::has_switching && !TimeSwitchedModel<Model>;
+     requires !Model::has_switching;
      { m.delays() } -> std::convertible_to<std::array<double, delay_count_of<Model>()>>;
    })
 &&(!Model::has_switching ||

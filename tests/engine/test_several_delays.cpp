@@ -349,5 +349,54 @@ TEST(SeveralDelays, NonlinearLyapunovExponentsAreTheOrbitsLeadingMultipliers) {
   EXPECT_NEAR(r.per_period[1], std::log(std::abs(mu[1])), 3 * r.error_per_period[1] + 1e-3);
 }
 
+// A time window with two delays: x' = a_j x + b1 x(t - tau1) + b2 x(t - tau2), a_1 inside the
+// window sin(2 pi t / T) > c and a_2 outside (time switches, model.hpp). With tau1 = tau2 the two
+// delayed terms are one, (b1 + b2) x(t - tau): the same multipliers as that one-delay model, to
+// rounding (an identity; the split steps of time_switch_step carry the stacked taps).
+template <int NT>
+struct WindowedScalar {
+  static constexpr int d = 1;
+  static constexpr int delay_count = NT;
+  static constexpr bool has_switching = false, has_time_switches = true, affine_in_state = true, is_linear = true;
+  double a1 = -2, a2 = 0.5, b1 = 0.4, b2 = -0.3, c = 0.3, tau1 = 1.25, tau2 = 1.25, T = 1;
+  std::array<double, NT> delays() const {
+    if constexpr (NT == 2) return {tau1, tau2};
+    else return {tau1};
+  }
+  double tau() const { return std::max(tau1, tau2); }
+  double period() const { return T; }
+  double a(int j) const { return j == 1 ? a1 : a2; }
+  Vec<1> f(int j, double, const Vec<1>& y, const Vec<NT>& z) const {
+    return Vec<1>(a(j) * y[0] + (NT == 2 ? b1 * z[0] + b2 * z[NT - 1] : (b1 + b2) * z[0]));
+  }
+  Mat<1> A(int j, double, const Vec<1>&, const Vec<NT>&) const { return Mat<1>::Constant(a(j)); }
+  RectMat<1, NT> B(int, double, const Vec<1>&, const Vec<NT>&) const {
+    RectMat<1, NT> b;
+    if constexpr (NT == 2) b << b1, b2;
+    else b << b1 + b2;
+    return b;
+  }
+  Vec<1> initial_state() const { return Vec<1>(1); }
+  int time_segment(double t) const { return std::sin(2 * M_PI * t / T) > c ? 1 : 2; }
+  double next_time_switch(double t0, double t1) const {  // the window's ends in (t0, t1), to adjacent doubles
+    const double ends[2] = {std::asin(c) / (2 * M_PI) * T, (0.5 - std::asin(c) / (2 * M_PI)) * T};
+    double best = t1;
+    for (double base = std::floor(t0 / T) * T; base < t1; base += T)
+      for (double e : ends)
+        if (base + e > t0 && base + e < best) best = base + e;
+    return best;
+  }
+};
+
+TEST(SeveralDelays, TimeWindowWithTwoEqualDelaysIsTheOneDelayModel) {
+  const WindowedScalar<2> two;
+  const WindowedScalar<1> one;
+  static_assert(DelayModel<WindowedScalar<2>> && TimeSwitchedModel<WindowedScalar<2>>);
+  const Multipliers mu2 = discrete_multipliers(two, 80, 6, FloquetSolver::dense_lapack);
+  const Multipliers mu1 = discrete_multipliers(one, 80, 6, FloquetSolver::dense_lapack);
+  ASSERT_EQ(mu1.size(), mu2.size());
+  for (size_t i = 0; i < mu1.size(); ++i) EXPECT_LT(std::abs(mu1[i] - mu2[i]), 1e-13) << i;
+}
+
 }  // namespace
 }  // namespace delayspec

@@ -244,63 +244,109 @@ inline void single_steps(const StepMap<D>* maps, long K, long M, long first_dela
 //   out = P u0 + sum_i Q_i w0_i + R_i w1_i,   w0_i = (1 - theta_i) b[j_i] + theta_i b[j_i - 1],
 //                                             w1_i = (1 - theta_i) b[j_i + 1] + theta_i b[j_i],
 //
-// j_i = current - m_i, Q_i and R_i the D x D column blocks of delay i. Portable, one vector at a
-// time: the taps of n delays are gathered into the stacked W0, W1 (D n rows) and the step's
-// derivative applied to them, formed (step_block's sum over the blocks) or factored
-// (SubStepDerivative::apply). The single-delay kernels above are the fast paths; these serve
-// the models that declare several delays.
-template <int D, int DW>
-struct DelayedStack {
-  Vec<DW> w0, w1;
-  // Gathers vector v's taps around slot `current` of b (k interleaved vectors).
-  void gather(const double* b, long current, const std::vector<HistoryGrid::DelayPosition>& delays, long k, long v) {
-    const long stride = static_cast<long>(D) * k;
-    for (size_t i = 0; i < delays.size(); ++i) {
-      const double* d0 = b + (current - delays[i].m) * stride + v;
-      const double th = delays[i].theta, c0 = 1 - th;
-      for (int c = 0; c < D; ++c) {
-        const long row = static_cast<long>(i) * D + c;
-        w0[row] = th == 0 ? d0[c * k] : c0 * d0[c * k] + th * d0[c * k - stride];
-        w1[row] = th == 0 ? d0[stride + c * k] : c0 * d0[stride + c * k] + th * d0[c * k];
-      }
-    }
+// j_i = current - m_i, Q_i and R_i the D x D column blocks of delay i. The same single pass over
+// the k vectors as step_block, D accumulators per vector, the delayed part first and P u0 last;
+// the interpolation is done for every delay (theta_i = 0 multiplies a valid slot by 0), so the
+// loop over the vectors has no branch and vectorises. NT = DW / D delays, KC as in step_block.
+template <int NT>
+struct DelayPlaces {
+  long m[NT];
+  double theta[NT];
+  // From the grid's delays (none with one delay: then unused, left 0).
+  explicit DelayPlaces(const std::vector<HistoryGrid::DelayPosition>& delays) : m{}, theta{} {
+    for (size_t i = 0; i < NT && i < delays.size(); ++i) m[i] = delays[i].m, theta[i] = delays[i].theta;
   }
 };
 
-// One vector's step: through the formed blocks, or the factored derivative when the step kept it.
-template <int D, int DW>
-inline Vec<D> apply_multi_delay(const StepMap<D, DW>& s, const Vec<D>& u0, const DelayedStack<D, DW>& w) {
-  return s.Q * w.w0 + s.R * w.w1 + s.P * u0;
-}
-template <int D, int DW>
-inline Vec<D> apply_multi_delay(const StepLinearisation<D, DW>& s, const Vec<D>& u0, const DelayedStack<D, DW>& w) {
-  if (s.factored) return s.sub.apply(u0, w.w0, w.w1);
-  return apply_multi_delay(s.map, u0, w);
+template <int D, int DW, int KC = 0>
+inline void multi_delay_block(const Mat<D>& P, const RectMat<D, DW>& Q, const RectMat<D, DW>& R, const double* b,
+                              long current, const DelayPlaces<DW / D>& places, long k_runtime,
+                              double* __restrict out) {
+  constexpr int NT = DW / D;
+  const long k = KC > 0 ? KC : k_runtime;
+  const long stride = static_cast<long>(D) * k;
+  const double* u0 = b + current * stride;
+  const double *d0[NT], *dm[NT], *d1[NT];
+  double c0[NT], th[NT];
+  for (int i = 0; i < NT; ++i) {
+    d0[i] = b + (current - places.m[i]) * stride;
+    d1[i] = d0[i] + stride;
+    th[i] = places.theta[i];
+    c0[i] = 1 - th[i];
+    dm[i] = th[i] == 0 ? d0[i] : d0[i] - stride;  // slot j - 1 only when it is read with a weight
+  }
+  if (k == 1) {  // one vector: a recurrence through u0, so the delayed part first, P u0 last
+    double acc[D] = {};
+    for (int i = 0; i < NT; ++i)
+      for (int c = 0; c < D; ++c) {
+        const double w0 = c0[i] * d0[i][c] + th[i] * dm[i][c], w1 = c0[i] * d1[i][c] + th[i] * d0[i][c];
+        for (int r = 0; r < D; ++r) acc[r] += Q.coeff(r, i * D + c) * w0 + R.coeff(r, i * D + c) * w1;
+      }
+    for (int r = 0; r < D; ++r) {
+      for (int c = 0; c < D; ++c) acc[r] += P.coeff(r, c) * u0[c];
+      out[r] = acc[r];
+    }
+    return;
+  }
+  // k vectors: one pass, D accumulators per vector (step_block's loop; vectorises over v)
+  for (long v = 0; v < k; ++v) {
+    double acc[D] = {};
+    for (int i = 0; i < NT; ++i)
+      for (int c = 0; c < D; ++c) {
+        const double w0 = c0[i] * d0[i][c * k + v] + th[i] * dm[i][c * k + v];
+        const double w1 = c0[i] * d1[i][c * k + v] + th[i] * d0[i][c * k + v];
+        for (int r = 0; r < D; ++r) {
+          acc[r] += Q.coeff(r, i * D + c) * w0;
+          acc[r] += R.coeff(r, i * D + c) * w1;
+        }
+      }
+    for (int r = 0; r < D; ++r) {
+      for (int c = 0; c < D; ++c) acc[r] += P.coeff(r, c) * u0[c * k + v];
+      out[r * k + v] = acc[r];
+    }
+  }
 }
 
-// Step `current` -> current + 1 of k interleaved vectors; Derivative: a StepMap or a
-// StepLinearisation of D x DW blocks.
-template <int D, int DW, class Derivative>
-inline void multi_delay_step(const Derivative& s, const double* b, long current,
-                             const std::vector<HistoryGrid::DelayPosition>& delays, long k, double* __restrict out) {
-  const long stride = static_cast<long>(D) * k;
-  DelayedStack<D, DW> w;
-  for (long v = 0; v < k; ++v) {
-    w.gather(b, current, delays, k, v);
-    Vec<D> u0;
-    for (int c = 0; c < D; ++c) u0[c] = b[current * stride + c * k + v];
-    const Vec<D> next = apply_multi_delay<D, DW>(s, u0, w);
-    for (int r = 0; r < D; ++r) out[r * k + v] = next[r];
+// A step's derivative, formed or factored (S^{-1} [L u0 + Bl w0 + Br w1]: the same pass with L,
+// Bl, Br, then S^{-1} per vector), applied to k interleaved vectors.
+template <int D, int DW, int KC = 0>
+inline void multi_delay_step(const StepMap<D, DW>& s, const double* b, long current,
+                             const DelayPlaces<DW / D>& places, long k, double* __restrict out) {
+  multi_delay_block<D, DW, KC>(s.P, s.Q, s.R, b, current, places, k, out);
+}
+template <int D, int DW, int KC = 0>
+inline void multi_delay_step(const StepLinearisation<D, DW>& s, const double* b, long current,
+                             const DelayPlaces<DW / D>& places, long k_runtime, double* __restrict out) {
+  if (!s.factored) return multi_delay_step<D, DW, KC>(s.map, b, current, places, k_runtime, out);
+  multi_delay_block<D, DW, KC>(s.sub.left, s.sub.bl, s.sub.br, b, current, places, k_runtime, out);
+  const long k = KC > 0 ? KC : k_runtime;
+  for (long v = 0; v < k; ++v) {  // out <- S^{-1} out, vector by vector
+    Vec<D> rhs;
+    for (int r = 0; r < D; ++r) rhs[r] = out[r * k + v];
+    const Vec<D> x = s.sub.s.solve(rhs);
+    for (int r = 0; r < D; ++r) out[r * k + v] = x[r];
   }
 }
 
 // The K steps of one map (formed step maps) on k interleaved vectors of the linear history b:
-// step l reads slot M + l and the taps, writes slot M + l + 1.
+// step l reads slot M + l and the taps, writes slot M + l + 1. k = 1, 2, 4, 8, 16 at compile time.
 template <int D, int DW>
 inline void multi_delay_steps(const StepMap<D, DW>* maps, long K, long M,
                               const std::vector<HistoryGrid::DelayPosition>& delays, double* b, long k) {
+  const DelayPlaces<DW / D> places(delays);
   const long stride = static_cast<long>(D) * k;
-  for (long l = 0; l < K; ++l) multi_delay_step<D, DW>(maps[l], b, M + l, delays, k, b + (M + l + 1) * stride);
+  auto run = [&]<int KC>() {
+    for (long l = 0; l < K; ++l)
+      multi_delay_step<D, DW, KC>(maps[l], b, M + l, places, k, b + (M + l + 1) * stride);
+  };
+  switch (k) {
+    case 1: return run.template operator()<1>();
+    case 2: return run.template operator()<2>();
+    case 4: return run.template operator()<4>();
+    case 8: return run.template operator()<8>();
+    case 16: return run.template operator()<16>();
+    default: return run.template operator()<0>();
+  }
 }
 
 }  // namespace delayspec

@@ -71,11 +71,12 @@ int time_switch_offsets(const Model& model, double t, double h,
   return count;
 }
 
+// With several delays w0, w1 are the stacked taps (DW rows, model.hpp) and so are Q and R.
 template <class Model>
 Vec<Model::d> time_switch_step(const TrapezoidStepper<Model>& stepper, double t, double h, const Vec<Model::d>& u0,
-                               const Vec<Model::d>& w0, const Vec<Model::d>& w1,
-                               StepLinearisation<Model::d>& linearisation) {
-  constexpr int D = Model::d;
+                               const DelayedVec<Model>& w0, const DelayedVec<Model>& w1,
+                               StepLinearisation<Model::d, delayed_rows<Model>>& linearisation) {
+  constexpr int D = Model::d, DW = delayed_rows<Model>;
   const Model& model = stepper.model();
   std::array<double, kMaxTimeSwitchesPerStep + 2> s;
   const int pieces = time_switch_offsets(model, t, h, s);
@@ -85,24 +86,25 @@ Vec<Model::d> time_switch_step(const TrapezoidStepper<Model>& stepper, double t,
     linearisation.factored = true;
     return stepper.factored_sub_step(t, h, u0, w0, w1, j, j, linearisation.sub, jr);
   }
-  auto w_at = [&](double x) { return Vec<D>((1 - x / h) * w0 + (x / h) * w1); };
+  auto w_at = [&](double x) { return DelayedVec<Model>((1 - x / h) * w0 + (x / h) * w1); };
   Vec<D> z = u0;
-  Eigen::Matrix<double, D, 3 * D> X = Eigen::Matrix<double, D, 3 * D>::Zero();  // dz / d(u0, w0, w1)
+  using Tangent = Eigen::Matrix<double, D, D + 2 * DW>;  // dz / d(u0, w0, w1)
+  Tangent X = Tangent::Zero();
   X.template leftCols<D>().setIdentity();
   for (int p = 1; p <= pieces; ++p) {
     const double s0 = s[p - 1], s1 = s[p];
     const int j = model.time_segment(t + 0.5 * (s0 + s1));
-    const SubStepResult<D> r = stepper.sub_step(t + s0, s1 - s0, z, w_at(s0), w_at(s1), j, j);
-    Eigen::Matrix<double, D, 3 * D> next = r.dz0 * X;
-    next.template middleCols<D>(D) += (1 - s0 / h) * r.dw0 + (1 - s1 / h) * r.dw1;
-    next.template rightCols<D>(D) += (s0 / h) * r.dw0 + (s1 / h) * r.dw1;
+    const SubStepResult<D, DW> r = stepper.sub_step(t + s0, s1 - s0, z, w_at(s0), w_at(s1), j, j);
+    Tangent next = r.dz0 * X;
+    next.template middleCols<DW>(D) += (1 - s0 / h) * r.dw0 + (1 - s1 / h) * r.dw1;
+    next.template rightCols<DW>() += (s0 / h) * r.dw0 + (s1 / h) * r.dw1;
     X = next;
     z = r.z1;
   }
   linearisation.factored = false;
   linearisation.map.P = X.template leftCols<D>();
-  linearisation.map.Q = X.template middleCols<D>(D);
-  linearisation.map.R = X.template rightCols<D>();
+  linearisation.map.Q = X.template middleCols<DW>(D);
+  linearisation.map.R = X.template rightCols<DW>();
   return z;
 }
 
