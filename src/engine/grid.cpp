@@ -31,8 +31,13 @@ Ratio rational_approximation(double x) {
 }  // namespace
 
 std::string HistoryGrid::describe() const {
-  return "N=" + std::to_string(N) + " h=" + format_number(h) + " K=" + std::to_string(K) + " M=" + std::to_string(M) +
-         (aligned() ? " (aligned delay)" : " (fractional delay, theta=" + format_number(theta) + ")");
+  std::string text = "N=" + std::to_string(N) + " h=" + format_number(h) + " K=" + std::to_string(K) +
+                     " M=" + std::to_string(M);
+  if (delays.empty())
+    return text + (aligned() ? " (aligned delay)" : " (fractional delay, theta=" + format_number(theta) + ")");
+  text += " (" + std::to_string(delays.size()) + " delays at m + theta steps:";
+  for (const DelayPosition& p : delays) text += " " + std::to_string(p.m) + (p.theta == 0 ? "" : "+" + format_number(p.theta));
+  return text + ")";
 }
 
 std::vector<double> HistoryGrid::delay_values() const {

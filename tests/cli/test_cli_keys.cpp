@@ -207,7 +207,8 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"milling_lobes_full", "chart"},
                                                        {"milling_point", "converge"},
                                                        {"equations_impact", "floquet"},
-                                                       {"equations_two_oscillators", "floquet"}};
+                                                       {"equations_two_oscillators", "floquet"},
+                                                       {"equations_two_delays", "floquet"}};
   const fs::path cache = DELAYSPEC_TEST_MODEL_CACHE;  // equation models compile here
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {
