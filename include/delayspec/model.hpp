@@ -46,8 +46,8 @@
 // and tau() returns the longest (the history's length: N steps per the longest delay). Its
 // delayed argument is then the n delayed states stacked, Vec<d n> (rows i d .. i d + d - 1 hold
 // y(t - tau_{i+1})), and B = df / d(that stack) is d x d n (DelayedVec, DelayedMat). A model
-// without delay_count has the one delay tau(). Several delays with time switches are supported,
-// with state switching (has_switching) not yet (the event step takes one delayed value).
+// without delay_count has the one delay tau(). Switching and time switches work with several
+// delays as with one (the event and time-switch steps carry the stacked delayed values).
 #include <array>
 #include <concepts>
 #include <vector>
@@ -106,15 +106,14 @@ concept DelayModel = requires(const Model& m, const Vec<Model::d>& y, double t, 
 }
 &&(delay_count_of<Model>() == 1 || requires(const Model& m) {
      requires delay_count_of<Model>() >= 2;
-     requires !Model::has_switching;
      { m.delays() } -> std::convertible_to<std::array<double, delay_count_of<Model>()>>;
    })
 &&(!Model::has_switching ||
    requires(const Model& m, const Vec<Model::d>& y, double t, int j) {
      { m.H(y) } -> std::convertible_to<double>;
      { m.grad_H(y) } -> std::convertible_to<Vec<Model::d>>;
-     { m.f_t(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
-     { m.f_tt(j, t, y, y) } -> std::convertible_to<Vec<Model::d>>;
+     { m.f_t(j, t, y, DelayedVec<Model>()) } -> std::convertible_to<Vec<Model::d>>;
+     { m.f_tt(j, t, y, DelayedVec<Model>()) } -> std::convertible_to<Vec<Model::d>>;
    }) &&
     (!TimeSwitchedModel<Model> || requires(const Model& m, double t) {
       { m.time_segment(t) } -> std::convertible_to<int>;

@@ -337,5 +337,24 @@ TEST(EquationModels, SeveralDelaysBadInputNamesTheDelay) {
   for (const Case& c : cases) EXPECT_NE(message(c.scene, c.sets).find(c.expected), std::string::npos) << message(c.scene, c.sets);
 }
 
+// A state switch with several delays (the event step carries the stacked taps): the impact model
+// with its feedback gain split over two delays of the same length, k1 (v_tau1 - v) + k2 (v_tau2 -
+// v), is the built-in model with k = k1 + k2 (the two taps are the same numbers), to rounding.
+TEST(EquationModels, ImpactWithItsFeedbackSplitOverTwoEqualDelaysIsTheBuiltInModel) {
+  std::string scene = kImpactScene;
+  const auto replace_all = [&](const std::string& from, const std::string& to) {
+    for (size_t at = scene.find(from); at != std::string::npos; at = scene.find(from, at + to.size()))
+      scene.replace(at, from.size(), to);
+  };
+  replace_all("delay = \"2*pi/omega\"", "delays = { tau1 = \"2*pi/omega\", tau2 = \"2*pi/omega\" }");
+  replace_all("k*(v_tau - v)", "k1*(v_tau1 - v) + k2*(v_tau2 - v)");
+  replace_all("k = 0.0 }", "k1 = 0.0, k2 = 0.0 }");
+  const Problem eq = problem_from(scene, {{"N", "800"}, {"k1", "0.3"}, {"k2", "0.25"}});
+  const Problem builtin = problem_from("", {{"model", "impact"}, {"N", "800"}, {"k", "0.55"}, {"tau_over_T", "1"}});
+  EXPECT_TRUE(eq.analyses->switches_in_state());
+  ASSERT_EQ(eq.analyses->delays().size(), 2u);
+  expect_same_multipliers(spectrum(eq, 6), spectrum(builtin, 6));
+}
+
 }  // namespace
 }  // namespace delayspec::cli

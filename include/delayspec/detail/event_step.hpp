@@ -117,23 +117,26 @@ template <class Model>
 class EventStepSolver {
  public:
   static constexpr int D = Model::d;
+  static constexpr int DW = delayed_rows<Model>;  // D, or D n with n delays (model.hpp)
   using V = Vec<D>;
+  using W = DelayedVec<Model>;  // the delayed values (stacked with several delays)
   using M = Mat<D>;
-  using Tangent = Eigen::Matrix<double, D, 3 * D>;  // d(.)/d(u0, w0, w1)
-  using Row = Eigen::Matrix<double, 1, 3 * D>;
+  using BM = DelayedMat<Model>;  // df / dw
+  using Tangent = Eigen::Matrix<double, D, D + 2 * DW>;  // d(.)/d(u0, w0, w1)
+  using Row = Eigen::Matrix<double, 1, D + 2 * DW>;
 
-  EventStepSolver(const TrapezoidStepper<Model>& stepper, double t, double h, const V& w0, const V& w1)
+  EventStepSolver(const TrapezoidStepper<Model>& stepper, double t, double h, const W& w0, const W& w1)
       : stepper_(stepper), model_(stepper.model()), options_(stepper.options()), t_(t), h_(h), w0_(w0), w1_(w1) {
     static_assert(
         requires(const Model& m, V y) {
-          { m.f_t(1, 0.0, y, y) } -> std::convertible_to<V>;
-          { m.f_tt(1, 0.0, y, y) } -> std::convertible_to<V>;
+          { m.f_t(1, 0.0, y, W()) } -> std::convertible_to<V>;
+          { m.f_tt(1, 0.0, y, W()) } -> std::convertible_to<V>;
         },
         "a model with switching must provide f_t and f_tt (model.hpp)");
     wdot_ = (w1 - w0) / h;
   }
 
-  V run(const V& u0, StepLinearisation<D>& linearisation, StepEvents* events) const {
+  V run(const V& u0, StepLinearisation<D, DW>& linearisation, StepEvents* events) const {
     double a = 0;
     V z = u0;
     int j = region_of(model_, u0);
@@ -197,8 +200,8 @@ class EventStepSolver {
     if (events) events->count = count;
     linearisation.factored = false;
     linearisation.map.P = dz.template leftCols<D>();
-    linearisation.map.Q = dz.template middleCols<D>(D);
-    linearisation.map.R = dz.template rightCols<D>();
+    linearisation.map.Q = dz.template middleCols<DW>(D);
+    linearisation.map.R = dz.template rightCols<DW>();
     return z;
   }
 
@@ -216,7 +219,7 @@ class EventStepSolver {
   };
 
   int substeps(int j) const { return j == 1 ? options_.contact_substeps : 1; }
-  V w_at(double s) const { return (1 - s / h_) * w0_ + (s / h_) * w1_; }
+  W w_at(double s) const { return (1 - s / h_) * w0_ + (s / h_) * w1_; }
   static double node(double a, double b, int m, int i) { return i == m ? b : a + (b - a) * i / m; }
   double threshold(const V& z) const {
     return 256 * std::numeric_limits<double>::epsilon() * (1 + z.template lpNorm<Eigen::Infinity>()) *
@@ -240,10 +243,10 @@ class EventStepSolver {
     Piece p{za, dza, V::Zero()};
     for (int i = 1; i <= m; ++i) {
       const double s0 = node(a, b, m, i - 1), s1 = node(a, b, m, i);
-      const SubStepResult<D> r = stepper_.sub_step(t_ + s0, s1 - s0, p.z, w_at(s0), w_at(s1), j, j);
+      const SubStepResult<D, DW> r = stepper_.sub_step(t_ + s0, s1 - s0, p.z, w_at(s0), w_at(s1), j, j);
       Tangent X = r.dz0 * p.X;
-      X.template middleCols<D>(D) += (1 - s0 / h_) * r.dw0 + (1 - s1 / h_) * r.dw1;
-      X.template rightCols<D>(D) += (s0 / h_) * r.dw0 + (s1 / h_) * r.dw1;
+      X.template middleCols<DW>(D) += (1 - s0 / h_) * r.dw0 + (1 - s1 / h_) * r.dw1;
+      X.template rightCols<DW>() += (s0 / h_) * r.dw0 + (s1 / h_) * r.dw1;
       p.X = X;
       p.z = r.z1;
     }
@@ -258,13 +261,13 @@ class EventStepSolver {
     for (int i = 1; i <= m; ++i) {
       const double s0 = node(a, b, m, i - 1), s1 = node(a, b, m, i), L = s1 - s0;
       const double c0 = static_cast<double>(i - 1) / m, c1 = static_cast<double>(i) / m;
-      const V wl = w_at(s0), wr = w_at(s1);
+      const W wl = w_at(s0), wr = w_at(s1);
       const V zl = p.z;
       const V zr = stepper_.sub_step_state(t_ + s0, L, zl, wl, wr, j, j);
       const double tl = t_ + s0, tr = t_ + s0 + L;
       const V fl = model_.f(j, tl, zl, wl), fr = model_.f(j, tr, zr, wr);
       const M Al = model_.A(j, tl, zl, wl), Ar = model_.A(j, tr, zr, wr);
-      const M Bl = model_.B(j, tl, zl, wl), Br = model_.B(j, tr, zr, wr);
+      const BM Bl = model_.B(j, tl, zl, wl), Br = model_.B(j, tr, zr, wr);
       const V ftl = model_.f_t(j, tl, zl, wl), ftr = model_.f_t(j, tr, zr, wr);
       const detail::SmallSolve<D> lu(M(M::Identity() - 0.5 * L * Ar));  // S = I - L/2 A_r
       const M Jz = lu.solve(M(M::Identity() + 0.5 * L * Al));           // dz_i/dz_{i-1}
@@ -273,11 +276,11 @@ class EventStepSolver {
       const V Js0 = lu.solve(V(-0.5 * (fl + fr) + 0.5 * L * (ftl + Bl * wdot_)));
       const V Js1 = lu.solve(V(0.5 * (fl + fr) + 0.5 * L * (ftr + Br * wdot_)));
       // dz_i/dw0, dz_i/dw1 through w(s_{i-1}) and w(s_i)
-      const M Jw0 = lu.solve(M(0.5 * L * (Bl * (1 - s0 / h_) + Br * (1 - s1 / h_))));
-      const M Jw1 = lu.solve(M(0.5 * L * (Bl * (s0 / h_) + Br * (s1 / h_))));
+      const BM Jw0 = lu.solve(BM(0.5 * L * (Bl * (1 - s0 / h_) + Br * (1 - s1 / h_))));
+      const BM Jw1 = lu.solve(BM(0.5 * L * (Bl * (s0 / h_) + Br * (s1 / h_))));
       Tangent X = Jz * p.X + Js0 * ((1 - c0) * da) + Js1 * ((1 - c1) * da);
-      X.template middleCols<D>(D) += Jw0;
-      X.template rightCols<D>(D) += Jw1;
+      X.template middleCols<DW>(D) += Jw0;
+      X.template rightCols<DW>() += Jw1;
       p.Y = Jz * p.Y + Js0 * c0 + Js1 * c1;
       p.X = X;
       p.z = zr;
@@ -302,13 +305,15 @@ class EventStepSolver {
   Row linear_event_time_derivative(double a, const V& za, const Tangent& dza, const Row& da, int j,
                                    bool from_surface) const {
     const double ta = t_ + a;
-    const V wa = w_at(a);
+    const W wa = w_at(a);
     const V g = model_.grad_H(za);
     const V F = model_.f(j, ta, za, wa), ft = model_.f_t(j, ta, za, wa);
-    const M A = model_.A(j, ta, za, wa), B = model_.B(j, ta, za, wa);
-    Tangent dw = Tangent::Zero();  // dw(a) = (1 - a/h) dw0 + (a/h) dw1 + w' da
-    dw.template middleCols<D>(D) = (1 - a / h_) * M::Identity();
-    dw.template rightCols<D>(D) = (a / h_) * M::Identity();
+    const M A = model_.A(j, ta, za, wa);
+    const BM B = model_.B(j, ta, za, wa);
+    // dw(a) = (1 - a/h) dw0 + (a/h) dw1 + w' da: DW rows
+    Eigen::Matrix<double, DW, D + 2 * DW> dw = Eigen::Matrix<double, DW, D + 2 * DW>::Zero();
+    dw.template middleCols<DW>(D) = (1 - a / h_) * Mat<DW>::Identity();
+    dw.template rightCols<DW>() = (a / h_) * Mat<DW>::Identity();
     dw += wdot_ * da;
     const Tangent dF = A * dza + B * dw + ft * da;
     const double H1 = g.dot(F);
@@ -321,8 +326,8 @@ class EventStepSolver {
     const V ftt = model_.f_tt(j, ta, za, wa);
     const double H2 = g.dot(ft + A * F + B * wdot_);
     Tangent dBwdot = Tangent::Zero();  // d(B w') = B (dw1 - dw0) / h
-    dBwdot.template middleCols<D>(D) = -B / h_;
-    dBwdot.template rightCols<D>(D) = B / h_;
+    dBwdot.template middleCols<DW>(D) = -B / h_;
+    dBwdot.template rightCols<DW>() = B / h_;
     const Row dH2 = g.transpose() * (ftt * da + A * dF + dBwdot);
     return da - 2 * (dH1 * H2 - H1 * dH2) / (H2 * H2);
   }
@@ -330,7 +335,7 @@ class EventStepSolver {
   // The paper's estimates (events = linear), clamped to [a, limit].
   Exit linear_estimate(double a, const V& za, int j, bool from_surface, double limit) const {
     const double ta = t_ + a;
-    const V wa = w_at(a);
+    const W wa = w_at(a);
     const V g = model_.grad_H(za);
     const V F = model_.f(j, ta, za, wa);
     const double H1 = g.dot(F);
@@ -409,15 +414,15 @@ class EventStepSolver {
   const Model& model_;
   const StepOptions& options_;
   double t_, h_;
-  V w0_, w1_, wdot_;
+  W w0_, w1_, wdot_;
 };
 
 }  // namespace detail
 
 template <class Model>
 Vec<Model::d> event_step(const TrapezoidStepper<Model>& stepper, double t, double h, const Vec<Model::d>& u0,
-                         const Vec<Model::d>& w0, const Vec<Model::d>& w1, StepLinearisation<Model::d>& linearisation,
-                         StepEvents* events) {
+                         const DelayedVec<Model>& w0, const DelayedVec<Model>& w1,
+                         StepLinearisation<Model::d, delayed_rows<Model>>& linearisation, StepEvents* events) {
   return detail::EventStepSolver<Model>(stepper, t, h, w0, w1).run(u0, linearisation, events);
 }
 

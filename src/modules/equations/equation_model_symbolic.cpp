@@ -266,9 +266,6 @@ class EquationsReader {
       return;
     }
     m_.switch_kind = SwitchKind::state;
-    if (m_.delay_count() > 1)
-      throw BadInput(item + "a state switch with several delays is not supported yet (event location takes one "
-                            "delayed value); a switch of t alone (a time window) is");
     for (const auto& ya : m_.y) {
       m_.grad_H.push_back(h.diff(ya));  // printed: not normal(), whose form may vary between runs
       if (depends_on(m_.grad_H.back().normal(), m_.y))
