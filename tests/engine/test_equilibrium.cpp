@@ -1,0 +1,148 @@
+// Equilibria and their characteristic roots (equilibrium.hpp), against references the engine does
+// not produce:
+//  * x' = a x + b x(t - tau): the roots are Lambert-W values, lambda = a + W_k(b tau e^{-a tau}) / tau
+//    (lambert_w.hpp), for a leading real root and a leading complex pair;
+//  * Mackey-Glass at its equilibrium x* = 1 (beta / gamma = 2): the linearisation is
+//    x' = -gamma x + beta (2 - n) / 4 x(t - tau), again Lambert W;
+//  * a d = 2 system with two delays: roots by Newton on its characteristic function from a grid
+//    of starts (tests/support/characteristic_roots.hpp), mapped back from exp(lambda T).
+// After refinement on the exact characteristic function the roots carry no discretisation error:
+// 1e-12 (Newton's stopping test is 1e-12 relative; the Lambert-W values are good to ~1e-15).
+#include <cmath>
+#include <complex>
+#include <iostream>
+
+#include <gtest/gtest.h>
+
+#include "characteristic_roots.hpp"
+#include "delayspec/equilibrium.hpp"
+#include "delayspec/lambert_w.hpp"
+#include "delayspec/model_linear.hpp"
+#include "delayspec/model_mackey_glass.hpp"
+
+namespace delayspec {
+namespace {
+
+using cd = std::complex<double>;
+
+void expect_roots(const EquilibriumResult& r, const std::vector<cd>& exact, size_t count, double tol) {
+  ASSERT_GE(r.roots.size(), count);
+  for (size_t i = 0; i < count; ++i) {
+    double best = INFINITY;
+    for (cd e : exact) best = std::min(best, std::abs(r.roots[i].value - e));
+    EXPECT_LT(best, tol) << "root " << i << " = " << r.roots[i].value;
+  }
+  // rightmost first, and every exact root to the right of the last reported one is reported
+  for (size_t i = 1; i < r.roots.size(); ++i) EXPECT_GE(r.roots[i - 1].value.real(), r.roots[i].value.real());
+  for (cd e : exact)
+    if (e.real() > r.roots[count - 1].value.real() + 1e-9) {
+      double best = INFINITY;
+      for (const auto& root : r.roots) best = std::min(best, std::abs(root.value - e));
+      EXPECT_LT(best, tol) << "missed the exact root " << e;
+    }
+}
+
+TEST(Equilibrium, ScalarLinearRootsAreTheLambertWRoots) {
+  // a = -1, b = 0.5: a real leading root; a = -1, b = -3: an unstable complex leading pair
+  for (const auto& [a, b] : {std::pair{-1.0, 0.5}, std::pair{-1.0, -3.0}}) {
+    SCOPED_TRACE("a = " + std::to_string(a) + ", b = " + std::to_string(b));
+    const LinearModel model({.a = a, .b = b, .tau = 1, .period = 1});
+    EquilibriumOptions o;
+    o.nroots = 6;
+    const EquilibriumResult r = find_equilibrium(model, Vec<1>(0.3), o);
+    EXPECT_NEAR(r.state[0], 0, 1e-15);
+    const std::vector<cd> exact = linear_dde_roots(a, b, 1, 12);
+    expect_roots(r, exact, 6, 1e-12);
+    std::cout << "a = " << a << ", b = " << b << ": rightmost root " << r.roots[0].value << ", moved "
+              << std::abs(r.roots[0].value - r.roots[0].discretised) << " by the refinement\n";
+    // the discretisation's error at N = 100 is what refinement removed: second order, ~1e-4
+    EXPECT_GT(std::abs(r.roots[0].value - r.roots[0].discretised), 1e-9);
+    EXPECT_LT(std::abs(r.roots[0].value - r.roots[0].discretised), 1e-2);
+    EXPECT_EQ(r.unstable, exact.front().real() > 0 ? (exact.front().imag() != 0 ? 2 : 1) : 0);
+  }
+}
+
+TEST(Equilibrium, MackeyGlassEquilibriumAndItsRoots) {
+  MackeyGlassParameters p;  // beta 0.2, gamma 0.1, n 10
+  p.tau = 2;
+  p.period = 2;
+  const MackeyGlassModel model(p);
+  const EquilibriumResult r = find_equilibrium(model, Vec<1>(1.05));
+  EXPECT_NEAR(r.state[0], 1, 1e-14);
+  EXPECT_LT(r.residual, 1e-15);
+  const double b = p.beta * (2 - p.n) / 4;  // d/dw beta w / (1 + w^n) at w = 1
+  expect_roots(r, linear_dde_roots(-p.gamma, b, p.tau, 12), 6, 1e-12);
+}
+
+// x' = y, y' = -c y - x + k1 x(t - tau1) + k2 y(t - tau2)
+struct TwoDelayOscillator {
+  static constexpr int d = 2;
+  static constexpr int delay_count = 2;
+  static constexpr bool has_switching = false, affine_in_state = true, is_linear = true;
+  double c = 0.1, k1 = 0.3, k2 = -0.6, tau1 = 0.7, tau2 = std::sqrt(1.7);
+  std::array<double, 2> delays() const { return {tau1, tau2}; }
+  double tau() const { return tau2; }
+  double period() const { return 1; }
+  Vec<2> f(int, double, const Vec<2>& y, const Vec<4>& z) const {
+    return Vec<2>(y[1], -c * y[1] - y[0] + k1 * z[0] + k2 * z[3]);
+  }
+  Mat<2> A(int, double, const Vec<2>&, const Vec<4>&) const { return (Mat<2>() << 0, 1, -1, -c).finished(); }
+  RectMat<2, 4> B(int, double, const Vec<2>&, const Vec<4>&) const {
+    RectMat<2, 4> b = RectMat<2, 4>::Zero();
+    b(1, 0) = k1;
+    b(1, 3) = k2;
+    return b;
+  }
+  Vec<2> initial_state() const { return Vec<2>(0, 0); }
+};
+
+TEST(Equilibrium, TwoDelaySystemRootsAgainstItsCharacteristicFunction) {
+  const TwoDelayOscillator m;
+  const EquilibriumResult r = find_equilibrium(m, Vec<2>(0.5, -0.2));
+  EXPECT_LT(r.state.cwiseAbs().maxCoeff(), 1e-14);
+  // lambda^2 + c lambda + 1 - k1 e1 - k2 lambda e2, found independently (T = 1: lambda = log mu)
+  const test::Characteristic ch{
+      [m](cd l) { return l * (l + m.c - m.k2 * std::exp(-l * m.tau2)) + 1.0 - m.k1 * std::exp(-l * m.tau1); },
+      [m](cd l) {
+        const cd e1 = std::exp(-l * m.tau1), e2 = std::exp(-l * m.tau2);
+        return 2.0 * l + m.c - m.k2 * e2 + m.k2 * m.tau2 * l * e2 + m.k1 * m.tau1 * e1;
+      }};
+  std::vector<cd> exact;
+  for (cd mu : test::exact_multipliers(ch, 1, -12, 60)) exact.push_back(std::log(mu));  // Im in (-pi, pi]
+  // compare modulo 2 pi i: the multipliers' logarithm loses the branch; the reported roots must
+  // be roots of c themselves, which Newton's last step checks
+  for (size_t i = 0; i < 6; ++i) {
+    double best = INFINITY;
+    for (cd e : exact)
+      for (int k = -20; k <= 20; ++k) best = std::min(best, std::abs(r.roots[i].value - (e + cd(0, 2 * M_PI * k))));
+    EXPECT_LT(best, 1e-10) << r.roots[i].value;
+    EXPECT_LT(std::abs(ch.value(r.roots[i].value)), 1e-10 * (1 + std::norm(r.roots[i].value)));
+  }
+}
+
+// x' = 1 + x(t - 1) - x: every constant history moves, no equilibrium (g = 1, g' = 0).
+struct NoEquilibrium {
+  static constexpr int d = 1;
+  static constexpr bool has_switching = false, affine_in_state = true, is_linear = false;
+  double tau() const { return 1; }
+  double period() const { return 1; }
+  Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const { return Vec<1>(1 + w[0] - y[0]); }
+  Mat<1> A(int, double, const Vec<1>&, const Vec<1>&) const { return Mat<1>::Constant(-1); }
+  Mat<1> B(int, double, const Vec<1>&, const Vec<1>&) const { return Mat<1>::Constant(1); }
+  Vec<1> initial_state() const { return Vec<1>(0); }
+};
+
+TEST(Equilibrium, BadInputAndAModelWithoutEquilibrium) {
+  EquilibriumOptions o;
+  o.nroots = 0;
+  EXPECT_THROW(find_equilibrium(LinearModel(), Vec<1>(0), o), BadInput);
+  try {
+    find_equilibrium(NoEquilibrium(), Vec<1>(0.5));
+    FAIL() << "no equilibrium exists";
+  } catch (const NumericalFailure& e) {
+    EXPECT_NE(std::string(e.what()).find("singular"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace delayspec
