@@ -10,11 +10,11 @@ Cases: the impact orbit at k = 1 (tau = T), nev = 6, at N = 200 and N = 10^5 (Kr
 solver), and the linear DDE at N = 200 with the dense solver."""
 import argparse
 import json
-import os
-import platform
 import statistics
 import subprocess
 import time
+
+from machine_stamp import machine_stamp
 
 CASES = [
     ("impact k=1 N=200", ["--set", "k=1", "--set", "N=200"]),
@@ -34,15 +34,7 @@ def main():
     ap.add_argument("--delayspec", default="build/delayspec")
     ap.add_argument("--runs", type=int, default=7)
     args = ap.parse_args()
-    load = os.getloadavg()
-    cpu = platform.machine()
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load {load[0]:.2f} {load[1]:.2f}, "
-          f"{cpu}, {os.cpu_count()} cores, {args.runs} pairs")
+    print(machine_stamp(f"{args.runs} pairs"))
     print(f"# {'case':24s} {'off s':>8s} {'on s':>8s} {'on/off':>7s}  bar of |mu_1| at N (verdict)")
     for name, keys in CASES:
         base = [args.delayspec, "floquet", "--json", "--set", "nev=6"] + keys

@@ -11,10 +11,10 @@ applied to one vector and to a block of 8 (ns per step per vector)."""
 import argparse
 import json
 import os
-import platform
 import statistics
 import subprocess
-import time
+
+from machine_stamp import machine_stamp
 
 CASES = [
     ("Lyapunov step, 2 exponents", "LyapunovStep{}$", "step_ns"),
@@ -34,15 +34,7 @@ def main():
     ap.add_argument("--bench", default="build/bench_several_delays")
     ap.add_argument("--runs", type=int, default=5)
     args = ap.parse_args()
-    load = os.getloadavg()
-    cpu = platform.machine()
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load {load[0]:.2f} {load[1]:.2f}, "
-          f"{cpu}, {os.cpu_count()} cores, {args.runs} pairs, N = 1000")
+    print(machine_stamp(f"{args.runs} pairs, N = 1000"))
     print(f"# {'case':28s} {'one delay':>10s} {'two delays':>11s} {'ratio':>6s} (range)")
     for name, pattern, counter in CASES:
         one, two, ratios = [], [], []

@@ -266,6 +266,18 @@ TEST(SeveralDelays, LyapunovExponentsAreTheRightmostRealParts) {
   EXPECT_NEAR(r.per_period[0], re[0], 2e-2) << re[0];
 }
 
+// The eigenvalues of the Jacobian of `map` at U by central differences with step e: column j is
+// (P(U + e e_j) - P(U - e e_j)) / 2e, from the nonlinear map alone (no step map is used).
+template <class Model>
+std::vector<cd> difference_jacobian_eigenvalues(const StroboscopicMap<Model>& map, const Eigen::VectorXd& U, double e) {
+  const long n = U.size();
+  Eigen::MatrixXd J(n, n);
+  for (long j = 0; j < n; ++j)
+    J.col(j) = (map.apply(U + e * Eigen::VectorXd::Unit(n, j)) - map.apply(U - e * Eigen::VectorXd::Unit(n, j))) / (2 * e);
+  const Eigen::VectorXcd ev = J.eigenvalues();
+  return std::vector<cd>(ev.data(), ev.data() + ev.size());
+}
+
 // A forced Duffing oscillator under two delayed loops (data/scenes/equations_two_delays.toml's
 // equation at its values): nonlinear, so Newton, shooting and the linearisation at the orbit run.
 struct TwoDelayDuffing {
@@ -316,14 +328,7 @@ TEST(SeveralDelays, NonlinearOrbitMultipliersEqualTheMapsFiniteDifferenceJacobia
   const Multipliers mu = floquet_multipliers(*newton.monodromy, o).multipliers;
 
   const StroboscopicMap<TwoDelayDuffing> map(TrapezoidStepper<TwoDelayDuffing>(model), analyses.grid(settings));
-  const Eigen::VectorXd& U = newton.orbit.history;
-  const long n = U.size();
-  Eigen::MatrixXd J(n, n);
-  const double e = 1e-5;
-  for (long j = 0; j < n; ++j)
-    J.col(j) = (map.apply(U + e * Eigen::VectorXd::Unit(n, j)) - map.apply(U - e * Eigen::VectorXd::Unit(n, j))) / (2 * e);
-  const Eigen::VectorXcd ev = J.eigenvalues();
-  const std::vector<cd> fd(ev.data(), ev.data() + ev.size());
+  const std::vector<cd> fd = difference_jacobian_eigenvalues(map, newton.orbit.history, 1e-5);
   EXPECT_GT(std::abs(mu[0]), 0.5);  // a non-trivial leading pair
   EXPECT_LT(worst_distance(mu, fd), 1e-7);
 }
@@ -453,14 +458,7 @@ TEST(SeveralDelays, ImpactingOrbitMultipliersEqualTheMapsFiniteDifferenceJacobia
   o.solver = FloquetSolver::dense_lapack;
   const Multipliers mu = floquet_multipliers(*at.monodromy, o).multipliers;
   const StroboscopicMap<TwoDelayImpact> map(TrapezoidStepper<TwoDelayImpact>(model), analyses.grid(settings));
-  const Eigen::VectorXd& U = at.orbit.history;
-  const long n = U.size();
-  Eigen::MatrixXd J(n, n);
-  const double e = 1e-6;
-  for (long j = 0; j < n; ++j)
-    J.col(j) = (map.apply(U + e * Eigen::VectorXd::Unit(n, j)) - map.apply(U - e * Eigen::VectorXd::Unit(n, j))) / (2 * e);
-  const Eigen::VectorXcd ev = J.eigenvalues();
-  const std::vector<cd> fd(ev.data(), ev.data() + ev.size());
+  const std::vector<cd> fd = difference_jacobian_eigenvalues(map, at.orbit.history, 1e-6);
   EXPECT_GT(std::abs(mu[0]), 0.5);
   EXPECT_LT(worst_distance(mu, fd), 1e-7);
 }
