@@ -103,29 +103,24 @@ struct FrozenLinearisation {
   }
 };
 
-}  // namespace detail
+// The n copies of y stacked: the delayed argument of f on a constant history.
+template <int D, int NT>
+Vec<D * NT> stacked(const Vec<D>& y) {
+  Vec<D * NT> w;
+  for (int i = 0; i < NT; ++i) w.template segment<D>(i * D) = y;
+  return w;
+}
 
-// Stages 1-3 above. BadInput: options out of range; NumericalFailure naming the residual when
-// Newton for y* does not converge, or a root's refinement does not.
+// Stage 1: Newton on g(y) = f(y, y, ..., y), g' = A + sum_i B_i. Fills state, residual and
+// newton_iterations of r.
 template <class Model>
-EquilibriumResult find_equilibrium(const Model& model, const Vec<Model::d>& guess, const EquilibriumOptions& o = {}) {
-  static_assert(!Model::has_switching, "equilibria of switching models are not supported");
+void equilibrium_state(const Model& model, Vec<Model::d> y, const EquilibriumOptions& o, EquilibriumResult& r) {
   constexpr int D = Model::d, NT = delay_count_of<Model>();
-  if (o.nroots < 1) throw BadInput("`nroots = " + std::to_string(o.nroots) + "`: must be >= 1");
-  if (!(o.tolerance > 0)) throw BadInput("`equilibrium_tolerance`: must be > 0");
-  const auto stacked = [](const Vec<D>& y) {
-    Vec<D * NT> w;
-    for (int i = 0; i < NT; ++i) w.template segment<D>(i * D) = y;
-    return w;
-  };
-  // Stage 1: Newton on g(y) = f(y, y, ..., y)
-  EquilibriumResult r;
-  Vec<D> y = guess;
   for (;; ++r.newton_iterations) {
-    const Vec<D> g = model.f(1, 0.0, y, stacked(y));
+    const Vec<D> g = model.f(1, 0.0, y, stacked<D, NT>(y));
     r.residual = g.template lpNorm<Eigen::Infinity>();
-    const RectMat<D, D * NT> b = model.B(1, 0.0, y, stacked(y));
-    Mat<D> jacobian = model.A(1, 0.0, y, stacked(y));
+    const RectMat<D, D * NT> b = model.B(1, 0.0, y, stacked<D, NT>(y));
+    Mat<D> jacobian = model.A(1, 0.0, y, stacked<D, NT>(y));
     for (int i = 0; i < NT; ++i) jacobian += b.template middleCols<D>(i * D);
     const Eigen::FullPivLU<Mat<D>> lu(jacobian);
     if (!lu.isInvertible())
@@ -139,55 +134,79 @@ EquilibriumResult find_equilibrium(const Model& model, const Vec<Model::d>& gues
                              " iterations)");
     y -= step;
     if (step.template lpNorm<Eigen::Infinity>() <= o.tolerance * (1 + y.template lpNorm<Eigen::Infinity>())) {
-      r.residual = model.f(1, 0.0, y, stacked(y)).template lpNorm<Eigen::Infinity>();
+      r.residual = model.f(1, 0.0, y, stacked<D, NT>(y)).template lpNorm<Eigen::Infinity>();
       ++r.newton_iterations;
       break;
     }
   }
   r.state = y;
+}
+
+// Stage 3 for one multiplier mu of the monodromy over T: the branch of log mu / T where the
+// Newton step on c is shortest, then Newton on c.
+template <int D, int NT>
+CharacteristicRoot refined_root(const FrozenLinearisation<D, NT>& lin, std::complex<double> mu, double T,
+                                const EquilibriumOptions& o) {
+  const double two_pi = 2 * std::numbers::pi;
+  const int branches = o.N / 2 + 1;  // frequencies the grid resolves: |Im lambda| T / 2 pi < N / 2
+  CharacteristicRoot root;
+  double best = INFINITY;
+  for (int k = -branches; k <= branches; ++k) {
+    const std::complex<double> l(std::log(std::abs(mu)) / T, (std::arg(mu) + two_pi * k) / T);
+    const double step = std::abs(lin.newton_step(l));
+    if (step < best) best = step, root.discretised = l;
+  }
+  std::complex<double> l = root.discretised;
+  for (root.iterations = 1;; ++root.iterations) {
+    const std::complex<double> step = lin.newton_step(l);
+    l -= step;
+    root.last_step = std::abs(step);
+    if (!std::isfinite(l.real()) || !std::isfinite(l.imag()) || root.iterations >= o.max_iterations)
+      throw NumericalFailure("equilibrium: the characteristic root near " + format_number(root.discretised.real()) +
+                             (root.discretised.imag() < 0 ? " - " : " + ") +
+                             format_number(std::abs(root.discretised.imag())) +
+                             "i did not converge on det(lambda I - A - sum B e^(-lambda tau)) (last step " +
+                             format_number(root.last_step) + ")");
+    if (root.last_step <= o.tolerance * (1 + std::abs(l))) break;
+  }
+  root.value = l;
+  return root;
+}
+
+}  // namespace detail
+
+// Stages 1-3 above. BadInput: options out of range; NumericalFailure naming the residual when
+// Newton for y* does not converge, or a root's refinement does not.
+template <class Model>
+EquilibriumResult find_equilibrium(const Model& model, const Vec<Model::d>& guess, const EquilibriumOptions& o = {}) {
+  static_assert(!Model::has_switching, "equilibria of switching models are not supported");
+  constexpr int D = Model::d, NT = delay_count_of<Model>();
+  using Linearisation = detail::FrozenLinearisation<D, NT>;
+  if (o.nroots < 1) throw BadInput("`nroots = " + std::to_string(o.nroots) + "`: must be >= 1");
+  if (!(o.tolerance > 0)) throw BadInput("`equilibrium_tolerance`: must be > 0");
+  EquilibriumResult r;
+  detail::equilibrium_state(model, guess, o, r);
 
   // Stage 2: the linearisation's multipliers over T = tau_max
-  detail::FrozenLinearisation<D, NT> lin;
-  lin.a = model.A(1, 0.0, y, stacked(y));
-  lin.b = model.B(1, 0.0, y, stacked(y));
+  const Vec<D> y = r.state;
+  Linearisation lin;
+  lin.a = model.A(1, 0.0, y, detail::stacked<D, NT>(y));
+  lin.b = model.B(1, 0.0, y, detail::stacked<D, NT>(y));
   const std::vector<double> taus = delays_of(model);
   std::copy(taus.begin(), taus.end(), lin.taus.begin());
   const double T = lin.tau();
-  const StroboscopicMap<detail::FrozenLinearisation<D, NT>> map(TrapezoidStepper<detail::FrozenLinearisation<D, NT>>(lin),
-                                                               make_grid(taus, T, o.N));
+  const StroboscopicMap<Linearisation> map(TrapezoidStepper<Linearisation>(lin), make_grid(taus, T, o.N));
   FloquetOptions fo;
   fo.nev = static_cast<int>(std::min<long>(o.nroots + 4, map.dimension() - 2));
   fo.solver = o.solver;
   const Multipliers mu = floquet_multipliers(map.monodromy(Eigen::VectorXd::Zero(map.dimension())), fo).multipliers;
 
-  // Stage 3: the branch of the logarithm, then Newton on c
-  const double two_pi = 2 * std::numbers::pi;
-  const int branches = o.N / 2 + 1;  // frequencies the grid resolves: |Im lambda| T / 2 pi < N / 2
+  // Stage 3, each multiplier; two that refine to one root count once
   for (const std::complex<double>& m : mu) {
     if (std::abs(m) == 0) continue;
-    CharacteristicRoot root;
-    double best = INFINITY;
-    for (int k = -branches; k <= branches; ++k) {
-      const std::complex<double> l((std::log(std::abs(m))) / T, (std::arg(m) + two_pi * k) / T);
-      const double step = std::abs(lin.newton_step(l));
-      if (step < best) best = step, root.discretised = l;
-    }
-    std::complex<double> l = root.discretised;
-    for (root.iterations = 1;; ++root.iterations) {
-      const std::complex<double> step = lin.newton_step(l);
-      l -= step;
-      root.last_step = std::abs(step);
-      if (!std::isfinite(l.real()) || !std::isfinite(l.imag()) || root.iterations >= o.max_iterations)
-        throw NumericalFailure("equilibrium: the characteristic root near " + format_number(root.discretised.real()) +
-                               (root.discretised.imag() < 0 ? " - " : " + ") +
-                               format_number(std::abs(root.discretised.imag())) +
-                               "i did not converge on det(lambda I - A - sum B e^(-lambda tau)) (last step " +
-                               format_number(root.last_step) + ")");
-      if (root.last_step <= o.tolerance * (1 + std::abs(l))) break;
-    }
-    root.value = l;
+    const CharacteristicRoot root = detail::refined_root(lin, m, T, o);
     const bool seen = std::any_of(r.roots.begin(), r.roots.end(), [&](const CharacteristicRoot& other) {
-      return std::abs(other.value - l) <= 1e3 * o.tolerance * (1 + std::abs(l));
+      return std::abs(other.value - root.value) <= 1e3 * o.tolerance * (1 + std::abs(root.value));
     });
     if (!seen) r.roots.push_back(root);
   }
