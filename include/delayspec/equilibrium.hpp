@@ -11,10 +11,12 @@
 //
 // Three stages:
 //  1. y* by Newton on g(y) = f(y, y, ..., y), g' = A + sum_i B_i, from a guess.
-//  2. The rightmost roots approximately, from the engine's matrix-free monodromy of the
-//     linearisation over the horizon T = tau_max (the same step maps as every other analysis;
-//     Krylov): a multiplier mu = exp(lambda T) gives lambda = (log |mu| + i (arg mu + 2 pi k)) / T,
-//     and the branch k is the one where |c| / |c'| (the Newton step's length) is least.
+//  2. The rightmost roots approximately, from the engine's matrix-free monodromy over the horizon
+//     T = tau_max of the model's own map linearised at the constant history y* (a fixed point
+//     of the map for an autonomous model: its step maps are those of the linearisation, so
+//     no other stepper is compiled; Krylov as for orbits): a multiplier mu = exp(lambda T) gives
+//     lambda = (log |mu| + i (arg mu + 2 pi k)) / T, and the branch k is the one where |c| / |c'|
+//     (the Newton step's length) is least.
 //  3. Each refined by Newton on c itself, lambda <- lambda - 1 / tr(Delta^{-1} Delta'),
 //     Delta' = I + sum_i tau_i B_i exp(-lambda tau_i) (Jacobi's formula for c'/c), to
 //     |step| <= tolerance (1 + |lambda|): the returned roots carry no discretisation error. How
@@ -26,6 +28,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -35,6 +38,7 @@
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/model.hpp"
+#include "delayspec/monodromy.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec {
@@ -44,13 +48,19 @@ struct EquilibriumOptions {
   int nroots = 6;             // rightmost roots returned
   double tolerance = 1e-12;   // Newton, relative: |step| <= tolerance (1 + |x|)
   int max_iterations = 50;    // Newton steps, each stage
-  FloquetSolver solver = FloquetSolver::automatic;
+  // The eigensolver of stage 2 (its nev is set here: nroots + 4, for the roots that refine to
+  // one another).
+  FloquetOptions eigensolver;
 };
 
 struct CharacteristicRoot {
   std::complex<double> value;        // refined on c(lambda)
   std::complex<double> discretised;  // from the monodromy at N (stage 2)
   double last_step = 0;              // |lambda_k+1 - lambda_k| of Newton's last step
+  double residual = 0;               // sigma_min(Delta) / (|lambda| + |A| + sum |B_i|) (header comment)
+  // A bound on |value - exact root|: Newton's last step (quadratic convergence: the error after
+  // it is far below it), and never below rounding, 4 eps (1 + |lambda|).
+  double error_bound = 0;
   int iterations = 0;
 };
 
@@ -59,27 +69,19 @@ struct EquilibriumResult {
   double residual = 0;                    // |f(y*, ..., y*)|_inf
   int newton_iterations = 0;
   std::vector<CharacteristicRoot> roots;  // rightmost first (largest real part)
-  int unstable = 0;                       // roots with Re lambda > 0
+  int unstable = 0;                       // roots with Re lambda > error_bound
+  int critical = 0;                       // roots with |Re lambda| <= error_bound: no sign to tell
+  bool stable() const { return unstable == 0 && critical == 0; }
 };
 
 namespace detail {
 
-// The linearisation at y*, a linear model with constant coefficients (model.hpp) for stage 2.
+// Delta(lambda) = lambda I - A - sum_i B_i exp(-lambda tau_i) of the linearisation at y*.
 template <int D, int NT>
-struct FrozenLinearisation {
-  static constexpr int d = D;
-  static constexpr int delay_count = NT;
-  static constexpr bool has_switching = false, affine_in_state = true, is_linear = true;
+struct CharacteristicMatrix {
   Mat<D> a;
   RectMat<D, D * NT> b;
   std::array<double, NT> taus;
-  std::array<double, NT> delays() const { return taus; }
-  double tau() const { return *std::max_element(taus.begin(), taus.end()); }
-  double period() const { return tau(); }
-  Vec<D> f(int, double, const Vec<D>& y, const Vec<D * NT>& w) const { return a * y + b * w; }
-  Mat<D> A(int, double, const Vec<D>&, const Vec<D * NT>&) const { return a; }
-  RectMat<D, D * NT> B(int, double, const Vec<D>&, const Vec<D * NT>&) const { return b; }
-  Vec<D> initial_state() const { return Vec<D>::Zero(); }
 
   // Delta(lambda) and Delta'(lambda).
   using CMat = Eigen::Matrix<std::complex<double>, D, D>;
@@ -100,6 +102,25 @@ struct FrozenLinearisation {
     const Eigen::PartialPivLU<CMat> lu(value);
     const std::complex<double> trace = lu.solve(derivative).trace();
     return 1.0 / trace;
+  }
+  // sigma_min(Delta(lambda)) / (|lambda| + |A| + sum_i |B_i|), 2-norms.
+  double residual(std::complex<double> l) const {
+    CMat value, derivative;
+    delta(l, value, derivative);
+    double scale = std::abs(l) + singular_value(a, false);
+    for (int i = 0; i < NT; ++i) scale += singular_value(Mat<D>(b.template middleCols<D>(i * D)), false);
+    return singular_value(value, true) / scale;
+  }
+  // The smallest or largest singular value of a D x D matrix (1 x 1: its modulus, which also
+  // spares GCC's false maybe-uninitialized warning on a 1 x 1 JacobiSVD).
+  template <class M>
+  static double singular_value(const M& m, bool smallest) {
+    if constexpr (D == 1) {
+      return std::abs(m(0, 0));
+    } else {
+      const auto values = Eigen::JacobiSVD<M>(m).singularValues();
+      return smallest ? values(D - 1) : values(0);
+    }
   }
 };
 
@@ -145,7 +166,7 @@ void equilibrium_state(const Model& model, Vec<Model::d> y, const EquilibriumOpt
 // Stage 3 for one multiplier mu of the monodromy over T: the branch of log mu / T where the
 // Newton step on c is shortest, then Newton on c.
 template <int D, int NT>
-CharacteristicRoot refined_root(const FrozenLinearisation<D, NT>& lin, std::complex<double> mu, double T,
+CharacteristicRoot refined_root(const CharacteristicMatrix<D, NT>& lin, std::complex<double> mu, double T,
                                 const EquilibriumOptions& o) {
   const double two_pi = 2 * std::numbers::pi;
   const int branches = o.N / 2 + 1;  // frequencies the grid resolves: |Im lambda| T / 2 pi < N / 2
@@ -170,6 +191,8 @@ CharacteristicRoot refined_root(const FrozenLinearisation<D, NT>& lin, std::comp
     if (root.last_step <= o.tolerance * (1 + std::abs(l))) break;
   }
   root.value = l;
+  root.residual = lin.residual(l);
+  root.error_bound = std::max(root.last_step, 4 * std::numeric_limits<double>::epsilon() * (1 + std::abs(l)));
   return root;
 }
 
@@ -179,27 +202,28 @@ CharacteristicRoot refined_root(const FrozenLinearisation<D, NT>& lin, std::comp
 // Newton for y* does not converge, or a root's refinement does not.
 template <class Model>
 EquilibriumResult find_equilibrium(const Model& model, const Vec<Model::d>& guess, const EquilibriumOptions& o = {}) {
-  static_assert(!Model::has_switching, "equilibria of switching models are not supported");
+  static_assert(AutonomousModel<Model>, "equilibria need an autonomous model (model.hpp: autonomous = true)");
   constexpr int D = Model::d, NT = delay_count_of<Model>();
-  using Linearisation = detail::FrozenLinearisation<D, NT>;
   if (o.nroots < 1) throw BadInput("`nroots = " + std::to_string(o.nroots) + "`: must be >= 1");
   if (!(o.tolerance > 0)) throw BadInput("`equilibrium_tolerance`: must be > 0");
   EquilibriumResult r;
   detail::equilibrium_state(model, guess, o, r);
 
-  // Stage 2: the linearisation's multipliers over T = tau_max
+  // Stage 2: the multipliers of the model's map over T = tau_max at the constant history y*
   const Vec<D> y = r.state;
-  Linearisation lin;
+  detail::CharacteristicMatrix<D, NT> lin;
   lin.a = model.A(1, 0.0, y, detail::stacked<D, NT>(y));
   lin.b = model.B(1, 0.0, y, detail::stacked<D, NT>(y));
   const std::vector<double> taus = delays_of(model);
   std::copy(taus.begin(), taus.end(), lin.taus.begin());
-  const double T = lin.tau();
-  const StroboscopicMap<Linearisation> map(TrapezoidStepper<Linearisation>(lin), make_grid(taus, T, o.N));
-  FloquetOptions fo;
+  const double T = *std::max_element(taus.begin(), taus.end());
+  const StroboscopicMap<Model> map(TrapezoidStepper<Model>(model), make_grid(taus, T, o.N));
+  std::vector<StepMap<D, delayed_rows<Model>>> steps;
+  map.apply(map.constant_history(y), &steps);
+  FloquetOptions fo = o.eigensolver;
   fo.nev = static_cast<int>(std::min<long>(o.nroots + 4, map.dimension() - 2));
-  fo.solver = o.solver;
-  const Multipliers mu = floquet_multipliers(map.monodromy(Eigen::VectorXd::Zero(map.dimension())), fo).multipliers;
+  const Monodromy<D, delayed_rows<Model>> monodromy(map.grid(), std::move(steps));
+  const Multipliers mu = floquet_multipliers(monodromy, fo).multipliers;
 
   // Stage 3, each multiplier; two that refine to one root count once
   for (const std::complex<double>& m : mu) {
@@ -214,8 +238,10 @@ EquilibriumResult find_equilibrium(const Model& model, const Vec<Model::d>& gues
     return p.value.real() != q.value.real() ? p.value.real() > q.value.real() : p.value.imag() > q.value.imag();
   });
   if (static_cast<int>(r.roots.size()) > o.nroots) r.roots.resize(static_cast<size_t>(o.nroots));
-  r.unstable = static_cast<int>(
-      std::count_if(r.roots.begin(), r.roots.end(), [](const CharacteristicRoot& c) { return c.value.real() > 0; }));
+  for (const CharacteristicRoot& c : r.roots) {
+    if (c.value.real() > c.error_bound) ++r.unstable;
+    else if (c.value.real() >= -c.error_bound) ++r.critical;
+  }
   return r;
 }
 

@@ -48,6 +48,11 @@
 // y(t - tau_{i+1})), and B = df / d(that stack) is d x d n (DelayedVec, DelayedMat). A model
 // without delay_count has the one delay tau(). Switching and time switches work with several
 // delays as with one (the event and time-switch steps carry the stacked delayed values).
+//
+// Autonomy. A model whose f does not depend on t (no forcing, no switch) declares
+//   static constexpr bool autonomous = true;
+// its period() is then only the stroboscopic map's sampling time, and it may have equilibria
+// (equilibrium.hpp). A model that does not declare it is taken as forced.
 #include <array>
 #include <concepts>
 #include <vector>
@@ -61,6 +66,12 @@ namespace delayspec {
 template <class Model>
 concept TimeSwitchedModel = requires {
   requires Model::has_time_switches;
+};
+
+// Is Model autonomous (see above)?
+template <class Model>
+concept AutonomousModel = requires {
+  requires Model::autonomous;
 };
 
 // The number of delays of Model (1 unless it declares delay_count).

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "delayspec/continuation.hpp"
+#include "delayspec/equilibrium.hpp"
 #include "delayspec/grid.hpp"
 #include "delayspec/linear_operator.hpp"
 #include "delayspec/lyapunov.hpp"
@@ -67,6 +68,7 @@ class ModelAnalyses {
   virtual bool switches_in_state() const = 0;  // H(y) with events (has_switching)
   virtual bool switches_in_time() const = 0;   // cutting windows (has_time_switches)
   virtual bool is_linear() const = 0;          // the monodromy does not depend on the orbit
+  virtual bool is_autonomous() const = 0;      // f does not depend on t (model.hpp): equilibria
   virtual double tau() const = 0;  // the longest delay
   // Every delay, in the model's order ({tau()} for one delay; model.hpp).
   virtual std::vector<double> delays() const = 0;
@@ -76,6 +78,10 @@ class ModelAnalyses {
   // The periodic orbit (orbit_search.hpp; the zero orbit of a linear model) and its monodromy.
   virtual LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
                                            const OrbitRequest& request = {}) const = 0;
+  // An equilibrium from `guess` (d entries; empty: the model's constant initial history) and its
+  // rightmost characteristic roots (equilibrium.hpp). BadInput for a model that is not
+  // autonomous or a guess of another size.
+  virtual EquilibriumResult equilibrium(const Eigen::VectorXd& guess, const EquilibriumOptions& options) const = 0;
   // Lyapunov exponents from the constant initial history.
   virtual LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const = 0;
   // The histories U_0 .. U_{count-1} of successive maps after `transient` maps, from the constant
@@ -116,6 +122,7 @@ class ModelAnalysesFor final : public ModelAnalyses {
   bool switches_in_state() const override { return Model::has_switching; }
   bool switches_in_time() const override { return TimeSwitchedModel<Model>; }
   bool is_linear() const override { return Model::is_linear; }
+  bool is_autonomous() const override { return AutonomousModel<Model>; }
   double tau() const override { return model_.tau(); }
   std::vector<double> delays() const override { return delays_of(model_); }
   double period() const override { return model_.period(); }
@@ -143,6 +150,18 @@ class ModelAnalysesFor final : public ModelAnalyses {
     out.contacts = orbit_contacts(model_, std::move(at_orbit.states));
     out.monodromy = std::make_unique<Monodromy<D, DW>>(map.grid(), std::move(at_orbit.maps));
     return out;
+  }
+
+  EquilibriumResult equilibrium(const Eigen::VectorXd& guess, const EquilibriumOptions& options) const override {
+    if constexpr (AutonomousModel<Model>) {
+      if (guess.size() == 0) return find_equilibrium(model_, model_.initial_state(), options);
+      if (guess.size() != D)
+        throw BadInput("the equilibrium guess has " + std::to_string(guess.size()) + " entries; the state has " +
+                       std::to_string(D));
+      return find_equilibrium(model_, Vec<D>(guess), options);
+    } else {
+      throw BadInput("equilibria are for autonomous models (no forcing: f independent of t); this one is forced");
+    }
   }
 
   LyapunovResult lyapunov(const MapSettings& s, const LyapunovOptions& options) const override {

@@ -19,6 +19,7 @@ class LinearModel {
   static constexpr int d = 1;
   static constexpr bool has_switching = false;
   static constexpr bool affine_in_state = true;
+  static constexpr bool autonomous = true;  // no forcing: equilibria (equilibrium.hpp)
   static constexpr bool is_linear = true;
   using V = Vec<1>;
   using M = Mat<1>;

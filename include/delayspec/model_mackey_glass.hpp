@@ -25,6 +25,7 @@ class MackeyGlassModel {
   static constexpr int d = 1;
   static constexpr bool has_switching = false;
   static constexpr bool affine_in_state = true;
+  static constexpr bool autonomous = true;  // no forcing: equilibria (equilibrium.hpp)
   static constexpr bool is_linear = false;
   using V = Vec<1>;
   using M = Mat<1>;

@@ -37,8 +37,8 @@ from ._delayspec import BadInput, NumericalFailure, __version__
 BadInput.__module__ = NumericalFailure.__module__ = "delayspec"
 
 __all__ = [
-    "BadInput", "NumericalFailure", "Result", "floquet", "lyapunov", "converge", "simulate", "sweep",
-    "chart", "basin", "continue_", "keys_help",
+    "BadInput", "NumericalFailure", "Result", "floquet", "equilibrium", "lyapunov", "converge", "simulate",
+    "sweep", "chart", "basin", "continue_", "keys_help",
 ]
 
 
@@ -144,6 +144,13 @@ class Result:
         scalars = ", ".join(f"{k}={v!r}" for k, v in self._data.items()
                             if isinstance(v, (int, float, str)) and k in ("model", "N", "solver", "events"))
         return f"<delayspec.{type(self).__name__} {self.command}: {scalars}>"
+
+
+class EquilibriumResult(Result):
+    """`equilibrium`: `equilibrium` (float64, the state), `roots` (complex128, the rightmost
+    characteristic roots, largest real part first, exact to their `error_bound`), `unstable`,
+    `critical`, `stable` and the other fields of the CLI's JSON (docs/cli.md, equilibrium); each
+    root's own fields (`error_bound`, `residual`, `moved`) in `r["roots"]`."""
 
 
 class FloquetResult(Result):
@@ -270,6 +277,10 @@ def floquet(scene=None, *, progress=False, **keys):
     return _run("floquet", FloquetResult, scene, keys, progress=progress)
 
 
+def equilibrium(scene=None, *, progress=False, **keys):
+    return _run("equilibrium", EquilibriumResult, scene, keys, progress=progress)
+
+
 def lyapunov(scene=None, *, progress=False, **keys):
     return _run("lyapunov", Result, scene, keys, progress=progress)
 
@@ -303,7 +314,7 @@ def keys_help(command):
     return _delayspec.keys_help(command)
 
 
-_RESULT_TYPES = {floquet: FloquetResult, lyapunov: Result, converge: ConvergeResult, simulate: SimulateResult,
+_RESULT_TYPES = {floquet: FloquetResult, equilibrium: EquilibriumResult, lyapunov: Result, converge: ConvergeResult, simulate: SimulateResult,
                  sweep: SweepResult, chart: GridResult, basin: GridResult, continue_: ContinueResult}
 
 

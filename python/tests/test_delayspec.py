@@ -114,6 +114,15 @@ assert "libdelayspec_equations.so" in after and "libginac" in after
     assert p.returncode == 0, p.stderr
 
 
+def test_equilibrium_equals_cli_json_and_roots_are_complex():
+    keys = dict(model="linear", a=-1, b=-3)
+    r = delayspec.equilibrium(**keys)
+    same_as_cli(r, "equilibrium", **keys)
+    assert r.roots.dtype == np.complex128 and r.roots.shape == (6,)
+    assert r.roots[0] == complex(r["roots"][0]["re"], r["roots"][0]["im"])
+    assert r.unstable == 2 and not r.stable
+
+
 def test_lyapunov_equals_cli_json():
     r = delayspec.lyapunov(**LYAPUNOV_KEYS)
     same_as_cli(r, "lyapunov", **LYAPUNOV_KEYS)

@@ -78,7 +78,7 @@ TEST(Equilibrium, MackeyGlassEquilibriumAndItsRoots) {
 struct TwoDelayOscillator {
   static constexpr int d = 2;
   static constexpr int delay_count = 2;
-  static constexpr bool has_switching = false, affine_in_state = true, is_linear = true;
+  static constexpr bool has_switching = false, affine_in_state = true, is_linear = true, autonomous = true;
   double c = 0.1, k1 = 0.3, k2 = -0.6, tau1 = 0.7, tau2 = std::sqrt(1.7);
   std::array<double, 2> delays() const { return {tau1, tau2}; }
   double tau() const { return tau2; }
@@ -123,7 +123,7 @@ TEST(Equilibrium, TwoDelaySystemRootsAgainstItsCharacteristicFunction) {
 // x' = 1 + x(t - 1) - x: every constant history moves, no equilibrium (g = 1, g' = 0).
 struct NoEquilibrium {
   static constexpr int d = 1;
-  static constexpr bool has_switching = false, affine_in_state = true, is_linear = false;
+  static constexpr bool has_switching = false, affine_in_state = true, is_linear = false, autonomous = true;
   double tau() const { return 1; }
   double period() const { return 1; }
   Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const { return Vec<1>(1 + w[0] - y[0]); }

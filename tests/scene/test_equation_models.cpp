@@ -290,6 +290,44 @@ TEST(EquationModels, AParameterADelayDependsOnReTapsWithoutRecompiling) {
   EXPECT_GT(test::worst_distance(mu, two_delay_exact(1)), 1e-2);
 }
 
+// Equilibria (issue 35): an equation model without t is autonomous, its equilibrium's roots are
+// the exact roots of its characteristic function (found here by Newton from a grid of starts,
+// tests/support); a model with t in its right-hand side is not. The scenes are the ones compiled
+// above: no compile of their own.
+TEST(EquationModels, AutonomousEquationsHaveEquilibriaWithTheExactRoots) {
+  using cd = std::complex<double>;
+  EXPECT_FALSE(problem_from(kImpactScene, {}).analyses->is_autonomous());
+  const Problem two = problem_from(kTwoDelayScene, {});
+  ASSERT_TRUE(two.analyses->is_autonomous());
+  EquilibriumOptions o;
+  const EquilibriumResult r = two.analyses->equilibrium(Eigen::VectorXd::Constant(1, 0.3), o);
+  EXPECT_LT(std::abs(r.state[0]), 1e-15);
+  const double a = -1, b1 = 0.5, b2 = -0.7, tau2 = std::sqrt(2.0);
+  const std::vector<cd> exact = test::exact_roots(
+      {[=](cd l) { return l - a - b1 * std::exp(-l) - b2 * std::exp(-l * tau2); },
+       [=](cd l) { return 1.0 + b1 * std::exp(-l) + b2 * tau2 * std::exp(-l * tau2); }},
+      -12, 60);
+  ASSERT_EQ(r.roots.size(), 6u);
+  // Both are Newton on the same function to ~1e-15 relative: 1e-12 is the engine's stopping test.
+  // (the nearest exact root of each: conjugates come in either order) and none of the six
+  // rightmost exact roots is missed
+  std::vector<cd> got;
+  for (const CharacteristicRoot& root : r.roots) got.push_back(root.value);
+  EXPECT_LT(test::worst_distance(got, exact), 1e-12);
+  EXPECT_LT(test::worst_distance({exact.begin(), exact.begin() + 6}, got), 1e-12);
+
+  // Mackey-Glass at x* = 1: x' = -gamma x + beta (2 - n) / 4 x(t - tau), Lambert W
+  const Problem mg = problem_from(kMackeyGlassScene, {});
+  const EquilibriumResult m = mg.analyses->equilibrium(Eigen::VectorXd::Constant(1, 1.1), o);
+  EXPECT_NEAR(m.state[0], 1, 1e-14);
+  const std::vector<cd> lambert = linear_dde_roots(-0.1, 0.2 * (2 - 10) / 4, 8, 12);
+  for (size_t k = 0; k < 6; ++k) {
+    double best = INFINITY;
+    for (cd e : lambert) best = std::min(best, std::abs(m.roots[k].value - e));
+    EXPECT_LT(best, 1e-12) << m.roots[k].value;
+  }
+}
+
 TEST(EquationModels, OneDelayWrittenEitherWayIsBitIdentical) {
   std::string with_table = kLinearScene;
   with_table.replace(with_table.find("delay = \"1\""), 11, "delays = { tau = \"1\" }");

@@ -16,8 +16,8 @@ struct Characteristic {
   std::function<std::complex<double>(std::complex<double>)> value, derivative;
 };
 
-inline std::vector<std::complex<double>> exact_multipliers(const Characteristic& ch, double T, double re_min,
-                                                           double im_max) {
+// The distinct roots found in the rectangle, rightmost first.
+inline std::vector<std::complex<double>> exact_roots(const Characteristic& ch, double re_min, double im_max) {
   using cd = std::complex<double>;
   std::vector<cd> roots;
   for (double re = re_min; re <= 3; re += 0.25)
@@ -31,8 +31,15 @@ inline std::vector<std::complex<double>> exact_multipliers(const Characteristic&
       if (!(std::abs(ch.value(l)) < 1e-12 * (1 + std::abs(l))) || l.real() < re_min) continue;
       if (std::none_of(roots.begin(), roots.end(), [&](cd r) { return std::abs(r - l) < 1e-8; })) roots.push_back(l);
     }
+  std::sort(roots.begin(), roots.end(), [](cd x, cd y) { return x.real() > y.real(); });
+  return roots;
+}
+
+inline std::vector<std::complex<double>> exact_multipliers(const Characteristic& ch, double T, double re_min,
+                                                           double im_max) {
+  using cd = std::complex<double>;
   std::vector<cd> mu;
-  for (cd l : roots) mu.push_back(std::exp(l * T));
+  for (cd l : exact_roots(ch, re_min, im_max)) mu.push_back(std::exp(l * T));
   std::sort(mu.begin(), mu.end(), [](cd x, cd y) { return std::abs(x) > std::abs(y); });
   return mu;
 }

@@ -49,6 +49,7 @@ class ModelPrinter {
          << "  static constexpr bool has_time_switches = " << bool_text(time_switch) << ";\n"
          << "  static constexpr bool affine_in_state = " << bool_text(m_.affine_in_state) << ";\n"
          << "  static constexpr bool is_linear = " << bool_text(m_.is_linear) << ";\n"
+         << "  static constexpr bool autonomous = " << bool_text(m_.autonomous) << ";\n"
          << "  using Vector = delayspec::Vec<d>;\n"
          << "  using Matrix = delayspec::Mat<d>;\n"
          << "  std::array<double, parameter_count> p{};\n"

@@ -338,6 +338,9 @@ class EquationsReader {
     m_.is_linear = m_.switch_kind != SwitchKind::state &&
                    std::all_of(m_.fields.begin(), m_.fields.end(),
                                [&](const SymbolicField& f) { return affine_in(f, state_and_delayed); });
+    m_.autonomous = m_.switch_kind == SwitchKind::none &&
+                    std::all_of(m_.fields.front().f_t.begin(), m_.fields.front().f_t.end(),
+                                [](const GiNaC::ex& e) { return e.normal().is_zero(); });
   }
 
   const toml::table& table_;

@@ -45,6 +45,7 @@ struct SymbolicEquationModel {
   std::vector<SymbolicField> fields;
   bool affine_in_state = false;  // every d2 f_j / dy_a dy_b == 0
   bool is_linear = false;        // no state switch, every f_j affine in (y, z) jointly
+  bool autonomous = false;       // no switch, and d f / dt == 0: no forcing (equilibria)
 
   int d() const { return static_cast<int>(state.size()); }
   int delay_count() const { return static_cast<int>(delays.size()); }

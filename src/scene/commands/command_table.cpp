@@ -55,6 +55,15 @@ const std::vector<CommandSpec>& command_table() {
        .distributes = false,
        .analysis = true,
        .placeholders = {}},
+      {.name = "equilibrium",
+       .run = command_equilibrium,
+       .summary = "delayspec equilibrium [SCENE]: an equilibrium of an autonomous model and its rightmost characteristic "
+                "roots, exact (refined on the characteristic function), with their stability.",
+       .out = OutDirUse::ignored,
+       .resume = false,
+       .distributes = false,
+       .analysis = true,
+       .placeholders = {}},
       {.name = "floquet",
        .run = command_floquet,
        .summary = "delayspec floquet [SCENE]: the leading Floquet multipliers of the periodic orbit, each with its distance to "

@@ -18,6 +18,7 @@ namespace delayspec::cli {
 
 using CommandFunction = int (*)(Config&, const Invocation&);
 
+int command_equilibrium(Config& config, const Invocation& inv);
 int command_floquet(Config& config, const Invocation& inv);
 int command_lyapunov(Config& config, const Invocation& inv);
 int command_sweep(Config& config, const Invocation& inv);

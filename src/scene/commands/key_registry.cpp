@@ -121,6 +121,10 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
       {"orbit_guess_periods", "newton, auto, shooting: periods simulated from the initial history before the guess"},
       {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this, then this; one level below 2x it"},
       {"nev", "multipliers wanted, >= 1"},
+      // equilibrium (equilibrium_settings.cpp)
+      {"nroots", "equilibrium: rightmost characteristic roots wanted, 1..1000"},
+      {"equilibrium_guess", "equilibrium: where Newton starts, one number per state component (default: the initial history)"},
+      {"equilibrium_tolerance", "equilibrium: Newton's relative step at which the state and each root count as converged, (0, 1e-3]"},
       {"error_bars",
        "on: each multiplier's distance to the N -> infinity value, from solves at N/16 and N/4 (about 1.3x the "
        "time), and a verdict stable / unstable / undecided; off: the solve at N alone"},

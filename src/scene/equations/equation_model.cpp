@@ -69,12 +69,16 @@ class ExplainedAnalyses final : public ModelAnalyses {
   bool switches_in_state() const override { return inner_->switches_in_state(); }
   bool switches_in_time() const override { return inner_->switches_in_time(); }
   bool is_linear() const override { return inner_->is_linear(); }
+  bool is_autonomous() const override { return inner_->is_autonomous(); }
   double tau() const override { return inner_->tau(); }
   std::vector<double> delays() const override { return inner_->delays(); }
   double period() const override { return inner_->period(); }
   LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
                                    const OrbitRequest& request) const override {
     return explained([&] { return inner_->linearised_orbit(map, orbit, request); });
+  }
+  EquilibriumResult equilibrium(const Eigen::VectorXd& guess, const EquilibriumOptions& options) const override {
+    return explained([&] { return inner_->equilibrium(guess, options); });
   }
   LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const override {
     return explained([&] { return inner_->lyapunov(map, options); });

@@ -263,6 +263,23 @@ std::optional<std::string> Config::lookup(const std::string& key) {
 
 void Config::mark_used(const std::string& key) { used_.insert(key); }
 
+namespace {
+
+// `item` (all of `text`, or one item of the list `text`) as a finite double; BadInput naming the key.
+double parse_finite_number(const std::string& key, const std::string& text, const std::string& item) {
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(item.c_str(), &end);
+  const std::string what = item == text ? "" : "`" + item + "` is ";
+  // ERANGE also flags underflow (subnormal results, or 0): those are numbers; only overflow is not.
+  if (item.empty() || end != item.c_str() + item.size() || (errno == ERANGE && std::abs(value) == HUGE_VAL))
+    throw BadInput("`" + key + " = " + text + "`: " + what + "not a number");
+  if (!std::isfinite(value)) throw BadInput("`" + key + " = " + text + "`: " + (what.empty() ? "must be" : what + "not") + " a finite number");
+  return value;
+}
+
+}  // namespace
+
 double Config::get_double(const std::string& key, double fallback) {
   auto text = lookup(key);
   if (!text) {
@@ -270,16 +287,25 @@ double Config::get_double(const std::string& key, double fallback) {
     note_read(key, format_number(fallback));
     return fallback;
   }
-  const std::string& s = *text;
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(s.c_str(), &end);
-  // ERANGE also flags underflow (subnormal results, or 0): those are numbers; only overflow is not.
-  if (s.empty() || end != s.c_str() + s.size() || (errno == ERANGE && std::abs(value) == HUGE_VAL))
-    throw BadInput("`" + key + " = " + s + "`: not a number");
-  if (!std::isfinite(value)) throw BadInput("`" + key + " = " + s + "`: must be a finite number");
+  const double value = parse_finite_number(key, *text, *text);
   note_value(key, format_number(value));
   return value;
+}
+
+std::vector<double> Config::get_double_list(const std::string& key, const std::string& fallback_text) {
+  auto text = lookup(key);
+  if (!text) {
+    note_read(key, fallback_text);
+    return {};
+  }
+  std::vector<double> out;
+  std::string shown;
+  for (const std::string& item : split_items(*text)) {
+    out.push_back(parse_finite_number(key, *text, item));
+    shown.append(shown.empty() ? "" : ",").append(format_number(out.back()));
+  }
+  note_value(key, shown);
+  return out;
 }
 
 double Config::require_double(const std::string& key) {

@@ -57,6 +57,9 @@ class Config {
   // A value that must be one of `allowed`.
   std::string get_choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed);
   std::vector<long> get_int_list(const std::string& key, const std::vector<long>& fallback);
+  // A list of finite numbers ("1, 2.5" or a TOML array); empty when the key is absent
+  // (fallback_text: what is used then, for --help).
+  std::vector<double> get_double_list(const std::string& key, const std::string& fallback_text);
 
   // Marks a key as known without reading it (e.g. keys of another command in a shared scene).
   void mark_used(const std::string& key);

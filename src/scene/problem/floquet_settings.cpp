@@ -8,8 +8,14 @@
 namespace delayspec::cli {
 
 FloquetOptions read_floquet_options(Config& config, int default_nev) {
+  const long nev = config.get_int_in_range("nev", default_nev, 1, std::numeric_limits<int>::max());
+  FloquetOptions options = read_eigensolver_options(config);
+  options.nev = static_cast<int>(nev);
+  return options;
+}
+
+FloquetOptions read_eigensolver_options(Config& config) {
   FloquetOptions options;
-  options.nev = static_cast<int>(config.get_int_in_range("nev", default_nev, 1, std::numeric_limits<int>::max()));
   options.solver = parse_floquet_solver(config.get_choice(
       "solver", "auto", {"auto", "spectra", "arpack", "block", "dense", "dense-eigen", "dense-lapack"}));
   options.block_size = static_cast<int>(config.get_int_in_range("block_size", options.block_size, 1, 64));

@@ -1,0 +1,80 @@
+// The `delayspec equilibrium` command: its JSON against the Lambert-W roots (which the engine does
+// not use), stability counts, and bad input (exit 2 naming the key or the model).
+#include <gtest/gtest.h>
+
+#include <complex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli_test_support.hpp"
+#include "delayspec/lambert_w.hpp"
+
+namespace {
+
+using delayspec::testing::CliResult;
+using delayspec::testing::run;
+
+// x' = a x + b x(t - 1): the equilibrium 0 and its six rightmost roots, against
+// lambda = a + W_k(b e^{-a}) (the roots are refined to |step| <= 1e-12 (1 + |lambda|) on the exact
+// characteristic function; the Lambert-W values are good to ~1e-15).
+TEST(EquilibriumCli, LinearRootsAreTheLambertWRootsWithTheirStability) {
+  for (const auto& [a, b, unstable] : {std::tuple{-1.0, 0.5, 0}, std::tuple{-1.0, -3.0, 2}, std::tuple{0.5, 0.2, 1}}) {
+    SCOPED_TRACE("a = " + std::to_string(a) + ", b = " + std::to_string(b));
+    const CliResult r = run({"equilibrium", "--json", "--set", "model=linear", "--set", "a=" + std::to_string(a), "--set",
+                             "b=" + std::to_string(b), "--set", "equilibrium_guess=0.7"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_NEAR(j["equilibrium"][0].get<double>(), 0, 1e-15);
+    const std::vector<std::complex<double>> exact = delayspec::linear_dde_roots(a, b, 1, 12);
+    ASSERT_EQ(j["roots"].size(), 6u);
+    for (const auto& root : j["roots"]) {
+      const std::complex<double> l(root["re"].get<double>(), root["im"].get<double>());
+      double best = INFINITY;
+      for (auto e : exact) best = std::min(best, std::abs(l - e));
+      EXPECT_LT(best, 1e-12) << l;
+      EXPECT_LE(root["error_bound"].get<double>(), 1e-11);
+      // refinement removed the discretisation's error at N = 100 (second order: 1e-7 .. 1e-2)
+      EXPECT_GT(root["moved"].get<double>(), 1e-9);
+    }
+    EXPECT_EQ(j["unstable"].get<int>(), unstable);
+    EXPECT_EQ(j["stable"].get<bool>(), unstable == 0);
+  }
+}
+
+TEST(EquilibriumCli, MackeyGlassFromTheGuessFindsItsEquilibriumAndText) {
+  // beta / gamma = 2: x* = 1 from a guess near it; the default history 0.5 reaches x* = 0.
+  const CliResult one = run({"equilibrium", "--set", "model=mackey-glass", "--set", "tau=2", "--set",
+                             "equilibrium_guess=1.2"});
+  ASSERT_EQ(one.status, 0) << one.err;
+  EXPECT_NE(one.out.find("equilibrium: x = 1 "), std::string::npos) << one.out;
+  EXPECT_NE(one.out.find("stability: stable"), std::string::npos) << one.out;
+  const CliResult zero = run({"equilibrium", "--json", "--set", "model=mackey-glass"});
+  ASSERT_EQ(zero.status, 0) << zero.err;
+  EXPECT_NEAR(nlohmann::json::parse(zero.out)["equilibrium"][0].get<double>(), 0, 1e-15);
+}
+
+struct Bad {
+  std::vector<std::string> sets;
+  std::string says;
+};
+
+TEST(EquilibriumCli, BadInputExitsTwoNamingIt) {
+  for (const Bad& b : std::vector<Bad>{
+           {{"model=impact"}, "`model = impact` is not autonomous"},
+           {{"model=milling"}, "`model = milling` is not autonomous"},
+           {{"model=linear", "equilibrium_guess=1,2"}, "`equilibrium_guess`: 2 numbers given; the state has 1 (x)"},
+           {{"model=linear", "equilibrium_guess=one"}, "`equilibrium_guess = one`: not a number"},
+           {{"model=linear", "nroots=0"}, "`nroots = 0`"},
+           {{"model=linear", "equilibrium_tolerance=0.1"}, "`equilibrium_tolerance = 0.1`"},
+           {{"model=linear", "nev=3"}, "`nev`"}}) {
+    std::vector<std::string> args = {"equilibrium"};
+    for (const std::string& s : b.sets) args.insert(args.end(), {"--set", s});
+    const CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << b.says << ": " << r.err;
+    EXPECT_NE(r.err.find(b.says), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+}  // namespace
