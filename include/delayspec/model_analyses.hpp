@@ -82,6 +82,9 @@ class ModelAnalyses {
   // rightmost characteristic roots (equilibrium.hpp). BadInput for a model that is not
   // autonomous or a guess of another size.
   virtual EquilibriumResult equilibrium(const Eigen::VectorXd& guess, const EquilibriumOptions& options) const = 0;
+  // f, A, the B_i and the delays on the constant history y (d entries): what an equilibrium's
+  // Newton and its characteristic function need (equilibrium.hpp). BadInput as equilibrium().
+  virtual ConstantHistory at_constant_history(const Eigen::VectorXd& y) const = 0;
   // Lyapunov exponents from the constant initial history.
   virtual LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const = 0;
   // The histories U_0 .. U_{count-1} of successive maps after `transient` maps, from the constant
@@ -160,7 +163,16 @@ class ModelAnalysesFor final : public ModelAnalyses {
                        std::to_string(D));
       return find_equilibrium(model_, Vec<D>(guess), options);
     } else {
-      throw BadInput("equilibria are for autonomous models (no forcing: f independent of t); this one is forced");
+      throw BadInput(kNotAutonomous);
+    }
+  }
+  ConstantHistory at_constant_history(const Eigen::VectorXd& y) const override {
+    if constexpr (AutonomousModel<Model>) {
+      if (y.size() != D)
+        throw BadInput("the state has " + std::to_string(D) + " entries, not " + std::to_string(y.size()));
+      return constant_history(model_, Vec<D>(y));
+    } else {
+      throw BadInput(kNotAutonomous);
     }
   }
 
@@ -225,6 +237,8 @@ class ModelAnalysesFor final : public ModelAnalyses {
       if (!y.allFinite()) return false;
     return true;
   }
+  static constexpr const char* kNotAutonomous =
+      "equilibria are for autonomous models (no forcing: f independent of t); this one is forced";
   StroboscopicMap<Model> make_map(const MapSettings& s) const {
     return StroboscopicMap<Model>(TrapezoidStepper<Model>(model_, s.step), grid(s));
   }

@@ -16,6 +16,7 @@
 
 #include "characteristic_roots.hpp"
 #include "delayspec/equilibrium.hpp"
+#include "delayspec/equilibrium_branch.hpp"
 #include "delayspec/lambert_w.hpp"
 #include "delayspec/model_linear.hpp"
 #include "delayspec/model_mackey_glass.hpp"
@@ -142,6 +143,84 @@ TEST(Equilibrium, BadInputAndAModelWithoutEquilibrium) {
   } catch (const NumericalFailure& e) {
     EXPECT_NE(std::string(e.what()).find("singular"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace delayspec
+
+// ---- the branch of equilibria (equilibrium_branch.hpp) ----
+
+namespace delayspec {
+namespace {
+
+// The family of a model type made from a parameter: its values and its equilibria at p.
+template <class Model, class Make>
+EquilibriumFamily family_of(Make make) {
+  return {[make](const Eigen::VectorXd& y, double p) { return constant_history(make(p), Vec<Model::d>(y)); },
+          [make](const Eigen::VectorXd& guess, double p) { return find_equilibrium(make(p), Vec<Model::d>(guess)); }};
+}
+
+TEST(EquilibriumBranch, MackeyGlassHopfPointInTauIsTheClosedForm) {
+  // x* = 1, linearisation x' = a x + b x(t - tau) with a = -gamma, b = beta (2 - n) / 4: at
+  // lambda = i omega, omega = sqrt(b^2 - a^2) and cos(omega tau) = -a / b (sin > 0 as -b > 0).
+  const double a = -0.1, b = 0.2 * (2 - 10) / 4.0, omega = std::sqrt(b * b - a * a);
+  const double tau_H = std::acos(-a / b) / omega;
+  const EquilibriumFamily family = family_of<MackeyGlassModel>([](double tau) {
+    MackeyGlassParameters p;
+    p.tau = p.period = tau;
+    return MackeyGlassModel(p);
+  });
+  EquilibriumBranchOptions o;
+  o.from = 3, o.to = 6;
+  const EquilibriumBranch branch = continue_equilibrium(family, Vec<1>(1.1), o);
+  EXPECT_EQ(branch.end, BranchEnd::to);
+  EXPECT_EQ(branch.points.back().parameter, 6);
+  ASSERT_EQ(branch.bifurcations.size(), 1u);
+  const EquilibriumBifurcation& h = branch.bifurcations[0];
+  EXPECT_EQ(h.type, EquilibriumBifurcationType::hopf);
+  // located to the default tolerance 1e-10 |to - from| on the exact characteristic function
+  EXPECT_NEAR(h.parameter, tau_H, 1e-10);
+  EXPECT_NEAR(h.omega, omega, 1e-10);
+  EXPECT_NEAR(h.period, 2 * M_PI / omega, 1e-9);
+  EXPECT_NEAR(h.state[0], 1, 1e-14);
+  EXPECT_LE(h.parameter_bound, 3e-10);
+  // stable before, a pair unstable after
+  EXPECT_EQ(branch.points.front().equilibrium.unstable, 0);
+  EXPECT_EQ(branch.points.back().equilibrium.unstable, 2);
+}
+
+// x' = p - x^2 + c (x(t - 1) - x): equilibria x = +-sqrt(p), a fold at p = 0; the root through 0
+// is real (lambda = -2 x - c + c e^{-lambda}: at x = 0, lambda = 0).
+struct FoldModel {
+  static constexpr int d = 1;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double p = 1, c = 0.5;
+  double tau() const { return 1; }
+  double period() const { return 1; }
+  Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const { return Vec<1>(p - y[0] * y[0] + c * (w[0] - y[0])); }
+  Mat<1> A(int, double, const Vec<1>& y, const Vec<1>&) const { return Mat<1>::Constant(-2 * y[0] - c); }
+  Mat<1> B(int, double, const Vec<1>&, const Vec<1>&) const { return Mat<1>::Constant(c); }
+  Vec<1> initial_state() const { return Vec<1>(1); }
+};
+
+TEST(EquilibriumBranch, FoldIsPassedAndLocated) {
+  const EquilibriumFamily family = family_of<FoldModel>([](double p) { return FoldModel{p, 0.5}; });
+  EquilibriumBranchOptions o;
+  o.from = 1, o.to = -1;
+  const EquilibriumBranch branch = continue_equilibrium(family, Vec<1>(0.9), o);
+  // down the upper branch x = sqrt(p) to the fold, then back up the lower one to p = 1 again
+  EXPECT_EQ(branch.end, BranchEnd::from);
+  EXPECT_LT(branch.points.back().equilibrium.state[0], -0.9);
+  for (const EquilibriumPoint& pt : branch.points)
+    EXPECT_NEAR(pt.equilibrium.state[0] * pt.equilibrium.state[0], pt.parameter, 1e-12);
+  ASSERT_EQ(branch.bifurcations.size(), 1u);
+  const EquilibriumBifurcation& f = branch.bifurcations[0];
+  EXPECT_EQ(f.type, EquilibriumBifurcationType::fold);
+  EXPECT_NEAR(f.parameter, 0, 2e-10);   // the tolerance, 1e-10 |to - from|
+  EXPECT_NEAR(f.state[0], 0, 1e-9);     // the root is linear in x there: as precise as the root
+  EXPECT_EQ(f.root.value.imag(), 0);
+  EXPECT_EQ(branch.points.front().equilibrium.unstable, 0);
+  EXPECT_EQ(branch.points.back().equilibrium.unstable, 1);
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 
 #include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
+#include "scene/commands/continue_equilibria.hpp"
 #include "scene/problem/continue_settings.hpp"
 #include "delayspec/continuation.hpp"
 #include "scene/problem/floquet_settings.hpp"
@@ -38,16 +39,6 @@ namespace delayspec::cli {
 namespace {
 
 using nlohmann::json;
-
-// The model's analyses with `key` set to p: the scene `base` read again with that value (the
-// same validation as any scene value; an equation model keeps its compiled code, new constants).
-AnalysesAt analyses_with_key(const Config& base, const std::string& key) {
-  return [&base, &key](double p) {
-    Config c = base;
-    c.set(key, format_number(p), "continue");
-    return read_problem(c, 100).analyses;
-  };
-}
 
 // One level N with the continued key at p: the scene the family of models reads (analyses_with_key
 // keeps a reference to `config`), its problem, and the options' discretisation taken from it.
@@ -354,6 +345,9 @@ void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutc
 }  // namespace
 
 int command_continue(Config& config, const Invocation& inv) {
+  // continue_object = equilibrium: the branch of equilibria (continue_equilibria.hpp)
+  if (config.get_choice("continue_object", "orbit", {"orbit", "equilibrium"}) == "equilibrium")
+    return continue_equilibria(config, inv);
   const auto start = std::chrono::steady_clock::now();
   const ContinueRun run = read_continue_run(config);
   const ContinueOutcome out = compute_continue(config, run, inv);

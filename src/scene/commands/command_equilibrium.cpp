@@ -15,8 +15,6 @@ namespace delayspec::cli {
 
 namespace {
 
-nlohmann::json complex_json(std::complex<double> z) { return {{"re", z.real()}, {"im", z.imag()}}; }
-
 nlohmann::json equilibrium_json(const Problem& problem, const EquilibriumResult& r) {
   nlohmann::json j;
   j["model"] = problem.model_name;
@@ -26,17 +24,7 @@ nlohmann::json equilibrium_json(const Problem& problem, const EquilibriumResult&
   j["equilibrium"] = std::vector<double>(r.state.data(), r.state.data() + r.state.size());
   j["residual"] = r.residual;
   j["newton_iterations"] = r.newton_iterations;
-  nlohmann::json roots = nlohmann::json::array();
-  for (const CharacteristicRoot& c : r.roots) {
-    nlohmann::json root = complex_json(c.value);
-    root["error_bound"] = c.error_bound;
-    root["residual"] = c.residual;
-    root["discretised"] = complex_json(c.discretised);  // from the monodromy at N
-    root["moved"] = std::abs(c.value - c.discretised);  // the discretisation's error at N
-    root["iterations"] = c.iterations;
-    roots.push_back(root);
-  }
-  j["roots"] = roots;
+  j["roots"] = characteristic_roots_json(r.roots);
   j["unstable"] = r.unstable;
   j["critical"] = r.critical;
   j["stable"] = r.stable();
@@ -82,10 +70,7 @@ int command_equilibrium(Config& config, const Invocation& inv) {
   Problem problem = read_problem(config, 100);
   const EquilibriumSettings settings = read_equilibrium_settings(config, problem);
   config.check_all_used();
-  if (!problem.analyses->is_autonomous())
-    throw BadInput("`model = " + problem.model_name + "` is not autonomous: " +
-                   (problem.model ? "its forcing depends on t" : "its right-hand side depends on t, or it switches") +
-                   "; equilibria are for models with no forcing (linear, mackey-glass, or equations without t)");
+  require_autonomous(problem);
   const EquilibriumResult r = problem.analyses->equilibrium(settings.guess, settings.options);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (inv.json) {

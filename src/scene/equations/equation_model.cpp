@@ -80,6 +80,9 @@ class ExplainedAnalyses final : public ModelAnalyses {
   EquilibriumResult equilibrium(const Eigen::VectorXd& guess, const EquilibriumOptions& options) const override {
     return explained([&] { return inner_->equilibrium(guess, options); });
   }
+  ConstantHistory at_constant_history(const Eigen::VectorXd& y) const override {
+    return inner_->at_constant_history(y);
+  }
   LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const override {
     return explained([&] { return inner_->lyapunov(map, options); });
   }

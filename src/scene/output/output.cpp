@@ -24,6 +24,21 @@ nlohmann::json lyapunov_json(const LyapunovResult& r) {
   return j;
 }
 
+nlohmann::json characteristic_roots_json(const std::vector<CharacteristicRoot>& roots) {
+  const auto complex_json = [](std::complex<double> z) { return nlohmann::json{{"re", z.real()}, {"im", z.imag()}}; };
+  nlohmann::json list = nlohmann::json::array();
+  for (const CharacteristicRoot& c : roots) {
+    nlohmann::json root = complex_json(c.value);
+    root["error_bound"] = c.error_bound;
+    root["residual"] = c.residual;
+    root["discretised"] = complex_json(c.discretised);  // from the monodromy at N
+    root["moved"] = std::abs(c.value - c.discretised);  // the discretisation's error at N
+    root["iterations"] = c.iterations;
+    list.push_back(root);
+  }
+  return list;
+}
+
 nlohmann::json multipliers_json(const std::vector<std::complex<double>>& values) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& mu : values) list.push_back({{"re", mu.real()}, {"im", mu.imag()}, {"abs", std::abs(mu)}});

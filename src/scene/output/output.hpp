@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "delayspec/equilibrium.hpp"
 #include "delayspec/error_bars.hpp"
 #include "delayspec/lyapunov.hpp"
 #include "delayspec/orbit_contacts.hpp"
@@ -24,6 +25,10 @@ std::string csv_number(double x);
 // exponents_per_time, standard_error_per_time,
 // batch_standard_error_per_period, fluctuation_bound_per_period, period_time.
 nlohmann::json lyapunov_json(const LyapunovResult& r);
+
+// Characteristic roots, rightmost first: [{"re", "im", "error_bound", "residual", "discretised":
+// {"re", "im"}, "moved", "iterations"}, ...] (docs/cli.md, equilibrium).
+nlohmann::json characteristic_roots_json(const std::vector<CharacteristicRoot>& roots);
 
 // [{"re": .., "im": .., "abs": ..}, ...]
 nlohmann::json multipliers_json(const std::vector<std::complex<double>>& values);

@@ -4,6 +4,7 @@
 
 #include "delayspec/errors.hpp"
 #include "scene/problem/parameter_grid.hpp"
+#include "scene/problem/problem.hpp"
 
 namespace delayspec::cli {
 
@@ -57,6 +58,14 @@ ContinueSettings read_continue_settings(Config& config) {
   }
   s.switch_period_doubling = config.get_choice("continue_switch", "false", {"false", "true"}) == "true";
   return s;
+}
+
+AnalysesAt analyses_with_key(const Config& base, const std::string& key) {
+  return [&base, &key](double p) {
+    Config c = base;
+    c.set(key, format_number(p), "continue");
+    return read_problem(c, 100).analyses;
+  };
 }
 
 }  // namespace delayspec::cli

@@ -6,6 +6,7 @@
 
 #include "scene/keys/config.hpp"
 #include "delayspec/continuation.hpp"
+#include "delayspec/model_analyses.hpp"
 
 namespace delayspec::cli {
 
@@ -22,5 +23,10 @@ struct ContinueSettings {
 // range, a non-positive step or tolerance, step_min > step_max, Ns not increasing or out of range.
 // The Floquet and discretisation options are the caller's (read_floquet_options, read_problem).
 ContinueSettings read_continue_settings(Config& config);
+
+// The model's analyses with `key` set to p: the scene `base` read again with that value (the
+// same validation as any scene value; an equation model keeps its compiled code, new constants).
+// Keeps references to `base` and `key`.
+AnalysesAt analyses_with_key(const Config& base, const std::string& key);
 
 }  // namespace delayspec::cli

@@ -30,4 +30,11 @@ EquilibriumSettings read_equilibrium_settings(Config& config, const Problem& pro
   return s;
 }
 
+void require_autonomous(const Problem& problem) {
+  if (!problem.analyses->is_autonomous())
+    throw BadInput("`model = " + problem.model_name + "` is not autonomous: " +
+                   (problem.model ? "its forcing depends on t" : "its right-hand side depends on t, or it switches") +
+                   "; equilibria are for models with no forcing (linear, mackey-glass, or equations without t)");
+}
+
 }  // namespace delayspec::cli

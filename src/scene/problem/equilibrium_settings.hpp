@@ -18,4 +18,7 @@ struct EquilibriumSettings {
 // tolerance that is not in (0, 1e-3].
 EquilibriumSettings read_equilibrium_settings(Config& config, const Problem& problem);
 
+// BadInput "`model = NAME` is not autonomous: ..." unless the problem's model is (model.hpp).
+void require_autonomous(const Problem& problem);
+
 }  // namespace delayspec::cli

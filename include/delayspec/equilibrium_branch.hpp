@@ -1,0 +1,84 @@
+#pragma once
+// The branch of equilibria of an autonomous model in one parameter p, and its fold and Hopf
+// points located on the exact characteristic function (issue 35, item 2).
+//
+// The branch: pseudo-arclength on F(y, p) = f(y, ..., y; p) = 0 in x = (y, p), d + 1 unknowns:
+// tangent t from [F_y F_p] t = 0 (F_y = A + sum B_i, F_p by central differences in p with
+// delta = eps^(1/3) (1 + |p|): an error ~eps^(2/3) in the corrector's Jacobian, which slows
+// Newton by nothing measurable and leaves its solution exact), predictor x + h t, corrector Newton
+// on [F(x); t . (x - x_pred)] = 0. It passes folds (where p turns back). At each point the
+// rightmost roots come from find_equilibrium's stages 2-3 (equilibrium.hpp), so they are exact.
+//
+// Bifurcations: where the count of roots with Re lambda > 0 changes between two points, the root
+// that crossed (each root at the later point followed back to the earlier one by Newton on c; the
+// crossing one nearest the axis) is followed along the segment between them, and Re lambda = 0 is
+// solved by the Illinois method in the arclength; every evaluation is a corrected branch point
+// and a root refined on c there, so the location has no discretisation error and its bracket in
+// p shrinks to `tolerance`. A complex pair is a Hopf point (omega = Im lambda, the period of the
+// orbit born 2 pi / omega); a real root a fold when p turns back on the segment, else a branch
+// point (a transcritical or pitchfork crossing). One crossing per segment: steps are limited by
+// step_max.
+#include <complex>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "delayspec/continuation.hpp"
+#include "delayspec/equilibrium.hpp"
+
+namespace delayspec {
+
+// The model at parameter p: its values on a constant history, and its equilibrium near a guess
+// with its rightmost roots (find_equilibrium).
+struct EquilibriumFamily {
+  std::function<ConstantHistory(const Eigen::VectorXd& y, double p)> at;
+  std::function<EquilibriumResult(const Eigen::VectorXd& guess, double p)> equilibrium;
+};
+
+struct EquilibriumBranchOptions {
+  double from = 0, to = 1;    // the parameter range; the branch starts at `from`
+  double step = 0;            // initial arclength step; 0 = |to - from| / 50
+  double step_min = 0;        // 0 = 1e-6 |to - from|
+  double step_max = 0;        // 0 = |to - from| / 10
+  int max_points = 1000;      // branch points at most (the start included), >= 2
+  double tolerance = 0;       // location tolerance in p; 0 = 1e-10 |to - from|
+  double newton_tolerance = 1e-12;  // corrector: |dx|_inf <= this (1 + |x|_inf)
+  int newton_iterations = 10;       // corrector iterations per point
+  std::function<void()> on_point;   // after every accepted point; may be empty
+};
+
+enum class EquilibriumBifurcationType { fold, hopf, branch_point };
+// "fold", "hopf", "branch_point".
+std::string to_string(EquilibriumBifurcationType type);
+
+struct EquilibriumBifurcation {
+  EquilibriumBifurcationType type = EquilibriumBifurcationType::fold;
+  double parameter = 0;
+  double parameter_bound = 0;  // the final bracket's width in p (<= tolerance), or less where Re lambda hit 0
+  Eigen::VectorXd state;       // the equilibrium there
+  CharacteristicRoot root;     // the critical root (Im >= 0), refined there
+  double omega = 0, period = 0;  // Hopf: Im lambda and 2 pi / omega (0 otherwise)
+  int evaluations = 0;           // branch points computed to locate it
+};
+
+struct EquilibriumPoint {
+  double parameter = 0;
+  EquilibriumResult equilibrium;  // the state and its rightmost roots
+  int corrector_iterations = 0;
+};
+
+struct EquilibriumBranch {
+  std::vector<EquilibriumPoint> points;
+  std::vector<EquilibriumBifurcation> bifurcations;  // in order along the branch
+  BranchEnd end = BranchEnd::max_points;
+  std::string failure;  // when end == failure: where and why
+};
+
+// BadInput for options out of range; NumericalFailure when the start has no equilibrium. A step
+// that cannot be corrected even at step_min ends the branch (end = failure, the points so far).
+EquilibriumBranch continue_equilibrium(const EquilibriumFamily& family, const Eigen::VectorXd& guess,
+                                       const EquilibriumBranchOptions& options);
+
+}  // namespace delayspec

@@ -1,0 +1,135 @@
+// Stages 1 and 3 of equilibrium.hpp: Newton for the equilibrium, and Newton on the exact
+// characteristic function c(lambda) = det Delta(lambda) for each root.
+#include "delayspec/equilibrium.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "delayspec/errors.hpp"
+
+namespace delayspec {
+
+Eigen::MatrixXd ConstantHistory::jacobian() const {
+  const long d = A.rows();
+  Eigen::MatrixXd j = A;
+  for (size_t i = 0; i < taus.size(); ++i) j += B.middleCols(static_cast<long>(i) * d, d);
+  return j;
+}
+
+Eigen::MatrixXcd ConstantHistory::delta(std::complex<double> l, Eigen::MatrixXcd* derivative) const {
+  const long d = A.rows();
+  Eigen::MatrixXcd value = l * Eigen::MatrixXcd::Identity(d, d) - A.cast<std::complex<double>>();
+  if (derivative) *derivative = Eigen::MatrixXcd::Identity(d, d);
+  for (size_t i = 0; i < taus.size(); ++i) {
+    const std::complex<double> e = std::exp(-l * taus[i]);
+    const Eigen::MatrixXcd bi = B.middleCols(static_cast<long>(i) * d, d).cast<std::complex<double>>();
+    value -= e * bi;
+    if (derivative) *derivative += taus[i] * e * bi;
+  }
+  return value;
+}
+
+std::complex<double> ConstantHistory::newton_step(std::complex<double> l) const {
+  Eigen::MatrixXcd derivative;
+  const Eigen::MatrixXcd value = delta(l, &derivative);
+  // infinite where Delta is singular: lambda is a root
+  return 1.0 / Eigen::PartialPivLU<Eigen::MatrixXcd>(value).solve(derivative).trace();
+}
+
+namespace {
+
+double largest_singular_value(const Eigen::MatrixXd& m) {
+  return m.size() == 1 ? std::abs(m(0, 0)) : Eigen::JacobiSVD<Eigen::MatrixXd>(m).singularValues()(0);
+}
+
+}  // namespace
+
+double ConstantHistory::residual(std::complex<double> l) const {
+  const long d = A.rows();
+  double scale = std::abs(l) + largest_singular_value(A);
+  for (size_t i = 0; i < taus.size(); ++i)
+    scale += largest_singular_value(B.middleCols(static_cast<long>(i) * d, d));
+  const Eigen::MatrixXcd value = delta(l);
+  const double smallest =
+      d == 1 ? std::abs(value(0, 0)) : Eigen::JacobiSVD<Eigen::MatrixXcd>(value).singularValues()(d - 1);
+  return smallest / scale;
+}
+
+void equilibrium_state(const std::function<ConstantHistory(const Eigen::VectorXd&)>& at, Eigen::VectorXd y,
+                       const EquilibriumOptions& o, EquilibriumResult& r) {
+  for (;; ++r.newton_iterations) {
+    const ConstantHistory h = at(y);
+    r.residual = h.f.lpNorm<Eigen::Infinity>();
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(h.jacobian());
+    if (!lu.isInvertible())
+      throw NumericalFailure("equilibrium: the Jacobian A + sum B of f(y, ..., y) is singular at the iterate " +
+                             std::to_string(r.newton_iterations) + " (|f|_inf = " + format_number(r.residual) +
+                             "): no isolated equilibrium there");
+    const Eigen::VectorXd step = lu.solve(h.f);
+    if (!y.allFinite() || !step.allFinite() || r.newton_iterations >= o.max_iterations)
+      throw NumericalFailure("equilibrium: Newton did not converge from the guess (|f(y, ..., y)|_inf = " +
+                             format_number(r.residual) + " after " + std::to_string(r.newton_iterations) +
+                             " iterations)");
+    y -= step;
+    if (step.lpNorm<Eigen::Infinity>() <= o.tolerance * (1 + y.lpNorm<Eigen::Infinity>())) {
+      r.residual = at(y).f.lpNorm<Eigen::Infinity>();
+      ++r.newton_iterations;
+      break;
+    }
+  }
+  r.state = y;
+}
+
+CharacteristicRoot refined_root(const ConstantHistory& h, std::complex<double> l, const EquilibriumOptions& o) {
+  CharacteristicRoot root;
+  root.discretised = l;
+  for (root.iterations = 1;; ++root.iterations) {
+    const std::complex<double> step = h.newton_step(l);
+    l -= step;
+    root.last_step = std::abs(step);
+    if (!std::isfinite(l.real()) || !std::isfinite(l.imag()) || root.iterations >= o.max_iterations)
+      throw NumericalFailure("equilibrium: the characteristic root near " + format_number(root.discretised.real()) +
+                             (root.discretised.imag() < 0 ? " - " : " + ") +
+                             format_number(std::abs(root.discretised.imag())) +
+                             "i did not converge on det(lambda I - A - sum B e^(-lambda tau)) (last step " +
+                             format_number(root.last_step) + ")");
+    if (root.last_step <= o.tolerance * (1 + std::abs(l))) break;
+  }
+  root.value = l;
+  root.residual = h.residual(l);
+  root.error_bound = std::max(root.last_step, 4 * std::numeric_limits<double>::epsilon() * (1 + std::abs(l)));
+  return root;
+}
+
+void refine_multipliers(const ConstantHistory& h, const Multipliers& mu, double T, const EquilibriumOptions& o,
+                        EquilibriumResult& r) {
+  const double two_pi = 2 * std::numbers::pi;
+  const int branches = o.N / 2 + 1;  // frequencies the grid resolves: |Im lambda| T / 2 pi < N / 2
+  for (const std::complex<double>& m : mu) {
+    if (std::abs(m) == 0) continue;
+    std::complex<double> start;
+    double shortest = INFINITY;
+    for (int k = -branches; k <= branches; ++k) {
+      const std::complex<double> l(std::log(std::abs(m)) / T, (std::arg(m) + two_pi * k) / T);
+      const double step = std::abs(h.newton_step(l));
+      if (step < shortest) shortest = step, start = l;
+    }
+    const CharacteristicRoot root = refined_root(h, start, o);
+    const bool seen = std::any_of(r.roots.begin(), r.roots.end(), [&](const CharacteristicRoot& other) {
+      return std::abs(other.value - root.value) <= 1e3 * o.tolerance * (1 + std::abs(root.value));
+    });
+    if (!seen) r.roots.push_back(root);
+  }
+  std::sort(r.roots.begin(), r.roots.end(), [](const CharacteristicRoot& p, const CharacteristicRoot& q) {
+    return p.value.real() != q.value.real() ? p.value.real() > q.value.real() : p.value.imag() > q.value.imag();
+  });
+  if (static_cast<int>(r.roots.size()) > o.nroots) r.roots.resize(static_cast<size_t>(o.nroots));
+  r.unstable = r.critical = 0;
+  for (const CharacteristicRoot& c : r.roots) {
+    if (c.value.real() > c.error_bound) ++r.unstable;
+    else if (c.value.real() >= -c.error_bound) ++r.critical;
+  }
+}
+
+}  // namespace delayspec
