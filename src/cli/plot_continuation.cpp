@@ -89,4 +89,67 @@ void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& di
   if (mu1 >= 0) figure("branch_mu1", mu1, "|{/Symbol m}_1|", marks_mu, labels_mu, true);
 }
 
+void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir) {
+  // the root columns are nan where a point has fewer roots than nroots
+  ResultTable t = read_result_table(dir / "equilibria.csv", [](const std::string& c) {
+    return c.rfind("lambda", 0) == 0;
+  });
+  t.require_header({"parameter", "stable", "unstable"});
+  t.require_rows();
+  const int stable = t.column("stable"), y1 = 3, re1 = t.require_column("lambda1_re", "the roots lambda1_re, lambda1_im, ...");
+  const std::string key = t.metadata_text("continue_key", "parameter"), y1_name = t.columns.at(3);
+  // The bifurcations of continue.json: marked at their state and on Re lambda = 0.
+  std::string marks_y, marks_re, labels_y, labels_re;
+  if (std::filesystem::exists(dir / "continue.json")) {
+    const nlohmann::json doc = read_json_file(dir / "continue.json");
+    const JsonField j(doc, "continue.json", "");
+    int index = 0;
+    for (const JsonField& b : j.at("bifurcations").elements()) {
+      const double p = b.at("parameter").number();
+      const double y = b.at("equilibrium").elements().at(0).number();
+      const std::string type = b.at("type").text();
+      if (type != "fold" && type != "hopf" && type != "branch_point") b.at("type").fail("unknown bifurcation type");
+      // a row at the bifurcation, with the stability after it: the stretches meet there, not at
+      // the next branch point
+      for (size_t i = 1; i < t.rows.size(); ++i)
+        if (!t.rows[i - 1].empty() && !t.rows[i].empty() && (p - t.rows[i - 1][0]) * (p - t.rows[i][0]) <= 0) {
+          std::vector<double> row = t.rows[i];
+          row[0] = p, row[y1] = y, row[re1] = 0;
+          t.rows.insert(t.rows.begin() + static_cast<long>(i), row);
+          break;
+        }
+      ++index;
+      marks_y += gnuplot_number(p) + " " + gnuplot_number(y) + "\n";
+      marks_re += gnuplot_number(p) + " 0\n";
+      labels_y += "set label " + std::to_string(index) + " " + gnuplot_string(type) + " at " + gnuplot_number(p) +
+                  "," + gnuplot_number(y) + " offset 0.5,0.8 font ',9'\n";
+      labels_re += "set label " + std::to_string(index) + " " + gnuplot_string(type) + " at " + gnuplot_number(p) +
+                   ",0 offset 0.5,0.8 font ',9'\n";
+    }
+  }
+  auto figure = [&](const std::string& name, int y, const std::string& ylabel, const std::string& marks,
+                    const std::string& labels, bool zero_line) {
+    std::string solid, dashed;
+    stable_and_unstable(t, 0, y, stable, solid, dashed);
+    std::ostringstream gp;
+    gp << gnuplot_datablock("stable", solid.empty() ? "nan nan\n" : solid)
+       << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
+       << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
+    gp << "set title "
+       << gnuplot_string("Equilibria of " + t.metadata_text("model", "?") + " against " + key +
+                         " (stable solid, unstable dashed)")
+       << "\n";
+    gp << "set xlabel " << gnuplot_label(key) << "\nset ylabel " << gnuplot_string(ylabel)
+       << "\nset grid\nset key top left\n"
+       << labels;
+    gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
+       << "     $unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable'"
+       << (marks.empty() ? "" : ", \\\n     $marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'")
+       << (zero_line ? ", \\\n     0 with lines lc rgb '#2ca02c' title 'Re {/Symbol l} = 0'" : "") << "\n";
+    renderer.figure(name, gp.str());
+  };
+  figure("equilibria", y1, y1_name + " at the equilibrium", marks_y, labels_y, false);
+  figure("equilibria_re_lambda", re1, "Re {/Symbol l}_1 (rightmost root)", marks_re, labels_re, true);
+}
+
 }  // namespace delayspec::cli

@@ -13,4 +13,11 @@ namespace delayspec::cli {
 
 void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& dir);
 
+// The figures of `continue` with continue_object = equilibrium (DIR has equilibria.csv):
+//   equilibria            the first state component against the parameter, stable solid,
+//                         unstable dashed, the folds and Hopf points of
+//                         equilibrium_bifurcations.csv marked and named
+//   equilibria_re_lambda  Re lambda_1, the rightmost root, with the zero line and the same marks
+void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir);
+
 }  // namespace delayspec::cli

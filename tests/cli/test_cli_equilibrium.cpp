@@ -2,7 +2,9 @@
 // not use), stability counts, and bad input (exit 2 naming the key or the model).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <complex>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -74,6 +76,59 @@ TEST(EquilibriumCli, BadInputExitsTwoNamingIt) {
     EXPECT_EQ(r.status, 2) << b.says << ": " << r.err;
     EXPECT_NE(r.err.find(b.says), std::string::npos) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// continue_object = equilibrium: Mackey-Glass's equilibrium x* = 1 in tau. Its Hopf point has a
+// closed form from the linearisation x' = a x + b x(t - tau) (a = -gamma, b = beta (2 - n) / 4):
+// omega = sqrt(b^2 - a^2), cos(omega tau_H) = -a / b. Located on the exact characteristic
+// function to continue_tolerance = 1e-12, so 1e-10 leaves two orders for rounding in the root.
+TEST(EquilibriumCli, ContinueLocatesTheMackeyGlassHopfPoint) {
+  const double a = -0.1, b = -0.4, omega = std::sqrt(b * b - a * a), tau_H = std::acos(-a / b) / omega;
+  const std::string dir = delayspec::testing::fresh_dir("continue_equilibria").string();
+  const CliResult r = run({"continue", "--json", "--out", dir, "--set", "model=mackey-glass", "--set",
+                           "continue_object=equilibrium", "--set", "continue_key=tau", "--set", "continue_from=3",
+                           "--set", "continue_to=6", "--set", "continue_tolerance=1e-12", "--set",
+                           "equilibrium_guess=1.1"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["continue_object"], "equilibrium");
+  EXPECT_EQ(j["end"], "to");
+  ASSERT_EQ(j["bifurcations"].size(), 1u);
+  const auto& h = j["bifurcations"][0];
+  EXPECT_EQ(h["type"], "hopf");
+  EXPECT_NEAR(h["parameter"].get<double>(), tau_H, 1e-10);
+  EXPECT_NEAR(h["omega"].get<double>(), omega, 1e-10);
+  EXPECT_NEAR(h["period"].get<double>(), 2 * M_PI / omega, 1e-9);
+  EXPECT_EQ(j["points"].front()["unstable"], 0);
+  EXPECT_EQ(j["points"].back()["unstable"], 2);
+  // the files: one row per point and per bifurcation after the metadata lines
+  for (const char* file : {"equilibria.csv", "equilibrium_bifurcations.csv", "continue.json"})
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / file)) << file;
+  // and `plot` draws them (gnuplot: a CI dependency)
+  const CliResult plot = run({"plot", dir});
+  ASSERT_EQ(plot.status, 0) << plot.err;
+  for (const char* file : {"plots/equilibria.png", "plots/equilibria_re_lambda.svg"})
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / file)) << file;
+}
+
+TEST(EquilibriumCli, ContinueEquilibriaBadInput) {
+  const std::vector<std::string> base = {"continue", "--set", "continue_object=equilibrium", "--set", "continue_key=tau",
+                                         "--set", "continue_from=3", "--set", "continue_to=6"};
+  for (const auto& [extra, says] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"model=impact", "continue_key=k"}, "`model = impact` is not autonomous"},
+           {{"model=mackey-glass", "continue_Ns=50,100"}, "`continue_Ns` with `continue_object = equilibrium`"},
+           {{"model=mackey-glass", "continue_switch=true"}, "not implemented yet"},
+           {{"model=mackey-glass", "continue_object=orbits"}, "`continue_object = orbits`"}}) {
+    std::vector<std::string> args = base;
+    for (const std::string& s : extra) args.insert(args.end(), {"--set", s});
+    const CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << says << ": " << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
   }
 }
 
