@@ -9,15 +9,16 @@
 // on [F(x); t . (x - x_pred)] = 0. It passes folds (where p turns back). At each point the
 // rightmost roots come from find_equilibrium's stages 2-3 (equilibrium.hpp), so they are exact.
 //
-// Bifurcations: where the count of roots with Re lambda > 0 changes between two points, the root
-// that crossed (each root at the later point followed back to the earlier one by Newton on c; the
-// crossing one nearest the axis) is followed along the segment between them, and Re lambda = 0 is
+// Bifurcations: where the count of roots with Re lambda > 0 changes between two points, each root
+// that crossed (each root at the later point followed back to the earlier one by Newton on c;
+// those whose real part changed sign) is followed along the segment between them, and Re lambda = 0 is
 // solved by the Illinois method in the arclength; every evaluation is a corrected branch point
 // and a root refined on c there, so the location has no discretisation error and its bracket in
 // p shrinks to `tolerance`. A complex pair is a Hopf point (omega = Im lambda, the period of the
 // orbit born 2 pi / omega); a real root a fold when p turns back on the segment, else a branch
-// point (a transcritical or pitchfork crossing). One crossing per segment: steps are limited by
-// step_max.
+// point (a transcritical or pitchfork crossing). Several roots crossing in one segment are each
+// located; a root that crosses twice within one segment (out and back) is not seen: steps are
+// limited by step_max.
 #include <complex>
 #include <functional>
 #include <string>

@@ -1,5 +1,5 @@
-"""delayspec: Floquet multipliers and Lyapunov exponents of periodically forced delay
-differential equations, from Python.
+"""delayspec: Floquet multipliers, Lyapunov exponents and characteristic roots of delay
+differential equations (periodically forced or autonomous), from Python.
 
 Each function runs the command of the same name of the `delayspec` program, with the same keys,
 defaults, validation and messages (one code path: the CLI's key-reading layer and commands):

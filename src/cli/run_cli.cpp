@@ -19,8 +19,8 @@ namespace delayspec::cli {
 
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{
-      "delayspec: stability spectra (Floquet multipliers, Lyapunov exponents) of periodically forced "
-      "delay differential equations, matrix-free.\nCommands: " +
+      "delayspec: stability spectra (Floquet multipliers, Lyapunov exponents, characteristic roots) of delay "
+      "differential equations, periodically forced or autonomous, matrix-free.\nCommands: " +
       command_list()};
   app.set_version_flag("--version", std::string("delayspec ") + DELAYSPEC_VERSION);
   std::string command;

@@ -1,6 +1,7 @@
 // The branch of equilibria and its fold and Hopf points (equilibrium_branch.hpp for the method).
 #include "delayspec/equilibrium_branch.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -99,13 +100,14 @@ EquilibriumOptions root_options(const Tracer& tracer) {
   return o;
 }
 
-// The root of `b` (Im >= 0) that crossed the imaginary axis between a and b, followed back to a
-// by Newton on c there: the one nearest the axis at b. False when none crossed (a count changed
-// by roots beyond the ones returned).
-bool crossing_root(const Tracer& tracer, const OnBranch& a, const EquilibriumResult& rb, std::complex<double>& at_a,
-                   std::complex<double>& at_b) {
+// The roots of `b` (Im >= 0) that crossed the imaginary axis between a and b, each followed back
+// to a by Newton on c there: {at a, at b} per root. Empty when none crossed (a count changed by
+// roots beyond the ones returned).
+std::vector<std::pair<std::complex<double>, std::complex<double>>> crossing_roots(const Tracer& tracer,
+                                                                                const OnBranch& a,
+                                                                                const EquilibriumResult& rb) {
   const ConstantHistory ha = tracer.family().at(a.y(), a.p());
-  bool found = false;
+  std::vector<std::pair<std::complex<double>, std::complex<double>>> crossed;
   for (const CharacteristicRoot& root : rb.roots) {
     if (root.value.imag() < 0) continue;
     CharacteristicRoot back;
@@ -114,11 +116,9 @@ bool crossing_root(const Tracer& tracer, const OnBranch& a, const EquilibriumRes
     } catch (const NumericalFailure&) {
       continue;
     }
-    if ((back.value.real() > 0) == (root.value.real() > 0)) continue;
-    if (!found || std::abs(root.value.real()) < std::abs(at_b.real())) at_a = back.value, at_b = root.value;
-    found = true;
+    if ((back.value.real() > 0) != (root.value.real() > 0)) crossed.emplace_back(back.value, root.value);
   }
-  return found;
+  return crossed;
 }
 
 // Locates Re lambda = 0 on the segment from a (arclength 0) to b (arclength h), lambda the root
@@ -151,8 +151,11 @@ EquilibriumBifurcation locate(const Tracer& tracer, const OnBranch& a, double h,
                         root_options(tracer));
     const double g = root.value.real();
     const End c{s, at.p(), root.value};
-    if (std::abs(g) <= root.error_bound) {  // on the axis to rounding: the slope gives the bound
-      out.parameter_bound = root.error_bound * std::abs(hi.p - lo.p) / std::abs(g_hi - g_lo);
+    // On the axis to rounding: the slope gives the bound. (Not to the root's error_bound, Newton's
+    // last step: the root is far more accurate than that, and the bracket goes on shrinking.)
+    const double rounding = 4 * std::numeric_limits<double>::epsilon() * (1 + std::abs(root.value));
+    if (std::abs(g) <= rounding) {
+      out.parameter_bound = rounding * std::abs(hi.p - lo.p) / std::abs(g_hi - g_lo);
       break;
     }
     if ((g > 0) == (g_hi > 0)) {
@@ -235,14 +238,19 @@ EquilibriumBranch continue_equilibrium(const EquilibriumFamily& family, const Ei
     }
     const EquilibriumResult& previous = branch.points.back().equilibrium;
     if (point.equilibrium.unstable != previous.unstable) {
-      std::complex<double> at_here, at_next;
-      if (crossing_root(tracer, here, point.equilibrium, at_here, at_next)) {
+      // every root that crossed, each located on its own, in order along the segment
+      std::vector<EquilibriumBifurcation> found;
+      for (const auto& [at_here, at_next] : crossing_roots(tracer, here, point.equilibrium)) {
         EquilibriumBifurcation b = locate(tracer, here, h, at_here, at_next, o.tolerance);
         if (b.type != EquilibriumBifurcationType::hopf)
           b.type = here.tangent(d) * next.tangent(d) < 0 ? EquilibriumBifurcationType::fold
                                                          : EquilibriumBifurcationType::branch_point;
-        if (!past_to || (b.parameter - o.to) * direction <= 0) branch.bifurcations.push_back(std::move(b));
+        if (!past_to || (b.parameter - o.to) * direction <= 0) found.push_back(std::move(b));
       }
+      std::sort(found.begin(), found.end(), [&](const EquilibriumBifurcation& x, const EquilibriumBifurcation& y) {
+        return (x.parameter - y.parameter) * direction < 0;
+      });
+      for (EquilibriumBifurcation& b : found) branch.bifurcations.push_back(std::move(b));
     }
     branch.points.push_back(std::move(point));
     if (o.on_point) o.on_point();

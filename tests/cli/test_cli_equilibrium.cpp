@@ -116,6 +116,28 @@ TEST(EquilibriumCli, ContinueLocatesTheMackeyGlassHopfPoint) {
     EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / file)) << file;
 }
 
+// x' = b x(t - 1) (a = 0): at lambda = i omega, i omega = b e^{-i omega}, so cos omega = 0 and
+// b = -omega / sin omega: Hopf points at b = -pi/2 (omega = pi/2) and b = -5 pi/2 (omega = 5 pi/2)
+// on the way to b = -9. One step covers the whole range: both pairs cross inside one segment and
+// each must be located on its own.
+TEST(EquilibriumCli, TwoPairsCrossingInOneStepAreBothLocated) {
+  const CliResult r = run({"continue", "--json", "--set", "model=linear", "--set", "a=0", "--set",
+                           "continue_object=equilibrium", "--set", "continue_key=b", "--set", "continue_from=-0.5",
+                           "--set", "continue_to=-9", "--set", "continue_step=10", "--set", "continue_step_max=10",
+                           "--set", "continue_tolerance=1e-12"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["points"].size(), 2u);
+  ASSERT_EQ(j["bifurcations"].size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    const double omega = (4 * k + 1) * M_PI / 2;
+    EXPECT_EQ(j["bifurcations"][k]["type"], "hopf");
+    EXPECT_NEAR(j["bifurcations"][k]["parameter"].get<double>(), -omega, 1e-10);
+    EXPECT_NEAR(j["bifurcations"][k]["omega"].get<double>(), omega, 1e-10);
+  }
+  EXPECT_EQ(j["points"].back()["unstable"], 4);
+}
+
 TEST(EquilibriumCli, ContinueEquilibriaBadInput) {
   const std::vector<std::string> base = {"continue", "--set", "continue_object=equilibrium", "--set", "continue_key=tau",
                                          "--set", "continue_from=3", "--set", "continue_to=6"};

@@ -40,7 +40,7 @@ const std::vector<CommandSpec>& command_table() {
       {.name = "continue",
        .run = command_continue,
        .summary = "delayspec continue [SCENE]: the periodic orbit continued in one parameter, its bifurcations located and "
-                "extrapolated to N -> infinity.",
+                "extrapolated to N -> infinity (continue_object = equilibrium: the equilibria, their folds and Hopf points).",
        .out = OutDirUse::written,
        .resume = false,
        .distributes = false,

@@ -194,6 +194,7 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"basin_max_period", "basin: longest period detected (0 in the result: none up to it)"},
       {"basin_tolerance", "basin: relative sup-norm tolerance of a repeat"},
       // continue (continue_settings.cpp, command_continue.cpp)
+      {"continue_object", "continue: orbit (the periodic orbit) or equilibrium (an autonomous model's equilibria, folds and Hopf points)"},
       {"continue_key", "continue: the model parameter continued (any numeric model key)"},
       {"continue_from", "continue: start of the branch (the orbit there is found as `floquet` finds it)"},
       {"continue_to", "continue: end of the range (the branch may turn back at folds; it ends at either end)"},
