@@ -4,7 +4,8 @@ quote are what it computes.
 
     doc_test.py --delayspec BUILD/delayspec --source SOURCE_DIR [FILE.md ...]
 
-(ctest runs it as `doc_test`; default files: README.md and docs/tutorial.md.)
+(ctest runs it as `doc_test`; default files: README.md, docs/tutorial.md, docs/cli.md and
+docs/autonomous.md.)
 
 What is run. Fenced code blocks tagged `sh` (```sh). In them, every line (after joining `\\`
 continuations and dropping a trailing `# comment`) that starts with `build/delayspec`, or with
@@ -228,7 +229,7 @@ def main():
                         help="rewrite the help blocks (docs/cli.md) from the program, run nothing")
     parser.add_argument("--keep", metavar="DIR",
                         help="copy the scratch directory (the files the documents' commands wrote) to DIR")
-    parser.add_argument("docs", nargs="*", default=["README.md", "docs/tutorial.md", "docs/cli.md"])
+    parser.add_argument("docs", nargs="*", default=["README.md", "docs/tutorial.md", "docs/cli.md", "docs/autonomous.md"])
     a = parser.parse_args()
     program = os.path.abspath(a.delayspec)
     have_gnuplot = shutil.which("gnuplot") is not None
