@@ -125,4 +125,12 @@ HistoryGrid make_grid(double tau, double period, int N, int periods_per_map = 1)
 HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map = 1,
                       const std::vector<std::string>& names = {});
 
+// A grid of exactly `steps_per_period` steps per period (h = period / steps_per_period), every
+// delay placed where it falls, (m_i, theta_i) = tau_i / h as above (aligned only where tau_i / h
+// is whole). For a problem whose delays move against the period while the discretisation must
+// keep its size: an autonomous orbit's unknown period (autonomous_orbit.hpp). N = m of the
+// longest delay. BadInput for a delay not positive, or shorter than one step.
+HistoryGrid make_grid_with_steps(const std::vector<double>& taus, double period, int steps_per_period,
+                                 int periods_per_map = 1);
+
 }  // namespace delayspec

@@ -28,6 +28,16 @@ Ratio rational_approximation(double x) {
   return {};
 }
 
+// tau / h = m + theta with theta in [0, 1), snapped to a whole number of steps within 1e-12 (the
+// one rule of where a delay falls between grid nodes).
+HistoryGrid::DelayPosition position_on_grid(double tau, double h) {
+  const double ratio = tau / h;
+  double m = std::floor(ratio), theta = ratio - m;
+  if (theta > 1 - 1e-12) m += 1, theta = 0;  // tau is a whole number of steps after all
+  if (theta < 1e-12) theta = 0;
+  return {tau, static_cast<int>(std::min(m, static_cast<double>(kMaxSteps))), theta};
+}
+
 }  // namespace
 
 std::string HistoryGrid::describe() const {
@@ -36,7 +46,10 @@ std::string HistoryGrid::describe() const {
   if (delays.empty())
     return text + (aligned() ? " (aligned delay)" : " (fractional delay, theta=" + format_number(theta) + ")");
   text += " (" + std::to_string(delays.size()) + " delays at m + theta steps:";
-  for (const DelayPosition& p : delays) text += " " + std::to_string(p.m) + (p.theta == 0 ? "" : "+" + format_number(p.theta));
+  for (const DelayPosition& p : delays) {  // (append: GCC 12 warns falsely on "+" + string, -Wrestrict)
+    text.append(" ").append(std::to_string(p.m));
+    if (p.theta != 0) text.append("+").append(format_number(p.theta));
+  }
   return text + ")";
 }
 
@@ -63,17 +76,11 @@ HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int
   for (size_t i = 0; i < taus.size(); ++i) {
     HistoryGrid::DelayPosition p{taus[i], g.m, g.theta};
     if (i != longest) {
-      // tau_i = (m_i + theta_i) h, snapped to a whole number of steps as make_grid snaps tau
-      const double ratio = taus[i] / g.h;
-      double m = std::floor(ratio), theta = ratio - m;
-      if (theta > 1 - 1e-12) m += 1, theta = 0;
-      if (theta < 1e-12) theta = 0;
-      if (m < 1)
+      p = position_on_grid(taus[i], g.h);  // tau_i = (m_i + theta_i) h, snapped as make_grid snaps tau
+      if (p.m < 1)
         throw BadInput("`N = " + std::to_string(N) + "`: " + name(i) + " = " + format_number(taus[i]) +
                        " is shorter than one step h = " + format_number(g.h) +
                        " (N steps per the longest delay, " + format_number(taus[longest]) + "); increase N");
-      p.m = static_cast<int>(m);
-      p.theta = theta;
     }
     g.delays.push_back(p);
   }
@@ -123,21 +130,54 @@ HistoryGrid make_grid(double tau, double period, int N, int periods_per_map) {
                      " steps of h = " + format_number(g.h) + " (T = " + format_number(period) + " in " +
                      format_number(k1) + " steps at N = " + std::to_string(N) + "), more than the " +
                      std::to_string(kMaxSteps) + " steps a history can hold; reduce tau or N");
-    double m = std::floor(ratio);
-    double theta = ratio - m;
-    if (theta > 1 - 1e-12) {  // tau is a whole number of steps after all
-      m += 1;
-      theta = 0;
-    }
-    if (theta < 1e-12) theta = 0;
-    if (m < 1)
+    const HistoryGrid::DelayPosition at = position_on_grid(tau, g.h);
+    if (at.m < 1)
       throw BadInput("`N = " + std::to_string(N) + "`: the delay tau = " + format_number(tau) +
                      " is shorter than one step h = " + format_number(g.h) + "; increase N");
-    g.m = static_cast<int>(m);
-    g.theta = theta;
-    g.M = theta > 0 ? g.m + 1 : g.m;
+    g.m = at.m;
+    g.theta = at.theta;
+    g.M = g.theta > 0 ? g.m + 1 : g.m;
   }
   g.K = g.steps_per_period * periods_per_map;
+  return g;
+}
+
+HistoryGrid make_grid_with_steps(const std::vector<double>& taus, double period, int steps_per_period,
+                                 int periods_per_map) {
+  require_positive("period", period);
+  if (taus.empty()) throw BadInput("make_grid_with_steps: no delay given");
+  if (steps_per_period < 1 || static_cast<long>(steps_per_period) * periods_per_map > kMaxSteps)
+    throw BadInput(std::string("steps per period ")
+                       .append(std::to_string(steps_per_period))
+                       .append(": must be between 1 and ")
+                       .append(std::to_string(kMaxSteps / std::max(periods_per_map, 1))));
+  HistoryGrid g;
+  g.period = period;
+  g.periods_per_map = periods_per_map;
+  g.steps_per_period = steps_per_period;
+  g.K = steps_per_period * periods_per_map;
+  g.h = period / steps_per_period;
+  size_t longest = 0;
+  for (size_t i = 0; i < taus.size(); ++i) {
+    // (append, not "delay " + string: GCC 12 warns falsely on that, -Wrestrict)
+    const std::string delay = std::string("delay ").append(std::to_string(i + 1));
+    if (!(std::isfinite(taus[i]) && taus[i] > 0 && taus[i] / g.h <= static_cast<double>(kMaxSteps)))
+      throw BadInput(delay + " is " + format_number(taus[i]) +
+                     ": must be positive, finite and at most " + std::to_string(kMaxSteps) + " steps");
+    const HistoryGrid::DelayPosition p = position_on_grid(taus[i], g.h);
+    if (p.m < 1)
+      throw BadInput(delay + " = " + format_number(taus[i]) +
+                     " is shorter than one step h = " + format_number(g.h) + " (" + std::to_string(steps_per_period) +
+                     " steps per period " + format_number(period) + ")");
+    if (taus[i] > taus[longest]) longest = i;
+    if (taus.size() > 1) g.delays.push_back(p);
+  }
+  const HistoryGrid::DelayPosition at = position_on_grid(taus[longest], g.h);
+  g.tau = at.tau;
+  g.m = at.m;
+  g.theta = at.theta;
+  g.M = g.theta > 0 ? g.m + 1 : g.m;
+  g.N = g.m;  // steps per the longest delay, as laid
   return g;
 }
 

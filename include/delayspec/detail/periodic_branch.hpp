@@ -115,7 +115,7 @@ class PeriodicBranch {
       }
       std::optional<SparseLU> lu;
       try {
-        lu.emplace(bordered_matrix(Fx, Fp, row_x, row_p));
+        lu.emplace(bordered_matrix(Fx, Fp, row_x, row_p));  // sparse_lu.hpp
       } catch (const NumericalFailure& e) {
         why = std::string("bordered matrix singular at parameter ") + format_number(p) + " (" + e.what() + ")";
         return std::nullopt;
@@ -244,26 +244,6 @@ class PeriodicBranch {
       why = std::string("the model rejects parameter ") + format_number(p) + " (" + e.what() + ")";
     }
     return false;
-  }
-
-  // The bordered matrix [F_x F_p; row_x^T row_p] (n + 1 square), compressed for the LU.
-  Eigen::SparseMatrix<double> bordered_matrix(const Eigen::SparseMatrix<double>& Fx, const Eigen::VectorXd& Fp,
-                                              const Eigen::VectorXd& row_x, double row_p) const {
-    const long n = unknowns();
-    std::vector<Eigen::Triplet<double>> triplets;
-    triplets.reserve(static_cast<size_t>(Fx.nonZeros() + 2 * n + 1));
-    for (int k = 0; k < Fx.outerSize(); ++k)
-      for (Eigen::SparseMatrix<double>::InnerIterator e(Fx, k); e; ++e)
-        triplets.emplace_back(static_cast<int>(e.row()), static_cast<int>(e.col()), e.value());
-    for (long i = 0; i < n; ++i) {
-      if (Fp[i] != 0) triplets.emplace_back(static_cast<int>(i), static_cast<int>(n), Fp[i]);
-      if (row_x[i] != 0) triplets.emplace_back(static_cast<int>(n), static_cast<int>(i), row_x[i]);
-    }
-    triplets.emplace_back(static_cast<int>(n), static_cast<int>(n), row_p);
-    Eigen::SparseMatrix<double> A(n + 1, n + 1);
-    A.setFromTriplets(triplets.begin(), triplets.end());
-    A.makeCompressed();
-    return A;
   }
 
   // The converged point with its tangent z: [F_x F_p; row] z = e_{n+1}, z / |z|_w.

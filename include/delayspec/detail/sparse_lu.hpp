@@ -50,4 +50,9 @@ class SparseLU {
   long factor_nonzeros_ = 0;
 };
 
+// The bordered matrix [A c; r^T corner] (n + 1 square), compressed for the LU: a Newton system
+// with one more unknown (a parameter, a period) and one more equation (a constraint).
+Eigen::SparseMatrix<double> bordered_matrix(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& c,
+                                            const Eigen::VectorXd& r, double corner);
+
 }  // namespace delayspec

@@ -135,4 +135,23 @@ Eigen::VectorXd SparseLU::solve(const Eigen::VectorXd& b) const {
   return x;
 }
 
+Eigen::SparseMatrix<double> bordered_matrix(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& c,
+                                            const Eigen::VectorXd& r, double corner) {
+  const long n = A.rows();
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<size_t>(A.nonZeros() + 2 * n + 1));
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator e(A, k); e; ++e)
+      triplets.emplace_back(static_cast<int>(e.row()), static_cast<int>(e.col()), e.value());
+  for (long i = 0; i < n; ++i) {
+    if (c[i] != 0) triplets.emplace_back(static_cast<int>(i), static_cast<int>(n), c[i]);
+    if (r[i] != 0) triplets.emplace_back(static_cast<int>(n), static_cast<int>(i), r[i]);
+  }
+  triplets.emplace_back(static_cast<int>(n), static_cast<int>(n), corner);
+  Eigen::SparseMatrix<double> out(n + 1, n + 1);
+  out.setFromTriplets(triplets.begin(), triplets.end());
+  out.makeCompressed();
+  return out;
+}
+
 }  // namespace delayspec
