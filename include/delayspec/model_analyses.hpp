@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 
+#include "delayspec/autonomous_orbit.hpp"
 #include "delayspec/continuation.hpp"
 #include "delayspec/equilibrium.hpp"
 #include "delayspec/grid.hpp"
@@ -54,6 +55,12 @@ struct LinearisedOrbit {
   Eigen::VectorXd sequence;                   // u_0 .. u_{K-1} when requested (empty for linear models)
 };
 
+// A periodic orbit of unknown period (autonomous_orbit.hpp) and its monodromy over one period.
+struct AutonomousLinearisedOrbit {
+  AutonomousOrbit orbit;
+  std::unique_ptr<LinearOperator> monodromy;
+};
+
 class ModelAnalyses;
 // The analyses of one model with one parameter set to p (continuation's family of models): for
 // the built-in models the scene's keys with the continued one changed, for an equation model its
@@ -85,6 +92,9 @@ class ModelAnalyses {
   // f, A, the B_i and the delays on the constant history y (d entries): what an equilibrium's
   // Newton and its characteristic function need (equilibrium.hpp). BadInput as equilibrium().
   virtual ConstantHistory at_constant_history(const Eigen::VectorXd& y) const = 0;
+  // A periodic orbit of unknown period near the guess (autonomous_orbit.hpp) and its monodromy.
+  // BadInput for a model that is not autonomous, or linear (no isolated orbits).
+  virtual AutonomousLinearisedOrbit autonomous_orbit(const AutonomousOrbitOptions& options) const = 0;
   // Lyapunov exponents from the constant initial history.
   virtual LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const = 0;
   // The histories U_0 .. U_{count-1} of successive maps after `transient` maps, from the constant
@@ -176,6 +186,20 @@ class ModelAnalysesFor final : public ModelAnalyses {
     }
   }
 
+  AutonomousLinearisedOrbit autonomous_orbit(const AutonomousOrbitOptions& options) const override {
+    if constexpr (AutonomousModel<Model> && !Model::is_linear) {
+      AutonomousLinearisedOrbit out;
+      out.orbit = find_autonomous_orbit(model_, options);
+      out.monodromy = std::make_unique<Monodromy<D, DW>>(
+          autonomous_orbit_map(model_, out.orbit, options.step).monodromy(out.orbit.history));
+      return out;
+    } else if constexpr (AutonomousModel<Model>) {
+      throw BadInput("a linear model has no isolated periodic orbits: `period_guess` is for nonlinear autonomous models");
+    } else {
+      throw BadInput(kNotAutonomous);
+    }
+  }
+
   LyapunovResult lyapunov(const MapSettings& s, const LyapunovOptions& options) const override {
     const StroboscopicMap<Model> map = make_map(s);
     const Eigen::VectorXd U0 = map.constant_history(model_.initial_state());
@@ -238,7 +262,8 @@ class ModelAnalysesFor final : public ModelAnalyses {
     return true;
   }
   static constexpr const char* kNotAutonomous =
-      "equilibria are for autonomous models (no forcing: f independent of t); this one is forced";
+      "equilibria and orbits of unknown period are for autonomous models (no forcing: f independent of t); this "
+      "one is forced";
   StroboscopicMap<Model> make_map(const MapSettings& s) const {
     return StroboscopicMap<Model>(TrapezoidStepper<Model>(model_, s.step), grid(s));
   }

@@ -328,6 +328,20 @@ TEST(EquationModels, AutonomousEquationsHaveEquilibriaWithTheExactRoots) {
   }
 }
 
+// An orbit of unknown period (autonomous_orbit.hpp) of the equations and of the built-in model:
+// the same discrete problem, evaluated by GiNaC's printed expressions or by hand (kSameProblem).
+TEST(EquationModels, MackeyGlassOrbitOfUnknownPeriodEqualsTheBuiltInModels) {
+  AutonomousOrbitOptions o;
+  o.period_guess = 20;
+  o.N = 100;
+  const AutonomousLinearisedOrbit eq = problem_from(kMackeyGlassScene, {}).analyses->autonomous_orbit(o);
+  const AutonomousLinearisedOrbit builtin =
+      problem_from("", {{"model", "mackey-glass"}, {"tau", "8"}, {"period", "8"}}).analyses->autonomous_orbit(o);
+  EXPECT_NEAR(eq.orbit.period, builtin.orbit.period, kSameProblem * builtin.orbit.period);
+  EXPECT_LE((eq.orbit.sequence - builtin.orbit.sequence).norm(), kSameProblem * builtin.orbit.sequence.norm());
+  EXPECT_GT(eq.orbit.period, 20);  // an orbit, not the equilibrium
+}
+
 TEST(EquationModels, OneDelayWrittenEitherWayIsBitIdentical) {
   std::string with_table = kLinearScene;
   with_table.replace(with_table.find("delay = \"1\""), 11, "delays = { tau = \"1\" }");

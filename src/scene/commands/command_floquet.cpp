@@ -5,6 +5,7 @@
 
 #include "scene/commands/commands.hpp"
 #include "delayspec/floquet.hpp"
+#include "scene/problem/autonomous_floquet.hpp"
 #include "scene/problem/floquet_settings.hpp"
 #include "scene/problem/level_runner.hpp"
 #include "delayspec/stroboscopic_map.hpp"
@@ -14,6 +15,37 @@
 
 namespace delayspec::cli {
 
+namespace {
+
+int floquet_of_unknown_period(const Problem& problem, const OrbitSettings& orbit_settings,
+                              const FloquetOptions& options, bool with_error_bars, double period_guess,
+                              const Invocation& inv, std::chrono::steady_clock::time_point start) {
+  if (!problem.analyses->is_autonomous())
+    throw BadInput("`period_guess` with `model = " + problem.model_name +
+                   "`: a forced model's orbit has the forcing's period; `period_guess` is for autonomous models");
+  const AutonomousFloquet r = autonomous_floquet(problem, period_guess, static_cast<int>(orbit_settings.guess_periods),
+                                                 orbit_settings.newton, options, with_error_bars);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (inv.json) {
+    nlohmann::json json;
+    json["model"] = problem.model_name;
+    json["N"] = problem.N;
+    json["dimension"] = r.at_N.orbit.history.size();
+    json["solver"] = to_string(r.at_N.result.solver);
+    add_autonomous_floquet_json(json, r, period_guess);
+    json["seconds"] = seconds;
+    inv.out << json.dump(2) << "\n";
+  } else {
+    inv.out << "delayspec floquet: model " << problem.model_name << ", autonomous, N = " << problem.N
+            << " steps per the longest delay, n = " << r.at_N.orbit.history.size() << "\n";
+    print_autonomous_floquet(inv.out, r, period_guess);
+    inv.out << "time: " << seconds << " s\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
 int command_floquet(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
   Problem problem = read_problem(config, 100);
@@ -21,7 +53,12 @@ int command_floquet(Config& config, const Invocation& inv) {
   const FloquetOptions options = read_floquet_options(config);
   // The error bars (error_bars.hpp): two coarser solves, about 1.3x the single one.
   const bool with_error_bars = config.get_choice("error_bars", "on", {"on", "off"}) == "on";
+  // An autonomous model's orbit of unknown period (autonomous_floquet.hpp)
+  const double period_guess = config.get_double("period_guess", 0);
+  const bool period_unknown = config.has("period_guess");
   config.check_all_used();
+  if (period_unknown)
+    return floquet_of_unknown_period(problem, orbit_settings, options, with_error_bars, period_guess, inv, start);
   const long n = problem.dimension();
   validate_floquet_options(options, n);  // before the orbit: fail fast
 

@@ -80,6 +80,9 @@ class ExplainedAnalyses final : public ModelAnalyses {
   EquilibriumResult equilibrium(const Eigen::VectorXd& guess, const EquilibriumOptions& options) const override {
     return explained([&] { return inner_->equilibrium(guess, options); });
   }
+  AutonomousLinearisedOrbit autonomous_orbit(const AutonomousOrbitOptions& options) const override {
+    return explained([&] { return inner_->autonomous_orbit(options); });
+  }
   ConstantHistory at_constant_history(const Eigen::VectorXd& y) const override {
     return inner_->at_constant_history(y);
   }
@@ -224,7 +227,8 @@ EquationModel read_equation_model(Config& config,
     if (!std::isfinite(constants[1 + n + i]))
       throw BadInput("`equations.history." + src.state[i] + "` is not a finite number at these parameters");
   std::vector<std::string> delay_items;
-  for (size_t k = 0; k < n; ++k) delay_items.push_back("`" + delay_item(src, k) + "`");
+  for (size_t k = 0; k < n; ++k)  // (append: GCC 12 warns falsely on "`" + string, -Wrestrict)
+    delay_items.push_back(std::string("`").append(delay_item(src, k)).append("`"));
   check_grid(taus_exact, delay_items, period_exact);
 
   const EquationPlugin& plugin = compiled(src, cache_dir);

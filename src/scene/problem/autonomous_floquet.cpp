@@ -1,0 +1,149 @@
+#include "scene/problem/autonomous_floquet.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "delayspec/errors.hpp"
+#include "scene/output/output.hpp"
+#include "scene/problem/level_runner.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+// One level: the orbit at N from period_guess, and nev + 1 multipliers split into the trivial one
+// and the others.
+AutonomousFloquetLevel level_at(const Problem& problem, int N, double period_guess, int guess_periods,
+                                const OrbitByNewtonOptions& newton, const FloquetOptions& solver) {
+  AutonomousOrbitOptions o;
+  o.period_guess = period_guess;
+  o.N = N;
+  o.guess_periods = guess_periods;
+  o.newton = newton;
+  o.step = step_options(problem);
+  AutonomousLinearisedOrbit at = problem.analyses->autonomous_orbit(o);
+  AutonomousFloquetLevel level;
+  level.N = N;
+  level.orbit = std::move(at.orbit);
+  FloquetOptions fo = solver;
+  fo.nev = static_cast<int>(std::min<long>(solver.nev + 1, at.monodromy->rows()));
+  level.result = floquet_multipliers(*at.monodromy, fo);
+  const LevelResult all = level_result(level.result, at.monodromy->rows(), level.orbit.grid.K);
+  size_t trivial = 0;
+  for (size_t i = 1; i < all.multipliers.size(); ++i)
+    if (std::abs(all.multipliers[i] - 1.0) < std::abs(all.multipliers[trivial] - 1.0)) trivial = i;
+  level.trivial = all.multipliers.at(trivial);
+  for (size_t i = 0; i < all.multipliers.size(); ++i)
+    if (i != trivial) {
+      level.others.multipliers.push_back(all.multipliers[i]);
+      level.others.accuracy.push_back(all.accuracy[i]);
+    }
+  return level;
+}
+
+}  // namespace
+
+AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess, int guess_periods,
+                                     const OrbitByNewtonOptions& newton, const FloquetOptions& solver,
+                                     bool with_error_bars) {
+  AutonomousFloquet out;
+  out.at_N = level_at(problem, problem.N, period_guess, guess_periods, newton, solver);
+  if (!with_error_bars) return out;
+  const auto start = std::chrono::steady_clock::now();
+  // The coarser levels, each from the period found at N (the guess closest to their orbit).
+  std::vector<int> Ns = coarser_levels(problem.N, [](int N) { return N >= 8; });
+  std::vector<LevelResult> levels;
+  for (int N : Ns) {
+    LevelResult r;
+    try {
+      AutonomousFloquetLevel level = level_at(problem, N, out.at_N.orbit.period, guess_periods, newton, solver);
+      out.Ns.push_back(N);
+      out.Ks.push_back(level.orbit.grid.K);
+      out.periods.push_back(level.orbit.period);
+      r = std::move(level.others);
+    } catch (const NumericalFailure& e) {
+      r.failure = e.what();
+    }
+    levels.push_back(std::move(r));
+  }
+  Ns.push_back(problem.N);
+  levels.push_back(out.at_N.others);
+  out.Ns.push_back(problem.N);
+  out.Ks.push_back(out.at_N.orbit.grid.K);
+  out.periods.push_back(out.at_N.orbit.period);
+  out.bars = error_bars(Ns, levels, error_expansion(problem));
+  if (out.periods.size() >= 2) {
+    // h = 1 / K, the step in the scaled time
+    std::vector<double> h;
+    std::vector<std::complex<double>> periods;
+    for (size_t i = 0; i < out.Ns.size(); ++i) {
+      h.push_back(1.0 / out.Ks[i]);
+      periods.emplace_back(out.periods[i]);
+    }
+    out.period = richardson_extrapolate(h, periods, error_expansion(problem));
+  }
+  out.error_bar_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+void add_autonomous_floquet_json(nlohmann::json& j, const AutonomousFloquet& r, double period_guess) {
+  const AutonomousOrbit& orbit = r.at_N.orbit;
+  j["period"] = orbit.period;
+  j["period_guess"] = period_guess;
+  j["steps_per_period"] = orbit.grid.K;
+  j["trivial_multiplier"] = {{"re", r.at_N.trivial.real()},
+                             {"im", r.at_N.trivial.imag()},
+                             {"distance_from_1", std::abs(r.at_N.trivial - 1.0)}};
+  j["multipliers"] = multipliers_json(r.at_N.others.multipliers);
+  add_resolution_json(j["multipliers"], r.at_N.others.multipliers, r.at_N.others.accuracy);
+  if (r.bars) {
+    add_error_bars_json(j["multipliers"], *r.bars);
+    j["verdict"] = to_string(r.bars->verdict);
+    j["error_bars"] = error_bars_json(*r.bars, r.error_bar_seconds);
+    nlohmann::json p;
+    p["Ns"] = r.Ns;
+    p["steps_per_period"] = r.Ks;
+    p["periods"] = r.periods;
+    if (r.period) {
+      p["extrapolated"] = r.period->value.real();
+      p["error_estimate"] = number_or_null(r.period->error_estimate);
+      p["note"] = r.period->note;
+    }
+    j["period_error_bars"] = p;
+  }
+  j["orbit"] = {{"method", "newton (period unknown, integral phase condition)"},
+                {"newton_iterations", orbit.newton_iterations},
+                {"newton_residuals", orbit.newton_residuals},
+                {"periods", orbit.periods},
+                {"residual", orbit.residual}};
+}
+
+void print_autonomous_floquet(std::ostream& out, const AutonomousFloquet& r, double period_guess) {
+  const AutonomousOrbit& orbit = r.at_N.orbit;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "orbit of unknown period: T = %.15g from period_guess %g (%d Newton iterations, |F|_inf = %.1e), "
+                "%d steps per period\n",
+                orbit.period, period_guess, orbit.newton_iterations, orbit.residual, orbit.grid.K);
+  out << line;
+  if (r.period) {
+    std::snprintf(line, sizeof line, "period: %.12g +- %.1e at N (from N = ", orbit.period,
+                  std::abs(orbit.period - r.period->value.real()) + r.period->error_estimate);
+    out << line;
+    for (size_t i = 0; i < r.Ns.size(); ++i) out << (i ? ", " : "") << r.Ns[i];
+    std::snprintf(line, sizeof line, "); extrapolated %.12g +- %.1e\n", r.period->value.real(),
+                  r.period->error_estimate);
+    out << line;
+  }
+  std::snprintf(line, sizeof line,
+                "trivial multiplier (the time shift's): %+.15f %+.1ei, |mu - 1| = %.1e (1 for the exact orbit)\n",
+                r.at_N.trivial.real(), r.at_N.trivial.imag(), std::abs(r.at_N.trivial - 1.0));
+  out << line;
+  out << "leading " << r.at_N.others.multipliers.size() << " other Floquet multipliers ("
+      << to_string(r.at_N.result.solver) << "):\n";
+  print_multipliers(out, r.at_N.others.multipliers, r.at_N.others.accuracy);
+  if (r.bars) print_error_bars(out, r.at_N.others.multipliers, *r.bars);
+}
+
+}  // namespace delayspec::cli

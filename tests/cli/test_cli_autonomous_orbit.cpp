@@ -1,0 +1,70 @@
+// `floquet` with `period_guess`: a periodic orbit of unknown period (autonomous_orbit.hpp; the
+// engine's own tests check it against closed forms). Here: the command's fields, its period's
+// error bar against a much finer solve (N = 1600, whose own error is (100 / 1600)^2 = 1/256 of the
+// default's), and bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli_test_support.hpp"
+
+namespace {
+
+using delayspec::testing::CliResult;
+using delayspec::testing::run;
+
+const std::vector<std::string> kMackeyGlass8 = {"floquet", "--json", "--set", "model=mackey-glass", "--set", "tau=8",
+                                                "--set",   "x0=1.1", "--set",  "period_guess=20"};
+
+nlohmann::json floquet_json(std::vector<std::string> args) {
+  const CliResult r = run(args);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return nlohmann::json::parse(r.out);
+}
+
+TEST(AutonomousOrbitCli, MackeyGlassOrbitItsPeriodErrorBarAndTrivialMultiplier) {
+  const nlohmann::json j = floquet_json(kMackeyGlass8);
+  std::vector<std::string> fine = kMackeyGlass8;
+  fine.insert(fine.end(), {"--set", "N=1600", "--set", "error_bars=off"});
+  const double reference = floquet_json(fine)["period"].get<double>();
+  const double T = j["period"].get<double>();
+  EXPECT_GT(T, 20);
+  // the period at N = 100 is within its error bar of the much finer solve, and the extrapolated
+  // one within its own
+  const auto& bars = j["period_error_bars"];
+  const double extrapolated = bars["extrapolated"].get<double>(), error = bars["error_estimate"].get<double>();
+  EXPECT_LE(std::abs(extrapolated - reference), error + std::abs(reference) * 1e-6) << bars.dump();
+  EXPECT_LE(std::abs(T - reference), std::abs(T - extrapolated) + error) << bars.dump();
+  EXPECT_GT(std::abs(T - reference), 1e-6);  // N = 100 is not N = 1600: the bar has something to cover
+  // the trivial multiplier apart, at rounding; the orbit is stable
+  EXPECT_LT(j["trivial_multiplier"]["distance_from_1"].get<double>(), 1e-10);
+  EXPECT_EQ(j["multipliers"].size(), 6u);
+  EXPECT_LT(j["multipliers"][0]["abs"].get<double>(), 1);
+  EXPECT_EQ(j["verdict"], "stable");
+  EXPECT_EQ(j["steps_per_period"].get<int>(), 250);  // round(N T_guess / tau) = round(100 * 20 / 8)
+}
+
+TEST(AutonomousOrbitCli, BadInputAndNoOrbit) {
+  for (const auto& [sets, says] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"model=impact", "period_guess=6"}, "`period_guess` with `model = impact`"},
+           {{"model=linear", "period_guess=2"}, "a linear model has no isolated periodic orbits"},
+           {{"model=mackey-glass", "period_guess=-1"}, "`period_guess = -1`"},
+           {{"model=mackey-glass", "period_guess=abc"}, "`period_guess = abc`"}}) {
+    std::vector<std::string> args = {"floquet"};
+    for (const std::string& s : sets) args.insert(args.end(), {"--set", s});
+    const CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << says << ": " << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  }
+  // the history at the equilibrium x* = 1: the guess is that equilibrium, no orbit (exit 3)
+  const CliResult r = run({"floquet", "--set", "model=mackey-glass", "--set", "tau=8", "--set", "x0=1", "--set",
+                           "period_guess=20"});
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("no periodic orbit near the guess"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("residual"), std::string::npos) << r.err;
+}
+
+}  // namespace
