@@ -54,8 +54,8 @@ int command_floquet(Config& config, const Invocation& inv) {
   // The error bars (error_bars.hpp): two coarser solves, about 1.3x the single one.
   const bool with_error_bars = config.get_choice("error_bars", "on", {"on", "off"}) == "on";
   // An autonomous model's orbit of unknown period (autonomous_floquet.hpp)
-  const double period_guess = config.get_double("period_guess", 0);
-  const bool period_unknown = config.has("period_guess");
+  const bool period_unknown = config.get_string("period_guess", "none") != "none";
+  const double period_guess = period_unknown ? config.get_double("period_guess", 0) : 0;
   config.check_all_used();
   if (period_unknown)
     return floquet_of_unknown_period(problem, orbit_settings, options, with_error_bars, period_guess, inv, start);
