@@ -47,6 +47,22 @@ TEST(AutonomousOrbitCli, MackeyGlassOrbitItsPeriodErrorBarAndTrivialMultiplier) 
   EXPECT_EQ(j["steps_per_period"].get<int>(), 250);  // round(N T_guess / tau) = round(100 * 20 / 8)
 }
 
+TEST(AutonomousOrbitCli, ConvergeExtrapolatesThePeriod) {
+  const nlohmann::json j = floquet_json({"converge", "--json", "--set", "model=mackey-glass", "--set", "tau=8", "--set",
+                                         "x0=1.1", "--set", "period_guess=20", "--set", "Ns=50,100,200,400"});
+  const auto& p = j["period"];
+  ASSERT_EQ(p["periods"].size(), 4u);
+  std::vector<std::string> fine = kMackeyGlass8;
+  fine.insert(fine.end(), {"--set", "N=1600", "--set", "error_bars=off"});
+  const double reference = floquet_json(fine)["period"].get<double>();
+  // the extrapolation over N = 50 .. 400 within its error estimate of the N = 1600 solve (whose
+  // own error is (400 / 1600)^2 = 1/16 of N = 400's, which is itself inside the estimate's scale)
+  EXPECT_LE(std::abs(p["extrapolated"].get<double>() - reference),
+            p["error_estimate"].get<double>() + std::abs(p["periods"][3].get<double>() - reference) / 16)
+      << p.dump();
+  EXPECT_EQ(j["rows"].size(), 4u);  // the other multipliers' study, as for any orbit
+}
+
 TEST(AutonomousOrbitCli, BadInputAndNoOrbit) {
   for (const auto& [sets, says] : std::vector<std::pair<std::vector<std::string>, std::string>>{
            {{"model=impact", "period_guess=6"}, "`period_guess` with `model = impact`"},

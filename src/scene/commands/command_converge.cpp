@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "scene/output/output_directory.hpp"
@@ -25,6 +26,7 @@
 #include "delayspec/convergence.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
+#include "scene/problem/autonomous_floquet.hpp"
 #include "scene/problem/floquet_settings.hpp"
 #include "scene/problem/level_runner.hpp"
 #include "scene/output/metadata.hpp"
@@ -213,6 +215,22 @@ void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string
   if (!s.stop_note.empty()) out << "stopped: " << s.stop_note << "\n";
 }
 
+// The period of an orbit of unknown period at each level, and extrapolated.
+void print_period_study(std::ostream& out, const PeriodStudy& p) {
+  char line[200];
+  out << "period of the orbit (unknown, found with it; the multipliers below are the others, the trivial one "
+         "apart):\n";
+  for (size_t i = 0; i < p.Ns.size(); ++i) {
+    std::snprintf(line, sizeof line, "  N = %6d  (K = %7d)  T = %.15g\n", p.Ns[i], p.Ks[i], p.periods[i]);
+    out << line;
+  }
+  if (p.extrapolated) {
+    std::snprintf(line, sizeof line, "  extrapolated T = %.15g +- %.1e\n", p.extrapolated->value.real(),
+                  p.extrapolated->error_estimate);
+    out << line << "  (" << p.extrapolated->note << ")\n";
+  }
+}
+
 // What the command reads and checks before any work; the keys are read in this order (--help lists them so).
 struct ConvergeSettings {
   std::vector<std::string> events;  // the variants, side by side; the problem has the first
@@ -223,6 +241,7 @@ struct ConvergeSettings {
   FloquetOptions solver_options;
   bool order_given = false, step_given = false;  // else each variant's own expansion (error_expansion)
   double x_order = 2, x_step = 2;
+  std::optional<double> period_guess;  // an autonomous orbit of unknown period (autonomous_floquet.hpp)
 };
 
 // Reads and checks the keys, the levels and the reference (the exact multipliers where a model has them).
@@ -262,6 +281,7 @@ ConvergeSettings read_converge_settings(Config& config) {
       if (config.has(key))
         throw BadInput("`" + std::string(key) + " = " + config.get_string(key, "") +
                        "`: a limit of `converge_target`, which is not given");
+  if (config.get_string("period_guess", "none") != "none") s.period_guess = config.get_double("period_guess", 0);
   if (config.has("converge_target") && !(base.target > 0))
     throw BadInput("`converge_target = " + config.get_string("converge_target", "") + "`: must be > 0");
   if (!(base.max_seconds > 0) || !std::isfinite(base.max_seconds) || base.max_seconds > 1e7)
@@ -273,15 +293,19 @@ ConvergeSettings read_converge_settings(Config& config) {
   coarsest.N = base.Ns.front();
   const long n_min = coarsest.dimension();
   validate_floquet_options(s.solver_options, n_min);  // at the coarsest N, the smallest n
-  base.exact = exact_multipliers(s.problem, base.nev + base.extra);
+  if (s.period_guess && !s.problem.analyses->is_autonomous())
+    throw BadInput("`period_guess` with `model = " + s.problem.model_name +
+                   "`: a forced model's orbit has the forcing's period; `period_guess` is for autonomous models");
+  base.exact = s.period_guess ? Multipliers{} : exact_multipliers(s.problem, base.nev + base.extra);
   if (base.reference == ReferenceKind::exact && base.exact.empty())
     throw BadInput("`reference = exact`: model `" + s.problem.model_name +
                    "` has no exact multipliers (use extrapolated or finest)");
   return s;
 }
 
-// One convergence study per events variant, each with its own Richardson orders.
-std::vector<ConvergenceStudy> run_studies(const ConvergeSettings& s, const Invocation& inv) {
+// One convergence study per events variant, each with its own Richardson orders; with
+// period_guess also the period's study (`period`).
+std::vector<ConvergenceStudy> run_studies(const ConvergeSettings& s, const Invocation& inv, PeriodStudy& period) {
   std::vector<ConvergenceStudy> studies;
   Progress progress(inv.err, "converge", s.base.target > 0 ? 0 : static_cast<long>(s.base.Ns.size() * s.events.size()),
                     inv.quiet);
@@ -292,6 +316,30 @@ std::vector<ConvergenceStudy> run_studies(const ConvergeSettings& s, const Invoc
     const RichardsonOptions expansion = error_expansion(with_events);  // h, h^2 with events = off
     options.richardson.order = s.order_given ? s.x_order : expansion.order;
     options.richardson.order_step = s.step_given ? s.x_step : expansion.order_step;
+    if (s.period_guess) {  // each level's orbit and period from the guess; the trivial multiplier apart
+      studies.push_back(run_convergence_study(
+          [&](int N, int count) {
+            LevelResult r;
+            const auto start = std::chrono::steady_clock::now();
+            try {
+              FloquetOptions solver = s.solver_options;
+              solver.nev = count;
+              AutonomousFloquetLevel level = autonomous_level(with_events, N, *s.period_guess,
+                                                              static_cast<int>(s.orbit_settings.guess_periods),
+                                                              s.orbit_settings.newton, solver);
+              period.add(N, level.orbit);
+              r = std::move(level.others);
+            } catch (const NumericalFailure& e) {
+              r.failure = e.what();
+            }
+            r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            progress.add();
+            return r;
+          },
+          options));
+      period.extrapolate(options.richardson);
+      continue;
+    }
     StudyLevels levels(s.problem, with_events.events, s.orbit_settings, s.solver_options, &progress);
     studies.push_back(
         run_convergence_study([&](int N, int count) { return levels.level(N, count); }, options,
@@ -341,8 +389,13 @@ void write_converge_files(const Invocation& inv, const Config& config, const Con
 }
 
 // The --json result: the first variant's study at the top level, every variant's under by_events.
-nlohmann::json converge_json(const ConvergeSettings& s, const std::vector<ConvergenceStudy>& studies) {
+nlohmann::json converge_json(const ConvergeSettings& s, const std::vector<ConvergenceStudy>& studies,
+                            const PeriodStudy& period) {
   nlohmann::json j = study_json(studies.front(), s.events.front());
+  if (s.period_guess) {
+    j["period_guess"] = *s.period_guess;
+    j["period"] = period_study_json(period);
+  }
   j["model"] = s.problem.model_name;
   j["solver"] = to_string(s.solver_options.solver);
   j["nev"] = s.base.nev;
@@ -385,18 +438,20 @@ void print_side_by_side(std::ostream& out, const std::vector<ConvergenceStudy>& 
 int command_converge(Config& config, const Invocation& inv) {
   const auto command_start = std::chrono::steady_clock::now();
   const ConvergeSettings s = read_converge_settings(config);
-  const std::vector<ConvergenceStudy> studies = run_studies(s, inv);
+  PeriodStudy period;
+  const std::vector<ConvergenceStudy> studies = run_studies(s, inv, period);
   if (inv.out_dir)
     write_converge_files(inv, config, s, studies,
                          std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count());
   if (inv.json) {
-    inv.out << converge_json(s, studies).dump(2) << "\n";
+    inv.out << converge_json(s, studies, period).dump(2) << "\n";
     return 0;
   }
   inv.out << "delayspec converge: model " << s.problem.model_name << ", solver " << to_string(s.solver_options.solver)
           << ", nev " << s.base.nev << ", N = ";
   for (size_t i = 0; i < s.base.Ns.size(); ++i) inv.out << (i ? "," : "") << s.base.Ns[i];
   inv.out << "\n";
+  if (s.period_guess) print_period_study(inv.out, period);
   for (size_t v = 0; v < studies.size(); ++v) print_study(inv.out, studies[v], s.events[v], s.switching);
   if (studies.size() > 1) print_side_by_side(inv.out, studies, s.events);
   return 0;

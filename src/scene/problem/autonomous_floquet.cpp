@@ -10,11 +10,7 @@
 
 namespace delayspec::cli {
 
-namespace {
-
-// One level: the orbit at N from period_guess, and nev + 1 multipliers split into the trivial one
-// and the others.
-AutonomousFloquetLevel level_at(const Problem& problem, int N, double period_guess, int guess_periods,
+AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess, int guess_periods,
                                 const OrbitByNewtonOptions& newton, const FloquetOptions& solver) {
   AutonomousOrbitOptions o;
   o.period_guess = period_guess;
@@ -42,13 +38,41 @@ AutonomousFloquetLevel level_at(const Problem& problem, int N, double period_gue
   return level;
 }
 
-}  // namespace
+void PeriodStudy::add(int N, const AutonomousOrbit& orbit) {
+  Ns.push_back(N);
+  Ks.push_back(orbit.grid.K);
+  periods.push_back(orbit.period);
+}
+
+void PeriodStudy::extrapolate(const RichardsonOptions& expansion) {
+  if (periods.size() < 2) return;
+  std::vector<double> h;
+  std::vector<std::complex<double>> values;
+  for (size_t i = 0; i < periods.size(); ++i) {
+    h.push_back(1.0 / Ks[i]);
+    values.emplace_back(periods[i]);
+  }
+  extrapolated = richardson_extrapolate(h, values, expansion);
+}
+
+nlohmann::json period_study_json(const PeriodStudy& study) {
+  nlohmann::json p;
+  p["Ns"] = study.Ns;
+  p["steps_per_period"] = study.Ks;
+  p["periods"] = study.periods;
+  if (study.extrapolated) {
+    p["extrapolated"] = study.extrapolated->value.real();
+    p["error_estimate"] = number_or_null(study.extrapolated->error_estimate);
+    p["note"] = study.extrapolated->note;
+  }
+  return p;
+}
 
 AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess, int guess_periods,
                                      const OrbitByNewtonOptions& newton, const FloquetOptions& solver,
                                      bool with_error_bars) {
   AutonomousFloquet out;
-  out.at_N = level_at(problem, problem.N, period_guess, guess_periods, newton, solver);
+  out.at_N = autonomous_level(problem, problem.N, period_guess, guess_periods, newton, solver);
   if (!with_error_bars) return out;
   const auto start = std::chrono::steady_clock::now();
   // The coarser levels, each from the period found at N (the guess closest to their orbit).
@@ -57,10 +81,9 @@ AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess
   for (int N : Ns) {
     LevelResult r;
     try {
-      AutonomousFloquetLevel level = level_at(problem, N, out.at_N.orbit.period, guess_periods, newton, solver);
-      out.Ns.push_back(N);
-      out.Ks.push_back(level.orbit.grid.K);
-      out.periods.push_back(level.orbit.period);
+      AutonomousFloquetLevel level =
+          autonomous_level(problem, N, out.at_N.orbit.period, guess_periods, newton, solver);
+      out.period.add(N, level.orbit);
       r = std::move(level.others);
     } catch (const NumericalFailure& e) {
       r.failure = e.what();
@@ -69,20 +92,9 @@ AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess
   }
   Ns.push_back(problem.N);
   levels.push_back(out.at_N.others);
-  out.Ns.push_back(problem.N);
-  out.Ks.push_back(out.at_N.orbit.grid.K);
-  out.periods.push_back(out.at_N.orbit.period);
+  out.period.add(problem.N, out.at_N.orbit);
   out.bars = error_bars(Ns, levels, error_expansion(problem));
-  if (out.periods.size() >= 2) {
-    // h = 1 / K, the step in the scaled time
-    std::vector<double> h;
-    std::vector<std::complex<double>> periods;
-    for (size_t i = 0; i < out.Ns.size(); ++i) {
-      h.push_back(1.0 / out.Ks[i]);
-      periods.emplace_back(out.periods[i]);
-    }
-    out.period = richardson_extrapolate(h, periods, error_expansion(problem));
-  }
+  out.period.extrapolate(error_expansion(problem));
   out.error_bar_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
@@ -101,16 +113,7 @@ void add_autonomous_floquet_json(nlohmann::json& j, const AutonomousFloquet& r, 
     add_error_bars_json(j["multipliers"], *r.bars);
     j["verdict"] = to_string(r.bars->verdict);
     j["error_bars"] = error_bars_json(*r.bars, r.error_bar_seconds);
-    nlohmann::json p;
-    p["Ns"] = r.Ns;
-    p["steps_per_period"] = r.Ks;
-    p["periods"] = r.periods;
-    if (r.period) {
-      p["extrapolated"] = r.period->value.real();
-      p["error_estimate"] = number_or_null(r.period->error_estimate);
-      p["note"] = r.period->note;
-    }
-    j["period_error_bars"] = p;
+    j["period_error_bars"] = period_study_json(r.period);
   }
   j["orbit"] = {{"method", "newton (period unknown, integral phase condition)"},
                 {"newton_iterations", orbit.newton_iterations},
@@ -127,13 +130,12 @@ void print_autonomous_floquet(std::ostream& out, const AutonomousFloquet& r, dou
                 "%d steps per period\n",
                 orbit.period, period_guess, orbit.newton_iterations, orbit.residual, orbit.grid.K);
   out << line;
-  if (r.period) {
+  if (const auto& x = r.period.extrapolated) {
     std::snprintf(line, sizeof line, "period: %.12g +- %.1e at N (from N = ", orbit.period,
-                  std::abs(orbit.period - r.period->value.real()) + r.period->error_estimate);
+                  std::abs(orbit.period - x->value.real()) + x->error_estimate);
     out << line;
-    for (size_t i = 0; i < r.Ns.size(); ++i) out << (i ? ", " : "") << r.Ns[i];
-    std::snprintf(line, sizeof line, "); extrapolated %.12g +- %.1e\n", r.period->value.real(),
-                  r.period->error_estimate);
+    for (size_t i = 0; i < r.period.Ns.size(); ++i) out << (i ? ", " : "") << r.period.Ns[i];
+    std::snprintf(line, sizeof line, "); extrapolated %.12g +- %.1e\n", x->value.real(), x->error_estimate);
     out << line;
   }
   std::snprintf(line, sizeof line,

@@ -26,15 +26,31 @@ struct AutonomousFloquetLevel {
   LevelResult others;                 // the rest, by modulus, with their accuracy
 };
 
+// The period at several levels and its Richardson extrapolation in h = 1 / K (the step in the
+// scaled time), with the problem's error expansion.
+struct PeriodStudy {
+  std::vector<int> Ns;          // the levels whose orbit was found, increasing
+  std::vector<int> Ks;          // their steps per period
+  std::vector<double> periods;  // their periods
+  std::optional<Extrapolation> extrapolated;  // two levels or more
+  void add(int N, const AutonomousOrbit& orbit);
+  void extrapolate(const RichardsonOptions& expansion);
+};
+// {Ns, steps_per_period, periods, extrapolated, error_estimate, observed_order, note}
+nlohmann::json period_study_json(const PeriodStudy& study);
+
 struct AutonomousFloquet {
   AutonomousFloquetLevel at_N;
   std::optional<ErrorBars> bars;  // of at_N.others (error_bars = on)
-  std::vector<int> Ns;            // the levels whose orbit was found, coarsest first; the last is N
-  std::vector<int> Ks;            // their steps per period
-  std::vector<double> periods;    // their periods
-  std::optional<Extrapolation> period;  // Richardson on the periods (two levels or more)
+  PeriodStudy period;             // error_bars = on: the coarser levels and N
   double error_bar_seconds = 0;
 };
+
+// One level: the orbit at N from period_guess (its guess simulated for guess_periods periods) and
+// nev + 1 multipliers, split into the trivial one and the others. BadInput: period_guess <= 0, a
+// forced or linear model; NumericalFailure: no orbit.
+AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess, int guess_periods,
+                                        const OrbitByNewtonOptions& newton, const FloquetOptions& solver);
 
 // The orbit at problem.N from period_guess (its guess simulated for guess_periods periods), its
 // top nev multipliers besides the trivial one; with error_bars the coarser levels (coarser_levels;
