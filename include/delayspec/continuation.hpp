@@ -142,13 +142,21 @@ struct Bifurcation {
   Eigen::VectorXd orbit;  // the sequence x at the located point (continue_period_doubled starts there)
 };
 
-struct ContinuationOptions {
-  double from = 0, to = 1;                 // the parameter range; the branch starts at `from`
-  double step = 0;                         // initial arclength step; 0 = |to - from| / 50
-  double step_min = 0;                     // 0 = 1e-6 |to - from|
-  double step_max = 0;                     // 0 = |to - from| / 10
-  int max_points = 1000;                   // branch points at most (the start included), >= 2
-  double tolerance = 0;                    // location tolerance in p; 0 = 1e-10 |to - from|
+// The parameter range and step control of a branch (continue_orbit, continue_equilibrium).
+struct BranchRange {
+  double from = 0, to = 1;  // the parameter range; the branch starts at `from`
+  double step = 0;          // initial arclength step; 0 = |to - from| / 50
+  double step_min = 0;      // 0 = 1e-6 |to - from|
+  double step_max = 0;      // 0 = |to - from| / 10
+  int max_points = 1000;    // branch points at most (the start included), >= 2
+  double tolerance = 0;     // location tolerance in p; 0 = 1e-10 |to - from|
+};
+// The range with the defaults for 0 filled in, the step clamped to [step_min, step_max].
+// BadInput naming the field: from or to not finite, an empty range, a step or tolerance <= 0,
+// step_min > step_max, max_points < 2.
+BranchRange checked_range(const BranchRange& range);
+
+struct ContinuationOptions : BranchRange {
   OrbitByNewtonOptions newton{1e-12, 10};  // corrector: relative residual, iterations per point
   int start_iterations = 30;               // Newton iterations allowed for the first point
   FloquetOptions floquet;

@@ -38,13 +38,7 @@ struct EquilibriumFamily {
   std::function<EquilibriumResult(const Eigen::VectorXd& guess, double p)> equilibrium;
 };
 
-struct EquilibriumBranchOptions {
-  double from = 0, to = 1;    // the parameter range; the branch starts at `from`
-  double step = 0;            // initial arclength step; 0 = |to - from| / 50
-  double step_min = 0;        // 0 = 1e-6 |to - from|
-  double step_max = 0;        // 0 = |to - from| / 10
-  int max_points = 1000;      // branch points at most (the start included), >= 2
-  double tolerance = 0;       // location tolerance in p; 0 = 1e-10 |to - from|
+struct EquilibriumBranchOptions : BranchRange {  // the range and steps as continue_orbit's
   double newton_tolerance = 1e-12;  // corrector: |dx|_inf <= this (1 + |x|_inf)
   int newton_iterations = 10;       // corrector iterations per point
   std::function<void()> on_point;   // after every accepted point; may be empty

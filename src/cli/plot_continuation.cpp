@@ -30,6 +30,39 @@ void stable_and_unstable(const ResultTable& t, int x, int y, int stable, std::st
   }
 }
 
+// A bifurcation's label in a figure, at (x, y).
+std::string bifurcation_label(int index, const std::string& type, double x, double y) {
+  return "set label " + std::to_string(index) + " " + gnuplot_string(type) + " at " + gnuplot_number(x) + "," +
+         gnuplot_number(y) + " offset 0.5,0.8 font ',9'\n";
+}
+
+// One figure of a branch: column y of t against column 0, stable solid and unstable dashed, the
+// bifurcations (`marks`, "x y" lines, with their `labels`) and a reference line (a gnuplot
+// expression with its legend) when given; a legend entry only for what is drawn.
+struct BranchFigure {
+  std::string name, title, key, ylabel, marks, labels, reference, reference_title;
+  int y = 0, stable = 0;
+};
+void branch_figure(FigureRenderer& renderer, const ResultTable& t, const BranchFigure& f) {
+  std::string solid, dashed;
+  stable_and_unstable(t, 0, f.y, f.stable, solid, dashed);
+  std::ostringstream gp;
+  gp << gnuplot_datablock("stable", solid.empty() ? "nan nan\n" : solid)
+     << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
+     << gnuplot_datablock("marks", f.marks.empty() ? "nan nan\n" : f.marks);
+  gp << "set title " << gnuplot_string(f.title + " (stable solid, unstable dashed)") << "\n";
+  gp << "set xlabel " << gnuplot_label(f.key) << "\nset ylabel " << gnuplot_string(f.ylabel)
+     << "\nset grid\nset key top left\n"
+     << f.labels;
+  gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
+     << "     $unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable'"
+     << (f.marks.empty() ? "" : ", \\\n     $marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'")
+     << (f.reference.empty() ? "" : ", \\\n     " + f.reference + " with lines lc rgb '#2ca02c' title '" +
+                                        f.reference_title + "'")
+     << "\n";
+  renderer.figure(f.name, gp.str());
+}
+
 }  // namespace
 
 void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& dir) {
@@ -55,38 +88,19 @@ void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& di
       if (type != "fold" && type != "period-doubling" && type != "neimark-sacker" && type != "grazing")
         b.at("type").fail("unknown bifurcation type");
       marks_y += gnuplot_number(p) + " " + gnuplot_number(y) + "\n";
-      labels_y += "set label " + std::to_string(++index) + " " + gnuplot_string(type) + " at " + gnuplot_number(p) +
-                  "," + gnuplot_number(y) + " offset 0.5,0.8 font ',9'\n";
+      labels_y += bifurcation_label(++index, type, p, y);
       if (type != "grazing") {
         marks_mu += gnuplot_number(p) + " 1\n";
-        labels_mu += "set label " + std::to_string(index) + " " + gnuplot_string(type) + " at " + gnuplot_number(p) +
-                     ",1 offset 0.5,0.8 font ',9'\n";
+        labels_mu += bifurcation_label(index, type, p, 1);
       }
     }
   }
-  auto figure = [&](const std::string& name, int y, const std::string& ylabel, const std::string& marks,
-                    const std::string& labels, bool unit_line) {
-    std::string solid, dashed;
-    stable_and_unstable(t, 0, y, stable, solid, dashed);
-    std::ostringstream gp;
-    gp << gnuplot_datablock("stable", solid.empty() ? "nan nan\n" : solid)
-       << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
-       << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
-    gp << "set title "
-       << gnuplot_string("Branch of " + t.metadata_text("model", "?") + " against " + key +
-                         " (stable solid, unstable dashed)")
-       << "\n";
-    gp << "set xlabel " << gnuplot_label(key) << "\nset ylabel " << gnuplot_string(ylabel)
-       << "\nset grid\nset key top left\n"
-       << labels;
-    gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
-       << "     $unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable', \\\n"
-       << "     $marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'"
-       << (unit_line ? ", \\\n     1 with lines lc rgb '#2ca02c' title '|{/Symbol m}| = 1'" : "") << "\n";
-    renderer.figure(name, gp.str());
-  };
-  figure("branch", max_y1, "max y_1 over the orbit", marks_y, labels_y, false);
-  if (mu1 >= 0) figure("branch_mu1", mu1, "|{/Symbol m}_1|", marks_mu, labels_mu, true);
+  const std::string title = "Branch of " + t.metadata_text("model", "?") + " against " + key;
+  branch_figure(renderer, t, {"branch", title, key, "max y_1 over the orbit", marks_y, labels_y, "", "", max_y1, stable});
+  if (mu1 >= 0)
+    branch_figure(renderer, t,
+                  {"branch_mu1", title, key, "|{/Symbol m}_1|", marks_mu, labels_mu, "1", "|{/Symbol m}| = 1", mu1,
+                   stable});
 }
 
 void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir) {
@@ -96,6 +110,7 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir)
   });
   t.require_header({"parameter", "stable", "unstable"});
   t.require_rows();
+  // the first state component: the column after parameter, stable, unstable (docs/formats.md)
   const int stable = t.column("stable"), y1 = 3, re1 = t.require_column("lambda1_re", "the roots lambda1_re, lambda1_im, ...");
   const std::string key = t.metadata_text("continue_key", "parameter"), y1_name = t.columns.at(3);
   // The bifurcations of continue.json: marked at their state and on Re lambda = 0.
@@ -121,35 +136,16 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir)
       ++index;
       marks_y += gnuplot_number(p) + " " + gnuplot_number(y) + "\n";
       marks_re += gnuplot_number(p) + " 0\n";
-      labels_y += "set label " + std::to_string(index) + " " + gnuplot_string(type) + " at " + gnuplot_number(p) +
-                  "," + gnuplot_number(y) + " offset 0.5,0.8 font ',9'\n";
-      labels_re += "set label " + std::to_string(index) + " " + gnuplot_string(type) + " at " + gnuplot_number(p) +
-                   ",0 offset 0.5,0.8 font ',9'\n";
+      labels_y += bifurcation_label(index, type, p, y);
+      labels_re += bifurcation_label(index, type, p, 0);
     }
   }
-  auto figure = [&](const std::string& name, int y, const std::string& ylabel, const std::string& marks,
-                    const std::string& labels, bool zero_line) {
-    std::string solid, dashed;
-    stable_and_unstable(t, 0, y, stable, solid, dashed);
-    std::ostringstream gp;
-    gp << gnuplot_datablock("stable", solid.empty() ? "nan nan\n" : solid)
-       << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
-       << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
-    gp << "set title "
-       << gnuplot_string("Equilibria of " + t.metadata_text("model", "?") + " against " + key +
-                         " (stable solid, unstable dashed)")
-       << "\n";
-    gp << "set xlabel " << gnuplot_label(key) << "\nset ylabel " << gnuplot_string(ylabel)
-       << "\nset grid\nset key top left\n"
-       << labels;
-    gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
-       << "     $unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable'"
-       << (marks.empty() ? "" : ", \\\n     $marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'")
-       << (zero_line ? ", \\\n     0 with lines lc rgb '#2ca02c' title 'Re {/Symbol l} = 0'" : "") << "\n";
-    renderer.figure(name, gp.str());
-  };
-  figure("equilibria", y1, y1_name + " at the equilibrium", marks_y, labels_y, false);
-  figure("equilibria_re_lambda", re1, "Re {/Symbol l}_1 (rightmost root)", marks_re, labels_re, true);
+  const std::string title = "Equilibria of " + t.metadata_text("model", "?") + " against " + key;
+  branch_figure(renderer, t,
+                {"equilibria", title, key, y1_name + " at the equilibrium", marks_y, labels_y, "", "", y1, stable});
+  branch_figure(renderer, t,
+                {"equilibria_re_lambda", title, key, "Re {/Symbol l}_1 (rightmost root)", marks_re, labels_re, "0",
+                 "Re {/Symbol l} = 0", re1, stable});
 }
 
 }  // namespace delayspec::cli

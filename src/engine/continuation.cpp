@@ -30,30 +30,35 @@ std::string to_string(BranchEnd end) {
   return "?";
 }
 
+BranchRange checked_range(const BranchRange& range) {
+  BranchRange o = range;
+  // Named by the fields: the scene layer checks its keys before (continue_settings.cpp).
+  require_finite("BranchRange::from", o.from);
+  require_finite("BranchRange::to", o.to);
+  if (o.from == o.to) throw BadInput("`BranchRange::from = to = " + format_number(o.from) + "`: an empty range");
+  const double width = std::abs(o.to - o.from);
+  if (o.step == 0) o.step = width / 50;
+  if (o.step_min == 0) o.step_min = 1e-6 * width;
+  if (o.step_max == 0) o.step_max = width / 10;
+  if (o.tolerance == 0) o.tolerance = 1e-10 * width;
+  require_positive("BranchRange::step", o.step);
+  require_positive("BranchRange::step_min", o.step_min);
+  require_positive("BranchRange::step_max", o.step_max);
+  require_positive("BranchRange::tolerance", o.tolerance);
+  if (o.step_min > o.step_max)
+    throw BadInput("`BranchRange::step_min = " + format_number(o.step_min) + "` exceeds `step_max = " +
+                   format_number(o.step_max) + "`" + (range.step_max == 0 ? " (its default, |to - from| / 10)" : ""));
+  o.step = std::clamp(o.step, o.step_min, o.step_max);
+  if (o.max_points < 2)
+    throw BadInput("`BranchRange::max_points = " + std::to_string(o.max_points) + "`: must be >= 2");
+  return o;
+}
+
 namespace continuation_detail {
 
 ContinuationOptions checked_options(const ContinuationOptions& options) {
   ContinuationOptions o = options;
-  // Named by the options' fields: the scene layer checks its keys before (continue_settings.cpp).
-  require_finite("ContinuationOptions::from", o.from);
-  require_finite("ContinuationOptions::to", o.to);
-  if (o.from == o.to)
-    throw BadInput("`ContinuationOptions::from = to = " + format_number(o.from) + "`: an empty range");
-  const double range = std::abs(o.to - o.from);
-  if (o.step == 0) o.step = range / 50;
-  if (o.step_min == 0) o.step_min = 1e-6 * range;
-  if (o.step_max == 0) o.step_max = range / 10;
-  if (o.tolerance == 0) o.tolerance = 1e-10 * range;
-  require_positive("ContinuationOptions::step", o.step);
-  require_positive("ContinuationOptions::step_min", o.step_min);
-  require_positive("ContinuationOptions::step_max", o.step_max);
-  require_positive("ContinuationOptions::tolerance", o.tolerance);
-  if (o.step_min > o.step_max)
-    throw BadInput("`ContinuationOptions::step_min = " + format_number(o.step_min) + "` exceeds `step_max = " +
-                   format_number(o.step_max) + "`" + (options.step_max == 0 ? " (its default, |to - from| / 10)" : ""));
-  o.step = std::clamp(o.step, o.step_min, o.step_max);
-  if (o.max_points < 2)
-    throw BadInput("`ContinuationOptions::max_points = " + std::to_string(o.max_points) + "`: must be >= 2");
+  static_cast<BranchRange&>(o) = checked_range(options);
   return o;
 }
 

@@ -190,13 +190,8 @@ EquilibriumBifurcation locate(const Tracer& tracer, const OnBranch& a, double h,
 EquilibriumBranch continue_equilibrium(const EquilibriumFamily& family, const Eigen::VectorXd& guess,
                                        const EquilibriumBranchOptions& options) {
   EquilibriumBranchOptions o = options;
-  const double range = std::abs(o.to - o.from), direction = o.to > o.from ? 1 : -1;
-  if (!(range > 0)) throw BadInput("the continuation range is empty (from = to)");
-  if (o.step == 0) o.step = range / 50;
-  if (o.step_min == 0) o.step_min = 1e-6 * range;
-  if (o.step_max == 0) o.step_max = range / 10;
-  if (o.tolerance == 0) o.tolerance = 1e-10 * range;
-  if (o.max_points < 2) throw BadInput("max_points must be >= 2");
+  static_cast<BranchRange&>(o) = checked_range(options);
+  const double direction = o.to > o.from ? 1 : -1;
   const Tracer tracer(family, o);
 
   EquilibriumBranch branch;

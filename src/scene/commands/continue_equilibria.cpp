@@ -140,9 +140,7 @@ int continue_equilibria(Config& config, const Invocation& inv) {
   require_autonomous(problem);
 
   EquilibriumBranchOptions o;
-  const ContinuationOptions& c = settings.options;
-  o.from = c.from, o.to = c.to, o.step = c.step, o.step_min = c.step_min, o.step_max = c.step_max;
-  o.max_points = c.max_points, o.tolerance = c.tolerance;
+  static_cast<BranchRange&>(o) = settings.options;
   o.newton_tolerance = eq.options.tolerance;
   Progress progress(inv.err, "continue", 0, inv.quiet);
   o.on_point = [&progress] { progress.add(); };
