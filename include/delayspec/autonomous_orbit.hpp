@@ -109,6 +109,119 @@ StroboscopicMap<TimeScaled<Model>> scaled_map(const Model& model, double T, int 
                                             make_grid_with_steps(delays_of(scaled), 1.0, K));
 }
 
+// Newton's guess: one period of the map at T after guess_periods - 1 simulated from the constant
+// history.
+template <class Model>
+Eigen::VectorXd simulated_guess(const Model& model, double T, int K, const AutonomousOrbitOptions& o) {
+  using Map = StroboscopicMap<TimeScaled<Model>>;
+  const Map map = scaled_map(model, T, K, o.step);
+  Eigen::VectorXd U = map.constant_history(model.initial_state());
+  for (int i = 1; i < o.guess_periods; ++i) U = map.apply(U);
+  const Eigen::VectorXd x = PeriodicOrbitProblem<Map>(map).sequence_from_history(U);
+  if (!x.allFinite()) throw NumericalFailure("autonomous orbit: the simulated guess is not finite");
+  return x;
+}
+
+// The phase condition's row: the reference's derivative in s, periodic central differences.
+template <int D>
+Eigen::VectorXd phase_row(const Eigen::VectorXd& reference, int K) {
+  Eigen::VectorXd row(reference.size());
+  for (long l = 0; l < K; ++l)
+    row.segment<D>(D * l) =
+        0.5 * (reference.segment<D>(D * ((l + 1) % K)) - reference.segment<D>(D * ((l + K - 1) % K)));
+  return row;
+}
+
+// max_i (max_l u_l[i] - min_l u_l[i]): 0 for an equilibrium.
+template <int D>
+double amplitude(const Eigen::VectorXd& x, int K) {
+  double out = 0;
+  for (int i = 0; i < D; ++i) {
+    const auto component =
+        Eigen::Map<const Eigen::VectorXd, 0, Eigen::InnerStride<>>(x.data() + i, K, Eigen::InnerStride<>(D));
+    out = std::max(out, component.maxCoeff() - component.minCoeff());
+  }
+  return out;
+}
+
+// Newton on (x, T) (header comment): F, the phase condition g, the bordered step, the line search.
+template <class Model>
+class PeriodNewton {
+ public:
+  using Map = StroboscopicMap<TimeScaled<Model>>;
+  PeriodNewton(const Model& model, const AutonomousOrbitOptions& o, int K, const Eigen::VectorXd& reference)
+      : model_(model), o_(o), K_(K), row_(phase_row<Model::d>(reference, K)), target_(row_.dot(reference)) {}
+
+  // F(x, T), and F_x when asked; false where the model cannot be stepped (a delay shorter than
+  // one step at this period, a step that fails, a value that is not finite).
+  bool residual(const Eigen::VectorXd& x, double T, Eigen::SparseMatrix<double>* Fx, Eigen::VectorXd& F) const {
+    try {
+      const Map map = scaled_map(model_, T, K_, o_.step);
+      F = PeriodicOrbitProblem<Map>(map).residual(x, Fx);
+      return F.allFinite();
+    } catch (const BadInput&) {
+      return false;
+    } catch (const NumericalFailure&) {
+      return false;
+    }
+  }
+  double phase(const Eigen::VectorXd& x) const { return row_.dot(x) - target_; }
+  // |F|_inf <= tolerance (1 + |x|_inf), and g (linear) at its rounding level.
+  bool converged(const Eigen::VectorXd& x, const Eigen::VectorXd& F, double g) const {
+    const double g_scale = row_.cwiseAbs().dot(x.cwiseAbs()) + std::abs(target_);
+    return F.lpNorm<Eigen::Infinity>() <= o_.newton.tolerance * (1 + x.lpNorm<Eigen::Infinity>()) &&
+           std::abs(g) <= 1e-12 * (1 + g_scale);
+  }
+  // The Newton step (dx, dT) of [F_x F_T; row 0] = -(F, g), F_T by central differences; false
+  // and why when F_T cannot be formed or the bordered matrix is singular.
+  bool direction(const Eigen::VectorXd& x, double T, const Eigen::VectorXd& F, const Eigen::SparseMatrix<double>& Fx,
+                 double g, Eigen::VectorXd& step, std::string& why) const {
+    const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * T;
+    Eigen::VectorXd up, down;
+    if (!residual(x, T + delta, nullptr, up) || !residual(x, T - delta, nullptr, down)) {
+      why = "the period's derivative could not be formed";
+      return false;
+    }
+    const Eigen::VectorXd FT = (up - down) / ((T + delta) - (T - delta));
+    Eigen::VectorXd rhs(x.size() + 1);
+    rhs << -F, -g;
+    try {
+      step = SparseLU(bordered_matrix(Fx, FT, row_, 0.0)).solve(rhs);
+    } catch (const NumericalFailure& e) {
+      why = std::string("the bordered Jacobian is singular (") + e.what() + ")";
+      return false;
+    }
+    return true;
+  }
+  // The full step unless |(F, g)|_2 grows; then halved, at most 30 times. Updates x, T, F, Fx;
+  // false when no fraction reduces the residual.
+  bool line_search(const Eigen::VectorXd& step, Eigen::VectorXd& x, double& T, Eigen::VectorXd& F,
+                   Eigen::SparseMatrix<double>& Fx) const {
+    const long n = x.size();
+    const double norm = std::hypot(F.norm(), phase(x));
+    double lambda = 1;
+    for (int halvings = 0; halvings <= 30; ++halvings, lambda *= 0.5) {
+      const Eigen::VectorXd x_trial = x + lambda * step.head(n);
+      const double T_trial = T + lambda * step[n];
+      Eigen::SparseMatrix<double> Fx_trial;
+      Eigen::VectorXd F_trial;
+      if (!(T_trial > 0) || !residual(x_trial, T_trial, &Fx_trial, F_trial)) continue;
+      if (std::hypot(F_trial.norm(), phase(x_trial)) < norm) {
+        x = x_trial, T = T_trial, F = std::move(F_trial), Fx = std::move(Fx_trial);
+        return true;
+      }
+    }
+    return false;
+  }
+
+ private:
+  const Model& model_;
+  const AutonomousOrbitOptions& o_;
+  int K_;
+  Eigen::VectorXd row_;
+  double target_;
+};
+
 }  // namespace detail
 
 // The map over one period of a found orbit (its monodromy at orbit.history gives the multipliers).
@@ -135,37 +248,10 @@ AutonomousOrbit find_autonomous_orbit(const Model& model, const AutonomousOrbitO
   if (steps > 2.5e8) throw BadInput("`N = " + std::to_string(o.N) + "`: too many steps per period");
   const int K = static_cast<int>(steps);
 
-  // The guess: one period after guess_periods - 1 simulated ones.
   AutonomousOrbit out;
   double T = o.period_guess;
-  Eigen::VectorXd x;
-  {
-    const Map map = detail::scaled_map(model, T, K, o.step);
-    Eigen::VectorXd U = map.constant_history(model.initial_state());
-    for (int i = 1; i < o.guess_periods; ++i) U = map.apply(U);
-    x = PeriodicOrbitProblem<Map>(map).sequence_from_history(U);
-  }
-  if (!x.allFinite()) throw NumericalFailure("autonomous orbit: the simulated guess is not finite");
-  // The phase condition's row: the reference's derivative in s, periodic central differences.
-  const long n = x.size();
-  Eigen::VectorXd row(n);
-  for (long l = 0; l < K; ++l)
-    row.segment<D>(D * l) = 0.5 * (x.segment<D>(D * ((l + 1) % K)) - x.segment<D>(D * ((l + K - 1) % K)));
-  const double target = row.dot(x);
-
-  // (F, g) and the Jacobian's parts at (x, T); false where the model cannot be stepped there.
-  auto residual = [&](const Eigen::VectorXd& at, double period, Eigen::SparseMatrix<double>* Fx,
-                      Eigen::VectorXd& F) -> bool {
-    try {
-      const Map map = detail::scaled_map(model, period, K, o.step);
-      F = PeriodicOrbitProblem<Map>(map).residual(at, Fx);
-      return F.allFinite();
-    } catch (const BadInput&) {  // a delay shorter than one step at this period
-      return false;
-    } catch (const NumericalFailure&) {
-      return false;
-    }
-  };
+  Eigen::VectorXd x = detail::simulated_guess(model, T, K, o);
+  const detail::PeriodNewton<Model> newton(model, o, K, x);
   auto failure = [&](const std::string& why, double r) {
     return NumericalFailure("autonomous orbit: " + why + " after " + std::to_string(out.newton_iterations) +
                             " Newton iterations from period_guess = " + format_number(o.period_guess) +
@@ -174,56 +260,22 @@ AutonomousOrbit find_autonomous_orbit(const Model& model, const AutonomousOrbitO
   };
   Eigen::SparseMatrix<double> Fx;
   Eigen::VectorXd F;
-  if (!residual(x, T, &Fx, F)) throw failure("the guess cannot be stepped", INFINITY);
+  if (!newton.residual(x, T, &Fx, F)) throw failure("the guess cannot be stepped", INFINITY);
   for (;;) {
-    const double g = row.dot(x) - target;
-    const double r = std::max(F.lpNorm<Eigen::Infinity>(), std::abs(g));
+    const double g = newton.phase(x), r = std::max(F.lpNorm<Eigen::Infinity>(), std::abs(g));
     out.newton_residuals.push_back(r);
     out.periods.push_back(T);
-    const double g_scale = row.cwiseAbs().dot(x.cwiseAbs()) + std::abs(target);
-    if (F.lpNorm<Eigen::Infinity>() <= o.newton.tolerance * (1 + x.lpNorm<Eigen::Infinity>()) &&
-        std::abs(g) <= 1e-12 * (1 + g_scale))
-      break;
+    if (newton.converged(x, F, g)) break;
     if (out.newton_iterations >= o.newton.max_iterations) throw failure("Newton did not converge", r);
-    // F_T by central differences
-    const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * T;
-    Eigen::VectorXd up, down;
-    if (!residual(x, T + delta, nullptr, up) || !residual(x, T - delta, nullptr, down))
-      throw failure("the period's derivative could not be formed", r);
-    const Eigen::VectorXd FT = (up - down) / ((T + delta) - (T - delta));
-    Eigen::VectorXd rhs(n + 1);
-    rhs << -F, -g;
     Eigen::VectorXd step;
-    try {
-      step = SparseLU(bordered_matrix(Fx, FT, row, 0.0)).solve(rhs);
-    } catch (const NumericalFailure& e) {
-      throw failure(std::string("the bordered Jacobian is singular (") + e.what() + ")", r);
-    }
+    std::string why;
+    if (!newton.direction(x, T, F, Fx, g, step, why)) throw failure(why, r);
     ++out.newton_iterations;
-    // Full step unless |(F, g)|_2 grows; then halved (at most 30 times).
-    const double norm = std::hypot(F.norm(), g);
-    bool accepted = false;
-    double lambda = 1;
-    for (int halvings = 0; halvings <= 30 && !accepted; ++halvings, lambda *= 0.5) {
-      const Eigen::VectorXd x_trial = x + lambda * step.head(n);
-      const double T_trial = T + lambda * step[n];
-      Eigen::SparseMatrix<double> Fx_trial;
-      Eigen::VectorXd F_trial;
-      if (!(T_trial > 0) || !residual(x_trial, T_trial, &Fx_trial, F_trial)) continue;
-      if (std::hypot(F_trial.norm(), row.dot(x_trial) - target) < norm) {
-        x = x_trial, T = T_trial, F = std::move(F_trial), Fx = std::move(Fx_trial);
-        accepted = true;
-      }
-    }
-    if (!accepted) throw failure("Newton stalled (no step along its direction reduces the residual)", r);
+    if (!newton.line_search(step, x, T, F, Fx))
+      throw failure("Newton stalled (no step along its direction reduces the residual)", r);
   }
   // An equilibrium solves F = 0 with any T: not an orbit.
-  double amplitude = 0;
-  for (int i = 0; i < D; ++i) {
-    const auto component = Eigen::Map<const Eigen::VectorXd, 0, Eigen::InnerStride<>>(x.data() + i, K,
-                                                                                      Eigen::InnerStride<>(D));
-    amplitude = std::max(amplitude, component.maxCoeff() - component.minCoeff());
-  }
+  const double amplitude = detail::amplitude<D>(x, K);
   if (!(amplitude > 1e-6 * (1 + x.lpNorm<Eigen::Infinity>())))
     throw failure("Newton converged to an equilibrium (amplitude " + format_number(amplitude) + ")",
                   F.lpNorm<Eigen::Infinity>());
