@@ -159,6 +159,71 @@ TEST(AutonomousOrbit, MackeyGlassPeriodConvergesAtOrderTwoAndTheTrivialMultiplie
   for (double e : trivial) EXPECT_LT(e, 1e-10);
 }
 
+// Pyragas control of the subcritical Hopf normal form (Fiedler et al., PRL 98, 114101, 2007):
+//   z' = (lam + i) z + (1 + i gam) |z|^2 z + b0 e^{i beta} (z(t - tau) - z(t)),
+// the orbit |z|^2 = -lam of period T = 2 pi / (1 - gam lam), tau = T. Uncontrolled (b0 = 0) its
+// radial exponent is -2 lam: the multiplier exp(-2 lam T) > 1, found although unstable; with
+// b0 = 0.3, beta = pi / 4 the control makes it stable.
+struct PyragasNormalForm {
+  static constexpr int d = 2;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double lam = -0.005, gam = -10, b0 = 0, beta = M_PI / 4;
+  double tau() const { return 2 * M_PI / (1 - gam * lam); }
+  double period() const { return tau(); }
+  Vec<2> f(int, double, const Vec<2>& y, const Vec<2>& w) const {
+    const double r2 = y.squaredNorm(), c = b0 * std::cos(beta), s = b0 * std::sin(beta);
+    const Vec<2> dz = w - y;
+    return Vec<2>(lam * y[0] - y[1] + r2 * (y[0] - gam * y[1]) + c * dz[0] - s * dz[1],
+                  y[0] + lam * y[1] + r2 * (gam * y[0] + y[1]) + s * dz[0] + c * dz[1]);
+  }
+  Mat<2> A(int, double, const Vec<2>& y, const Vec<2>&) const {
+    const double r2 = y.squaredNorm(), c = b0 * std::cos(beta), s = b0 * std::sin(beta);
+    Mat<2> a;
+    a << lam + r2 + 2 * y[0] * (y[0] - gam * y[1]) - c, -1 - gam * r2 + 2 * y[1] * (y[0] - gam * y[1]) + s,
+        1 + gam * r2 + 2 * y[0] * (gam * y[0] + y[1]) - s, lam + r2 + 2 * y[1] * (gam * y[0] + y[1]) - c;
+    return a;
+  }
+  Mat<2> B(int, double, const Vec<2>&, const Vec<2>&) const {
+    const double c = b0 * std::cos(beta), s = b0 * std::sin(beta);
+    return (Mat<2>() << c, -s, s, c).finished();
+  }
+  Vec<2> initial_state() const { return Vec<2>(std::sqrt(-lam), 0); }
+};
+
+TEST(AutonomousOrbit, PyragasControlStabilisesTheOrbitItLeavesInPlace) {
+  PyragasNormalForm model;
+  const double T_exact = model.tau();
+  std::vector<double> period_errors, multiplier_errors;
+  for (int N : {100, 200, 400}) {
+    AutonomousOrbitOptions o;
+    o.period_guess = 6.6;
+    o.N = N;
+    o.guess_periods = 1;
+    const AutonomousOrbit orbit = find_autonomous_orbit(model, o);
+    FloquetOptions fo;
+    fo.nev = 3;
+    const FloquetResult r = floquet_multipliers(autonomous_orbit_map(model, orbit).monodromy(orbit.history), fo);
+    period_errors.push_back(std::abs(orbit.period - T_exact));
+    multiplier_errors.push_back(std::abs(r.multipliers[0] - std::exp(-2 * model.lam * T_exact)));
+  }
+  // second order over h ratio 4, through the fractional delay's wandering coefficient (+-0.2)
+  EXPECT_NEAR(std::log2(period_errors[0] / period_errors[2]) / 2, 2.0, 0.2);
+  EXPECT_NEAR(std::log2(multiplier_errors[0] / multiplier_errors[2]) / 2, 2.0, 0.2);
+  model.b0 = 0.3;  // controlled: the same orbit (the control vanishes on it), now stable
+  AutonomousOrbitOptions o;
+  o.period_guess = 6.6;
+  o.N = 200;
+  o.guess_periods = 1;
+  const AutonomousOrbit orbit = find_autonomous_orbit(model, o);
+  EXPECT_NEAR(orbit.period, T_exact, 1e-4);  // the period's error at N = 200 (4e-5 measured)
+  FloquetOptions fo;
+  fo.nev = 3;
+  const FloquetResult r = floquet_multipliers(autonomous_orbit_map(model, orbit).monodromy(orbit.history), fo);
+  // the trivial multiplier and then the leading other one, inside the unit circle
+  EXPECT_LT(std::abs(r.multipliers[0] - 1.0), 1e-9);
+  EXPECT_LT(std::abs(r.multipliers[1]), 0.95);
+}
+
 TEST(AutonomousOrbit, AnUnstableOrbitIsFound) {
   Circle c;
   c.k = 1.5;  // lambda = -2 + 3 e^{-lambda tau} has a positive real root: the circle repels
