@@ -121,21 +121,17 @@ std::vector<std::pair<std::complex<double>, std::complex<double>>> crossing_root
   return crossed;
 }
 
-// Locates Re lambda = 0 on the segment from a (arclength 0) to b (arclength h), lambda the root
-// followed from lambda_a to lambda_b: Illinois on the arclength s.
-EquilibriumBifurcation locate(const Tracer& tracer, const OnBranch& a, double h, std::complex<double> lambda_a,
-                              std::complex<double> lambda_b, double tolerance) {
+// Locates Re lambda = 0 on the segment from a (arclength 0) to b (arclength h, the corrected
+// point there), lambda the root followed from lambda_a to lambda_b: Illinois on the arclength s.
+// `s` receives the arclength of the location (the order along the segment).
+EquilibriumBifurcation locate(const Tracer& tracer, const OnBranch& a, double h, const OnBranch& b,
+                              std::complex<double> lambda_a, std::complex<double> lambda_b, double tolerance,
+                              double& s_located) {
   struct End {
     double s, p;
     std::complex<double> lambda;
   };
-  End lo{0, a.p(), lambda_a}, hi{h, NAN, lambda_b};
-  {
-    OnBranch b;
-    int its = 0;
-    if (!tracer.correct(a, h, b, its)) throw NumericalFailure("the segment's end could not be corrected again");
-    hi.p = b.p();
-  }
+  End lo{0, a.p(), lambda_a}, hi{h, b.p(), lambda_b};
   double g_lo = lo.lambda.real(), g_hi = hi.lambda.real();
   int side = 0;
   EquilibriumBifurcation out;
@@ -146,6 +142,7 @@ EquilibriumBifurcation locate(const Tracer& tracer, const OnBranch& a, double h,
     int its = 0;
     if (!tracer.correct(a, s, at, its))
       throw NumericalFailure("a point inside the segment could not be corrected while locating the crossing");
+    s_located = s;
     const double w = (s - lo.s) / (hi.s - lo.s);
     root = refined_root(tracer.family().at(at.y(), at.p()), (1 - w) * lo.lambda + w * hi.lambda,
                         root_options(tracer));
@@ -233,19 +230,24 @@ EquilibriumBranch continue_equilibrium(const EquilibriumFamily& family, const Ei
     }
     const EquilibriumResult& previous = branch.points.back().equilibrium;
     if (point.equilibrium.unstable != previous.unstable) {
-      // every root that crossed, each located on its own, in order along the segment
-      std::vector<EquilibriumBifurcation> found;
-      for (const auto& [at_here, at_next] : crossing_roots(tracer, here, point.equilibrium)) {
-        EquilibriumBifurcation b = locate(tracer, here, h, at_here, at_next, o.tolerance);
-        if (b.type != EquilibriumBifurcationType::hopf)
-          b.type = here.tangent(d) * next.tangent(d) < 0 ? EquilibriumBifurcationType::fold
-                                                         : EquilibriumBifurcationType::branch_point;
-        if (!past_to || (b.parameter - o.to) * direction <= 0) found.push_back(std::move(b));
+      // every root that crossed, each located on its own, in order of arclength along the segment
+      std::vector<std::pair<double, EquilibriumBifurcation>> found;
+      try {
+        for (const auto& [at_here, at_next] : crossing_roots(tracer, here, point.equilibrium)) {
+          double s = 0;
+          EquilibriumBifurcation b = locate(tracer, here, h, next, at_here, at_next, o.tolerance, s);
+          if (b.type != EquilibriumBifurcationType::hopf)
+            b.type = here.tangent(d) * next.tangent(d) < 0 ? EquilibriumBifurcationType::fold
+                                                           : EquilibriumBifurcationType::branch_point;
+          if (!past_to || (b.parameter - o.to) * direction <= 0) found.emplace_back(s, std::move(b));
+        }
+      } catch (const NumericalFailure& e) {  // the branch so far stands; the failure is named
+        branch.end = BranchEnd::failure;
+        branch.failure = "locating a crossing after p = " + format_number(here.p()) + ": " + e.what();
+        return branch;
       }
-      std::sort(found.begin(), found.end(), [&](const EquilibriumBifurcation& x, const EquilibriumBifurcation& y) {
-        return (x.parameter - y.parameter) * direction < 0;
-      });
-      for (EquilibriumBifurcation& b : found) branch.bifurcations.push_back(std::move(b));
+      std::sort(found.begin(), found.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      for (auto& [s, b] : found) branch.bifurcations.push_back(std::move(b));
     }
     branch.points.push_back(std::move(point));
     if (o.on_point) o.on_point();

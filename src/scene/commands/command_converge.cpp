@@ -281,7 +281,7 @@ ConvergeSettings read_converge_settings(Config& config) {
       if (config.has(key))
         throw BadInput("`" + std::string(key) + " = " + config.get_string(key, "") +
                        "`: a limit of `converge_target`, which is not given");
-  if (config.get_string("period_guess", "none") != "none") s.period_guess = config.get_double("period_guess", 0);
+  s.period_guess = read_period_guess(config, s.problem);
   if (config.has("converge_target") && !(base.target > 0))
     throw BadInput("`converge_target = " + config.get_string("converge_target", "") + "`: must be > 0");
   if (!(base.max_seconds > 0) || !std::isfinite(base.max_seconds) || base.max_seconds > 1e7)
@@ -293,9 +293,6 @@ ConvergeSettings read_converge_settings(Config& config) {
   coarsest.N = base.Ns.front();
   const long n_min = coarsest.dimension();
   validate_floquet_options(s.solver_options, n_min);  // at the coarsest N, the smallest n
-  if (s.period_guess && !s.problem.analyses->is_autonomous())
-    throw BadInput("`period_guess` with `model = " + s.problem.model_name +
-                   "`: a forced model's orbit has the forcing's period; `period_guess` is for autonomous models");
   base.exact = s.period_guess ? Multipliers{} : exact_multipliers(s.problem, base.nev + base.extra);
   if (base.reference == ReferenceKind::exact && base.exact.empty())
     throw BadInput("`reference = exact`: model `" + s.problem.model_name +

@@ -20,9 +20,6 @@ namespace {
 int floquet_of_unknown_period(const Problem& problem, const OrbitSettings& orbit_settings,
                               const FloquetOptions& options, bool with_error_bars, double period_guess,
                               const Invocation& inv, std::chrono::steady_clock::time_point start) {
-  if (!problem.analyses->is_autonomous())
-    throw BadInput("`period_guess` with `model = " + problem.model_name +
-                   "`: a forced model's orbit has the forcing's period; `period_guess` is for autonomous models");
   const AutonomousFloquet r = autonomous_floquet(problem, period_guess, static_cast<int>(orbit_settings.guess_periods),
                                                  orbit_settings.newton, options, with_error_bars);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -54,11 +51,10 @@ int command_floquet(Config& config, const Invocation& inv) {
   // The error bars (error_bars.hpp): two coarser solves, about 1.3x the single one.
   const bool with_error_bars = config.get_choice("error_bars", "on", {"on", "off"}) == "on";
   // An autonomous model's orbit of unknown period (autonomous_floquet.hpp)
-  const bool period_unknown = config.get_string("period_guess", "none") != "none";
-  const double period_guess = period_unknown ? config.get_double("period_guess", 0) : 0;
+  const std::optional<double> period_guess = read_period_guess(config, problem);
   config.check_all_used();
-  if (period_unknown)
-    return floquet_of_unknown_period(problem, orbit_settings, options, with_error_bars, period_guess, inv, start);
+  if (period_guess)
+    return floquet_of_unknown_period(problem, orbit_settings, options, with_error_bars, *period_guess, inv, start);
   const long n = problem.dimension();
   validate_floquet_options(options, n);  // before the orbit: fail fast
 

@@ -10,6 +10,15 @@
 
 namespace delayspec::cli {
 
+std::optional<double> read_period_guess(Config& config, const Problem& problem) {
+  if (config.get_string("period_guess", "none") == "none") return std::nullopt;
+  const double guess = config.get_double("period_guess", 0);
+  if (!problem.analyses->is_autonomous())
+    throw BadInput("`period_guess` with `model = " + problem.model_name +
+                   "`: a forced model's orbit has the forcing's period; `period_guess` is for autonomous models");
+  return guess;
+}
+
 AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess, int guess_periods,
                                 const OrbitByNewtonOptions& newton, const FloquetOptions& solver) {
   AutonomousOrbitOptions o;

@@ -46,6 +46,10 @@ struct AutonomousFloquet {
   double error_bar_seconds = 0;
 };
 
+// The key `period_guess` (absent: "none", the forced orbit as ever); BadInput when it is not a
+// number, or given for a model that is not autonomous (its orbit has the forcing's period).
+std::optional<double> read_period_guess(Config& config, const Problem& problem);
+
 // One level: the orbit at N from period_guess (its guess simulated for guess_periods periods) and
 // nev + 1 multipliers, split into the trivial one and the others. BadInput: period_guess <= 0, a
 // forced or linear model; NumericalFailure: no orbit.
