@@ -127,6 +127,10 @@ struct ContinuationPoint {
   double step = 0;            // arclength step from the previous point (0 for the first)
   double residual = 0;        // |F|_inf at the point
   double tangent_p = 0;       // dp/ds of the unit tangent (oriented along the branch): 0 at a fold
+  // An orbit of unknown period (hopf_branch.hpp): its period, and the trivial multiplier (the
+  // time shift's, 1 to rounding: not among `multipliers`). NaN for a forced orbit.
+  double period = NAN;
+  std::complex<double> trivial_multiplier{NAN, NAN};
 };
 
 struct Bifurcation {
@@ -140,6 +144,7 @@ struct Bifurcation {
   int evaluations = 0;    // corrected points evaluated to locate it
   std::string note;       // e.g. why the bracket stayed wider than the tolerance
   Eigen::VectorXd orbit;  // the sequence x at the located point (continue_period_doubled starts there)
+  double period = NAN;    // an orbit of unknown period: its period there (the last entry of `orbit`)
 };
 
 // The parameter range and step control of a branch (continue_orbit, continue_equilibrium).
@@ -214,11 +219,14 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
                                                           const RichardsonOptions& richardson = {});
 
 namespace continuation_detail {
-// The tracer behind both continue_* (detail/continuation_branch.hpp).
+// The tracer behind every continue_* (detail/continuation_branch.hpp) and the problem of a forced
+// orbit along a branch (detail/periodic_branch.hpp).
+template <class Branch, class... BranchArguments>
+ContinuationResult trace_branch(const Eigen::VectorXd& guess, const ContinuationOptions& options,
+                                const Eigen::VectorXd* start_tangent, double start_p,
+                                const BranchArguments&... branch_arguments);
 template <class Model, class ModelAt>
-ContinuationResult trace_branch(const ModelAt& model_at, const Eigen::VectorXd& guess,
-                                const ContinuationOptions& options, const Eigen::VectorXd* start_tangent,
-                                double start_p);
+class PeriodicBranch;
 }  // namespace continuation_detail
 
 // The branch through the periodic orbit near `guess` (a sequence, PeriodicOrbitProblem, at
@@ -226,7 +234,8 @@ ContinuationResult trace_branch(const ModelAt& model_at, const Eigen::VectorXd& 
 template <class Model, class ModelAt>
 ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd& guess,
                                   const ContinuationOptions& options) {
-  return continuation_detail::trace_branch<Model>(model_at, guess, options, nullptr, options.from);
+  return continuation_detail::trace_branch<continuation_detail::PeriodicBranch<Model, ModelAt>>(guess, options, nullptr,
+                                                                                             options.from, model_at);
 }
 
 // The period-2 branch born at a period doubling `at` of the branch continue_orbit traced with
@@ -283,7 +292,8 @@ ContinuationResult continue_period_doubled(const ModelAt& model_at, const Bifurc
   tangent[tangent.size() - 1] = 0;
   ContinuationOptions o2 = options;
   o2.periods_per_map = 2 * options.periods_per_map;
-  return continuation_detail::trace_branch<Model>(model_at, x0, o2, &tangent, at.parameter);
+  return continuation_detail::trace_branch<continuation_detail::PeriodicBranch<Model, ModelAt>>(x0, o2, &tangent,
+                                                                                             at.parameter, model_at);
 }
 
 }  // namespace delayspec

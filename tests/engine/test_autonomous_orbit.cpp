@@ -26,30 +26,10 @@
 #include "delayspec/lambert_w.hpp"
 #include "delayspec/model_mackey_glass.hpp"
 #include "delayspec/richardson.hpp"
+#include "circle_oscillator.hpp"
 
 namespace delayspec {
 namespace {
-
-struct Circle {
-  static constexpr int d = 2;
-  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
-  double omega = 2 * M_PI, k = 0.5, delay = 0.37;
-  Vec<2> start{1.2, 0.0};
-  double tau() const { return delay; }
-  double period() const { return 1; }
-  Vec<2> f(int, double, const Vec<2>& y, const Vec<2>& w) const {
-    const double r2 = y.squaredNorm(), g = 1 - r2 + k * (w.squaredNorm() - 1);
-    return Vec<2>(g * y[0] - omega * y[1], omega * y[0] + g * y[1]);
-  }
-  Mat<2> A(int, double, const Vec<2>& y, const Vec<2>& w) const {
-    const double g = 1 - y.squaredNorm() + k * (w.squaredNorm() - 1);
-    Mat<2> a;
-    a << g - 2 * y[0] * y[0], -omega - 2 * y[0] * y[1], omega - 2 * y[0] * y[1], g - 2 * y[1] * y[1];
-    return a;
-  }
-  Mat<2> B(int, double, const Vec<2>& y, const Vec<2>& w) const { return 2 * k * y * w.transpose(); }
-  Vec<2> initial_state() const { return start; }
-};
 
 AutonomousOrbit orbit_of(const Circle& c, int N, double guess = 1.1, int guess_periods = 10) {
   AutonomousOrbitOptions o;

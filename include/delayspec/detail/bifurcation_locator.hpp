@@ -206,6 +206,7 @@ class BifurcationLocator {
     bif_.multipliers = best.multipliers;
     bif_.measures = best.measures;
     bif_.orbit = nearer.x;
+    bif_.period = best.period;
     std::complex<double> critical;
     if (type_ == BifurcationType::grazing) {
       bif_.angle = NAN;

@@ -25,21 +25,23 @@ namespace delayspec::continuation_detail {
 // step_max, max_points < 2.
 ContinuationOptions checked_options(const ContinuationOptions& options);
 
-// One branch from its first point to an end (continuation.hpp, "End of the branch").
-template <class Model, class ModelAt>
+// One branch from its first point to an end (continuation.hpp, "End of the branch"). Branch: the
+// problem along it, PeriodicBranch (a forced orbit) or AutonomousBranch (an orbit of unknown
+// period): unknowns, correct, point_along, dot, evaluate.
+template <class Branch>
 class BranchTracer {
  public:
-  using Branch = PeriodicBranch<Model, ModelAt>;
   using State = typename Branch::State;
 
-  // start_tangent: see trace_branch.
-  BranchTracer(const ModelAt& model_at, const ContinuationOptions& options, const Eigen::VectorXd* start_tangent,
-               double start_p)
+  // start_tangent: see trace_branch. branch_arguments: Branch's constructor's before the options.
+  template <class... BranchArguments>
+  BranchTracer(const ContinuationOptions& options, const Eigen::VectorXd* start_tangent, double start_p,
+               const BranchArguments&... branch_arguments)
       : o_(checked_options(options)),
         direction_(o_.to > o_.from ? 1 : -1),
         start_tangent_(start_tangent),
         start_p_(start_p),
-        branch_(model_at, o_) {}
+        branch_(branch_arguments..., o_) {}
 
   // The branch from `guess`: its first point, then predictor-corrector steps until an end.
   ContinuationResult trace(const Eigen::VectorXd& guess) {
@@ -210,7 +212,7 @@ class BranchTracer {
     const bool turning = (a.tangent_p > 0) != (b.tangent_p > 0);
     if (turning && std::find(found.begin(), found.end(), BifurcationType::fold) == found.end())
       found.push_back(BifurcationType::fold);
-    if constexpr (Model::has_switching)
+    if constexpr (Branch::has_switching)
       if ((a.measures.max_H > 0) != (b.measures.max_H > 0)) found.push_back(BifurcationType::grazing);
     const long after = static_cast<long>(result_.points.size()) - 1;
     for (BifurcationType type : found) {
@@ -238,12 +240,12 @@ class BranchTracer {
 // The branch from `guess` at p = options.from (Newton there), or, when start_tangent is given,
 // from the point (guess, start_p) itself along that tangent (no Newton: the point may be singular,
 // e.g. a period doubling seen by the doubled problem), the first segment not searched.
-template <class Model, class ModelAt>
-ContinuationResult trace_branch(const ModelAt& model_at, const Eigen::VectorXd& guess,
-                                const ContinuationOptions& options, const Eigen::VectorXd* start_tangent,
-                                double start_p) {
+template <class Branch, class... BranchArguments>
+ContinuationResult trace_branch(const Eigen::VectorXd& guess, const ContinuationOptions& options,
+                                const Eigen::VectorXd* start_tangent, double start_p,
+                                const BranchArguments&... branch_arguments) {
   const auto run_start = std::chrono::steady_clock::now();
-  BranchTracer<Model, ModelAt> tracer(model_at, options, start_tangent, start_p);
+  BranchTracer<Branch> tracer(options, start_tangent, start_p, branch_arguments...);
   ContinuationResult result = tracer.trace(guess);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   return result;

@@ -5,7 +5,6 @@
 // Part of continuation.hpp's implementation (its header states the mathematics), included by
 // it; not an interface.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -20,7 +19,7 @@
 #include "delayspec/floquet.hpp"
 #include "delayspec/grid.hpp"
 #include "delayspec/orbit_newton.hpp"
-#include "delayspec/detail/sparse_lu.hpp"
+#include "delayspec/detail/branch_corrector.hpp"
 #include "delayspec/stepper.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
@@ -41,19 +40,12 @@ double hermite_maximum(double g0, double g1, double s0, double s1, double h);
 template <class Model, class ModelAt>
 class PeriodicBranch {
  public:
+  static constexpr bool has_switching = Model::has_switching;
   static constexpr int D = Model::d;
   using V = Vec<D>;
   using Map = StroboscopicMap<Model>;
 
-  // A corrected point with the tangent there.
-  struct State {
-    Eigen::VectorXd x;
-    double p = 0;
-    Eigen::VectorXd tx;  // unit tangent (weighted norm)
-    double tp = 0;
-    int iterations = 0;
-    double residual = 0;
-  };
+  using State = BranchState;  // branch_corrector.hpp
 
   // `o` with its defaults filled in (the tracer's checked options): the corrector reads newton from it.
   PeriodicBranch(const ModelAt& model_at, const ContinuationOptions& o) : model_at_(model_at), o_(o) {
@@ -72,62 +64,13 @@ class PeriodicBranch {
     return Map(TrapezoidStepper<Model>(model, o_.step_options), g);
   }
 
-  // Newton from (x, p) on F = 0 and  row_x . x + row_p p = target:
-  //   [ F_x    F_p   ] [dx]     [ F ]
-  //   [ row_x  row_p ] [dp] = - [ g ],   g = row_x . x + row_p p - target,
-  // one sparse LU per iteration. Converged when |F|_inf <= tolerance (1 + |x|_inf) and g is at
-  // its rounding level; then the tangent solves the same matrix with e_{n+1} (oriented by the
-  // row: row . t > 0), normalised in the weighted norm. Returns nullopt and the reason on
-  // failure (not converged in max_iterations, diverging, singular, a parameter the model rejects).
+  // Newton from (x, p) on F = 0 and row_x . x + row_p p = target (bordered_corrector).
   std::optional<State> correct(Eigen::VectorXd x, double p, const Eigen::VectorXd& row_x, double row_p, double target,
                                int max_iterations, std::string& why, double& seconds) const {
-    const auto start = std::chrono::steady_clock::now();
-    struct Timer {
-      std::chrono::steady_clock::time_point start;
-      double& seconds;
-      ~Timer() { seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
-    } timer{start, seconds};
-    const long n = unknowns();
-    double first = INFINITY;
-    for (int it = 0;; ++it) {
-      Eigen::VectorXd F, Fp;
-      Eigen::SparseMatrix<double> Fx;
-      if (!linearise_or_reason(x, p, F, Fx, Fp, why)) return std::nullopt;
-      const double r = F.lpNorm<Eigen::Infinity>();
-      const double g = row_x.dot(x) + row_p * p - target;
-      if (!std::isfinite(r)) {
-        why = "non-finite residual, |F|_inf = " + format_number(r) + " at parameter " + format_number(p);
-        return std::nullopt;
-      }
-      // g is linear: after one Newton step it is at its rounding level, eps times the size of its terms
-      const double g_scale = row_x.cwiseAbs().dot(x.cwiseAbs()) + std::abs(row_p * p) + std::abs(target);
-      const bool converged =
-          r <= o_.newton.tolerance * (1 + x.lpNorm<Eigen::Infinity>()) && std::abs(g) <= 1e-12 * (1 + g_scale);
-      // Diverging: the residual 1e3 times above the one after the first step (not any growth: near
-      // grazing the discrete problem is only piecewise smooth and an iterate may raise |F| before
-      // converging; the start may have |F| = 0 with the constraint violated).
-      if (it == 1) first = r;
-      if (!converged && (it >= max_iterations || r > 1e3 * first)) {
-        why = (it >= max_iterations ? "not converged in " + std::to_string(it) + " iterations"
-                                    : "residual diverging at iteration " + std::to_string(it)) +
-              ", |F|_inf = " + format_number(r) + " at parameter " + format_number(p);
-        return std::nullopt;
-      }
-      std::optional<SparseLU> lu;
-      try {
-        lu.emplace(bordered_matrix(Fx, Fp, row_x, row_p));  // sparse_lu.hpp
-      } catch (const NumericalFailure& e) {
-        why = std::string("bordered matrix singular at parameter ") + format_number(p) + " (" + e.what() + ")";
-        return std::nullopt;
-      }
-      if (converged) return tangent_state(*lu, std::move(x), p, it, r);
-      Eigen::VectorXd rhs(n + 1);
-      rhs.head(n) = -F;
-      rhs[n] = -g;
-      const Eigen::VectorXd step = lu->solve(rhs);
-      x += step.head(n);
-      p += step[n];
-    }
+    auto linearise = [this](const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
+                            Eigen::VectorXd& Fp, std::string& why) { return linearise_or_reason(x, p, F, Fx, Fp, why); };
+    return bordered_corrector(linearise, std::move(x), p, row_x, row_p, target, max_iterations, o_.newton.tolerance,
+                              weight_, why, seconds);
   }
 
   // The corrected point at arclength s from `base` along its tangent: the predictor
@@ -140,43 +83,19 @@ class PeriodicBranch {
                    reason, seconds);
   }
 
-  // F(x, p), F_x and F_p. F_p by the central difference (F(x, p + delta) - F(x, p - delta)) /
-  // (2 delta), delta = eps^(1/3) max(|p|, |to - from|) (continuation.hpp: why that is enough).
+  // F(x, p), F_x and F_p (parameter_derivative: central differences, one-sided at a bound of the
+  // key's range).
   void linearise(const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
                  Eigen::VectorXd& Fp) const {
-    const Map map = map_at(p);
-    F = PeriodicOrbitProblem<Map>(map).residual(x, &Fx);
-    const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max({std::abs(p), range_, 1e-300});
-    const double up = p + delta, down = p - delta;
-    // At a bound of the key's range (milling's depth from 0: p - delta = -6e-9 is rejected) the
-    // one-sided second-order stencil on the side the model accepts, (-3 F(p) + 4 F(p + s) -
-    // F(p + 2 s)) / (2 s), s = +-delta: the same order, and truncation 2x the central one's.
-    auto map_if_accepted = [&](double q) -> std::optional<Map> {
-      try {
-        return map_at(q);
-      } catch (const BadInput&) {
-        return std::nullopt;
-      }
-    };
-    auto residual = [&](const Map& m) { return PeriodicOrbitProblem<Map>(m).residual(x); };
-    const std::optional<Map> map_up = map_if_accepted(up), map_down = map_if_accepted(down);
-    if (map_up && map_down) {
-      Fp = (residual(*map_up) - residual(*map_down)) / (up - down);
-      return;
-    }
-    if (!map_up && !map_down) map_at(down);  // neither side: the model's reason (BadInput)
-    const double side = map_up ? delta : -delta;
-    const double s1 = (p + side) - p, s2 = (p + 2 * side) - p;  // the steps as represented
-    const Eigen::VectorXd F1 = residual(map_up ? *map_up : *map_down), F2 = residual(map_at(p + 2 * side));
-    // Quadratic through (0, F), (s1, F1), (s2, F2), differentiated at 0.
-    Fp = (-(s1 + s2) / (s1 * s2)) * F + (s2 / (s1 * (s2 - s1))) * F1 - (s1 / (s2 * (s2 - s1))) * F2;
+    F = PeriodicOrbitProblem<Map>(map_at(p)).residual(x, &Fx);
+    Fp = parameter_derivative([&](double q) { return PeriodicOrbitProblem<Map>(map_at(q)).residual(x); }, p, F,
+                              range_);
   }
 
   // Weighted inner product of the state parts plus the parameters' product.
   double dot(const Eigen::VectorXd& ax, double ap, const Eigen::VectorXd& bx, double bp) const {
     return weight_ * ax.dot(bx) + ap * bp;
   }
-  double weight() const { return weight_; }
 
   // Multipliers and measures of the orbit x at p.
   ContinuationPoint evaluate(const State& s, double& krylov_seconds) const {
@@ -187,25 +106,8 @@ class PeriodicBranch {
     point.tangent_p = s.tp;
     const Map map = map_at(s.p);
     PeriodicOrbitProblem<Map> problem(map);
-    const auto start = std::chrono::steady_clock::now();
-    const auto monodromy = map.monodromy(problem.history(s.x));
-    // A pair failing the residual gate is nearly always one of the smallest requested (|mu| ~ 1e-7
-    // on a nearly rank-deficient monodromy, far below anything that crosses the circle): retried
-    // with one multiplier fewer, down to one; the point has then fewer multipliers.
-    FloquetOptions floquet = o_.floquet;
-    FloquetResult r;
-    for (;;) {
-      try {
-        r = floquet_multipliers(monodromy, floquet);
-        break;
-      } catch (const NumericalFailure&) {
-        if (floquet.nev <= 1) throw;
-        --floquet.nev;
-      }
-    }
-    krylov_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    point.multipliers = r.multipliers;
-    for (const auto& mu : r.multipliers) point.unstable += std::abs(mu) > 1;
+    point.multipliers = leading_multipliers(map.monodromy(problem.history(s.x)), o_.floquet, krylov_seconds);
+    for (const auto& mu : point.multipliers) point.unstable += std::abs(mu) > 1;
     point.measures = measures(map, s.x);
     return point;
   }
@@ -213,13 +115,11 @@ class PeriodicBranch {
   // The orbit's extremes per component; for a switching model also max H between the nodes and
   // the contact time (OrbitMeasures).
   OrbitMeasures measures(const Map& map, const Eigen::VectorXd& x) const {
-    OrbitMeasures m;
-    const Eigen::Map<const Eigen::Matrix<double, D, Eigen::Dynamic>> states(x.data(), D, K_);
-    for (int i = 0; i < D; ++i) {
-      m.max.push_back(states.row(i).maxCoeff());
-      m.min.push_back(states.row(i).minCoeff());
+    OrbitMeasures m = state_extremes<D>(x, K_);
+    if constexpr (Model::has_switching) {
+      const Eigen::Map<const Eigen::Matrix<double, D, Eigen::Dynamic>> states(x.data(), D, K_);
+      switching_measures(map, states, m);
     }
-    if constexpr (Model::has_switching) switching_measures(map, states, m);
     return m;
   }
 
@@ -244,23 +144,6 @@ class PeriodicBranch {
       why = std::string("the model rejects parameter ") + format_number(p) + " (" + e.what() + ")";
     }
     return false;
-  }
-
-  // The converged point with its tangent z: [F_x F_p; row] z = e_{n+1}, z / |z|_w.
-  State tangent_state(const SparseLU& lu, Eigen::VectorXd x, double p, int iterations, double residual) const {
-    const long n = unknowns();
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + 1);
-    rhs[n] = 1;
-    const Eigen::VectorXd z = lu.solve(rhs);
-    const double norm = std::sqrt(weight_ * z.head(n).squaredNorm() + z[n] * z[n]);
-    State s;
-    s.x = std::move(x);
-    s.p = p;
-    s.tx = z.head(n) / norm;
-    s.tp = z[n] / norm;
-    s.iterations = iterations;
-    s.residual = residual;
-    return s;
   }
 
   // Switching models: over each step [t, t + h] of the orbit, max H from the cubic Hermite

@@ -1,0 +1,150 @@
+#pragma once
+// The discrete problem of a branch of orbits of unknown period (hopf_branch.hpp) at one parameter
+// value: what the branch tracer (continuation_branch.hpp) and the locator ask of it. Part of
+// hopf_branch.hpp's implementation, included by it; not an interface.
+//
+// Unknowns X = (x, T, p): the K states of the orbit on its own time scale (autonomous_orbit.hpp,
+// K fixed along the branch), the period and the parameter. The tracer's x is (x, T); the
+// problem G(x, T, p) = 0 it corrects is
+//
+//   F(x, T, p) = 0                      the scaled periodic problem (autonomous_orbit.hpp)
+//   sum_l <u_l - r_l, r'_l> = 0         the integral phase condition against the corrector's
+//                                       starting point r (the predictor: it moves with the branch)
+//
+// so G_x is [F_x F_T; r'^T 0] (F_T by central differences, as PeriodNewton) and G_p = (F_p, 0).
+// The weighted inner product is the forced branch's, x.y / K + p q, with T counted among the
+// states (weight 1 / K): the arclength follows the orbit and the parameter, T follows them.
+//
+// A point's multipliers: those of the scaled map's monodromy over one period, nev + 1 computed
+// and the trivial one (the multiplier nearest 1: the time shift, 1 to rounding, autonomous.md)
+// left out, so the detection counts and test functions of continuation.hpp see only the others.
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "delayspec/autonomous_orbit.hpp"
+#include "delayspec/continuation.hpp"
+#include "delayspec/detail/branch_corrector.hpp"
+
+namespace delayspec::continuation_detail {
+
+template <class Model, class ModelAt>
+class AutonomousBranch {
+ public:
+  static constexpr bool has_switching = false;  // autonomous models do not switch (model.hpp)
+  static constexpr int D = Model::d;
+  using Map = StroboscopicMap<TimeScaled<Model>>;
+  using State = BranchState;  // x = (u_0, ..., u_{K-1}, T)
+
+  AutonomousBranch(const ModelAt& model_at, int K, const ContinuationOptions& o)
+      : model_at_(model_at), o_(o), K_(K), weight_(1.0 / K), range_(std::abs(o.to - o.from)) {}
+
+  long unknowns() const { return static_cast<long>(D) * K_ + 1; }
+
+  // Newton from (x, T, p) on G = 0 and row_x . (x, T) + row_p p = target, the phase condition's
+  // reference the starting point.
+  std::optional<State> correct(Eigen::VectorXd x, double p, const Eigen::VectorXd& row_x, double row_p, double target,
+                               int max_iterations, std::string& why, double& seconds) const {
+    const long n = unknowns() - 1;
+    const Eigen::VectorXd phase = detail::phase_row<D>(x.head(n), K_);
+    const double phase_target = phase.dot(x.head(n));
+    auto linearise = [&](const Eigen::VectorXd& xT, double q, Eigen::VectorXd& G, Eigen::SparseMatrix<double>& Gx,
+                         Eigen::VectorXd& Gp, std::string& reason) {
+      return linearise_or_reason(xT, q, phase, phase_target, G, Gx, Gp, reason);
+    };
+    return bordered_corrector(linearise, std::move(x), p, row_x, row_p, target, max_iterations, o_.newton.tolerance,
+                              weight_, why, seconds);
+  }
+
+  // The corrected point at arclength s from `base` along its tangent (as PeriodicBranch).
+  std::optional<State> point_along(const State& base, double s, std::string& reason, double& seconds) const {
+    const Eigen::VectorXd pred_x = base.x + s * base.tx;
+    const double pred_p = base.p + s * base.tp;
+    const Eigen::VectorXd row_x = weight_ * base.tx;
+    return correct(pred_x, pred_p, row_x, base.tp, row_x.dot(pred_x) + base.tp * pred_p, o_.newton.max_iterations,
+                   reason, seconds);
+  }
+
+  double dot(const Eigen::VectorXd& ax, double ap, const Eigen::VectorXd& bx, double bp) const {
+    return weight_ * ax.dot(bx) + ap * bp;
+  }
+
+  // The multipliers but the trivial one, the period and the extremes of the orbit at the point.
+  ContinuationPoint evaluate(const State& s, double& krylov_seconds) const {
+    const long n = unknowns() - 1;
+    ContinuationPoint point;
+    point.parameter = s.p;
+    point.period = s.x[n];
+    point.newton_iterations = s.iterations;
+    point.residual = s.residual;
+    point.tangent_p = s.tp;
+    const Map map = map_at(s.p, point.period);
+    const Eigen::VectorXd U = PeriodicOrbitProblem<Map>(map).history(s.x.head(n));
+    FloquetOptions floquet = o_.floquet;
+    floquet.nev += 1;
+    std::vector<std::complex<double>> mu = leading_multipliers(map.monodromy(U), floquet, krylov_seconds);
+    size_t trivial = 0;
+    for (size_t i = 1; i < mu.size(); ++i)
+      if (std::abs(mu[i] - 1.0) < std::abs(mu[trivial] - 1.0)) trivial = i;
+    if (!mu.empty()) point.trivial_multiplier = mu[trivial], mu.erase(mu.begin() + static_cast<long>(trivial));
+    point.multipliers = std::move(mu);
+    for (const auto& m : point.multipliers) point.unstable += std::abs(m) > 1;
+    point.measures = state_extremes<D>(s.x.head(n), K_);
+    return point;
+  }
+
+ private:
+  Map map_at(double p, double T) const { return detail::scaled_map(model_at_(p), T, K_, o_.step_options); }
+  Eigen::VectorXd residual(const Eigen::VectorXd& x, double T, double p, Eigen::SparseMatrix<double>* Fx) const {
+    return PeriodicOrbitProblem<Map>(map_at(p, T)).residual(x, Fx);
+  }
+
+  // G, G_x, G_p at (x, T, p) (header comment), or false and the reason: a period <= 0, a residual
+  // the stepper cannot compute, a parameter or period outside the model's domain (a delay shorter
+  // than one step).
+  bool linearise_or_reason(const Eigen::VectorXd& xT, double p, const Eigen::VectorXd& phase, double phase_target,
+                           Eigen::VectorXd& G, Eigen::SparseMatrix<double>& Gx, Eigen::VectorXd& Gp,
+                           std::string& why) const {
+    const long n = unknowns() - 1;
+    const Eigen::VectorXd x = xT.head(n);
+    const double T = xT[n];
+    if (!(T > 0) || !std::isfinite(T)) {
+      why = "the period reached " + format_number(T) + " at parameter " + format_number(p);
+      return false;
+    }
+    try {
+      Eigen::SparseMatrix<double> Fx;
+      const Eigen::VectorXd F = residual(x, T, p, &Fx);
+      const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * T;
+      const Eigen::VectorXd FT =
+          (residual(x, T + delta, p, nullptr) - residual(x, T - delta, p, nullptr)) / ((T + delta) - (T - delta));
+      const Eigen::VectorXd Fp =
+          parameter_derivative([&](double q) { return residual(x, T, q, nullptr); }, p, F, range_);
+      G.resize(n + 1);
+      G << F, phase.dot(x) - phase_target;
+      Gx = bordered_matrix(Fx, FT, phase, 0.0);
+      Gp = Eigen::VectorXd::Zero(n + 1);
+      Gp.head(n) = Fp;
+      return true;
+    } catch (const NumericalFailure& e) {
+      why = std::string("residual not computable at ") + format_number(p) + " (" + e.what() + ")";
+    } catch (const BadInput& e) {
+      why = std::string("the model rejects parameter ") + format_number(p) + " with period " + format_number(T) +
+            " (" + e.what() + ")";
+    }
+    return false;
+  }
+
+  const ModelAt& model_at_;
+  ContinuationOptions o_;
+  int K_;
+  double weight_, range_;
+};
+
+}  // namespace delayspec::continuation_detail
