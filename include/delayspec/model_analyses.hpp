@@ -62,6 +62,7 @@ struct AutonomousLinearisedOrbit {
 };
 
 class ModelAnalyses;
+struct EquilibriumBifurcation;  // equilibrium_branch.hpp
 // The analyses of one model with one parameter set to p (continuation's family of models): for
 // the built-in models the scene's keys with the continued one changed, for an equation model its
 // compiled code with other constants. Must give analyses of the same model type as the caller.
@@ -116,6 +117,10 @@ class ModelAnalyses {
   // (continuation.hpp: continue_period_doubled).
   virtual ContinuationResult continue_period_doubled(const AnalysesAt& at, const Bifurcation& at_pd,
                                                      const ContinuationOptions& options) const = 0;
+  // The branch of periodic orbits born at the Hopf point `hopf` of the family's equilibria
+  // (hopf_branch.hpp: continue_from_hopf). BadInput for a model that is not autonomous, or linear.
+  virtual ContinuationResult continue_from_hopf(const AnalysesAt& at, const EquilibriumBifurcation& hopf,
+                                                const ContinuationOptions& options) const = 0;
 
  protected:
   ModelAnalyses() = default;
@@ -252,6 +257,8 @@ class ModelAnalysesFor final : public ModelAnalyses {
                                     const ContinuationOptions& options) const override;
   ContinuationResult continue_period_doubled(const AnalysesAt& at, const Bifurcation& at_pd,
                                              const ContinuationOptions& options) const override;
+  ContinuationResult continue_from_hopf(const AnalysesAt& at, const EquilibriumBifurcation& hopf,
+                                        const ContinuationOptions& options) const override;
 
  private:
   static bool all_finite(const OrbitLinearisation<D, DW>& at) {

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "delayspec/continuation.hpp"
+#include "delayspec/hopf_branch.hpp"
 #include "delayspec/model_analyses.hpp"
 
 namespace delayspec {
@@ -39,6 +40,18 @@ template <class Model>
 ContinuationResult ModelAnalysesFor<Model>::continue_period_doubled(const AnalysesAt& at, const Bifurcation& at_pd,
                                                                     const ContinuationOptions& options) const {
   return delayspec::continue_period_doubled<Model>(detail::model_at<Model>(at), at_pd, options);
+}
+
+template <class Model>
+ContinuationResult ModelAnalysesFor<Model>::continue_from_hopf(const AnalysesAt& at, const EquilibriumBifurcation& hopf,
+                                                               const ContinuationOptions& options) const {
+  if constexpr (AutonomousModel<Model> && !Model::is_linear) {
+    return delayspec::continue_from_hopf<Model>(detail::model_at<Model>(at), hopf, options);
+  } else if constexpr (AutonomousModel<Model>) {
+    throw BadInput("a linear model has no isolated periodic orbits: its Hopf points start no branch of orbits");
+  } else {
+    throw BadInput(kNotAutonomous);
+  }
 }
 
 }  // namespace delayspec

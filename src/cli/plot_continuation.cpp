@@ -1,5 +1,6 @@
 #include "cli/plot_continuation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -30,10 +31,32 @@ void stable_and_unstable(const ResultTable& t, int x, int y, int stable, std::st
   }
 }
 
-// A bifurcation's label in a figure, at (x, y).
-std::string bifurcation_label(int index, const std::string& type, double x, double y) {
+// A bifurcation's label in a figure, at (x, y): to the right of the point, or to its left when
+// the point is in the right quarter of the branch's range [x0, x1] (the label would be clipped).
+std::string bifurcation_label(int index, const std::string& type, double x, double y, double x0, double x1) {
+  const bool left = (x - std::min(x0, x1)) > 0.75 * std::abs(x1 - x0);
   return "set label " + std::to_string(index) + " " + gnuplot_string(type) + " at " + gnuplot_number(x) + "," +
-         gnuplot_number(y) + " offset 0.5,0.8 font ',9'\n";
+         gnuplot_number(y) + (left ? " right offset -0.5,0.8" : " offset 0.5,0.8") + " font ',9'\n";
+}
+
+// The range of column 0 over the rows.
+void parameter_range(const ResultTable& t, double& x0, double& x1) {
+  x0 = INFINITY, x1 = -INFINITY;
+  for (const auto& row : t.rows)
+    if (!row.empty()) x0 = std::min(x0, row[0]), x1 = std::max(x1, row[0]);
+}
+
+// A row at the bifurcation (p, y in column `yc`, `extra` column set to `extra_value`) with the
+// stability after it, so that the stable and unstable stretches meet there, not at the next point.
+void insert_bifurcation_row(ResultTable& t, double p, int yc, double y, int extra, double extra_value) {
+  for (size_t i = 1; i < t.rows.size(); ++i)
+    if (!t.rows[i - 1].empty() && !t.rows[i].empty() && (p - t.rows[i - 1][0]) * (p - t.rows[i][0]) <= 0) {
+      std::vector<double> row = t.rows[i];
+      row[0] = p, row[static_cast<size_t>(yc)] = y;
+      if (extra >= 0) row[static_cast<size_t>(extra)] = extra_value;
+      t.rows.insert(t.rows.begin() + static_cast<long>(i), row);
+      return;
+    }
 }
 
 // One figure of a branch: column y of t against column 0, stable solid and unstable dashed, the
@@ -63,12 +86,13 @@ void branch_figure(FigureRenderer& renderer, const ResultTable& t, const BranchF
   renderer.figure(f.name, gp.str());
 }
 
-}  // namespace
-
-void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& dir) {
+// The figures of one branch of orbits: `name` (max y1 over the orbit) and `name`_mu1 (|mu_1|)
+// from its CSV, the bifurcations (`bifurcations`: continue.json's list for it, or null) marked.
+void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path& csv, const JsonField* bifurcations,
+                          const std::string& name, const std::string& what) {
   // max_H and contact_time are nan for models without switching; the multiplier columns for points
   // with fewer multipliers than nev.
-  const ResultTable t = read_result_table(dir / "branch.csv", [](const std::string& c) {
+  ResultTable t = read_result_table(csv, [](const std::string& c) {
     return c == "max_H" || c == "contact_time" || c.rfind("mu", 0) == 0 || c == "abs_mu1";
   });
   t.require_header({"parameter", "stable", "unstable", "abs_mu1", "max_y1"});
@@ -77,30 +101,44 @@ void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& di
   const std::string key = t.metadata_text("continue_key", "parameter");
   // The bifurcations: parameter, max y1 at the point, |mu| (1 on the circle; grazing: none).
   std::string marks_y, marks_mu, labels_y, labels_mu;
-  if (std::filesystem::exists(dir / "continue.json")) {
-    const nlohmann::json doc = read_json_file(dir / "continue.json");
-    const JsonField j(doc, "continue.json", "");
+  double x0, x1;
+  parameter_range(t, x0, x1);
+  if (bifurcations) {
     int index = 0;
-    for (const JsonField& b : j.at("bifurcations").elements()) {
+    for (const JsonField& b : bifurcations->elements()) {
       const double p = b.at("parameter").number();
       const double y = b.at("measures").at("max").elements().at(0).number();
       const std::string type = b.at("type").text();
       if (type != "fold" && type != "period-doubling" && type != "neimark-sacker" && type != "grazing")
         b.at("type").fail("unknown bifurcation type");
+      if (type != "grazing") insert_bifurcation_row(t, p, max_y1, y, mu1, 1);
       marks_y += gnuplot_number(p) + " " + gnuplot_number(y) + "\n";
-      labels_y += bifurcation_label(++index, type, p, y);
+      labels_y += bifurcation_label(++index, type, p, y, x0, x1);
       if (type != "grazing") {
         marks_mu += gnuplot_number(p) + " 1\n";
-        labels_mu += bifurcation_label(index, type, p, 1);
+        labels_mu += bifurcation_label(index, type, p, 1, x0, x1);
       }
     }
   }
-  const std::string title = "Branch of " + t.metadata_text("model", "?") + " against " + key;
-  branch_figure(renderer, t, {"branch", title, key, "max y_1 over the orbit", marks_y, labels_y, "", "", max_y1, stable});
+  const std::string title = what + " of " + t.metadata_text("model", "?") + " against " + key;
+  branch_figure(renderer, t, {name, title, key, "max y_1 over the orbit", marks_y, labels_y, "", "", max_y1, stable});
   if (mu1 >= 0)
     branch_figure(renderer, t,
-                  {"branch_mu1", title, key, "|{/Symbol m}_1|", marks_mu, labels_mu, "1", "|{/Symbol m}| = 1", mu1,
+                  {name + "_mu1", title, key, "|{/Symbol m}_1|", marks_mu, labels_mu, "1", "|{/Symbol m}| = 1", mu1,
                    stable});
+}
+
+}  // namespace
+
+void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& dir) {
+  if (!std::filesystem::exists(dir / "continue.json")) {
+    orbit_branch_figures(renderer, dir / "branch.csv", nullptr, "branch", "Branch");
+    return;
+  }
+  const nlohmann::json doc = read_json_file(dir / "continue.json");
+  const JsonField j(doc, "continue.json", "");
+  const JsonField bifurcations = j.at("bifurcations");
+  orbit_branch_figures(renderer, dir / "branch.csv", &bifurcations, "branch", "Branch");
 }
 
 void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir) {
@@ -115,6 +153,8 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir)
   const std::string key = t.metadata_text("continue_key", "parameter"), y1_name = t.columns.at(3);
   // The bifurcations of continue.json: marked at their state and on Re lambda = 0.
   std::string marks_y, marks_re, labels_y, labels_re;
+  double x0, x1;
+  parameter_range(t, x0, x1);
   if (std::filesystem::exists(dir / "continue.json")) {
     const nlohmann::json doc = read_json_file(dir / "continue.json");
     const JsonField j(doc, "continue.json", "");
@@ -124,20 +164,12 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir)
       const double y = b.at("equilibrium").elements().at(0).number();
       const std::string type = b.at("type").text();
       if (type != "fold" && type != "hopf" && type != "branch_point") b.at("type").fail("unknown bifurcation type");
-      // a row at the bifurcation, with the stability after it: the stretches meet there, not at
-      // the next branch point
-      for (size_t i = 1; i < t.rows.size(); ++i)
-        if (!t.rows[i - 1].empty() && !t.rows[i].empty() && (p - t.rows[i - 1][0]) * (p - t.rows[i][0]) <= 0) {
-          std::vector<double> row = t.rows[i];
-          row[0] = p, row[y1] = y, row[re1] = 0;
-          t.rows.insert(t.rows.begin() + static_cast<long>(i), row);
-          break;
-        }
+      insert_bifurcation_row(t, p, y1, y, re1, 0);
       ++index;
       marks_y += gnuplot_number(p) + " " + gnuplot_number(y) + "\n";
       marks_re += gnuplot_number(p) + " 0\n";
-      labels_y += bifurcation_label(index, type, p, y);
-      labels_re += bifurcation_label(index, type, p, 0);
+      labels_y += bifurcation_label(index, type, p, y, x0, x1);
+      labels_re += bifurcation_label(index, type, p, 0, x0, x1);
     }
   }
   const std::string title = "Equilibria of " + t.metadata_text("model", "?") + " against " + key;
@@ -146,6 +178,22 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir)
   branch_figure(renderer, t,
                 {"equilibria_re_lambda", title, key, "Re {/Symbol l}_1 (rightmost root)", marks_re, labels_re, "0",
                  "Re {/Symbol l} = 0", re1, stable});
+  // continue_switch: the orbits born at each Hopf point, hopf_branch_K.csv with continue.json's
+  // hopf_branches[K - 1]
+  for (int k = 1; std::filesystem::exists(dir / ("hopf_branch_" + std::to_string(k) + ".csv")); ++k) {
+    const std::string name = "hopf_branch_" + std::to_string(k);
+    if (!std::filesystem::exists(dir / "continue.json")) {
+      orbit_branch_figures(renderer, dir / (name + ".csv"), nullptr, name, "Orbits from a Hopf point");
+      continue;
+    }
+    const nlohmann::json doc = read_json_file(dir / "continue.json");
+    const JsonField j(doc, "continue.json", "");
+    const std::vector<JsonField> branches = j.at("hopf_branches").elements();
+    if (branches.size() < static_cast<size_t>(k))
+      j.at("hopf_branches").fail("has " + std::to_string(branches.size()) + " entries, but " + name + ".csv exists");
+    const JsonField bifurcations = branches[static_cast<size_t>(k - 1)].at("bifurcations");
+    orbit_branch_figures(renderer, dir / (name + ".csv"), &bifurcations, name, "Orbits from a Hopf point");
+  }
 }
 
 }  // namespace delayspec::cli

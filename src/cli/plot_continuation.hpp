@@ -18,6 +18,8 @@ void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& di
 //                         unstable dashed, the folds and Hopf points of
 //                         equilibrium_bifurcations.csv marked and named
 //   equilibria_re_lambda  Re lambda_1, the rightmost root, with the zero line and the same marks
+//   hopf_branch_K, hopf_branch_K_mu1  with continue_switch, the orbits born at the K-th Hopf point
+//                         (hopf_branch_K.csv), as `branch` and `branch_mu1`
 void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir);
 
 }  // namespace delayspec::cli

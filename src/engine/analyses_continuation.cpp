@@ -9,7 +9,9 @@ namespace delayspec {
   template ContinuationResult ModelAnalysesFor<Model>::continue_orbit(const AnalysesAt&, const OrbitSettings&, \
                                                                       const ContinuationOptions&) const;   \
   template ContinuationResult ModelAnalysesFor<Model>::continue_period_doubled(                           \
-      const AnalysesAt&, const Bifurcation&, const ContinuationOptions&) const;
+      const AnalysesAt&, const Bifurcation&, const ContinuationOptions&) const;                           \
+  template ContinuationResult ModelAnalysesFor<Model>::continue_from_hopf(                                \
+      const AnalysesAt&, const EquilibriumBifurcation&, const ContinuationOptions&) const;
 
 DELAYSPEC_CONTINUATION_OF(ImpactModel)
 DELAYSPEC_CONTINUATION_OF(LinearModel)

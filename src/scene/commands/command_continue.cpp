@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scene/output/branch_output.hpp"
 #include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "scene/commands/continue_equilibria.hpp"
@@ -74,31 +75,6 @@ ContinuationResult switched_at(const Config& config, const ContinueSettings& set
   const Level level = level_at(config, settings.key, pd.parameter, N, options, progress);
   return level.problem.analyses->continue_period_doubled(analyses_with_key(level.config, settings.key), pd,
                                                          options);
-}
-
-json measures_json(const OrbitMeasures& m) {
-  json j;
-  j["max"] = m.max;
-  j["min"] = m.min;
-  j["max_H"] = m.max_H;  // NaN (no switching) is written as null
-  j["contact_time"] = m.contact_time;
-  return j;
-}
-
-json points_json(const std::vector<ContinuationPoint>& points) {
-  json list = json::array();
-  for (const auto& p : points) {
-    json pj;
-    pj["parameter"] = p.parameter;
-    pj["multipliers"] = multipliers_json(p.multipliers);
-    pj["unstable"] = p.unstable;
-    pj["stable"] = p.stable();
-    pj["measures"] = measures_json(p.measures);
-    pj["newton_iterations"] = p.newton_iterations;
-    pj["step"] = p.step;
-    list.push_back(pj);
-  }
-  return list;
 }
 
 // What the command reads and checks before any work; the keys are read in this order (--help lists them so).
@@ -174,30 +150,6 @@ ContinueOutcome compute_continue(const Config& config, const ContinueRun& run, c
   return out;
 }
 
-// The extrapolated bifurcations, each with the finest branch's multipliers, measures and note.
-json bifurcations_json(const std::vector<BifurcationEstimate>& estimates, const ContinuationResult& branch) {
-  json list = json::array();
-  for (size_t b = 0; b < estimates.size(); ++b) {
-    const BifurcationEstimate& e = estimates[b];
-    const Bifurcation& finest = branch.bifurcations[b];
-    json bj;
-    bj["type"] = to_string(e.type);
-    bj["parameter"] = e.parameter;
-    bj["multipliers"] = multipliers_json(finest.multipliers);
-    bj["angle"] = e.angle;  // NaN for grazing: null
-    bj["measures"] = measures_json(finest.measures);
-    bj["by_N"] = json::array();
-    for (size_t i = 0; i < e.Ns.size(); ++i) bj["by_N"].push_back({{"N", e.Ns[i]}, {"parameter", e.parameters[i]}});
-    bj["extrapolated"] = e.extrapolated;
-    bj["error_estimate"] = e.error_estimate;  // infinity (one level): null
-    bj["observed_order"] = e.observed_order;
-    bj["bracket"] = finest.bracket;
-    if (!e.note.empty() || !finest.note.empty()) bj["note"] = finest.note + (finest.note.empty() ? "" : "; ") + e.note;
-    list.push_back(bj);
-  }
-  return list;
-}
-
 // The period-2 branches (continue_switch), at the finest N.
 json switched_json(const ContinueRun& run, const ContinueOutcome& out) {
   json list = json::array();
@@ -246,53 +198,6 @@ json continue_json(const ContinueRun& run, const ContinueOutcome& out, double se
   j["cost_finest_N"] = cost;
   j["seconds"] = seconds;
   return j;
-}
-
-// branch.csv after `header`: one row per point, with the first `nev` multipliers.
-std::string branch_csv(const std::string& header, const ContinuationResult& branch, int nev) {
-  std::ostringstream rows;
-  rows << header << "parameter,stable,unstable,abs_mu1";
-  const size_t d = branch.points.front().measures.max.size();
-  for (size_t c = 0; c < d; ++c) rows << ",max_y" << c + 1;
-  for (size_t c = 0; c < d; ++c) rows << ",min_y" << c + 1;
-  rows << ",max_H,contact_time,newton_iterations";
-  for (int k = 0; k < nev; ++k) rows << ",mu" << k + 1 << "_re,mu" << k + 1 << "_im";
-  rows << "\n";
-  for (const auto& p : branch.points) {
-    rows << csv_number(p.parameter) << "," << (p.stable() ? 1 : 0) << "," << p.unstable << ","
-         << csv_number(p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]));
-    for (double v : p.measures.max) rows << "," << csv_number(v);
-    for (double v : p.measures.min) rows << "," << csv_number(v);
-    rows << "," << csv_number(p.measures.max_H) << "," << csv_number(p.measures.contact_time) << ","
-         << p.newton_iterations;
-    for (int k = 0; k < nev; ++k) {
-      const bool has = static_cast<size_t>(k) < p.multipliers.size();
-      rows << "," << csv_number(has ? p.multipliers[k].real() : NAN) << ","
-           << csv_number(has ? p.multipliers[k].imag() : NAN);
-    }
-    rows << "\n";
-  }
-  return rows.str();
-}
-
-// bifurcations.csv after `header`: one row per bifurcation, |mu| the critical multiplier's.
-std::string bifurcations_csv(const std::string& header, const std::vector<BifurcationEstimate>& estimates,
-                             const ContinuationResult& branch) {
-  std::ostringstream bifs;
-  bifs << header << "type,parameter,extrapolated,error_estimate,observed_order,angle,abs_mu,by_N\n";
-  for (size_t b = 0; b < estimates.size(); ++b) {
-    const BifurcationEstimate& e = estimates[b];
-    std::complex<double> critical;
-    const double g = e.type == BifurcationType::grazing
-                         ? NAN
-                         : continuation_detail::multiplier_test(e.type, branch.bifurcations[b].multipliers, &critical);
-    bifs << to_string(e.type) << "," << csv_number(e.parameter) << "," << csv_number(e.extrapolated) << ","
-         << csv_number(e.error_estimate) << "," << csv_number(e.observed_order) << "," << csv_number(e.angle) << ","
-         << csv_number(std::isfinite(g) ? std::abs(critical) : NAN) << ",";
-    for (size_t i = 0; i < e.Ns.size(); ++i) bifs << (i ? ";" : "") << e.Ns[i] << ":" << format_number(e.parameters[i]);
-    bifs << "\n";
-  }
-  return bifs.str();
 }
 
 // --out DIR: branch.csv, bifurcations.csv and continue.json, marked incomplete after a failure.

@@ -8,12 +8,15 @@
 
 #include "delayspec/equilibrium_branch.hpp"
 #include "delayspec/errors.hpp"
+#include "scene/output/branch_output.hpp"
 #include "scene/output/metadata.hpp"
 #include "scene/output/output.hpp"
 #include "scene/output/output_directory.hpp"
 #include "scene/output/progress.hpp"
 #include "scene/problem/continue_settings.hpp"
 #include "scene/problem/equilibrium_settings.hpp"
+#include "scene/problem/floquet_settings.hpp"
+#include "scene/problem/orbit_settings.hpp"
 #include "scene/problem/problem.hpp"
 
 namespace delayspec::cli {
@@ -83,7 +86,7 @@ std::string points_csv(const std::string& header, const Problem& problem, const 
   return rows.str();
 }
 
-std::string bifurcations_csv(const std::string& header, const EquilibriumBranch& b) {
+std::string equilibrium_bifurcations_csv(const std::string& header, const EquilibriumBranch& b) {
   std::ostringstream rows;
   rows << header << "type,parameter,parameter_bound,omega,period,lambda_re,lambda_im\n";
   for (const EquilibriumBifurcation& f : b.bifurcations)
@@ -92,6 +95,93 @@ std::string bifurcations_csv(const std::string& header, const EquilibriumBranch&
          << csv_number(f.type == EquilibriumBifurcationType::hopf ? f.period : NAN) << ","
          << csv_number(f.root.value.real()) << "," << csv_number(f.root.value.imag()) << "\n";
   return rows.str();
+}
+
+// continue_switch: the branch of orbits born at each Hopf point of the equilibria, at every N of
+// continue_Ns (or N), its bifurcations extrapolated to N -> infinity as an orbit branch's.
+struct HopfBranch {
+  const EquilibriumBifurcation* hopf = nullptr;
+  std::vector<ContinuationResult> levels;  // by N; the reported branch is the last
+  std::vector<BifurcationEstimate> estimates;
+  const ContinuationResult& finest() const { return levels.back(); }
+};
+
+std::vector<HopfBranch> hopf_branches(const EquilibriumBranch& equilibria, const AnalysesAt& at,
+                                      const std::vector<int>& Ns, const ContinuationOptions& options,
+                                      Progress& progress) {
+  std::vector<HopfBranch> out;
+  for (const EquilibriumBifurcation& b : equilibria.bifurcations) {
+    if (b.type != EquilibriumBifurcationType::hopf) continue;
+    HopfBranch branch;
+    branch.hopf = &b;
+    std::vector<std::vector<Bifurcation>> by_N;
+    for (int N : Ns) {
+      ContinuationOptions o = options;
+      o.N = N;
+      o.on_point = [&progress](const ContinuationPoint&) { progress.add(); };
+      branch.levels.push_back(at(b.parameter)->continue_from_hopf(at, b, o));
+      by_N.push_back(branch.levels.back().bifurcations);
+    }
+    branch.estimates = extrapolate_bifurcations(Ns, by_N, options.tolerance);
+    out.push_back(std::move(branch));
+  }
+  return out;
+}
+
+// Every Hopf branch's failures on one line (empty: none).
+std::string hopf_failures(const std::vector<HopfBranch>& branches, const std::vector<int>& Ns, const std::string& key) {
+  std::string failures;
+  for (const HopfBranch& b : branches)
+    for (size_t i = 0; i < b.levels.size(); ++i)
+      if (!b.levels[i].failure.empty())
+        failures += (failures.empty() ? "" : "; ") + std::string("orbits from the Hopf point at ") + key + " = " +
+                    format_number(b.hopf->parameter) + ", N = " + std::to_string(Ns[i]) + ": " + b.levels[i].failure;
+  return failures;
+}
+
+json hopf_branches_json(const std::vector<HopfBranch>& branches, const std::vector<int>& Ns) {
+  json list = json::array();
+  for (const HopfBranch& b : branches) {
+    json bj;
+    bj["from_parameter"] = b.hopf->parameter;
+    bj["omega"] = b.hopf->omega;
+    bj["period"] = b.hopf->period;
+    bj["N"] = Ns.back();
+    bj["Ns"] = Ns;
+    bj["end"] = to_string(b.finest().end);
+    if (!b.finest().failure.empty()) bj["failure"] = b.finest().failure;
+    bj["points"] = points_json(b.finest().points);
+    bj["bifurcations"] = bifurcations_json(b.estimates, b.finest());
+    list.push_back(bj);
+  }
+  return list;
+}
+
+void print_hopf_branches(std::ostream& os, const std::string& key, const std::vector<HopfBranch>& branches,
+                         const std::vector<int>& Ns) {
+  char line[256];
+  for (const HopfBranch& b : branches) {
+    const ContinuationResult& r = b.finest();
+    os << "orbits from the Hopf point at " << key << " = " << format_number(b.hopf->parameter) << " (N = " << Ns.back()
+       << "): " << r.points.size() << " points, ended at `" << to_string(r.end) << "`\n";
+    std::snprintf(line, sizeof line, "  %16s  %16s  %12s  %8s  %14s\n", key.c_str(), "period", "|mu_1|", "unstable",
+                  "amplitude y1");
+    os << line;
+    for (const ContinuationPoint& p : r.points) {
+      std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %12.8f  %8d  %14.8g\n", p.parameter, p.period,
+                    p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable,
+                    (p.measures.max[0] - p.measures.min[0]) / 2);
+      os << line;
+    }
+    os << "  bifurcations: " << b.estimates.size() << "\n";
+    for (const BifurcationEstimate& e : b.estimates) {
+      os << "    " << to_string(e.type) << " at " << key << " = " << format_number(e.parameter);
+      if (e.Ns.size() > 1)
+        os << "; extrapolated " << format_number(e.extrapolated) << " +- " << format_number(e.error_estimate, 2)
+           << " (order " << format_number(e.observed_order, 3) << ")";
+      os << "\n";
+    }
+  }
 }
 
 void print_branch(std::ostream& os, const Problem& problem, const std::string& key, const EquilibriumBranchOptions& o,
@@ -127,17 +217,29 @@ void print_branch(std::ostream& os, const Problem& problem, const std::string& k
 int continue_equilibria(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
   const ContinueSettings settings = read_continue_settings(config);
-  if (!settings.Ns.empty())
-    throw BadInput("`continue_Ns` with `continue_object = equilibrium`: an equilibrium's bifurcations are located on "
-                   "the exact characteristic function, with no discretisation error to extrapolate");
-  if (settings.switch_period_doubling)
-    throw BadInput("`continue_switch = true` with `continue_object = equilibrium`: following the orbits born at a "
-                   "Hopf point is not implemented yet (issue 35, item 4)");
+  const bool from_hopf = settings.switch_period_doubling;  // continue_switch: the orbits born at Hopf points
+  if (!settings.Ns.empty() && !from_hopf)
+    throw BadInput("`continue_Ns` with `continue_object = equilibrium` and no `continue_switch = true`: an "
+                   "equilibrium's bifurcations are located on the exact characteristic function, with no "
+                   "discretisation error to extrapolate (continue_Ns gives the error bars of the orbit branches "
+                   "born at its Hopf points)");
   config.set(settings.key, format_number(settings.options.from), "continue_from");
   const Problem problem = read_problem(config, 100);
   const EquilibriumSettings eq = read_equilibrium_settings(config, problem);
+  ContinuationOptions orbit_options = settings.options;  // the orbit branches': the range with its defaults
+  static_cast<BranchRange&>(orbit_options) = checked_range(settings.options);
+  if (from_hopf) {
+    orbit_options.floquet = read_floquet_options(config);
+    orbit_options.newton.tolerance = read_orbit_settings(config).newton.tolerance;
+    orbit_options.step_options = step_options(problem);
+  }
   config.check_all_used();
   require_autonomous(problem);
+  if (from_hopf && problem.analyses->is_linear())
+    throw BadInput("`continue_switch = true` with `model = " + problem.model_name +
+                   "`: a linear model's Hopf point has a continuum of periodic orbits, none isolated, so no branch "
+                   "of orbits to follow");
+  const std::vector<int> Ns = settings.Ns.empty() ? std::vector<int>{problem.N} : settings.Ns;
 
   EquilibriumBranchOptions o;
   static_cast<BranchRange&>(o) = settings.options;
@@ -149,31 +251,46 @@ int continue_equilibria(Config& config, const Invocation& inv) {
       [&at](const Eigen::VectorXd& y, double p) { return at(p)->at_constant_history(y); },
       [&at, &eq](const Eigen::VectorXd& guess, double p) { return at(p)->equilibrium(guess, eq.options); }};
   const EquilibriumBranch branch = continue_equilibrium(family, eq.guess, o);
+  const std::vector<HopfBranch> orbits =
+      from_hopf ? hopf_branches(branch, at, Ns, orbit_options, progress) : std::vector<HopfBranch>{};
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::string failures = branch.failure;
+  const std::string orbit_failures = hopf_failures(orbits, Ns, settings.key);
+  if (!orbit_failures.empty()) failures += (failures.empty() ? "" : "; ") + orbit_failures;
 
-  const json j = branch_json(problem, settings.key, branch, seconds);
+  json j = branch_json(problem, settings.key, branch, seconds);
+  if (from_hopf) j["hopf_branches"] = hopf_branches_json(orbits, Ns);
   if (inv.out_dir) {
     const std::filesystem::path dir(*inv.out_dir);
     OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
     metadata.parameters.erase(settings.key);  // per row
     std::string header = metadata_comment_lines(metadata);
-    if (!branch.failure.empty()) header += "# INCOMPLETE: the branch ended in a failure: " + branch.failure + "\n";
+    if (!failures.empty()) header += "# INCOMPLETE: a branch ended in a failure: " + failures + "\n";
     write_output(inv, dir / "equilibria.csv", points_csv(header, problem, branch, eq.options.nroots));
-    write_output(inv, dir / "equilibrium_bifurcations.csv", bifurcations_csv(header, branch));
+    write_output(inv, dir / "equilibrium_bifurcations.csv", equilibrium_bifurcations_csv(header, branch));
+    for (size_t i = 0; i < orbits.size(); ++i) {  // hopf_branch_1.csv, hopf_bifurcations_1.csv, ...
+      const std::string n = std::to_string(i + 1);
+      write_output(inv, dir / ("hopf_branch_" + n + ".csv"),
+                   branch_csv(header, orbits[i].finest(), orbit_options.floquet.nev));
+      write_output(inv, dir / ("hopf_bifurcations_" + n + ".csv"),
+                   bifurcations_csv(header, orbits[i].estimates, orbits[i].finest()));
+    }
     json file = j;
     file["metadata"] = metadata_json(metadata);
     write_output(inv, dir / "continue.json", file.dump(2) + "\n");
   }
-  if (!branch.failure.empty()) {
-    inv.err << "delayspec continue: numerical failure: " << branch.failure
+  if (!failures.empty()) {
+    inv.err << "delayspec continue: numerical failure: " << failures
             << (inv.out_dir ? "; the branch so far is in " + *inv.out_dir : std::string()) << "\n";
     return 3;
   }
   if (inv.json)
     inv.out << j.dump(2) << "\n";
-  else
+  else {
     print_branch(inv.out, problem, settings.key, o, branch, seconds);
+    print_hopf_branches(inv.out, settings.key, orbits, Ns);
+  }
   return 0;
 }
 

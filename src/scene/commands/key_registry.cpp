@@ -205,7 +205,7 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"continue_max_points", "continue: branch points at most, 2..1e7"},
       {"continue_tolerance", "continue: bifurcations located to this in the parameter; 0 = 1e-10 |to - from|"},
       {"continue_Ns", "continue: N list (increasing) for error bars on the bifurcations (none: N only)"},
-      {"continue_switch", "continue: true = also the period-2 branch from each period doubling (finest N)"},
+      {"continue_switch", "continue: true = also the period-2 branch from each period doubling (finest N), or the orbits from each Hopf point"},
       // plot, run
       {"plot_gnuplot", "plot: the gnuplot program"},
       {"plot_width", "plot: PNG width in pixels, 100..10000"},

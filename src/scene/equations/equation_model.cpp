@@ -107,6 +107,10 @@ class ExplainedAnalyses final : public ModelAnalyses {
                                              const ContinuationOptions& options) const override {
     return explained([&] { return inner_->continue_period_doubled(unwrapped(at), at_pd, options); });
   }
+  ContinuationResult continue_from_hopf(const AnalysesAt& at, const EquilibriumBifurcation& hopf,
+                                        const ContinuationOptions& options) const override {
+    return explained([&] { return inner_->continue_from_hopf(unwrapped(at), hopf, options); });
+  }
 
  private:
   // The family `at` gives explained analyses; the plugin's own continuation takes its own.
