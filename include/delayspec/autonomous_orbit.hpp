@@ -231,14 +231,10 @@ StroboscopicMap<TimeScaled<Model>> autonomous_orbit_map(const Model& model, cons
   return detail::scaled_map(model, orbit.period, orbit.grid.K, step);
 }
 
-// The orbit near the simulated guess (header comment). BadInput: period_guess <= 0, N < 1, a
-// grid whose delay is shorter than one step; NumericalFailure naming the residual and the period
-// reached when Newton does not converge (a guess far from any orbit), or when the bordered matrix
-// is singular (an equilibrium: no isolated orbit there).
+// K = round(N T_guess / tau_max), the steps per period of the options' N (header). BadInput:
+// period_guess <= 0, N < 1, more than 2.5e8 steps.
 template <class Model>
-AutonomousOrbit find_autonomous_orbit(const Model& model, const AutonomousOrbitOptions& o) {
-  using Map = StroboscopicMap<TimeScaled<Model>>;
-  constexpr int D = Model::d;
+int autonomous_steps_per_period(const Model& model, const AutonomousOrbitOptions& o) {
   if (!(o.period_guess > 0) || !std::isfinite(o.period_guess))
     throw BadInput("`period_guess = " + format_number(o.period_guess) + "`: must be > 0");
   if (o.N < 1) throw BadInput("`N = " + std::to_string(o.N) + "`: must be >= 1");
@@ -246,8 +242,14 @@ AutonomousOrbit find_autonomous_orbit(const Model& model, const AutonomousOrbitO
   const double tau_max = *std::max_element(taus.begin(), taus.end());
   const double steps = std::max(1.0, std::round(o.N * o.period_guess / tau_max));
   if (steps > 2.5e8) throw BadInput("`N = " + std::to_string(o.N) + "`: too many steps per period");
-  const int K = static_cast<int>(steps);
+  return static_cast<int>(steps);
+}
 
+// find_autonomous_orbit on a grid of K steps per period.
+template <class Model>
+AutonomousOrbit find_autonomous_orbit_with_steps(const Model& model, const AutonomousOrbitOptions& o, int K) {
+  using Map = StroboscopicMap<TimeScaled<Model>>;
+  constexpr int D = Model::d;
   AutonomousOrbit out;
   double T = o.period_guess;
   Eigen::VectorXd x = detail::simulated_guess(model, T, K, o);
@@ -287,6 +289,15 @@ AutonomousOrbit find_autonomous_orbit(const Model& model, const AutonomousOrbitO
   out.history = problem.history(x);
   out.residual = F.lpNorm<Eigen::Infinity>();
   return out;
+}
+
+// The orbit near the simulated guess (header comment). BadInput: period_guess <= 0, N < 1, a
+// grid whose delay is shorter than one step; NumericalFailure naming the residual and the period
+// reached when Newton does not converge (a guess far from any orbit), or when the bordered matrix
+// is singular (an equilibrium: no isolated orbit there).
+template <class Model>
+AutonomousOrbit find_autonomous_orbit(const Model& model, const AutonomousOrbitOptions& o) {
+  return find_autonomous_orbit_with_steps(model, o, autonomous_steps_per_period(model, o));
 }
 
 }  // namespace delayspec

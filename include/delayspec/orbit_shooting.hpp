@@ -65,6 +65,21 @@ struct OrbitLinearisation {
   std::vector<Vec<D>> states;
 };
 
+// GMRES' relative tolerance for the next Newton step (header): Eisenstat-Walker choice 2 with its
+// safeguard from the previous eta and the residual norms |G_k|_2 = g_norm, |G_{k-1}|_2 =
+// previous_norm (eta_max at the first step), never below 0.5 tol_abs / |G_k|_2 (|r|_inf <= |r|_2
+// <= eta |G|_2 is then enough for the final test) nor GMRES' own rounding floor, 1e-13.
+inline double shooting_forcing_term(double eta, double g_norm, double previous_norm, double tol_abs,
+                                    double forcing_max, bool first) {
+  if (!first) {
+    const double ratio = g_norm / previous_norm;
+    double next = 0.9 * ratio * ratio;
+    if (0.9 * eta * eta > 0.1) next = std::max(next, 0.9 * eta * eta);
+    eta = std::min(next, forcing_max);
+  }
+  return std::max({eta, 0.5 * tol_abs / g_norm, 1e-13});
+}
+
 // Newton-Krylov shooting from history U (header). `at_orbit`, when given, receives the step maps
 // and states of the map at the returned history.
 template <class Map>
@@ -111,15 +126,8 @@ PeriodicOrbit orbit_by_shooting(const Map& map, Eigen::VectorXd U, const OrbitBy
   while (!(r <= opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>()))) {
     if (orbit.newton_iterations >= opt.max_iterations) throw failure("not converged");
     const double g_norm = G.norm();
-    if (orbit.newton_iterations > 0) {  // Eisenstat-Walker choice 2 with its safeguard
-      const double ratio = g_norm / previous_norm;
-      double next = 0.9 * ratio * ratio;
-      if (0.9 * eta * eta > 0.1) next = std::max(next, 0.9 * eta * eta);
-      eta = std::min(next, opt.forcing_max);
-    }
-    const double tol_abs = opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>());
-    eta = std::max(eta, 0.5 * tol_abs / g_norm);  // |r|_inf <= |r|_2 <= eta |G|_2: enough for the test
-    eta = std::max(eta, 1e-13);                   // GMRES' own rounding floor
+    eta = shooting_forcing_term(eta, g_norm, previous_norm, opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>()),
+                                opt.forcing_max, orbit.newton_iterations == 0);
     // (M - I) s = -G with M the monodromy at U (the step maps of the evaluation of G); the maps'
     // storage goes back to `lin` for the next evaluation, the Krylov basis stays in `basis`.
     Monodromy<D, Map::DW> monodromy(map.grid(), std::move(lin.maps));

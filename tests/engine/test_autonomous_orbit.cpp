@@ -22,6 +22,7 @@
 #include <gtest/gtest.h>
 
 #include "delayspec/autonomous_orbit.hpp"
+#include "delayspec/autonomous_shooting.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/lambert_w.hpp"
 #include "delayspec/model_mackey_glass.hpp"
@@ -229,6 +230,60 @@ TEST(AutonomousOrbit, NoOrbitNearTheGuessIsANumericalFailureNamingTheResidual) {
     EXPECT_NE(what.find("residual"), std::string::npos) << what;
   }
   EXPECT_THROW(orbit_of(c, 50, -1.0), BadInput);
+}
+
+// Nested shooting on (U, T) (autonomous_shooting.hpp) solves the same discrete problem as
+// sparse-LU Newton on the whole period (the same K). Newton's test bounds the residual of each of
+// the K steps; at its default 1e-12 (1 + |x|) those add up over K = 2500 steps to a period error
+// of 7e-10 (measured; shooting's test bounds P(U) - U over the whole period, the accurate one).
+// At 1e-13 Newton converges to rounding (residual 4e-16) and the two periods agree to 2e-14
+// (measured): 1e-11 asserted.
+TEST(AutonomousOrbit, ShootingAndNewtonFindTheSameOrbit) {
+  MackeyGlassParameters p;
+  p.tau = p.period = 8;
+  p.x0 = 1.1;
+  const MackeyGlassModel model(p);
+  AutonomousOrbitOptions o;
+  o.period_guess = 25;
+  o.N = 800;
+  o.guess_periods = 40;
+  o.newton.tolerance = 1e-13;
+  const AutonomousOrbit newton = find_autonomous_orbit(model, o);
+  const AutonomousOrbit shooting = find_autonomous_orbit_by_shooting(model, o);
+  ASSERT_EQ(newton.grid.K, shooting.grid.K);
+  EXPECT_NEAR(shooting.period, newton.period, 1e-11);
+  // The same orbit up to the time shift each phase condition picks (not a whole number of steps):
+  // the extremes over the nodes agree to the sampling's O(h^2) (h = 1 / K, K = 2577: ~1e-7), the
+  // multipliers (shift-invariant) to the eigensolver's tolerance
+  auto extremes = [](const AutonomousOrbit& a) {
+    return std::pair(a.sequence.maxCoeff(), a.sequence.minCoeff());
+  };
+  EXPECT_NEAR(extremes(shooting).first, extremes(newton).first, 1e-6);
+  EXPECT_NEAR(extremes(shooting).second, extremes(newton).second, 1e-6);
+  FloquetOptions fo;
+  fo.nev = 4;
+  const auto mu_newton = floquet_multipliers(autonomous_orbit_map(model, newton).monodromy(newton.history), fo);
+  const auto mu_shooting = floquet_multipliers(autonomous_orbit_map(model, shooting).monodromy(shooting.history), fo);
+  for (size_t i = 0; i < 4; ++i) EXPECT_NEAR(std::abs(mu_shooting.multipliers[i] - mu_newton.multipliers[i]), 0, 1e-8);
+}
+
+// An unstable orbit by shooting: the circle oscillator at k = 1.5 (test above), period and
+// radius the discrete closed form's.
+TEST(AutonomousOrbit, ShootingFindsAnUnstableOrbit) {
+  Circle c;
+  c.k = 1.5;
+  AutonomousOrbitOptions o;
+  o.period_guess = 1.05;
+  o.N = 400;
+  o.guess_periods = 1;  // one simulated period from near the circle: still near it
+  c.start = Vec<2>(1.02, 0);
+  const AutonomousOrbit orbit = find_autonomous_orbit_by_shooting(c, o);
+  const int K = orbit.grid.K;
+  EXPECT_NEAR(orbit.period, 2 * K * std::tan(M_PI / K) / c.omega, 1e-11);
+  FloquetOptions fo;
+  fo.nev = 3;
+  const FloquetResult r = floquet_multipliers(autonomous_orbit_map(c, orbit).monodromy(orbit.history), fo);
+  EXPECT_GT(std::abs(r.multipliers[0]), 1.1);
 }
 
 }  // namespace
