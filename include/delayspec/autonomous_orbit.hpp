@@ -80,22 +80,33 @@ struct TimeScaled {
   Vec<d> initial_state() const { return model.initial_state(); }
 };
 
+// How the orbit is solved for: sparse-LU Newton on all K states and T (find_autonomous_orbit), or
+// nested Newton-Krylov shooting on (U, T) from a sparse-LU coarse level (autonomous_shooting.hpp:
+// for large N, where the LU fills in).
+enum class AutonomousOrbitMethod { newton, shooting };
+inline std::string to_string(AutonomousOrbitMethod method) {
+  return method == AutonomousOrbitMethod::newton ? "newton" : "shooting";
+}
+
 struct AutonomousOrbitOptions {
   double period_guess = 0;  // T's starting value, > 0
   int N = 100;              // steps per the longest delay at T_guess: K = round(N T_guess / tau_max)
   int guess_periods = 10;   // periods of T_guess simulated from the constant history before Newton
-  OrbitByNewtonOptions newton{1e-12, 30};
+  OrbitByNewtonOptions newton{1e-12, 30};  // tolerance and iterations, for shooting's too
   StepOptions step;
+  AutonomousOrbitMethod method = AutonomousOrbitMethod::newton;
+  int coarse_N = 64;  // shooting: the coarsest level's N, solved by sparse-LU Newton
 };
 
 struct AutonomousOrbit {
+  AutonomousOrbitMethod method = AutonomousOrbitMethod::newton;  // of the finest level
   double period = 0;
   HistoryGrid grid;          // of the scaled problem: period 1, K steps
   Eigen::VectorXd sequence;  // u_0 .. u_{K-1}: the orbit at t = l T / K
   Eigen::VectorXd history;   // the history at s = 0: the fixed point of the scaled map
   double residual = 0;       // |F|_inf at the solution
-  int newton_iterations = 0;
-  std::vector<double> newton_residuals;  // |(F, g)|_inf of each iterate, the guess first
+  int newton_iterations = 0;             // all levels' (shooting)
+  std::vector<double> newton_residuals;  // |(F, g)|_inf of each iterate, the guess first (the finest level's)
   std::vector<double> periods;           // T of each iterate, the guess first
 };
 

@@ -32,7 +32,8 @@
 //
 // Levels. K_L = K = round(N T_guess / tau_max), exactly find_autonomous_orbit's, so that both
 // solve the same discrete problem; K_{i-1} = round(K_i / refinement) while >= K_coarse (the K of
-// N = coarse_N); the coarsest by find_autonomous_orbit (sparse LU, from the simulated guess);
+// N = coarse_N; one level, sparse LU alone, when N < refinement coarse_N); the coarsest by
+// find_autonomous_orbit (sparse LU, from the simulated guess);
 // each finer level from the coarser orbit's states prolonged (prolong_periodic_sequence) and its
 // period. The orbit returned carries the sequence of the last evaluation and the history of the
 // standard grid (autonomous_orbit_map: the multipliers' map).
@@ -52,11 +53,11 @@
 
 namespace delayspec {
 
+// The finer levels' Newton-Krylov iteration (the coarsest level's is the AutonomousOrbitOptions').
 struct AutonomousShootingOptions {
   OrbitByShootingOptions shooting;
-  int coarse_N = 64;    // the coarsest level's N (sparse LU there)
-  int refinement = 8;   // K_i / K_{i-1}
-  double margin = 0.25; // the period may fall to T_0 (1 - margin) within a level (header)
+  int refinement = 8;    // K_i / K_{i-1}
+  double margin = 0.25;  // the period may fall to T_0 (1 - margin) within a level (header)
 };
 
 namespace detail {
@@ -196,7 +197,8 @@ template <class Model>
 AutonomousOrbit find_autonomous_orbit_by_shooting(const Model& model, const AutonomousOrbitOptions& o,
                                                   const AutonomousShootingOptions& so = {}) {
   const int K = autonomous_steps_per_period(model, o);
-  const int K_coarse = std::max(1, static_cast<int>(std::lround(static_cast<double>(K) * so.coarse_N / o.N)));
+  if (o.coarse_N < 1) throw BadInput("`orbit_coarse_N = " + std::to_string(o.coarse_N) + "`: must be >= 1");
+  const int K_coarse = std::max(1, static_cast<int>(std::lround(static_cast<double>(K) * o.coarse_N / o.N)));
   if (so.refinement < 2) throw BadInput("autonomous shooting: refinement must be >= 2");
   std::vector<int> Ks{K};
   while (Ks.back() / so.refinement >= K_coarse && Ks.back() / so.refinement >= 4)
@@ -207,6 +209,7 @@ AutonomousOrbit find_autonomous_orbit_by_shooting(const Model& model, const Auto
   for (size_t i = 1; i < Ks.size(); ++i) {
     const Eigen::VectorXd x = prolong_periodic_sequence(orbit.sequence, Model::d, Ks[i]);
     orbit = detail::shoot_autonomous_level(model, Ks[i], x, orbit.period, so, o.step);
+    orbit.method = AutonomousOrbitMethod::shooting;
     iterations += orbit.newton_iterations;
   }
   orbit.newton_iterations = iterations;

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "delayspec/autonomous_orbit.hpp"
+#include "delayspec/autonomous_shooting.hpp"
 #include "delayspec/continuation.hpp"
 #include "delayspec/equilibrium.hpp"
 #include "delayspec/grid.hpp"
@@ -194,7 +195,14 @@ class ModelAnalysesFor final : public ModelAnalyses {
   AutonomousLinearisedOrbit autonomous_orbit(const AutonomousOrbitOptions& options) const override {
     if constexpr (AutonomousModel<Model> && !Model::is_linear) {
       AutonomousLinearisedOrbit out;
-      out.orbit = find_autonomous_orbit(model_, options);
+      if (options.method == AutonomousOrbitMethod::shooting) {
+        AutonomousShootingOptions shooting;
+        shooting.shooting.tolerance = options.newton.tolerance;
+        shooting.shooting.max_iterations = options.newton.max_iterations;
+        out.orbit = find_autonomous_orbit_by_shooting(model_, options, shooting);
+      } else {
+        out.orbit = find_autonomous_orbit(model_, options);
+      }
       out.monodromy = std::make_unique<Monodromy<D, DW>>(
           autonomous_orbit_map(model_, out.orbit, options.step).monodromy(out.orbit.history));
       return out;

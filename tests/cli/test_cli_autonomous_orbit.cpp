@@ -63,12 +63,34 @@ TEST(AutonomousOrbitCli, ConvergeExtrapolatesThePeriod) {
   EXPECT_EQ(j["rows"].size(), 4u);  // the other multipliers' study, as for any orbit
 }
 
+// At N = 3200 `orbit = auto` (the default) solves by nested shooting (autonomous_shooting.hpp),
+// `orbit = newton` by sparse LU on the whole period, on the same K: the same period. Newton's
+// per-step residual test (1e-12 (1 + |x|) per step) adds up over K = 8000 steps: 1e-8 allows
+// for it (at N = 800 it was 7e-10, test_autonomous_orbit.cpp), the multipliers to the
+// eigensolver's 1e-8.
+TEST(AutonomousOrbitCli, AutoShootsAndAgreesWithNewton) {
+  std::vector<std::string> args = kMackeyGlass8;
+  args.insert(args.end(), {"--set", "N=3200", "--set", "error_bars=off"});
+  const CliResult shooting = run(args);
+  ASSERT_EQ(shooting.status, 0) << shooting.err;
+  args.insert(args.end(), {"--set", "orbit=newton"});
+  const CliResult newton = run(args);
+  ASSERT_EQ(newton.status, 0) << newton.err;
+  const auto a = nlohmann::json::parse(shooting.out), b = nlohmann::json::parse(newton.out);
+  EXPECT_EQ(a["orbit"]["method"].get<std::string>().rfind("shooting", 0), 0u) << a["orbit"];
+  EXPECT_EQ(b["orbit"]["method"].get<std::string>().rfind("newton", 0), 0u) << b["orbit"];
+  EXPECT_EQ(a["steps_per_period"], b["steps_per_period"]);
+  EXPECT_NEAR(a["period"].get<double>(), b["period"].get<double>(), 1e-8);
+  EXPECT_NEAR(a["multipliers"][0]["re"].get<double>(), b["multipliers"][0]["re"].get<double>(), 1e-8);
+}
+
 TEST(AutonomousOrbitCli, BadInputAndNoOrbit) {
   for (const auto& [sets, says] : std::vector<std::pair<std::vector<std::string>, std::string>>{
            {{"model=impact", "period_guess=6"}, "`period_guess` with `model = impact`"},
            {{"model=linear", "period_guess=2"}, "a linear model has no isolated periodic orbits"},
            {{"model=mackey-glass", "period_guess=-1"}, "`period_guess = -1`"},
-           {{"model=mackey-glass", "period_guess=abc"}, "`period_guess = abc`"}}) {
+           {{"model=mackey-glass", "period_guess=abc"}, "`period_guess = abc`"},
+           {{"model=mackey-glass", "period_guess=20", "orbit=simulate"}, "`orbit = simulate` with `period_guess`"}}) {
     std::vector<std::string> args = {"floquet"};
     for (const std::string& s : sets) args.insert(args.end(), {"--set", s});
     const CliResult r = run(args);

@@ -321,9 +321,8 @@ std::vector<ConvergenceStudy> run_studies(const ConvergeSettings& s, const Invoc
             try {
               FloquetOptions solver = s.solver_options;
               solver.nev = count;
-              AutonomousFloquetLevel level = autonomous_level(with_events, N, *s.period_guess,
-                                                              static_cast<int>(s.orbit_settings.guess_periods),
-                                                              s.orbit_settings.newton, solver);
+              AutonomousFloquetLevel level =
+                  autonomous_level(with_events, N, *s.period_guess, s.orbit_settings, solver);
               period.add(N, level.orbit);
               r = std::move(level.others);
             } catch (const NumericalFailure& e) {

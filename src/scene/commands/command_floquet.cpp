@@ -20,8 +20,7 @@ namespace {
 int floquet_of_unknown_period(const Problem& problem, const OrbitSettings& orbit_settings,
                               const FloquetOptions& options, bool with_error_bars, double period_guess,
                               const Invocation& inv, std::chrono::steady_clock::time_point start) {
-  const AutonomousFloquet r = autonomous_floquet(problem, period_guess, static_cast<int>(orbit_settings.guess_periods),
-                                                 orbit_settings.newton, options, with_error_bars);
+  const AutonomousFloquet r = autonomous_floquet(problem, period_guess, orbit_settings, options, with_error_bars);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (inv.json) {
     nlohmann::json json;

@@ -19,14 +19,21 @@ std::optional<double> read_period_guess(Config& config, const Problem& problem) 
   return guess;
 }
 
-AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess, int guess_periods,
-                                const OrbitByNewtonOptions& newton, const FloquetOptions& solver) {
+AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess,
+                                        const OrbitSettings& orbit, const FloquetOptions& solver) {
   AutonomousOrbitOptions o;
   o.period_guess = period_guess;
   o.N = N;
-  o.guess_periods = guess_periods;
-  o.newton = newton;
+  o.guess_periods = static_cast<int>(std::min<long>(orbit.guess_periods, 1'000'000));
+  o.newton = orbit.newton;
   o.step = step_options(problem);
+  o.coarse_N = orbit.coarse_N;
+  // newton: sparse LU on the whole period; auto and shooting: nested shooting (sparse LU alone
+  // below refinement coarse_N, where it has one level)
+  if (orbit.method == OrbitMethod::simulate)
+    throw BadInput("`orbit = simulate` with `period_guess`: an orbit of unknown period is solved for with its "
+                   "period (orbit = newton, shooting or auto)");
+  o.method = orbit.method == OrbitMethod::newton ? AutonomousOrbitMethod::newton : AutonomousOrbitMethod::shooting;
   AutonomousLinearisedOrbit at = problem.analyses->autonomous_orbit(o);
   AutonomousFloquetLevel level;
   level.N = N;
@@ -77,11 +84,10 @@ nlohmann::json period_study_json(const PeriodStudy& study) {
   return p;
 }
 
-AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess, int guess_periods,
-                                     const OrbitByNewtonOptions& newton, const FloquetOptions& solver,
-                                     bool with_error_bars) {
+AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess, const OrbitSettings& orbit,
+                                     const FloquetOptions& solver, bool with_error_bars) {
   AutonomousFloquet out;
-  out.at_N = autonomous_level(problem, problem.N, period_guess, guess_periods, newton, solver);
+  out.at_N = autonomous_level(problem, problem.N, period_guess, orbit, solver);
   if (!with_error_bars) return out;
   const auto start = std::chrono::steady_clock::now();
   // The coarser levels, each from the period found at N (the guess closest to their orbit).
@@ -91,7 +97,7 @@ AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess
     LevelResult r;
     try {
       AutonomousFloquetLevel level =
-          autonomous_level(problem, N, out.at_N.orbit.period, guess_periods, newton, solver);
+          autonomous_level(problem, N, out.at_N.orbit.period, orbit, solver);
       out.period.add(N, level.orbit);
       r = std::move(level.others);
     } catch (const NumericalFailure& e) {
@@ -124,7 +130,9 @@ void add_autonomous_floquet_json(nlohmann::json& j, const AutonomousFloquet& r, 
     j["error_bars"] = error_bars_json(*r.bars, r.error_bar_seconds);
     j["period_error_bars"] = period_study_json(r.period);
   }
-  j["orbit"] = {{"method", "newton (period unknown, integral phase condition)"},
+  j["orbit"] = {{"method", orbit.method == AutonomousOrbitMethod::newton
+                                ? "newton (period unknown, integral phase condition)"
+                                : "shooting (nested, period unknown, phase condition on the history)"},
                 {"newton_iterations", orbit.newton_iterations},
                 {"newton_residuals", orbit.newton_residuals},
                 {"periods", orbit.periods},
@@ -135,9 +143,10 @@ void print_autonomous_floquet(std::ostream& out, const AutonomousFloquet& r, dou
   const AutonomousOrbit& orbit = r.at_N.orbit;
   char line[256];
   std::snprintf(line, sizeof line,
-                "orbit of unknown period: T = %.15g from period_guess %g (%d Newton iterations, |F|_inf = %.1e), "
+                "orbit of unknown period: T = %.15g from period_guess %g (%s, %d Newton iterations, |F|_inf = %.1e), "
                 "%d steps per period\n",
-                orbit.period, period_guess, orbit.newton_iterations, orbit.residual, orbit.grid.K);
+                orbit.period, period_guess, to_string(orbit.method).c_str(), orbit.newton_iterations, orbit.residual,
+                orbit.grid.K);
   out << line;
   if (const auto& x = r.period.extrapolated) {
     std::snprintf(line, sizeof line, "period: %.12g +- %.1e at N (from N = ", orbit.period,

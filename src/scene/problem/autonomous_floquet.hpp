@@ -50,18 +50,19 @@ struct AutonomousFloquet {
 // number, or given for a model that is not autonomous (its orbit has the forcing's period).
 std::optional<double> read_period_guess(Config& config, const Problem& problem);
 
-// One level: the orbit at N from period_guess (its guess simulated for guess_periods periods) and
-// nev + 1 multipliers, split into the trivial one and the others. BadInput: period_guess <= 0, a
-// forced or linear model; NumericalFailure: no orbit.
-AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess, int guess_periods,
-                                        const OrbitByNewtonOptions& newton, const FloquetOptions& solver);
+// One level: the orbit at N from period_guess (its guess simulated for orbit.guess_periods
+// periods; orbit = newton: sparse LU on the whole period, auto or shooting: nested shooting,
+// autonomous_shooting.hpp) and nev + 1 multipliers, split into the trivial one and the others.
+// BadInput: period_guess <= 0, a forced or linear model, orbit = simulate; NumericalFailure: no orbit.
+AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess,
+                                        const OrbitSettings& orbit, const FloquetOptions& solver);
 
-// The orbit at problem.N from period_guess (its guess simulated for guess_periods periods), its
+// The orbit at problem.N from period_guess (as autonomous_level finds it), its
 // top nev multipliers besides the trivial one; with error_bars the coarser levels (coarser_levels;
 // their orbits from the period found at N). BadInput: period_guess <= 0, a forced or linear model;
 // NumericalFailure: no orbit at N.
-AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess, int guess_periods,
-                                     const OrbitByNewtonOptions& newton, const FloquetOptions& solver,
+AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess, const OrbitSettings& orbit,
+                                     const FloquetOptions& solver,
                                      bool with_error_bars);
 
 // The JSON fields `floquet --json` adds or replaces for such an orbit (docs/cli.md, floquet):
