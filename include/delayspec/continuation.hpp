@@ -219,14 +219,21 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
                                                           const RichardsonOptions& richardson = {});
 
 namespace continuation_detail {
-// The tracer behind every continue_* (detail/continuation_branch.hpp) and the problem of a forced
-// orbit along a branch (detail/periodic_branch.hpp).
-template <class Branch, class... BranchArguments>
-ContinuationResult trace_branch(const Eigen::VectorXd& guess, const ContinuationOptions& options,
-                                const Eigen::VectorXd* start_tangent, double start_p,
-                                const BranchArguments&... branch_arguments);
+class BranchProblem;  // the problem along a branch (detail/branch_corrector.hpp)
 template <class Model, class ModelAt>
-class PeriodicBranch;
+class PeriodicBranch;  // a forced orbit's (detail/periodic_branch.hpp)
+// The options with the defaults relative to the range filled in (continuation.hpp), checked.
+// BadInput naming the option for an empty range, a non-positive step or tolerance, step_min >
+// step_max, max_points < 2.
+ContinuationOptions checked_options(const ContinuationOptions& options);
+// The tracer behind every continue_* (detail/continuation_branch.hpp, compiled in the library):
+// the branch of `branch` from `guess` at p = options.from (Newton there), or, when start_tangent
+// is given, from the point (guess, start_p) itself along that tangent (no Newton: the point may
+// be singular, e.g. a period doubling seen by the doubled problem, a Hopf point), the first
+// segment not searched. `branch` must have been built with checked_options(options).
+ContinuationResult trace_branch(const BranchProblem& branch, const Eigen::VectorXd& guess,
+                                const ContinuationOptions& options, const Eigen::VectorXd* start_tangent,
+                                double start_p);
 }  // namespace continuation_detail
 
 // The branch through the periodic orbit near `guess` (a sequence, PeriodicOrbitProblem, at
@@ -234,8 +241,9 @@ class PeriodicBranch;
 template <class Model, class ModelAt>
 ContinuationResult continue_orbit(const ModelAt& model_at, const Eigen::VectorXd& guess,
                                   const ContinuationOptions& options) {
-  return continuation_detail::trace_branch<continuation_detail::PeriodicBranch<Model, ModelAt>>(guess, options, nullptr,
-                                                                                             options.from, model_at);
+  const ContinuationOptions o = continuation_detail::checked_options(options);
+  const continuation_detail::PeriodicBranch<Model, ModelAt> branch(model_at, o);
+  return continuation_detail::trace_branch(branch, guess, o, nullptr, o.from);
 }
 
 // The period-2 branch born at a period doubling `at` of the branch continue_orbit traced with
@@ -292,11 +300,13 @@ ContinuationResult continue_period_doubled(const ModelAt& model_at, const Bifurc
   tangent[tangent.size() - 1] = 0;
   ContinuationOptions o2 = options;
   o2.periods_per_map = 2 * options.periods_per_map;
-  return continuation_detail::trace_branch<continuation_detail::PeriodicBranch<Model, ModelAt>>(x0, o2, &tangent,
-                                                                                             at.parameter, model_at);
+  const ContinuationOptions checked = continuation_detail::checked_options(o2);
+  const continuation_detail::PeriodicBranch<Model, ModelAt> branch(model_at, checked);
+  return continuation_detail::trace_branch(branch, x0, checked, &tangent, at.parameter);
 }
 
 }  // namespace delayspec
 
-// The implementation: the branch tracer, the discrete problem at one parameter, the locator.
-#include "delayspec/detail/continuation_branch.hpp"
+// The implementation: the discrete problem at one parameter (the tracer and the locator are
+// compiled in the library: src/engine/continuation_branch.cpp).
+#include "delayspec/detail/periodic_branch.hpp"

@@ -32,7 +32,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/SVD>
 
 #include "delayspec/autonomous_orbit.hpp"
 #include "delayspec/continuation.hpp"
@@ -64,11 +63,9 @@ ContinuationResult continue_from_hopf(const ModelAt& model_at, const Equilibrium
   const double steps = std::max(1.0, std::round(options.N * T0 / tau_max));
   if (steps > 2.5e8) throw BadInput("`N = " + std::to_string(options.N) + "`: too many steps per period");
   const int K = static_cast<int>(steps);
-  // c: the right singular vector of Delta(i omega)'s smallest singular value
-  const Eigen::MatrixXcd Delta =
-      constant_history(model, Vec<D>(hopf.state)).delta(std::complex<double>(0, hopf.omega));
-  const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(Delta, Eigen::ComputeFullV);
-  const Eigen::VectorXcd c = svd.matrixV().col(D - 1);
+  // c: Delta(i omega) c = 0 (the SVD in the library: compiled once, not per model)
+  const Eigen::VectorXcd c =
+      constant_history(model, Vec<D>(hopf.state)).null_vector(std::complex<double>(0, hopf.omega));
   const long n = static_cast<long>(D) * K;
   Eigen::VectorXd start(n + 1), tangent = Eigen::VectorXd::Zero(n + 2);  // (x, T), (x, T, p)
   for (long l = 0; l < K; ++l) {
@@ -77,8 +74,9 @@ ContinuationResult continue_from_hopf(const ModelAt& model_at, const Equilibrium
     tangent.segment<D>(D * l) = (c * phase).real();
   }
   start[n] = T0;
-  using Branch = continuation_detail::AutonomousBranch<Model, ModelAt>;
-  return continuation_detail::trace_branch<Branch>(start, options, &tangent, hopf.parameter, model_at, K);
+  const ContinuationOptions o = continuation_detail::checked_options(options);
+  const continuation_detail::AutonomousBranch<Model, ModelAt> branch(model_at, K, o);
+  return continuation_detail::trace_branch(branch, start, o, &tangent, hopf.parameter);
 }
 
 }  // namespace delayspec

@@ -2,6 +2,7 @@
 // detection counts, test functions, the Hermite maximum, and the extrapolation of bifurcation
 // points across N.
 #include "delayspec/continuation.hpp"
+#include "delayspec/detail/bifurcation_locator.hpp"
 #include "delayspec/detail/cubic_hermite.hpp"
 
 #include <algorithm>

@@ -45,6 +45,11 @@ double largest_singular_value(const Eigen::MatrixXd& m) {
 
 }  // namespace
 
+Eigen::VectorXcd ConstantHistory::null_vector(std::complex<double> l) const {
+  const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(delta(l), Eigen::ComputeFullV);
+  return svd.matrixV().col(A.rows() - 1);
+}
+
 double ConstantHistory::residual(std::complex<double> l) const {
   const long d = A.rows();
   double scale = std::abs(l) + largest_singular_value(A);

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "delayspec/continuation.hpp"
+#include "delayspec/detail/bifurcation_locator.hpp"
 #include "delayspec/model_impact.hpp"
 #include "delayspec/model_linear.hpp"
 #include "delayspec/model_mathieu.hpp"

@@ -35,22 +35,22 @@
 namespace delayspec::continuation_detail {
 
 template <class Model, class ModelAt>
-class AutonomousBranch {
+class AutonomousBranch final : public BranchProblem {
  public:
-  static constexpr bool has_switching = false;  // autonomous models do not switch (model.hpp)
   static constexpr int D = Model::d;
   using Map = StroboscopicMap<TimeScaled<Model>>;
   using State = BranchState;  // x = (u_0, ..., u_{K-1}, T)
 
   AutonomousBranch(const ModelAt& model_at, int K, const ContinuationOptions& o)
-      : model_at_(model_at), o_(o), K_(K), weight_(1.0 / K), range_(std::abs(o.to - o.from)) {}
+      : BranchProblem(1.0 / K, o.newton.max_iterations), model_at_(model_at), o_(o), K_(K), range_(std::abs(o.to - o.from)) {}
 
-  long unknowns() const { return static_cast<long>(D) * K_ + 1; }
+  bool has_switching() const override { return false; }  // autonomous models do not switch (model.hpp)
+  long unknowns() const override { return static_cast<long>(D) * K_ + 1; }
 
   // Newton from (x, T, p) on G = 0 and row_x . (x, T) + row_p p = target, the phase condition's
   // reference the starting point.
   std::optional<State> correct(Eigen::VectorXd x, double p, const Eigen::VectorXd& row_x, double row_p, double target,
-                               int max_iterations, std::string& why, double& seconds) const {
+                               int max_iterations, std::string& why, double& seconds) const override {
     const long n = unknowns() - 1;
     const Eigen::VectorXd phase = detail::phase_row<D>(x.head(n), K_);
     const double phase_target = phase.dot(x.head(n));
@@ -62,21 +62,8 @@ class AutonomousBranch {
                               weight_, why, seconds);
   }
 
-  // The corrected point at arclength s from `base` along its tangent (as PeriodicBranch).
-  std::optional<State> point_along(const State& base, double s, std::string& reason, double& seconds) const {
-    const Eigen::VectorXd pred_x = base.x + s * base.tx;
-    const double pred_p = base.p + s * base.tp;
-    const Eigen::VectorXd row_x = weight_ * base.tx;
-    return correct(pred_x, pred_p, row_x, base.tp, row_x.dot(pred_x) + base.tp * pred_p, o_.newton.max_iterations,
-                   reason, seconds);
-  }
-
-  double dot(const Eigen::VectorXd& ax, double ap, const Eigen::VectorXd& bx, double bp) const {
-    return weight_ * ax.dot(bx) + ap * bp;
-  }
-
   // The multipliers but the trivial one, the period and the extremes of the orbit at the point.
-  ContinuationPoint evaluate(const State& s, double& krylov_seconds) const {
+  ContinuationPoint evaluate(const State& s, double& krylov_seconds) const override {
     const long n = unknowns() - 1;
     ContinuationPoint point;
     point.parameter = s.p;
@@ -144,7 +131,7 @@ class AutonomousBranch {
   const ModelAt& model_at_;
   ContinuationOptions o_;
   int K_;
-  double weight_, range_;
+  double range_;
 };
 
 }  // namespace delayspec::continuation_detail

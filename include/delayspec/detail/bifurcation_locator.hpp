@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 
 #include "delayspec/continuation.hpp"
+#include "delayspec/detail/branch_corrector.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec::continuation_detail {
@@ -44,16 +45,15 @@ double multiplier_test(BifurcationType type, const std::vector<std::complex<doub
                        std::complex<double>* critical = nullptr);
 
 // One location: a bifurcation of `type` on the segment from `base` (point a, s = 0) along its
-// tangent. Branch: PeriodicBranch (point_along, evaluate). The corrector iterations, eigen-solves
+// tangent, on the problem `branch` (branch_corrector.hpp). The corrector iterations, eigen-solves
 // and their times are added to `cost`.
-template <class Branch>
 class BifurcationLocator {
  public:
-  using State = typename Branch::State;
+  using State = BranchState;
   static constexpr int kMaxEvaluations = 60;  // corrected points per location, all stages
 
   // by_tangent: a turning point, located where dp/ds = 0 (not by a multiplier).
-  BifurcationLocator(const Branch& branch, ContinuationResult& cost, BifurcationType type, bool by_tangent,
+  BifurcationLocator(const BranchProblem& branch, ContinuationResult& cost, BifurcationType type, bool by_tangent,
                      const State& base, double tolerance)
       : branch_(branch), cost_(cost), type_(type), by_tangent_(by_tangent), base_(base), tolerance_(tolerance) {}
 
@@ -219,7 +219,7 @@ class BifurcationLocator {
     return std::move(bif_);
   }
 
-  const Branch& branch_;
+  const BranchProblem& branch_;
   ContinuationResult& cost_;
   const BifurcationType type_;
   const bool by_tangent_;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -32,6 +33,47 @@ struct BranchState {
   double residual = 0;
 };
 
+// The discrete problem along a branch, as the tracer and the locator (continuation_branch.cpp)
+// ask it: an abstract class, so that they are compiled once in the library and only the problem
+// (PeriodicBranch, AutonomousBranch) per model: the same work at every corrected point (one
+// sparse LU per Newton step, an eigensolve per point) dwarfs a virtual call.
+class BranchProblem {
+ public:
+  using State = BranchState;
+  virtual ~BranchProblem() = default;
+  virtual bool has_switching() const = 0;  // grazing is watched (max H over the orbit)
+  virtual long unknowns() const = 0;       // entries of x
+  // Newton from (x, p) on the problem and row_x . x + row_p p = target (bordered_corrector).
+  virtual std::optional<BranchState> correct(Eigen::VectorXd x, double p, const Eigen::VectorXd& row_x, double row_p,
+                                             double target, int max_iterations, std::string& why,
+                                             double& seconds) const = 0;
+  // The multipliers, measures (and period) at a corrected point.
+  virtual ContinuationPoint evaluate(const BranchState& s, double& krylov_seconds) const = 0;
+
+  // The weighted inner product of continuation.hpp: x.y / K + p q.
+  double dot(const Eigen::VectorXd& ax, double ap, const Eigen::VectorXd& bx, double bp) const {
+    return weight_ * ax.dot(bx) + ap * bp;
+  }
+  // The corrected point at arclength s from `base` along its tangent: the predictor
+  // X_pred = X_base + s t_base, corrected on the hyperplane <t_base, X - X_pred>_w = 0.
+  std::optional<BranchState> point_along(const BranchState& base, double s, std::string& reason,
+                                         double& seconds) const {
+    const Eigen::VectorXd pred_x = base.x + s * base.tx;
+    const double pred_p = base.p + s * base.tp;
+    const Eigen::VectorXd row_x = weight_ * base.tx;
+    return correct(pred_x, pred_p, row_x, base.tp, row_x.dot(pred_x) + base.tp * pred_p, max_iterations_, reason,
+                   seconds);
+  }
+
+ protected:
+  // weight: 1 / K; max_iterations: the corrector's along the branch
+  BranchProblem(double weight, int max_iterations) : weight_(weight), max_iterations_(max_iterations) {}
+  BranchProblem(const BranchProblem&) = default;
+  BranchProblem& operator=(const BranchProblem&) = default;
+  double weight_ = 1;
+  int max_iterations_ = 10;
+};
+
 // Adds the time from construction to destruction to `seconds`.
 struct ScopedSeconds {
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
@@ -50,86 +92,24 @@ struct ScopedSeconds {
 // max_iterations, diverging (the residual 1e3 times above the one after the first step: not any
 // growth, since near grazing the discrete problem is only piecewise smooth and an iterate may
 // raise |G| before converging, and the start may have |G| = 0 with the constraint violated), a
-// singular matrix, a residual that cannot be formed.
-template <class Linearise>
+// singular matrix, a residual that cannot be formed. In the library (continuation_branch.cpp):
+// compiled once, not per model.
+using Linearise = std::function<bool(const Eigen::VectorXd& x, double p, Eigen::VectorXd& G,
+                                     Eigen::SparseMatrix<double>& G_x, Eigen::VectorXd& G_p, std::string& why)>;
 std::optional<BranchState> bordered_corrector(const Linearise& linearise, Eigen::VectorXd x, double p,
                                               const Eigen::VectorXd& row_x, double row_p, double target,
                                               int max_iterations, double tolerance, double weight, std::string& why,
-                                              double& seconds) {
-  const ScopedSeconds timer(seconds);
-  const long n = x.size();
-  double first = INFINITY;
-  for (int it = 0;; ++it) {
-    Eigen::VectorXd G, Gp;
-    Eigen::SparseMatrix<double> Gx;
-    if (!linearise(x, p, G, Gx, Gp, why)) return std::nullopt;
-    const double r = G.lpNorm<Eigen::Infinity>();
-    const double g = row_x.dot(x) + row_p * p - target;
-    if (!std::isfinite(r)) {
-      why = "non-finite residual, |F|_inf = " + format_number(r) + " at parameter " + format_number(p);
-      return std::nullopt;
-    }
-    // g is linear: after one Newton step it is at its rounding level, eps times the size of its terms
-    const double g_scale = row_x.cwiseAbs().dot(x.cwiseAbs()) + std::abs(row_p * p) + std::abs(target);
-    const bool converged = r <= tolerance * (1 + x.lpNorm<Eigen::Infinity>()) && std::abs(g) <= 1e-12 * (1 + g_scale);
-    if (it == 1) first = r;
-    if (!converged && (it >= max_iterations || r > 1e3 * first)) {
-      why = (it >= max_iterations ? "not converged in " + std::to_string(it) + " iterations"
-                                  : "residual diverging at iteration " + std::to_string(it)) +
-            ", |F|_inf = " + format_number(r) + " at parameter " + format_number(p);
-      return std::nullopt;
-    }
-    std::optional<SparseLU> lu;
-    try {
-      lu.emplace(bordered_matrix(Gx, Gp, row_x, row_p));  // sparse_lu.hpp
-    } catch (const NumericalFailure& e) {
-      why = std::string("bordered matrix singular at parameter ") + format_number(p) + " (" + e.what() + ")";
-      return std::nullopt;
-    }
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + 1);
-    if (converged) {  // the tangent z: [G_x G_p; row] z = e_{n+1}, z / |z|_w
-      rhs[n] = 1;
-      const Eigen::VectorXd z = lu->solve(rhs);
-      const double norm = std::sqrt(weight * z.head(n).squaredNorm() + z[n] * z[n]);
-      return BranchState{std::move(x), p, z.head(n) / norm, z[n] / norm, it, r};
-    }
-    rhs.head(n) = -G;
-    rhs[n] = -g;
-    const Eigen::VectorXd step = lu->solve(rhs);
-    x += step.head(n);
-    p += step[n];
-  }
-}
+                                              double& seconds);
 
 // G_p at p by the central difference (G(p + delta) - G(p - delta)) / (2 delta), delta = eps^(1/3)
 // max(|p|, scale) (continuation.hpp: why that is enough). `residual_at(q)` is G at q and throws
 // BadInput where the model rejects q: at a bound of the key's range (milling's depth from 0: p -
 // delta = -6e-9 is rejected) the one-sided second-order stencil on the side the model accepts,
 // (-3 G(p) + 4 G(p + s) - G(p + 2 s)) / (2 s), s = +-delta: the same order, and truncation 2x
-// the central one's. Neither side accepted: the model's reason (BadInput) passes through.
-template <class ResidualAt>
-Eigen::VectorXd parameter_derivative(const ResidualAt& residual_at, double p, const Eigen::VectorXd& G, double scale) {
-  const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max({std::abs(p), scale, 1e-300});
-  const double up = p + delta, down = p - delta;
-  std::exception_ptr rejected;
-  auto accepted = [&](double q) -> std::optional<Eigen::VectorXd> {
-    try {
-      return residual_at(q);
-    } catch (const BadInput&) {
-      rejected = std::current_exception();
-      return std::nullopt;
-    }
-  };
-  const std::optional<Eigen::VectorXd> G_up = accepted(up), G_down = accepted(down);
-  if (G_up && G_down) return (*G_up - *G_down) / (up - down);
-  if (!G_up && !G_down) std::rethrow_exception(rejected);
-  const double side = G_up ? delta : -delta;
-  const double s1 = (p + side) - p, s2 = (p + 2 * side) - p;  // the steps as represented
-  const Eigen::VectorXd& G1 = G_up ? *G_up : *G_down;
-  const Eigen::VectorXd G2 = residual_at(p + 2 * side);
-  // Quadratic through (0, G), (s1, G1), (s2, G2), differentiated at 0.
-  return (-(s1 + s2) / (s1 * s2)) * G + (s2 / (s1 * (s2 - s1))) * G1 - (s1 / (s2 * (s2 - s1))) * G2;
-}
+// the central one's. Neither side accepted: the model's reason (BadInput) passes through. In
+// the library.
+Eigen::VectorXd parameter_derivative(const std::function<Eigen::VectorXd(double)>& residual_at, double p,
+                                     const Eigen::VectorXd& G, double scale);
 
 // The leading multipliers of a monodromy with the options' nev. A pair failing the residual gate
 // is nearly always one of the smallest requested (|mu| ~ 1e-7 on a nearly rank-deficient

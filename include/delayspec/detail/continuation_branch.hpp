@@ -1,8 +1,9 @@
 #pragma once
-// The branch tracer of continue_orbit and continue_period_doubled: predictor, corrector, step
-// control, the ends of the range, detection of bifurcations between consecutive points
-// (continuation.hpp states the method). Part of continuation.hpp's implementation, included by
-// it; not an interface.
+// The branch tracer of continue_orbit, continue_period_doubled and continue_from_hopf: predictor,
+// corrector, step control, the ends of the range, detection of bifurcations between consecutive
+// points (continuation.hpp states the method). Part of continuation.hpp's implementation; not an
+// interface. Not a template: compiled once, in src/engine/continuation_branch.cpp, over the
+// abstract BranchProblem (branch_corrector.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,32 +17,24 @@
 #include "delayspec/continuation.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/detail/bifurcation_locator.hpp"
-#include "delayspec/detail/periodic_branch.hpp"
+#include "delayspec/detail/branch_corrector.hpp"
 
 namespace delayspec::continuation_detail {
 
-// The options with the defaults relative to the range filled in (continuation.hpp), checked.
-// BadInput naming the option for an empty range, a non-positive step or tolerance, step_min >
-// step_max, max_points < 2.
-ContinuationOptions checked_options(const ContinuationOptions& options);
-
-// One branch from its first point to an end (continuation.hpp, "End of the branch"). Branch: the
-// problem along it, PeriodicBranch (a forced orbit) or AutonomousBranch (an orbit of unknown
-// period): unknowns, correct, point_along, dot, evaluate.
-template <class Branch>
+// One branch from its first point to an end (continuation.hpp, "End of the branch"), of the
+// problem `branch` (PeriodicBranch: a forced orbit; AutonomousBranch: an orbit of unknown period).
 class BranchTracer {
  public:
-  using State = typename Branch::State;
+  using State = BranchState;
 
-  // start_tangent: see trace_branch. branch_arguments: Branch's constructor's before the options.
-  template <class... BranchArguments>
-  BranchTracer(const ContinuationOptions& options, const Eigen::VectorXd* start_tangent, double start_p,
-               const BranchArguments&... branch_arguments)
+  // start_tangent: see trace_branch.
+  BranchTracer(const BranchProblem& branch, const ContinuationOptions& options, const Eigen::VectorXd* start_tangent,
+               double start_p)
       : o_(checked_options(options)),
         direction_(o_.to > o_.from ? 1 : -1),
         start_tangent_(start_tangent),
         start_p_(start_p),
-        branch_(branch_arguments..., o_) {}
+        branch_(branch) {}
 
   // The branch from `guess`: its first point, then predictor-corrector steps until an end.
   ContinuationResult trace(const Eigen::VectorXd& guess) {
@@ -212,12 +205,12 @@ class BranchTracer {
     const bool turning = (a.tangent_p > 0) != (b.tangent_p > 0);
     if (turning && std::find(found.begin(), found.end(), BifurcationType::fold) == found.end())
       found.push_back(BifurcationType::fold);
-    if constexpr (Branch::has_switching)
+    if (branch_.has_switching())
       if ((a.measures.max_H > 0) != (b.measures.max_H > 0)) found.push_back(BifurcationType::grazing);
     const long after = static_cast<long>(result_.points.size()) - 1;
     for (BifurcationType type : found) {
       const auto locate_start = std::chrono::steady_clock::now();
-      BifurcationLocator<Branch> locator(branch_, result_, type, turning && type == BifurcationType::fold, *current_,
+      BifurcationLocator locator(branch_, result_, type, turning && type == BifurcationType::fold, *current_,
                                          o_.tolerance);
       result_.bifurcations.push_back(locator.locate(a, b, xb, s_b, after));
       result_.locate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - locate_start).count();
@@ -228,7 +221,7 @@ class BranchTracer {
   const double direction_;
   const Eigen::VectorXd* const start_tangent_;
   const double start_p_;
-  const Branch branch_;
+  const BranchProblem& branch_;
 
   ContinuationResult result_;
   Eigen::VectorXd zero_row_;             // the row of the constraint p = const
@@ -236,19 +229,5 @@ class BranchTracer {
   std::optional<State> previous_state_;  // the point before current_
   double ds_ = 0;                        // the next arclength step
 };
-
-// The branch from `guess` at p = options.from (Newton there), or, when start_tangent is given,
-// from the point (guess, start_p) itself along that tangent (no Newton: the point may be singular,
-// e.g. a period doubling seen by the doubled problem), the first segment not searched.
-template <class Branch, class... BranchArguments>
-ContinuationResult trace_branch(const Eigen::VectorXd& guess, const ContinuationOptions& options,
-                                const Eigen::VectorXd* start_tangent, double start_p,
-                                const BranchArguments&... branch_arguments) {
-  const auto run_start = std::chrono::steady_clock::now();
-  BranchTracer<Branch> tracer(options, start_tangent, start_p, branch_arguments...);
-  ContinuationResult result = tracer.trace(guess);
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
-  return result;
-}
 
 }  // namespace delayspec::continuation_detail

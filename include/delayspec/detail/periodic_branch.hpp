@@ -38,9 +38,8 @@ double hermite_maximum(double g0, double g1, double s0, double s1, double h);
 // The problem F(x, p) = 0 of one model factory and one discretisation (the options' N,
 // periods_per_map, step options), with the weighted inner product of continuation.hpp.
 template <class Model, class ModelAt>
-class PeriodicBranch {
+class PeriodicBranch final : public BranchProblem {
  public:
-  static constexpr bool has_switching = Model::has_switching;
   static constexpr int D = Model::d;
   using V = Vec<D>;
   using Map = StroboscopicMap<Model>;
@@ -48,7 +47,8 @@ class PeriodicBranch {
   using State = BranchState;  // branch_corrector.hpp
 
   // `o` with its defaults filled in (the tracer's checked options): the corrector reads newton from it.
-  PeriodicBranch(const ModelAt& model_at, const ContinuationOptions& o) : model_at_(model_at), o_(o) {
+  PeriodicBranch(const ModelAt& model_at, const ContinuationOptions& o)
+      : BranchProblem(1, o.newton.max_iterations), model_at_(model_at), o_(o) {
     const HistoryGrid g = grid_at(o.from);
     K_ = g.K;
     M_ = g.M;
@@ -56,7 +56,8 @@ class PeriodicBranch {
     range_ = std::abs(o.to - o.from);
   }
 
-  long unknowns() const { return static_cast<long>(D) * K_; }
+  bool has_switching() const override { return Model::has_switching; }
+  long unknowns() const override { return static_cast<long>(D) * K_; }
 
   Map map_at(double p) const {
     const Model model = model_at_(p);
@@ -66,21 +67,11 @@ class PeriodicBranch {
 
   // Newton from (x, p) on F = 0 and row_x . x + row_p p = target (bordered_corrector).
   std::optional<State> correct(Eigen::VectorXd x, double p, const Eigen::VectorXd& row_x, double row_p, double target,
-                               int max_iterations, std::string& why, double& seconds) const {
+                               int max_iterations, std::string& why, double& seconds) const override {
     auto linearise = [this](const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
                             Eigen::VectorXd& Fp, std::string& why) { return linearise_or_reason(x, p, F, Fx, Fp, why); };
     return bordered_corrector(linearise, std::move(x), p, row_x, row_p, target, max_iterations, o_.newton.tolerance,
                               weight_, why, seconds);
-  }
-
-  // The corrected point at arclength s from `base` along its tangent: the predictor
-  // X_pred = X_base + s t_base, corrected on the hyperplane <t_base, X - X_pred>_w = 0.
-  std::optional<State> point_along(const State& base, double s, std::string& reason, double& seconds) const {
-    const Eigen::VectorXd pred_x = base.x + s * base.tx;
-    const double pred_p = base.p + s * base.tp;
-    const Eigen::VectorXd row_x = weight_ * base.tx;
-    return correct(pred_x, pred_p, row_x, base.tp, row_x.dot(pred_x) + base.tp * pred_p, o_.newton.max_iterations,
-                   reason, seconds);
   }
 
   // F(x, p), F_x and F_p (parameter_derivative: central differences, one-sided at a bound of the
@@ -92,13 +83,8 @@ class PeriodicBranch {
                               range_);
   }
 
-  // Weighted inner product of the state parts plus the parameters' product.
-  double dot(const Eigen::VectorXd& ax, double ap, const Eigen::VectorXd& bx, double bp) const {
-    return weight_ * ax.dot(bx) + ap * bp;
-  }
-
   // Multipliers and measures of the orbit x at p.
-  ContinuationPoint evaluate(const State& s, double& krylov_seconds) const {
+  ContinuationPoint evaluate(const State& s, double& krylov_seconds) const override {
     ContinuationPoint point;
     point.parameter = s.p;
     point.newton_iterations = s.iterations;
@@ -195,7 +181,7 @@ class PeriodicBranch {
   const ModelAt& model_at_;
   ContinuationOptions o_;
   long K_ = 0, M_ = 0;
-  double weight_ = 1, range_ = 1;
+  double range_ = 1;
 };
 
 }  // namespace delayspec::continuation_detail

@@ -4,6 +4,7 @@
 #include <complex>
 #include <sstream>
 
+#include "delayspec/detail/bifurcation_locator.hpp"
 #include "scene/output/output.hpp"
 
 namespace delayspec::cli {
