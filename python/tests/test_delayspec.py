@@ -196,6 +196,17 @@ def test_continue_equals_cli_json():
     assert r.multipliers.dtype == np.complex128 and r.multipliers.shape == (len(r["points"]), 6)
 
 
+def test_continue_from_a_hopf_point_equals_cli_json():
+    # the equilibria of Mackey-Glass in tau and the orbits born at their Hopf point (continue_switch)
+    keys = dict(continue_to=6, continue_Ns=[50, 100])
+    scene = SCENES / "mackey_glass_hopf.toml"
+    r = delayspec.continue_(scene, **keys)
+    same_as_cli(r, "continue", scene, **keys)
+    orbits = r["hopf_branches"][0]
+    assert orbits["Ns"] == [50, 100] and orbits["end"] == "to"
+    assert abs(orbits["points"][0]["period"] - r["bifurcations"][0]["period"]) < 1e-12 * orbits["points"][0]["period"]
+
+
 # ---- numpy views -----------------------------------------------------------------------------
 
 def test_floquet_arrays_hold_the_json_numbers():
