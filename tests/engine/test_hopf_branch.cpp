@@ -88,18 +88,25 @@ TEST(HopfBranch, CircleOscillatorFollowsTheDiscreteClosedForm) {
   }
 }
 
-TEST(HopfBranch, MackeyGlassStartsAtThePredictedPeriodAndGrowsLikeASquareRoot) {
+// Mackey-Glass (beta 0.2, gamma 0.1, n 10) as a family in tau, and the Hopf point of x* = 1 in
+// closed form (test_equilibrium.cpp): x' = -gamma x + b x(t - tau), b = beta (2 - n) / 4 < 0; at
+// lambda = i omega, cos(omega tau) = gamma / b and sin(omega tau) = -omega / b.
+struct MackeyGlassInTau {
   MackeyGlassParameters base;
-  base.tau = base.period = 5;
-  auto mg_at = [&base](double tau) {
+  MackeyGlassInTau() { base.tau = base.period = 5; }
+  MackeyGlassModel operator()(double tau) const {
     MackeyGlassParameters p = base;
     p.tau = tau;
     return MackeyGlassModel(p);
-  };
-  // The Hopf point of x* = 1 (test_equilibrium.cpp): x' = -gamma x + b x(t - tau), b = beta (2 -
-  // n) / 4 < 0; at lambda = i omega, cos(omega tau) = gamma / b and sin(omega tau) = -omega / b
-  const double b = base.beta * (2 - base.n) / 4, omega = std::sqrt(b * b - base.gamma * base.gamma);
-  const double tau_H = std::acos(base.gamma / b) / omega;
+  }
+  double b() const { return base.beta * (2 - base.n) / 4; }
+  double omega() const { return std::sqrt(b() * b() - base.gamma * base.gamma); }
+  double tau_H() const { return std::acos(base.gamma / b()) / omega(); }
+};
+
+TEST(HopfBranch, MackeyGlassStartsAtThePredictedPeriodAndGrowsLikeASquareRoot) {
+  const MackeyGlassInTau mg_at;
+  const double omega = mg_at.omega(), tau_H = mg_at.tau_H();
   // Near the Hopf point a^2 = c1 (tau - tau_N) + c2 (tau - tau_N)^2 + ...: the discrete Hopf point
   // tau_N is where the parabola through the first points meets 0 (least squares), and it tends
   // to tau_H as h^2. Not at a clean observed order: K = round(N T_0 / tau_max) puts the delay at a
@@ -154,20 +161,13 @@ TEST(HopfBranch, MackeyGlassStartsAtThePredictedPeriodAndGrowsLikeASquareRoot) {
 // multiplier there is above -1 just before the located tau and below just after (the margin,
 // 0.05 in tau, covers the two discretisations' O(h^2) difference).
 TEST(HopfBranch, MackeyGlassBranchHasAPeriodDoublingWhereAMultiplierIsMinusOne) {
-  MackeyGlassParameters base;
-  base.tau = base.period = 5;
-  auto mg_at = [&base](double tau) {
-    MackeyGlassParameters p = base;
-    p.tau = tau;
-    return MackeyGlassModel(p);
-  };
-  const double b = base.beta * (2 - base.n) / 4, omega = std::sqrt(b * b - base.gamma * base.gamma);
+  const MackeyGlassInTau mg_at;
   ContinuationOptions o;
   o.from = 4;
   o.to = 14;
   o.N = 100;
   const ContinuationResult r = continue_from_hopf<MackeyGlassModel>(
-      mg_at, hopf_at(std::acos(base.gamma / b) / omega, omega, Eigen::VectorXd::Ones(1)), o);
+      mg_at, hopf_at(mg_at.tau_H(), mg_at.omega(), Eigen::VectorXd::Ones(1)), o);
   ASSERT_EQ(r.end, BranchEnd::to) << r.failure;
   ASSERT_EQ(r.bifurcations.size(), 1u);
   const Bifurcation& pd = r.bifurcations[0];
