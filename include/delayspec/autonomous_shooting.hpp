@@ -89,6 +89,98 @@ inline Eigen::VectorXd history_phase_row(const Eigen::VectorXd& U, int d) {
   return c / norm;
 }
 
+// One level's Newton-Krylov iteration on (U, T) (header): the residual, the bordered GMRES
+// direction, the line search; the grid's history keeps M + 1 slots.
+template <class Model>
+class PeriodShooter {
+ public:
+  static constexpr int D = Model::d;
+  using Map = StroboscopicMap<TimeScaled<Model>>;
+
+  PeriodShooter(const Model& model, int K, int M, const Eigen::VectorXd& U_ref, const OrbitByShootingOptions& opt,
+                const StepOptions& step)
+      : model_(model), K_(K), M_(M), opt_(opt), step_(step), c_(history_phase_row(U_ref, D)), U_ref_(U_ref) {}
+
+  Map map(double T) const { return scaled_map_with_slots(model_, T, K_, M_, step_); }
+  double phase(const Eigen::VectorXd& U) const { return c_.dot(U - U_ref_); }
+
+  // G = P_T(U) - U with the step maps and states of the evaluation in lin; false where it cannot
+  // be formed (a period that needs more slots, a step that fails, a value not finite).
+  bool evaluate(const Eigen::VectorXd& U, double T, Eigen::VectorXd& G) {
+    try {
+      G = map(T).apply(U, &lin.maps, &lin.states) - U;
+      return G.allFinite();
+    } catch (const NumericalFailure&) {
+      return false;
+    } catch (const BadInput&) {
+      return false;
+    }
+  }
+
+  // The Newton step (dU, dT) of [M_U - I, P_T; c^T, 0] = -(G, g) to GMRES' tolerance eta, M_U
+  // from the step maps of the last evaluation (at U, T); P_T by a forward difference (header).
+  // NumericalFailure's reason in `why` when P_T cannot be formed or GMRES makes no progress.
+  bool direction(const Eigen::VectorXd& U, double T, const Eigen::VectorXd& G, double eta, Eigen::VectorXd& step,
+                 std::string& why) {
+    const double delta = std::sqrt(std::numeric_limits<double>::epsilon()) * T;
+    Eigen::VectorXd PT;
+    try {
+      PT = (map(T + delta).apply(U) - (G + U)) / ((T + delta) - T);
+    } catch (const std::exception& e) {
+      why = std::string("the period's derivative cannot be formed (") + e.what() + ")";
+      return false;
+    }
+    const long n = U.size();
+    Eigen::VectorXd rhs(n + 1);
+    rhs << -G, -phase(U);
+    Monodromy<D, delayed_rows<Model>> monodromy(map(T).grid(), std::move(lin.maps));
+    const GmresResult s = gmres(
+        [&](const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::VectorXd& y) {
+          y.resize(n + 1);
+          monodromy.perform_op(v.data(), y.data());
+          y.head(n) -= v.head(n);
+          y.head(n) += v[n] * PT;
+          y[n] = c_.dot(v.head(n));
+        },
+        rhs, GmresOptions{eta, opt_.gmres_restart, opt_.gmres_max_iterations}, &basis_);
+    lin.maps = std::move(monodromy).take_step_maps();
+    if (!(s.relative_residual < 1)) {
+      why = "GMRES made no progress on the bordered shooting system (relative residual " +
+            format_number(s.relative_residual) + ")";
+      return false;
+    }
+    step = s.x;
+    return true;
+  }
+
+  // The full step unless |(G, g)|_2 does not decrease; then halved, at most 30 times. Updates U,
+  // T, G (and lin); false when no fraction reduces it.
+  bool line_search(const Eigen::VectorXd& step, Eigen::VectorXd& U, double& T, Eigen::VectorXd& G) {
+    const long n = U.size();
+    const double norm = std::hypot(G.norm(), phase(U));
+    double lambda = 1;
+    for (int halvings = 0; halvings <= 30; ++halvings, lambda *= 0.5) {
+      Eigen::VectorXd trial = U + lambda * step.head(n), G_trial;
+      const double T_trial = T + lambda * step[n];
+      if (T_trial > 0 && evaluate(trial, T_trial, G_trial) && std::hypot(G_trial.norm(), phase(trial)) < norm) {
+        U.swap(trial), G.swap(G_trial), T = T_trial;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  OrbitLinearisation<D, delayed_rows<Model>> lin;  // of the last evaluation
+
+ private:
+  const Model& model_;
+  int K_, M_;
+  const OrbitByShootingOptions& opt_;
+  const StepOptions& step_;
+  Eigen::VectorXd c_, U_ref_;
+  Eigen::MatrixXd basis_;  // GMRES' workspace, kept across Newton steps
+};
+
 // One level: Newton-Krylov on (U, T) from the sequence x (K states) and T (header).
 template <class Model>
 AutonomousOrbit shoot_autonomous_level(const Model& model, int K, const Eigen::VectorXd& x, double T,
@@ -97,21 +189,9 @@ AutonomousOrbit shoot_autonomous_level(const Model& model, int K, const Eigen::V
   constexpr int D = Model::d;
   const OrbitByShootingOptions& opt = o.shooting;
   const int M = make_grid_with_steps(delays_of(TimeScaled<Model>{model, T * (1 - o.margin)}), 1.0, K).M;
-  AutonomousOrbit out;
   Eigen::VectorXd U = PeriodicOrbitProblem<Map>(scaled_map_with_slots(model, T, K, M, step)).history(x);
-  const Eigen::VectorXd c = history_phase_row(U, D), U_ref = U;
-  OrbitLinearisation<D, delayed_rows<Model>> lin;
-  // G at (U, T) with the step maps of the evaluation in `lin`; false where it cannot be formed.
-  auto evaluate = [&](const Eigen::VectorXd& X, double period, Eigen::VectorXd& G) {
-    try {
-      G = scaled_map_with_slots(model, period, K, M, step).apply(X, &lin.maps, &lin.states) - X;
-      return G.allFinite();
-    } catch (const NumericalFailure&) {
-      return false;
-    } catch (const BadInput&) {
-      return false;
-    }
-  };
+  PeriodShooter<Model> shooter(model, K, M, U, opt, step);
+  AutonomousOrbit out;
   Eigen::VectorXd G;
   double r = NAN;
   auto failure = [&](const std::string& why) {
@@ -119,67 +199,28 @@ AutonomousOrbit shoot_autonomous_level(const Model& model, int K, const Eigen::V
                             " after " + std::to_string(out.newton_iterations) + " Newton iterations, |P(U) - U|_inf = " +
                             format_number(r) + ", period reached " + format_number(T));
   };
-  if (!evaluate(U, T, G)) throw failure("the map cannot be evaluated at the starting history");
-  auto phase = [&](const Eigen::VectorXd& X) { return c.dot(X - U_ref); };
-  r = G.lpNorm<Eigen::Infinity>();
-  out.newton_residuals.push_back(r);
-  out.periods.push_back(T);
-  Eigen::MatrixXd basis;
+  if (!shooter.evaluate(U, T, G)) throw failure("the map cannot be evaluated at the starting history");
   double eta = opt.forcing_max, previous_norm = NAN;
-  const double phase_tolerance = 1e-12 * (1 + U.lpNorm<Eigen::Infinity>());
-  while (!(r <= opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>()) && std::abs(phase(U)) <= phase_tolerance)) {
-    if (out.newton_iterations >= opt.max_iterations) throw failure("not converged");
-    const double g_norm = std::hypot(G.norm(), phase(U));
-    eta = shooting_forcing_term(eta, g_norm, previous_norm, opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>()),
-                                opt.forcing_max, out.newton_iterations == 0);
-    // P_T by a forward difference (header)
-    const double delta = std::sqrt(std::numeric_limits<double>::epsilon()) * T;
-    Eigen::VectorXd PT;
-    try {
-      PT = (scaled_map_with_slots(model, T + delta, K, M, step).apply(U) - (G + U)) / ((T + delta) - T);
-    } catch (const std::exception& e) {
-      throw failure(std::string("the period's derivative cannot be formed (") + e.what() + ")");
-    }
-    const long n = U.size();
-    Eigen::VectorXd rhs(n + 1);
-    rhs << -G, -phase(U);
-    Monodromy<D, delayed_rows<Model>> monodromy(scaled_map_with_slots(model, T, K, M, step).grid(), std::move(lin.maps));
-    const GmresResult s = gmres(
-        [&](const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::VectorXd& y) {
-          y.resize(n + 1);
-          monodromy.perform_op(v.data(), y.data());
-          y.head(n) -= v.head(n);
-          y.head(n) += v[n] * PT;
-          y[n] = c.dot(v.head(n));
-        },
-        rhs, GmresOptions{eta, opt.gmres_restart, opt.gmres_max_iterations}, &basis);
-    lin.maps = std::move(monodromy).take_step_maps();
-    out.newton_iterations++;
-    if (!(s.relative_residual < 1))
-      throw failure("GMRES made no progress on the bordered shooting system (relative residual " +
-                    format_number(s.relative_residual) + ")");
-    bool accepted = false;
-    double lambda = 1;
-    Eigen::VectorXd trial, G_trial;
-    double T_trial = T;
-    for (int halvings = 0; halvings <= 30 && !accepted; ++halvings, lambda *= 0.5) {
-      trial = U + lambda * s.x.head(n);
-      T_trial = T + lambda * s.x[n];
-      accepted = T_trial > 0 && evaluate(trial, T_trial, G_trial) &&
-                 std::hypot(G_trial.norm(), phase(trial)) < g_norm;
-    }
-    if (!accepted) throw failure("stalled (no step along the Newton direction reduces the residual)");
-    previous_norm = g_norm;
-    U.swap(trial);
-    G.swap(G_trial);
-    T = T_trial;
+  for (;;) {
     r = G.lpNorm<Eigen::Infinity>();
     out.newton_residuals.push_back(r);
     out.periods.push_back(T);
+    const double tol_abs = opt.tolerance * (1 + U.lpNorm<Eigen::Infinity>());
+    if (r <= tol_abs && std::abs(shooter.phase(U)) <= 1e-12 * (1 + U.lpNorm<Eigen::Infinity>())) break;
+    if (out.newton_iterations >= opt.max_iterations) throw failure("not converged");
+    const double g_norm = std::hypot(G.norm(), shooter.phase(U));
+    eta = shooting_forcing_term(eta, g_norm, previous_norm, tol_abs, opt.forcing_max, out.newton_iterations == 0);
+    Eigen::VectorXd s;
+    std::string why;
+    if (!shooter.direction(U, T, G, eta, s, why)) throw failure(why);
+    ++out.newton_iterations;
+    if (!shooter.line_search(s, U, T, G))
+      throw failure("stalled (no step along the Newton direction reduces the residual)");
+    previous_norm = g_norm;
   }
   // The sequence from the last evaluation (at U), the history on the standard grid.
   Eigen::VectorXd sequence(static_cast<long>(D) * K);
-  for (long l = 0; l < K; ++l) sequence.segment<D>(D * l) = lin.states[static_cast<size_t>(l)];
+  for (long l = 0; l < K; ++l) sequence.segment<D>(D * l) = shooter.lin.states[static_cast<size_t>(l)];
   const Map standard = scaled_map(model, T, K, step);
   out.period = T;
   out.grid = standard.grid();
