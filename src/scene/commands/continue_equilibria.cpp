@@ -212,84 +212,107 @@ void print_branch(std::ostream& os, const Problem& problem, const std::string& k
   os << "time: " << seconds << " s\n";
 }
 
-}  // namespace
+// What the command reads and checks before any work.
+struct EquilibriaRun {
+  ContinueSettings settings;
+  bool from_hopf = false;  // continue_switch: the orbits born at Hopf points
+  Problem problem;         // at continue_from
+  EquilibriumSettings eq;
+  ContinuationOptions orbit_options;  // the orbit branches': the range with its defaults, nev, orbit_tolerance
+  std::vector<int> Ns;                // continue_Ns, or the one level N
+};
 
-int continue_equilibria(Config& config, const Invocation& inv) {
-  const auto start = std::chrono::steady_clock::now();
-  const ContinueSettings settings = read_continue_settings(config);
-  const bool from_hopf = settings.switch_period_doubling;  // continue_switch: the orbits born at Hopf points
-  if (!settings.Ns.empty() && !from_hopf)
+EquilibriaRun read_equilibria_run(Config& config) {
+  EquilibriaRun run;
+  run.settings = read_continue_settings(config);
+  run.from_hopf = run.settings.switch_period_doubling;
+  if (!run.settings.Ns.empty() && !run.from_hopf)
     throw BadInput("`continue_Ns` with `continue_object = equilibrium` and no `continue_switch = true`: an "
                    "equilibrium's bifurcations are located on the exact characteristic function, with no "
                    "discretisation error to extrapolate (continue_Ns gives the error bars of the orbit branches "
                    "born at its Hopf points)");
-  config.set(settings.key, format_number(settings.options.from), "continue_from");
-  const Problem problem = read_problem(config, 100);
-  const EquilibriumSettings eq = read_equilibrium_settings(config, problem);
-  ContinuationOptions orbit_options = settings.options;  // the orbit branches': the range with its defaults
-  static_cast<BranchRange&>(orbit_options) = checked_range(settings.options);
-  if (from_hopf) {
-    orbit_options.floquet = read_floquet_options(config);
-    orbit_options.newton.tolerance = read_orbit_settings(config).newton.tolerance;
-    orbit_options.step_options = step_options(problem);
+  config.set(run.settings.key, format_number(run.settings.options.from), "continue_from");
+  run.problem = read_problem(config, 100);
+  run.eq = read_equilibrium_settings(config, run.problem);
+  run.orbit_options = run.settings.options;
+  static_cast<BranchRange&>(run.orbit_options) = checked_range(run.settings.options);
+  if (run.from_hopf) {
+    run.orbit_options.floquet = read_floquet_options(config);
+    run.orbit_options.newton.tolerance = read_orbit_settings(config).newton.tolerance;
+    run.orbit_options.step_options = step_options(run.problem);
   }
   config.check_all_used();
-  require_autonomous(problem);
-  if (from_hopf && problem.analyses->is_linear())
-    throw BadInput("`continue_switch = true` with `model = " + problem.model_name +
+  require_autonomous(run.problem);
+  if (run.from_hopf && run.problem.analyses->is_linear())
+    throw BadInput("`continue_switch = true` with `model = " + run.problem.model_name +
                    "`: a linear model's Hopf point has a continuum of periodic orbits, none isolated, so no branch "
                    "of orbits to follow");
-  const std::vector<int> Ns = settings.Ns.empty() ? std::vector<int>{problem.N} : settings.Ns;
+  run.Ns = run.settings.Ns.empty() ? std::vector<int>{run.problem.N} : run.settings.Ns;
+  return run;
+}
 
+// --out DIR: equilibria.csv, equilibrium_bifurcations.csv, hopf_branch_K.csv and
+// hopf_bifurcations_K.csv, continue.json, marked incomplete after a failure.
+void write_equilibria_files(const Invocation& inv, const Config& config, const EquilibriaRun& run,
+                            const EquilibriumBranch& branch, const std::vector<HopfBranch>& orbits,
+                            const std::string& failures, const json& j, double seconds) {
+  const std::filesystem::path dir(*inv.out_dir);
+  OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
+  metadata.parameters.erase(run.settings.key);  // per row
+  std::string header = metadata_comment_lines(metadata);
+  if (!failures.empty()) header += "# INCOMPLETE: a branch ended in a failure: " + failures + "\n";
+  write_output(inv, dir / "equilibria.csv", points_csv(header, run.problem, branch, run.eq.options.nroots));
+  write_output(inv, dir / "equilibrium_bifurcations.csv", equilibrium_bifurcations_csv(header, branch));
+  for (size_t i = 0; i < orbits.size(); ++i) {
+    const std::string n = std::to_string(i + 1);
+    write_output(inv, dir / ("hopf_branch_" + n + ".csv"),
+                 branch_csv(header, orbits[i].finest(), run.orbit_options.floquet.nev));
+    write_output(inv, dir / ("hopf_bifurcations_" + n + ".csv"),
+                 bifurcations_csv(header, orbits[i].estimates, orbits[i].finest()));
+  }
+  json file = j;
+  file["metadata"] = metadata_json(metadata);
+  write_output(inv, dir / "continue.json", file.dump(2) + "\n");
+}
+
+}  // namespace
+
+int continue_equilibria(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  const EquilibriaRun run = read_equilibria_run(config);
+  const std::string& key = run.settings.key;
   EquilibriumBranchOptions o;
-  static_cast<BranchRange&>(o) = settings.options;
-  o.newton_tolerance = eq.options.tolerance;
+  static_cast<BranchRange&>(o) = run.settings.options;
+  o.newton_tolerance = run.eq.options.tolerance;
   Progress progress(inv.err, "continue", 0, inv.quiet);
   o.on_point = [&progress] { progress.add(); };
-  const AnalysesAt at = analyses_with_key(config, settings.key);
+  const AnalysesAt at = analyses_with_key(config, key);
+  const EquilibriumOptions& eq = run.eq.options;
   const EquilibriumFamily family{
       [&at](const Eigen::VectorXd& y, double p) { return at(p)->at_constant_history(y); },
-      [&at, &eq](const Eigen::VectorXd& guess, double p) { return at(p)->equilibrium(guess, eq.options); }};
-  const EquilibriumBranch branch = continue_equilibrium(family, eq.guess, o);
+      [&at, &eq](const Eigen::VectorXd& guess, double p) { return at(p)->equilibrium(guess, eq); }};
+  const EquilibriumBranch branch = continue_equilibrium(family, run.eq.guess, o);
   const std::vector<HopfBranch> orbits =
-      from_hopf ? hopf_branches(branch, at, Ns, orbit_options, progress) : std::vector<HopfBranch>{};
+      run.from_hopf ? hopf_branches(branch, at, run.Ns, run.orbit_options, progress) : std::vector<HopfBranch>{};
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string failures = branch.failure;
-  const std::string orbit_failures = hopf_failures(orbits, Ns, settings.key);
+  const std::string orbit_failures = hopf_failures(orbits, run.Ns, key);
   if (!orbit_failures.empty()) failures += (failures.empty() ? "" : "; ") + orbit_failures;
 
-  json j = branch_json(problem, settings.key, branch, seconds);
-  if (from_hopf) j["hopf_branches"] = hopf_branches_json(orbits, Ns);
-  if (inv.out_dir) {
-    const std::filesystem::path dir(*inv.out_dir);
-    OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
-    metadata.parameters.erase(settings.key);  // per row
-    std::string header = metadata_comment_lines(metadata);
-    if (!failures.empty()) header += "# INCOMPLETE: a branch ended in a failure: " + failures + "\n";
-    write_output(inv, dir / "equilibria.csv", points_csv(header, problem, branch, eq.options.nroots));
-    write_output(inv, dir / "equilibrium_bifurcations.csv", equilibrium_bifurcations_csv(header, branch));
-    for (size_t i = 0; i < orbits.size(); ++i) {  // hopf_branch_1.csv, hopf_bifurcations_1.csv, ...
-      const std::string n = std::to_string(i + 1);
-      write_output(inv, dir / ("hopf_branch_" + n + ".csv"),
-                   branch_csv(header, orbits[i].finest(), orbit_options.floquet.nev));
-      write_output(inv, dir / ("hopf_bifurcations_" + n + ".csv"),
-                   bifurcations_csv(header, orbits[i].estimates, orbits[i].finest()));
-    }
-    json file = j;
-    file["metadata"] = metadata_json(metadata);
-    write_output(inv, dir / "continue.json", file.dump(2) + "\n");
-  }
+  json j = branch_json(run.problem, key, branch, seconds);
+  if (run.from_hopf) j["hopf_branches"] = hopf_branches_json(orbits, run.Ns);
+  if (inv.out_dir) write_equilibria_files(inv, config, run, branch, orbits, failures, j, seconds);
   if (!failures.empty()) {
     inv.err << "delayspec continue: numerical failure: " << failures
             << (inv.out_dir ? "; the branch so far is in " + *inv.out_dir : std::string()) << "\n";
     return 3;
   }
-  if (inv.json)
+  if (inv.json) {
     inv.out << j.dump(2) << "\n";
-  else {
-    print_branch(inv.out, problem, settings.key, o, branch, seconds);
-    print_hopf_branches(inv.out, settings.key, orbits, Ns);
+  } else {
+    print_branch(inv.out, run.problem, key, o, branch, seconds);
+    print_hopf_branches(inv.out, key, orbits, run.Ns);
   }
   return 0;
 }
