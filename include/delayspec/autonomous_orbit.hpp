@@ -34,6 +34,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <string>
 #include <vector>
@@ -110,15 +111,32 @@ struct AutonomousOrbit {
   std::vector<double> periods;           // T of each iterate, the guess first
 };
 
+// The index of the trivial multiplier among `mu` (the time shift's: the one nearest 1); 0 when empty.
+inline size_t trivial_multiplier_index(const std::vector<std::complex<double>>& mu) {
+  size_t trivial = 0;
+  for (size_t i = 1; i < mu.size(); ++i)
+    if (std::abs(mu[i] - 1.0) < std::abs(mu[trivial] - 1.0)) trivial = i;
+  return trivial;
+}
+
 namespace detail {
 
-// The scaled map at T on the K-step grid.
+// The scaled map at T on the K-step grid, its history M + 1 slots (M = 0: what T needs; more:
+// slots beyond the longest tap, autonomous_shooting.hpp). BadInput when T needs more than M.
 template <class Model>
-StroboscopicMap<TimeScaled<Model>> scaled_map(const Model& model, double T, int K, const StepOptions& step) {
+StroboscopicMap<TimeScaled<Model>> scaled_map(const Model& model, double T, int K, const StepOptions& step,
+                                              int M = 0) {
   const TimeScaled<Model> scaled{model, T};
-  return StroboscopicMap<TimeScaled<Model>>(TrapezoidStepper<TimeScaled<Model>>(scaled, step),
-                                            make_grid_with_steps(delays_of(scaled), 1.0, K));
+  HistoryGrid g = make_grid_with_steps(delays_of(scaled), 1.0, K);
+  if (M > 0) {
+    if (g.M > M)
+      throw BadInput("the period " + format_number(T) + " needs " + std::to_string(g.M + 1) + " history slots, " +
+                     std::to_string(M + 1) + " laid");
+    g.M = M;
+  }
+  return StroboscopicMap<TimeScaled<Model>>(TrapezoidStepper<TimeScaled<Model>>(scaled, step), g);
 }
+
 
 // Newton's guess: one period of the map at T after guess_periods - 1 simulated from the constant
 // history.

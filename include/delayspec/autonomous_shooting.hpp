@@ -62,20 +62,6 @@ struct AutonomousShootingOptions {
 
 namespace detail {
 
-// The scaled map at T on K steps with the history holding M + 1 slots (M at least what T needs).
-// BadInput when T needs more than M.
-template <class Model>
-StroboscopicMap<TimeScaled<Model>> scaled_map_with_slots(const Model& model, double T, int K, int M,
-                                                        const StepOptions& step) {
-  const TimeScaled<Model> scaled{model, T};
-  HistoryGrid g = make_grid_with_steps(delays_of(scaled), 1.0, K);
-  if (g.M > M)
-    throw BadInput("the period " + format_number(T) + " needs " + std::to_string(g.M + 1) + " history slots, " +
-                   std::to_string(M + 1) + " laid");
-  g.M = M;
-  return StroboscopicMap<TimeScaled<Model>>(TrapezoidStepper<TimeScaled<Model>>(scaled, step), g);
-}
-
 // The unit derivative of a history along its slots (d entries per slot).
 inline Eigen::VectorXd history_phase_row(const Eigen::VectorXd& U, int d) {
   const long slots = U.size() / d;
@@ -101,14 +87,16 @@ class PeriodShooter {
                 const StepOptions& step)
       : model_(model), K_(K), M_(M), opt_(opt), step_(step), c_(history_phase_row(U_ref, D)), U_ref_(U_ref) {}
 
-  Map map(double T) const { return scaled_map_with_slots(model_, T, K_, M_, step_); }
+  Map map(double T) const { return scaled_map(model_, T, K_, step_, M_); }
   double phase(const Eigen::VectorXd& U) const { return c_.dot(U - U_ref_); }
 
   // G = P_T(U) - U with the step maps and states of the evaluation in lin; false where it cannot
   // be formed (a period that needs more slots, a step that fails, a value not finite).
   bool evaluate(const Eigen::VectorXd& U, double T, Eigen::VectorXd& G) {
     try {
-      G = map(T).apply(U, &lin.maps, &lin.states) - U;
+      const Map m = map(T);
+      G = m.apply(U, &lin.maps, &lin.states) - U;
+      grid_ = m.grid();
       return G.allFinite();
     } catch (const NumericalFailure&) {
       return false;
@@ -118,7 +106,8 @@ class PeriodShooter {
   }
 
   // The Newton step (dU, dT) of [M_U - I, P_T; c^T, 0] = -(G, g) to GMRES' tolerance eta, M_U
-  // from the step maps of the last evaluation (at U, T); P_T by a forward difference (header).
+  // from the step maps and grid of the last evaluation (at U, T); P_T by a forward difference
+  // (header).
   // NumericalFailure's reason in `why` when P_T cannot be formed or GMRES makes no progress.
   bool direction(const Eigen::VectorXd& U, double T, const Eigen::VectorXd& G, double eta, Eigen::VectorXd& step,
                  std::string& why) {
@@ -133,7 +122,7 @@ class PeriodShooter {
     const long n = U.size();
     Eigen::VectorXd rhs(n + 1);
     rhs << -G, -phase(U);
-    Monodromy<D, delayed_rows<Model>> monodromy(map(T).grid(), std::move(lin.maps));
+    Monodromy<D, delayed_rows<Model>> monodromy(grid_, std::move(lin.maps));
     const GmresResult s = gmres(
         [&](const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::VectorXd& y) {
           y.resize(n + 1);
@@ -179,6 +168,7 @@ class PeriodShooter {
   const StepOptions& step_;
   Eigen::VectorXd c_, U_ref_;
   Eigen::MatrixXd basis_;  // GMRES' workspace, kept across Newton steps
+  HistoryGrid grid_;       // of the last evaluation
 };
 
 // One level: Newton-Krylov on (U, T) from the sequence x (K states) and T (header).
@@ -189,7 +179,7 @@ AutonomousOrbit shoot_autonomous_level(const Model& model, int K, const Eigen::V
   constexpr int D = Model::d;
   const OrbitByShootingOptions& opt = o.shooting;
   const int M = make_grid_with_steps(delays_of(TimeScaled<Model>{model, T * (1 - o.margin)}), 1.0, K).M;
-  Eigen::VectorXd U = PeriodicOrbitProblem<Map>(scaled_map_with_slots(model, T, K, M, step)).history(x);
+  Eigen::VectorXd U = PeriodicOrbitProblem<Map>(scaled_map(model, T, K, step, M)).history(x);
   PeriodShooter<Model> shooter(model, K, M, U, opt, step);
   AutonomousOrbit out;
   Eigen::VectorXd G;

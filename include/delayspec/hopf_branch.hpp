@@ -25,7 +25,6 @@
 //
 // BadInput: omega <= 0, a state of the wrong size, a model that is not autonomous or is linear
 // (a linear model's Hopf point has a continuum of orbits, none isolated).
-#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -55,14 +54,12 @@ ContinuationResult continue_from_hopf(const ModelAt& model_at, const Equilibrium
   if (hopf.state.size() != D)
     throw BadInput("continue_from_hopf: the equilibrium has " + std::to_string(hopf.state.size()) +
                    " entries, expected " + std::to_string(D));
-  if (options.N < 1) throw BadInput("`N = " + std::to_string(options.N) + "`: must be >= 1");
   const Model model = model_at(hopf.parameter);
-  const std::vector<double> taus = delays_of(model);
-  const double tau_max = *std::max_element(taus.begin(), taus.end());
   const double T0 = 2 * std::numbers::pi / hopf.omega;
-  const double steps = std::max(1.0, std::round(options.N * T0 / tau_max));
-  if (steps > 2.5e8) throw BadInput("`N = " + std::to_string(options.N) + "`: too many steps per period");
-  const int K = static_cast<int>(steps);
+  AutonomousOrbitOptions grid_of;  // K = round(N T0 / tau_max), as an orbit of unknown period lays it
+  grid_of.period_guess = T0;
+  grid_of.N = options.N;
+  const int K = autonomous_steps_per_period(model, grid_of);
   // c: Delta(i omega) c = 0 (the SVD in the library: compiled once, not per model)
   const Eigen::VectorXcd c =
       constant_history(model, Vec<D>(hopf.state)).null_vector(std::complex<double>(0, hopf.omega));

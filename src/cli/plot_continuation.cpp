@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -180,19 +181,19 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir)
                  "Re {/Symbol l} = 0", re1, stable});
   // continue_switch: the orbits born at each Hopf point, hopf_branch_K.csv with continue.json's
   // hopf_branches[K - 1]
+  if (!std::filesystem::exists(dir / "hopf_branch_1.csv")) return;
+  const bool has_json = std::filesystem::exists(dir / "continue.json");
+  const nlohmann::json doc = has_json ? read_json_file(dir / "continue.json") : nlohmann::json();
+  const JsonField j(doc, "continue.json", "");
+  const std::vector<JsonField> branches = has_json ? j.at("hopf_branches").elements() : std::vector<JsonField>{};
   for (int k = 1; std::filesystem::exists(dir / ("hopf_branch_" + std::to_string(k) + ".csv")); ++k) {
     const std::string name = "hopf_branch_" + std::to_string(k);
-    if (!std::filesystem::exists(dir / "continue.json")) {
-      orbit_branch_figures(renderer, dir / (name + ".csv"), nullptr, name, "Orbits from a Hopf point");
-      continue;
-    }
-    const nlohmann::json doc = read_json_file(dir / "continue.json");
-    const JsonField j(doc, "continue.json", "");
-    const std::vector<JsonField> branches = j.at("hopf_branches").elements();
-    if (branches.size() < static_cast<size_t>(k))
+    if (has_json && branches.size() < static_cast<size_t>(k))
       j.at("hopf_branches").fail("has " + std::to_string(branches.size()) + " entries, but " + name + ".csv exists");
-    const JsonField bifurcations = branches[static_cast<size_t>(k - 1)].at("bifurcations");
-    orbit_branch_figures(renderer, dir / (name + ".csv"), &bifurcations, name, "Orbits from a Hopf point");
+    const std::optional<JsonField> bifurcations =
+        has_json ? std::optional<JsonField>(branches[static_cast<size_t>(k - 1)].at("bifurcations")) : std::nullopt;
+    orbit_branch_figures(renderer, dir / (name + ".csv"), bifurcations ? &*bifurcations : nullptr, name,
+                         "Orbits from a Hopf point");
   }
 }
 

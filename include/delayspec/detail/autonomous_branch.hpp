@@ -76,9 +76,7 @@ class AutonomousBranch final : public BranchProblem {
     FloquetOptions floquet = o_.floquet;
     floquet.nev += 1;
     std::vector<std::complex<double>> mu = leading_multipliers(map.monodromy(U), floquet, krylov_seconds);
-    size_t trivial = 0;
-    for (size_t i = 1; i < mu.size(); ++i)
-      if (std::abs(mu[i] - 1.0) < std::abs(mu[trivial] - 1.0)) trivial = i;
+    const size_t trivial = trivial_multiplier_index(mu);
     if (!mu.empty()) point.trivial_multiplier = mu[trivial], mu.erase(mu.begin() + static_cast<long>(trivial));
     point.multipliers = std::move(mu);
     for (const auto& m : point.multipliers) point.unstable += std::abs(m) > 1;
@@ -88,8 +86,9 @@ class AutonomousBranch final : public BranchProblem {
 
  private:
   Map map_at(double p, double T) const { return detail::scaled_map(model_at_(p), T, K_, o_.step_options); }
-  Eigen::VectorXd residual(const Eigen::VectorXd& x, double T, double p, Eigen::SparseMatrix<double>* Fx) const {
-    return PeriodicOrbitProblem<Map>(map_at(p, T)).residual(x, Fx);
+  Eigen::VectorXd residual(const Model& model, const Eigen::VectorXd& x, double T,
+                           Eigen::SparseMatrix<double>* Fx) const {
+    return PeriodicOrbitProblem<Map>(detail::scaled_map(model, T, K_, o_.step_options)).residual(x, Fx);
   }
 
   // G, G_x, G_p at (x, T, p) (header comment), or false and the reason: a period <= 0, a residual
@@ -107,12 +106,13 @@ class AutonomousBranch final : public BranchProblem {
     }
     try {
       Eigen::SparseMatrix<double> Fx;
-      const Eigen::VectorXd F = residual(x, T, p, &Fx);
+      const Model model = model_at_(p);  // once for F and F_T
+      const Eigen::VectorXd F = residual(model, x, T, &Fx);
       const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * T;
-      const Eigen::VectorXd FT =
-          (residual(x, T + delta, p, nullptr) - residual(x, T - delta, p, nullptr)) / ((T + delta) - (T - delta));
+      const Eigen::VectorXd FT = (residual(model, x, T + delta, nullptr) - residual(model, x, T - delta, nullptr)) /
+                                 ((T + delta) - (T - delta));
       const Eigen::VectorXd Fp =
-          parameter_derivative([&](double q) { return residual(x, T, q, nullptr); }, p, F, range_);
+          parameter_derivative([&](double q) { return residual(model_at_(q), x, T, nullptr); }, p, F, range_);
       G.resize(n + 1);
       G << F, phase.dot(x) - phase_target;
       Gx = bordered_matrix(Fx, FT, phase, 0.0);

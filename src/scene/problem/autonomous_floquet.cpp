@@ -24,7 +24,7 @@ AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double pe
   AutonomousOrbitOptions o;
   o.period_guess = period_guess;
   o.N = N;
-  o.guess_periods = static_cast<int>(std::min<long>(orbit.guess_periods, 1'000'000));
+  o.guess_periods = static_cast<int>(orbit.guess_periods);
   o.newton = orbit.newton;
   o.step = step_options(problem);
   o.coarse_N = orbit.coarse_N;
@@ -42,9 +42,7 @@ AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double pe
   fo.nev = static_cast<int>(std::min<long>(solver.nev + 1, at.monodromy->rows()));
   level.result = floquet_multipliers(*at.monodromy, fo);
   const LevelResult all = level_result(level.result, at.monodromy->rows(), level.orbit.grid.K);
-  size_t trivial = 0;
-  for (size_t i = 1; i < all.multipliers.size(); ++i)
-    if (std::abs(all.multipliers[i] - 1.0) < std::abs(all.multipliers[trivial] - 1.0)) trivial = i;
+  const size_t trivial = trivial_multiplier_index(all.multipliers);
   level.trivial = all.multipliers.at(trivial);
   for (size_t i = 0; i < all.multipliers.size(); ++i)
     if (i != trivial) {
