@@ -1,5 +1,6 @@
 #include "delayspec/errors.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,13 +11,19 @@ namespace delayspec {
 
 std::string format_number(double value) {
   // The shortest text that reads back as the same double ("0.7", not "0.69999999999999996";
-  // "10", not "1e+01"): exact, and what a person would have typed.
+  // "10", not "1e+01"): exact, and what a person would have typed. Of the %.{1..17}g spellings
+  // that read back exactly, the shortest (the first of equal length). to_chars with a precision is
+  // %.*g and from_chars is strtod, both in the "C" locale, some ten times faster than snprintf and
+  // strtod: every key read records its value in this spelling (Config), thousands per command.
+  if (!std::isfinite(value)) return format_number(value, 1);
   char buffer[64];
   std::string best;
   for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
-    const bool exact = !std::isfinite(value) || std::strtod(buffer, nullptr) == value;
-    if (exact && (best.empty() || std::string(buffer).size() < best.size())) best = buffer;
+    const auto written = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general, digits);
+    double back = 0;
+    std::from_chars(buffer, written.ptr, back);
+    const auto length = static_cast<size_t>(written.ptr - buffer);
+    if (back == value && (best.empty() || length < best.size())) best.assign(buffer, length);
   }
   return best;
 }

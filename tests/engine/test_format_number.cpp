@@ -1,0 +1,72 @@
+// format_number(x): the shortest of the %.{1..17}g spellings of x that strtod reads back as x.
+// Checked against that definition computed here with the C library's own snprintf and strtod, on
+// doubles of every kind: random bit patterns (all exponents, subnormals), short decimals as a
+// person types them, integers and powers of ten around the %g switch to exponent notation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "delayspec/errors.hpp"
+
+namespace {
+
+std::string shortest_printf_spelling(double value) {
+  char buffer[64];
+  std::string best;
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+    const bool exact = !std::isfinite(value) || std::strtod(buffer, nullptr) == value;
+    if (exact && (best.empty() || std::string(buffer).size() < best.size())) best = buffer;
+  }
+  return best;
+}
+
+TEST(FormatNumber, IsTheShortestPrintfSpellingThatReadsBack) {
+  std::vector<double> values = {0.0,
+                                -0.0,
+                                0.7,
+                                0.1,
+                                1.0 / 3,
+                                10,
+                                100,
+                                1e4,
+                                1e5,
+                                123456789012.0,
+                                9007199254740993.0,
+                                1e-5,
+                                1e-4,
+                                2.5e-300,
+                                std::numeric_limits<double>::max(),
+                                std::numeric_limits<double>::min(),
+                                std::numeric_limits<double>::denorm_min(),
+                                std::numeric_limits<double>::epsilon(),
+                                std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity(),
+                                std::numeric_limits<double>::quiet_NaN()};
+  std::mt19937_64 rng(20261126);
+  for (int i = 0; i < 200000; ++i) {  // every bit pattern that is a finite double
+    const uint64_t bits = rng();
+    double x;
+    std::memcpy(&x, &bits, sizeof x);
+    if (std::isfinite(x)) values.push_back(x);
+  }
+  std::uniform_int_distribution<int> mantissa(-99999, 99999), exponent(-12, 12), digits(1, 5);
+  for (int i = 0; i < 100000; ++i)  // typed decimals: "0.25", "-3.125e-7", "40000"
+    values.push_back(std::strtod((std::to_string(mantissa(rng) % static_cast<int>(std::pow(10, digits(rng)))) +
+                                  "e" + std::to_string(exponent(rng)))
+                                     .c_str(),
+                                 nullptr));
+  for (int e = -20; e <= 20; ++e)
+    for (double m : {1.0, 2.0, 9.0, 12.0, 99.0, 1234.0}) values.push_back(m * std::pow(10.0, e));
+  for (double x : values) ASSERT_EQ(delayspec::format_number(x), shortest_printf_spelling(x)) << x;
+}
+
+}  // namespace
