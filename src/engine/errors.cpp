@@ -20,10 +20,11 @@ std::string format_number(double value) {
   std::string best;
   for (int digits = 1; digits <= 17; ++digits) {
     const auto written = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general, digits);
+    const auto length = static_cast<size_t>(written.ptr - buffer);
+    if (!best.empty() && length >= best.size()) continue;  // (no shorter: no need to read it back)
     double back = 0;
     std::from_chars(buffer, written.ptr, back);
-    const auto length = static_cast<size_t>(written.ptr - buffer);
-    if (back == value && (best.empty() || length < best.size())) best.assign(buffer, length);
+    if (back == value) best.assign(buffer, length);
   }
   return best;
 }
