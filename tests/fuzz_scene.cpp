@@ -27,7 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
     delayspec::cli::Config config = delayspec::cli::Config::from_scene_text(text, "fuzz.toml");
-    config.set_key_index(delayspec::cli::key_index());  // as run_command gives it
+    config.set_key_index(&delayspec::cli::key_index);  // as run_command gives it
     // Every key the scene gives, through every typed getter (each must throw BadInput or succeed).
     for (const auto& [key, value] : config.values()) {  // the getters below work on copies
       for (int getter = 0; getter < 4; ++getter) {

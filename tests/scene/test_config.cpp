@@ -41,7 +41,7 @@ std::string write_scene(const std::string& name, const std::string& text) {
 Config with(const std::string& key, const std::string& value) {
   Config c;
   c.set(key, value, "test");
-  c.set_key_index(delayspec::cli::key_index());
+  c.set_key_index(&delayspec::cli::key_index);
   return c;
 }
 
@@ -165,7 +165,7 @@ TEST(ConfigErrors, WithoutAKeyIndexTheKeyStoreKnowsNoCommand) {
   const std::string m = bad_input_message([&] { c.check_all_used(); });
   EXPECT_TRUE(contains(m, "unknown key `exponent`")) << m;
   EXPECT_FALSE(contains(m, "exponents")) << m;
-  c.set_key_index(delayspec::cli::key_index());
+  c.set_key_index(&delayspec::cli::key_index);
   const std::string indexed = bad_input_message([&] { c.check_all_used(); });
   EXPECT_TRUE(contains(indexed, "did you mean `exponents`?")) << indexed;
 }

@@ -154,7 +154,7 @@ void check_output_flags(const std::string& command, bool out_given, const std::s
 int run_command(Config& config, const Invocation& inv) {
   const CommandSpec& spec = command_spec(inv.command);
   config.set_reader(inv.command);
-  config.set_key_index(key_index());
+  config.set_key_index(&key_index);
   // Scene-level keys (for `run`): any command may be given a scene that has them.
   config.mark_used("analyses");
   config.mark_used("title");

@@ -403,7 +403,7 @@ std::string shortened(const std::string& text) {
 
 const KeyIndex& Config::key_index() const {
   static const KeyIndex none;
-  return key_index_ ? *key_index_ : none;
+  return key_index_ ? key_index_() : none;
 }
 
 void Config::check_all_used() const {

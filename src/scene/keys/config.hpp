@@ -70,8 +70,11 @@ class Config {
 
   // Which command reads which key, given by the command runner (run_command, from the key
   // registry): the key store calls no command. Without one (a Config used on its own), every key
-  // nobody read is unknown. The index must outlive the Config and its copies.
-  void set_key_index(const KeyIndex& index) { key_index_ = &index; }
+  // nobody read is unknown. Given as the function that builds it once per process, called only
+  // when a key is asked about: the registry probes every command with every model (some 2 ms),
+  // which a run whose keys are all read never needs.
+  using KeyIndexSource = const KeyIndex& (*)();
+  void set_key_index(KeyIndexSource index) { key_index_ = index; }
   const KeyIndex& key_index() const;
 
   // Keys read (or marked) so far.
@@ -124,7 +127,7 @@ class Config {
   mutable std::vector<Read> reads_;
   std::string reader_;
   bool collect_keys_only_ = false;
-  const KeyIndex* key_index_ = nullptr;
+  KeyIndexSource key_index_ = nullptr;
 };
 
 // "a, b,,c" -> {"a", "b", "", "c"}: a list value's items, split at commas and trimmed of blanks
