@@ -1,13 +1,16 @@
 // The run-time compilation of a model (equation_plugin.hpp), on a struct written here by hand in
 // the form the equation printer emits: x' = a x + b x(t - tau), the built-in linear model. What
 // is checked: the loaded analyses give the built-in model's multipliers; a second load is a
-// cache hit (counted compilations, not a clock); two threads loading a new model at once compile
+// cache hit (counted compilations, not a clock), and so is a later run of the same table found by
+// the table's record; two threads loading a new model at once compile
 // it once; a missing compiler, a compile error and an unwritable cache are BadInput.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <optional>
 #include <thread>
 
 #include "delayspec/builtin_analyses.hpp"
@@ -46,6 +49,9 @@ const char* kLinearCode = R"(struct EquationModel {
   Vector f_tt(int, double, const Vector&, const Vector&) const { return Vector::Zero(); }
 };)";
 
+// The table the code came from and what the scene layer keeps of it (here only its form matters).
+const TableRecord kRecord{"state = [ 'x' ]\nrhs = [ 'a*x + b*x_tau' ]", "state x\n"};
+
 class EquationPluginTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -67,9 +73,10 @@ std::vector<std::complex<double>> leading(const ModelAnalyses& analyses, int N) 
   return floquet_multipliers(*at.monodromy, options).multipliers;
 }
 
-TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInAndASecondLoadIsACacheHit) {
+TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInASecondLoadIsACacheHitAndItsTableFindsIt) {
+  EXPECT_FALSE(found_equation_plugin(kRecord.table_text, cache_));  // (an empty cache)
   const long before = equation_plugin_compilations();
-  const EquationPlugin plugin = load_equation_plugin(kLinearCode, cache_);
+  const EquationPlugin plugin = load_equation_plugin(kLinearCode, cache_, kRecord);
   EXPECT_EQ(equation_plugin_compilations(), before + 1);
   const double p[2] = {-1.0, 0.5};
   EXPECT_EQ(plugin.period(p), 1.0);
@@ -93,9 +100,36 @@ TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInAndASecondLoadIsACacheHit)
   // the compiled expressions, a few ulp per entry).
   for (size_t k = 0; k < a.size(); ++k) EXPECT_LE(std::abs(a[k] - b[k]), 1e-14 * std::abs(b[0])) << k;
 
-  const EquationPlugin again = load_equation_plugin(kLinearCode, cache_);
+  const EquationPlugin again = load_equation_plugin(kLinearCode, cache_, kRecord);
   EXPECT_EQ(equation_plugin_compilations(), before + 1);  // the cached object, not a compilation
   EXPECT_EQ(again.object, plugin.object);
+
+  // The table's record finds the object without the code (found_equation_plugin); another table,
+  // a record cut short and an object changed after its checksum was recorded find nothing (the
+  // caller then reads the table and compiles or loads by the code, as without a record). In this
+  // test, not its own: a test compiles a model for seconds.
+  const std::optional<FoundPlugin> hit = found_equation_plugin(kRecord.table_text, cache_);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->plugin.object, plugin.object);
+  EXPECT_EQ(hit->names, kRecord.names);
+  EXPECT_EQ(hit->plugin.period(p), 1.0);
+  EXPECT_FALSE(found_equation_plugin(kRecord.table_text + " ", cache_));
+
+  std::vector<std::filesystem::path> records;
+  for (const auto& entry : std::filesystem::directory_iterator(cache_))
+    if (entry.path().extension() == ".table") records.push_back(entry.path());
+  ASSERT_EQ(records.size(), 1u);
+  const auto contents = [](const std::filesystem::path& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string whole = contents(records[0]);
+  std::ofstream(records[0], std::ios::trunc) << whole.substr(0, whole.size() / 2);
+  EXPECT_FALSE(found_equation_plugin(kRecord.table_text, cache_));
+  std::ofstream(records[0], std::ios::trunc) << whole;
+  ASSERT_TRUE(found_equation_plugin(kRecord.table_text, cache_));
+  std::ofstream(plugin.object, std::ios::app) << '\0';  // the object's bytes no longer its checksum's
+  EXPECT_FALSE(found_equation_plugin(kRecord.table_text, cache_));
 }
 
 TEST_F(EquationPluginTest, ConcurrentFirstLoadsCompileOnce) {
@@ -103,8 +137,8 @@ TEST_F(EquationPluginTest, ConcurrentFirstLoadsCompileOnce) {
   const std::string code = std::string("// concurrent\n") + kLinearCode;
   const long before = equation_plugin_compilations();
   EquationPlugin first, second;
-  std::thread t1([&] { first = load_equation_plugin(code, cache_); });
-  std::thread t2([&] { second = load_equation_plugin(code, cache_); });
+  std::thread t1([&] { first = load_equation_plugin(code, cache_, kRecord); });
+  std::thread t2([&] { second = load_equation_plugin(code, cache_, kRecord); });
   t1.join();
   t2.join();
   EXPECT_EQ(equation_plugin_compilations(), before + 1);
@@ -120,8 +154,8 @@ TEST_F(EquationPluginTest, TwoModelsInOneProcessAreTwoObjects) {
   std::string other = kLinearCode;
   const std::string period = "static double period_of(const double*) { return 1.0; }";
   other.replace(other.find(period), period.size(), "static double period_of(const double*) { return 2.0; }");
-  const EquationPlugin first = load_equation_plugin(kLinearCode, cache_);
-  const EquationPlugin second = load_equation_plugin(other, cache_);
+  const EquationPlugin first = load_equation_plugin(kLinearCode, cache_, kRecord);
+  const EquationPlugin second = load_equation_plugin(other, cache_, kRecord);
   const double p[2] = {-1.0, 0.5};
   EXPECT_EQ(first.period(p), 1.0);
   EXPECT_EQ(second.period(p), 2.0);
@@ -130,7 +164,7 @@ TEST_F(EquationPluginTest, TwoModelsInOneProcessAreTwoObjects) {
 
 TEST_F(EquationPluginTest, ACompileErrorIsBadInputWithTheCompilersFirstLines) {
   try {
-    load_equation_plugin("struct EquationModel { this is not C++ };", cache_);
+    load_equation_plugin("struct EquationModel { this is not C++ };", cache_, kRecord);
     FAIL() << "no BadInput";
   } catch (const BadInput& e) {
     const std::string what = e.what();
@@ -144,7 +178,7 @@ TEST_F(EquationPluginTest, NoCompilerIsBadInputNamingThePackage) {
   const std::string saved = old ? old : "";
   ::setenv("DELAYSPEC_CXX", "/nonexistent/g++", 1);
   try {
-    load_equation_plugin(kLinearCode, cache_);
+    load_equation_plugin(kLinearCode, cache_, kRecord);
     ADD_FAILURE() << "no BadInput";
   } catch (const BadInput& e) {
     const std::string what = e.what();
@@ -159,7 +193,7 @@ TEST_F(EquationPluginTest, AnUnusableCacheDirectoryIsBadInput) {
   std::filesystem::create_directories(cache_);
   const std::filesystem::path file = cache_ / "a-file";
   { std::ofstream(file) << "x"; }
-  EXPECT_THROW(load_equation_plugin(kLinearCode, file / "cache"), BadInput);
+  EXPECT_THROW(load_equation_plugin(kLinearCode, file / "cache", kRecord), BadInput);
 }
 
 }  // namespace

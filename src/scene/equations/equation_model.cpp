@@ -4,6 +4,8 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <optional>
+#include <sstream>
 
 #include <toml++/toml.h>
 
@@ -48,12 +50,97 @@ std::vector<double> constants_at(const EquationModelSource& source, const std::v
   return source.constants(p);
 }
 
-const EquationPlugin& compiled(const EquationModelSource& source, const std::filesystem::path& cache_dir) {
+// What this layer needs of a model besides its compiled code: the names of keys, columns and
+// messages, and the parameters' defaults. From the table read by GiNaC, or from the record kept
+// beside the compiled model (TableRecord), so that a cached model costs no symbolic work.
+struct EquationNames {
+  std::vector<std::string> state, parameters, delays, delayed;
+  std::vector<double> parameter_defaults;
+  bool written_with_delays = false;
+};
+
+EquationNames names_of(const EquationModelSource& source) {
+  return {source.state, source.parameters, source.delays, source.delayed, source.parameter_defaults,
+          source.written_with_delays};
+}
+
+// The record's text: a line per list, "NAME ITEM ITEM ...", the defaults in the shortest exact
+// spelling. Every name is an identifier (the table's reader checks them).
+std::string names_text(const EquationNames& n) {
+  std::string text;
+  const auto line = [&](const char* name, const std::vector<std::string>& items) {
+    text += name;
+    for (const auto& item : items) text += " " + item;
+    text += "\n";
+  };
+  line("state", n.state);
+  line("parameters", n.parameters);
+  std::vector<std::string> defaults;
+  for (double v : n.parameter_defaults) defaults.push_back(format_number(v));
+  line("defaults", defaults);
+  line("delays", n.delays);
+  line("delayed", n.delayed);
+  line("written_with_delays", {n.written_with_delays ? "1" : "0"});
+  return text;
+}
+
+// names_text read back; nothing when the text is not what names_text writes.
+std::optional<EquationNames> names_from_text(const std::string& text) {
+  std::map<std::string, std::vector<std::string>> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string name;
+    words >> name;
+    for (std::string item; words >> item;) lines[name].push_back(item);
+  }
+  EquationNames n{lines["state"], lines["parameters"], lines["delays"], lines["delayed"], {}, false};
+  for (const auto& v : lines["defaults"]) {
+    char* end = nullptr;
+    n.parameter_defaults.push_back(std::strtod(v.c_str(), &end));
+    if (*end != '\0') return std::nullopt;
+  }
+  const auto& flag = lines["written_with_delays"];
+  n.written_with_delays = flag == std::vector<std::string>{"1"};
+  if (n.state.empty() || n.parameter_defaults.size() != n.parameters.size() ||
+      n.delayed.size() != n.state.size() * n.delays.size() || flag.size() != 1)
+    return std::nullopt;
+  return n;
+}
+
+struct LoadedEquations {
+  const EquationPlugin* plugin;
+  EquationNames names;
+};
+
+// The model compiled before from this table (found_equation_plugin), once per process and cache
+// directory; nothing when this program has not compiled it into `cache_dir`.
+std::optional<LoadedEquations> found(const std::string& table_text, const std::filesystem::path& cache_dir) {
+  static std::map<std::string, std::optional<LoadedEquations>> known;
+  static std::map<std::string, EquationPlugin> plugins;  // (never moved: the results point here)
+  const std::lock_guard<std::mutex> lock(equations_mutex());
+  const std::string key = cache_dir.string() + '\n' + table_text;
+  if (auto it = known.find(key); it != known.end()) return it->second;
+  std::optional<LoadedEquations> result;
+  try {
+    if (std::optional<FoundPlugin> hit = found_equation_plugin(table_text, cache_dir))
+      if (std::optional<EquationNames> names = names_from_text(hit->names))
+        result = LoadedEquations{&(plugins[key] = hit->plugin), *names};
+  } catch (const BadInput&) {
+    // No compiler, an unusable cache, an object that cannot be loaded: the table is read, and
+    // its constants checked, first; the compile then says the same (as without a record).
+  }
+  // A miss too: this process reads the table with GiNaC and compiles it, once (generated(), compiled()).
+  return known[key] = result;
+}
+
+const EquationPlugin& compiled(const EquationModelSource& source, const std::string& table_text,
+                               const std::filesystem::path& cache_dir) {
   static std::map<std::string, EquationPlugin> plugins;
   const std::lock_guard<std::mutex> lock(equations_mutex());
   const std::string key = cache_dir.string() + '\n' + source.code;
   if (auto it = plugins.find(key); it != plugins.end()) return it->second;
-  return plugins[key] = load_equation_plugin(source.code, cache_dir);
+  return plugins[key] = load_equation_plugin(source.code, cache_dir, {table_text, names_text(names_of(source))});
 }
 
 // The plugin's analyses (compiled from the equations), with a failure at a step that is not
@@ -61,9 +148,9 @@ const EquationPlugin& compiled(const EquationModelSource& source, const std::fil
 // model (NonFiniteStep), GiNaC says which term is not finite there. Only failures pay for it.
 class ExplainedAnalyses final : public ModelAnalyses {
  public:
-  ExplainedAnalyses(std::unique_ptr<const ModelAnalyses> inner, const EquationModelSource& source,
+  ExplainedAnalyses(std::unique_ptr<const ModelAnalyses> inner, std::string table_text, EquationNames names,
                     std::vector<double> p)
-      : inner_(std::move(inner)), source_(source), p_(std::move(p)) {}
+      : inner_(std::move(inner)), table_text_(std::move(table_text)), names_(std::move(names)), p_(std::move(p)) {}
 
   int state_dimension() const override { return inner_->state_dimension(); }
   bool switches_in_state() const override { return inner_->switches_in_state(); }
@@ -136,18 +223,21 @@ class ExplainedAnalyses final : public ModelAnalyses {
   std::string explanation(const NonFiniteStep& e) const {
     std::string text = e.what();
     bool named = false;
+    // The table read again by GiNaC (a cached model was loaded without it). It passed every
+    // check when it was compiled, so no key needs reserving (the index stays unbuilt).
+    const EquationModelSource& source = generated(table_text_, KeyIndex{});
     for (const ModelPoint& point : e.points()) {
       std::vector<std::string> terms;
       {
         const std::lock_guard<std::mutex> lock(equations_mutex());
-        terms = source_.terms_not_finite(point.t, point.y, point.y_tau, p_);
+        terms = source.terms_not_finite(point.t, point.y, point.y_tau, p_);
       }
       if (terms.empty()) continue;
       text += "; at t = " + format_number(point.t);
-      for (size_t i = 0; i < source_.state.size() && i < point.y.size(); ++i)
-        text += ", " + source_.state[i] + " = " + format_number(point.y[i]);
-      for (size_t a = 0; a < source_.delayed.size() && a < point.y_tau.size(); ++a)
-        text += ", " + source_.delayed[a] + " = " + format_number(point.y_tau[a]);
+      for (size_t i = 0; i < names_.state.size() && i < point.y.size(); ++i)
+        text += ", " + names_.state[i] + " = " + format_number(point.y[i]);
+      for (size_t a = 0; a < names_.delayed.size() && a < point.y_tau.size(); ++a)
+        text += ", " + names_.delayed[a] + " = " + format_number(point.y_tau[a]);
       for (size_t i = 0; i < terms.size(); ++i) text += (i ? "; " : ": ") + terms[i];
       named = true;
       break;  // the first point the step evaluated where a term is not finite
@@ -161,14 +251,15 @@ class ExplainedAnalyses final : public ModelAnalyses {
   }
 
   std::shared_ptr<const ModelAnalyses> inner_;
-  const EquationModelSource& source_;  // never destroyed (generated())
+  std::string table_text_;
+  EquationNames names_;
   std::vector<double> p_;
 };
 
 // The item of delay k in messages: equations.delay for a model written with `delay`, else
 // equations.delays.NAME.
-std::string delay_item(const EquationModelSource& source, size_t k) {
-  return source.written_with_delays ? "equations.delays." + source.delays[k] : "equations.delay";
+std::string delay_item(const EquationNames& names, size_t k) {
+  return names.written_with_delays ? "equations.delays." + names.delays[k] : "equations.delay";
 }
 
 double positive_value(const std::string& item, double value) {
@@ -198,18 +289,19 @@ EquationModel read_equation_model(Config& config,
                    ": a scene may not choose where compiled models are loaded from; give it on the command line " +
                    "(--set model_cache=DIR), as a Python keyword, or through XDG_CACHE_HOME");
   const std::filesystem::path cache_dir = config.get_string("model_cache", default_model_cache().string());
-  const EquationModelSource& src = generated(text, config.key_index());
-  std::vector<double> p(src.parameters.size());
+  // A table this program compiled before is found by its text (found_equation_plugin): no GiNaC
+  // and no key index, a few milliseconds. The first run of a table reads it with GiNaC, checks
+  // all it can before the compile (seconds), compiles and records it.
+  std::optional<LoadedEquations> loaded = found(text, cache_dir);
+  const bool was_compiled = loaded.has_value();
+  const EquationModelSource* src = was_compiled ? nullptr : &generated(text, config.key_index());
+  const EquationNames names = was_compiled ? loaded->names : names_of(*src);
+  std::vector<double> p(names.parameters.size());
   for (size_t k = 0; k < p.size(); ++k) {
-    p[k] = config.get_double(src.parameters[k], src.parameter_defaults[k]);
-    require_finite(src.parameters[k].c_str(), p[k]);
+    p[k] = config.get_double(names.parameters[k], names.parameter_defaults[k]);
+    require_finite(names.parameters[k].c_str(), p[k]);
   }
-
-  // Everything that can be checked without the compiled model is checked before the compile
-  // (seconds): the constant expressions, and the grid they give with N.
-  const std::vector<double> constants = constants_at(src, p);
-  const size_t n = src.delays.size();
-  const double period_exact = positive_value("equations.period", constants[0]);
+  const size_t n = names.delays.size();
   const bool delay_from_ratio = config.has("tau_over_T");
   if (delay_from_ratio) {
     require_positive("tau_over_T", config.get_double("tau_over_T", 1));
@@ -217,40 +309,50 @@ EquationModel read_equation_model(Config& config,
       throw BadInput("`tau_over_T`: sets the one delay of a model; this model has " + std::to_string(n) +
                      " (equations.delays): set the parameters its delays depend on instead");
   }
-  // The delays at these parameters, from `values` (the constants' GiNaC values, or the compiled
-  // model's): each > 0 and finite, named.
-  const auto delays_from = [&](std::vector<double> values, double period) {
-    if (delay_from_ratio) return std::vector<double>{config.get_double("tau_over_T", 1) * period};
-    for (size_t k = 0; k < n; ++k)
-      positive_value(delay_item(src, k), values[k]);
-    return values;
+  // The period, delays and history at these parameters, from `constants` (period, delays,
+  // history: GiNaC's values, or the compiled model's), each checked and named.
+  const auto period_from = [&](const std::vector<double>& constants) {
+    return positive_value("equations.period", constants[0]);
   };
-  const std::vector<double> taus_exact =
-      delays_from(std::vector<double>(constants.begin() + 1, constants.begin() + 1 + static_cast<long>(n)), period_exact);
-  for (size_t i = 0; i < src.state.size(); ++i)
-    if (!std::isfinite(constants[1 + n + i]))
-      throw BadInput("`equations.history." + src.state[i] + "` is not a finite number at these parameters");
+  const auto delays_from = [&](const std::vector<double>& constants) {
+    if (delay_from_ratio) return std::vector<double>{config.get_double("tau_over_T", 1) * period_from(constants)};
+    for (size_t k = 0; k < n; ++k) positive_value(delay_item(names, k), constants[1 + k]);
+    return std::vector<double>(constants.begin() + 1, constants.begin() + 1 + static_cast<long>(n));
+  };
+  const auto history_from = [&](const std::vector<double>& constants) {
+    const std::vector<double> history(constants.begin() + 1 + static_cast<long>(n), constants.end());
+    for (size_t i = 0; i < history.size(); ++i)
+      if (!std::isfinite(history[i]))
+        throw BadInput("`equations.history." + names.state[i] + "` evaluates to " + format_number(history[i]) +
+                       " at these parameters: must be finite");
+    return history;
+  };
   std::vector<std::string> delay_items;
   for (size_t k = 0; k < n; ++k)  // (append: GCC 12 warns falsely on "`" + string, -Wrestrict)
-    delay_items.push_back(std::string("`").append(delay_item(src, k)).append("`"));
-  check_grid(taus_exact, delay_items, period_exact);
-
-  const EquationPlugin& plugin = compiled(src, cache_dir);
-  const double period = positive_value("equations.period", plugin.period(p.data()));
-  std::vector<double> compiled_taus(n);
-  plugin.delays(p.data(), compiled_taus.data());
-  const std::vector<double> taus = delays_from(compiled_taus, period);
-  std::vector<double> history(src.state.size());
-  plugin.history(p.data(), history.data());
-  for (size_t i = 0; i < history.size(); ++i)
-    if (!std::isfinite(history[i]))
-      throw BadInput("`equations.history." + src.state[i] + "` evaluates to " + format_number(history[i]) +
-                     " at these parameters: must be finite");
+    delay_items.push_back(std::string("`").append(delay_item(names, k)).append("`"));
+  if (!was_compiled) {
+    // Everything that can be checked without the compiled model is checked before the compile
+    // (seconds): the constant expressions, and the grid they give with N.
+    const std::vector<double> exact = constants_at(*src, p);
+    history_from(exact);
+    check_grid(delays_from(exact), delay_items, period_from(exact));
+    loaded = LoadedEquations{&compiled(*src, text, cache_dir), names};
+  }
+  const EquationPlugin& plugin = *loaded->plugin;
+  std::vector<double> constants(1 + n + names.state.size());
+  constants[0] = plugin.period(p.data());
+  plugin.delays(p.data(), constants.data() + 1);
+  plugin.history(p.data(), constants.data() + 1 + n);
+  const double period = period_from(constants);
+  const std::vector<double> taus = delays_from(constants);
+  const std::vector<double> history = history_from(constants);
+  if (was_compiled) check_grid(taus, delay_items, period);
   EquationModel model;
-  model.state = src.state;
-  model.parameters = src.parameters;
+  model.state = names.state;
+  model.parameters = names.parameters;
   model.analyses = std::make_shared<const ExplainedAnalyses>(
-      std::unique_ptr<const ModelAnalyses>(plugin.analyses(p.data(), taus.data(), period, history.data())), src, p);
+      std::unique_ptr<const ModelAnalyses>(plugin.analyses(p.data(), taus.data(), period, history.data())), text,
+      names, p);
   return model;
 }
 

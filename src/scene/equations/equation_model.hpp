@@ -2,7 +2,8 @@
 // model = equations: a model written in the scene's [equations] table (docs/models.md). The
 // table is checked, differentiated and printed as C++ by GiNaC (src/modules/equations, a module loaded
 // on first use: equations_module_loader.hpp), then compiled at run time and loaded
-// (equation_plugin.hpp). Its parameters are keys like those of
+// (equation_plugin.hpp); a table compiled before is found by its text, without GiNaC (the
+// record kept beside the object). Its parameters are keys like those of
 // any model (`--set k=0.3`, sweep_key, chart_x), read here with the table's values as defaults,
 // so a new parameter value never recompiles. The delay is the `delay` expression, or
 // tau_over_T times the period when that key is given.

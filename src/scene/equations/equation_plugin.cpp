@@ -275,13 +275,10 @@ EquationPlugin plugin_of(const detail::SharedObject& model, const std::filesyste
   return plugin;
 }
 
-// The cached model NAME, when the cache holds it whole: its source equal to `source`, its object
-// with the checksum recorded when it was compiled. Nothing when any part is missing or differs
-// (the caller compiles it anew); BadInput when the object passes its checksum but cannot be loaded.
-std::optional<EquationPlugin> cached_plugin(const ModelCacheDir& cache, const std::string& name,
-                                            const std::string& source) {
-  const std::optional<std::string> stored_source = cache.read_entry(name + ".cpp");
-  if (!stored_source || *stored_source != source) return std::nullopt;
+// The cached object NAME.so, when its bytes are those whose checksum was recorded when this
+// program compiled it. Nothing when any part is missing or differs; BadInput when the object
+// passes its checksum but cannot be loaded.
+std::optional<EquationPlugin> cached_object(const ModelCacheDir& cache, const std::string& name) {
   const std::optional<std::string> recorded = cache.read_entry(name + ".sum");
   if (!recorded) return std::nullopt;
   UniqueFd object = cache.open_entry(name + ".so");
@@ -292,6 +289,29 @@ std::optional<EquationPlugin> cached_plugin(const ModelCacheDir& cache, const st
     throw BadInput("equations: the cached model " + cache.entry_path(name + ".so").string() +
                    " cannot be loaded (" + model.error() + "): delete it");
   return plugin_of(model, cache.entry_path(name + ".so"));
+}
+
+// The cached model NAME, when the cache holds it whole: its source equal to `source` (so not even
+// a hash collision loads another model) and its object as cached_object checks it. Nothing when
+// any part is missing or differs (the caller compiles it anew).
+std::optional<EquationPlugin> cached_plugin(const ModelCacheDir& cache, const std::string& name,
+                                            const std::string& source) {
+  const std::optional<std::string> stored_source = cache.read_entry(name + ".cpp");
+  if (!stored_source || *stored_source != source) return std::nullopt;
+  return cached_object(cache, name);
+}
+
+// The record of a table this program compiled (TableRecord): the entry tx-HASH.table, HASH of the
+// toolchain's identity (which holds this program's revision, hence its checks of a table) and the
+// table's text. It holds the object's name, the table's text (compared on a hit, as the source
+// is) and the scene layer's names.
+std::string table_entry(const Toolchain& tc, const std::string& table_text) {
+  return "tx-" + hash_hex(tc.identity + "\n" + table_text) + ".table";
+}
+
+void record_table(const ModelCacheDir& cache, const Toolchain& tc, const std::string& name, const TableRecord& r) {
+  cache.write_entry(table_entry(tc, r.table_text),
+                    name + "\n" + std::to_string(r.table_text.size()) + "\n" + r.table_text + "\n" + r.names);
 }
 
 // The time a compile may take: DELAYSPEC_COMPILE_TIMEOUT seconds, default 600 (a large model
@@ -380,7 +400,32 @@ EquationPlugin compile_plugin(const Toolchain& tc, const ModelCacheDir& cache, c
 
 long equation_plugin_compilations() { return compilations.load(); }
 
-EquationPlugin load_equation_plugin(const std::string& model_code, const std::filesystem::path& cache_dir) {
+std::optional<FoundPlugin> found_equation_plugin(const std::string& table_text, const std::filesystem::path& cache_dir) {
+  const Toolchain tc = toolchain();
+  const ModelCacheDir cache(cache_dir);
+  const std::optional<std::string> record = cache.read_entry(table_entry(tc, table_text));
+  if (!record) return std::nullopt;
+  // NAME "\n" SIZE "\n" TABLE "\n" NAMES; anything else is no record (the caller reads the table and
+  // records it again).
+  const size_t name_end = record->find('\n');
+  const std::string name = record->substr(0, name_end);
+  if (name_end == std::string::npos || name.size() != 19 || name.compare(0, 3, "eq-") != 0 ||
+      name.find_first_not_of("0123456789abcdef", 3) != std::string::npos)
+    return std::nullopt;
+  const size_t size_end = record->find('\n', name_end + 1);
+  if (size_end == std::string::npos) return std::nullopt;
+  const std::string size_text = record->substr(name_end + 1, size_end - name_end - 1);
+  const size_t names_start = size_end + 1 + table_text.size() + 1;
+  if (size_text != std::to_string(table_text.size()) || record->compare(size_end + 1, table_text.size(), table_text) != 0 ||
+      record->size() < names_start || (*record)[names_start - 1] != '\n')
+    return std::nullopt;
+  std::optional<EquationPlugin> plugin = cached_object(cache, name);
+  if (!plugin) return std::nullopt;
+  return FoundPlugin{*plugin, record->substr(names_start)};
+}
+
+EquationPlugin load_equation_plugin(const std::string& model_code, const std::filesystem::path& cache_dir,
+                                    const TableRecord& record) {
   const Toolchain tc = toolchain();
   const std::string source = plugin_source(model_code);
   const std::string name = "eq-" + hash_hex(tc.identity + source);
@@ -389,7 +434,10 @@ EquationPlugin load_equation_plugin(const std::string& model_code, const std::fi
   // the others wait and load its object. A read-only cache has no lock to take and can only serve
   // what it holds.
   const UniqueFd lock = cache.lock(name + ".lock");
-  if (auto hit = cached_plugin(cache, name, source)) return *hit;
+  if (auto hit = cached_plugin(cache, name, source)) {
+    if (lock) record_table(cache, tc, name, record);  // (a read-only cache is served as it is)
+    return *hit;
+  }
   if (!lock)
     throw BadInput("`model_cache = " + cache_dir.string() +
                    "`: the directory is read-only and does not hold this model compiled: choose a writable one");
@@ -400,6 +448,7 @@ EquationPlugin load_equation_plugin(const std::string& model_code, const std::fi
   cache.write_entry(name + ".cpp", source);
   cache.remove_entry(name + ".sum");  // an object without its record is never loaded
   EquationPlugin plugin = compile_plugin(tc, cache, name);
+  record_table(cache, tc, name, record);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cerr << "delayspec: compiled the equations model in " << format_number(std::round(seconds * 10) / 10)
             << " s (cached: " << plugin.object.string() << ")\n";

@@ -8,7 +8,7 @@
 //
 // Cache (model_cache.hpp: a directory private to the user, entries never opened through a link):
 // DIR/eq-HASH.so beside its source DIR/eq-HASH.cpp, its checksum DIR/eq-HASH.sum and the
-// compiler's log DIR/eq-HASH.log. HASH covers the source, delayspec's version and revision, the
+// compiler's log DIR/eq-HASH.log; DIR/tx-HASH2.table records which object a table's text gave. HASH covers the source, delayspec's version and revision, the
 // compiler (path, size, time), the library it links (path, size, time) and the contents of
 // delayspec's headers it is compiled against. A hit needs the stored source equal to this one (so
 // not even a hash collision loads another model) and the object's bytes equal to the checksum
@@ -19,6 +19,7 @@
 // with delayspec and within a time limit (child_process.hpp). A loaded object is never unloaded
 // (its code runs the analyses it made).
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,7 +45,25 @@ struct EquationPlugin {
 // (naming the Debian package), when the code does not compile (with the compiler's first lines)
 // and when the cache cannot be written or the object not loaded. Reports on stderr when it
 // compiles, and how long that took.
-EquationPlugin load_equation_plugin(const std::string& model_code, const std::filesystem::path& cache_dir);
+// `record` is kept beside the object (DIR/tx-HASH.table), so that a later run of the same table
+// finds the model by found_equation_plugin, without GiNaC.
+struct TableRecord {
+  std::string table_text;  // the [equations] table as the scene gave it
+  std::string names;       // what the caller needs of the model besides its code, as text
+};
+EquationPlugin load_equation_plugin(const std::string& model_code, const std::filesystem::path& cache_dir,
+                                    const TableRecord& record);
+
+// The model this program compiled from the table `table_text` into `cache_dir` (same program,
+// compiler, library and headers: the entry's hash), with the names recorded then: found from the
+// table's text alone, so a cached model costs no symbolic work. The object is checked as a cache
+// hit of load_equation_plugin is. Nothing when there is no such record or any part of it or of
+// the object is missing or differs: the caller reads the table and loads the model as above.
+struct FoundPlugin {
+  EquationPlugin plugin;
+  std::string names;  // TableRecord::names
+};
+std::optional<FoundPlugin> found_equation_plugin(const std::string& table_text, const std::filesystem::path& cache_dir);
 
 // The headers a model is compiled against, for the library in `libdir`: the build tree's include
 // paths (compiled in) when libdir is this build's, else an installed delayspec's LIBDIR/../include,
