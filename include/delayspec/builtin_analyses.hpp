@@ -9,6 +9,7 @@
 #include "delayspec/model_mackey_glass.hpp"
 #include "delayspec/model_mathieu.hpp"
 #include "delayspec/model_milling.hpp"
+#include "delayspec/model_milling_variable_pitch.hpp"
 
 namespace delayspec {
 
@@ -17,6 +18,7 @@ extern template class ModelAnalysesFor<LinearModel>;
 extern template class ModelAnalysesFor<MathieuModel>;
 extern template class ModelAnalysesFor<MackeyGlassModel>;
 extern template class ModelAnalysesFor<MillingModel>;
+extern template class ModelAnalysesFor<VariablePitchMillingModel>;
 
 template <class Model>
 std::shared_ptr<const ModelAnalyses> builtin_analyses(const Model& model) {

@@ -102,7 +102,7 @@ Eigen::MatrixXd van_loan_exponential(const Mat<D>& A, double dt, int levels) {
 }  // namespace detail
 
 // The dense monodromy of the classic discretisation with m steps per period. BadInput when the
-// model is not linear, tau != T, or m < 2.
+// model is not linear, has several delays, tau != T, or m < 2.
 template <class Model>
 Eigen::MatrixXd classic_monodromy(const Model& model, int m, ClassicMethod method) {
   constexpr int D = Model::d;
@@ -110,6 +110,9 @@ Eigen::MatrixXd classic_monodromy(const Model& model, int m, ClassicMethod metho
   using V = Vec<D>;
   if constexpr (!Model::is_linear) {
     throw BadInput("the classic discretisations (sdm0, fdm1) need a linear model");
+  } else if constexpr (delay_count_of<Model>() > 1) {
+    throw BadInput("the classic discretisations (sdm0, fdm1) take one delay (this model has " +
+                   std::to_string(delay_count_of<Model>()) + ")");
   } else {
     const double T = model.period();
     if (std::abs(model.tau() - T) > 1e-12 * T)

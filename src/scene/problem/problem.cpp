@@ -61,7 +61,9 @@ MackeyGlassModel read_mackey_glass(Config& c) {
   return MackeyGlassModel(p);
 }
 
-MillingModel read_milling(Config& c) {
+// Equal pitch unless `pitch_angles` gives unequal spacings (VariablePitchMillingModel); angles all
+// equal are the equal-pitch tool, the same model as without them.
+AnyModel read_milling(Config& c) {
   MillingParameters p;
   p.spindle_rpm = c.get_double("spindle_rpm", p.spindle_rpm);
   p.depth = c.get_double("depth", p.depth);
@@ -77,6 +79,12 @@ MillingModel read_milling(Config& c) {
   p.direction = c.get_choice("milling", "down", {"down", "up"}) == "up" ? MillingDirection::up : MillingDirection::down;
   p.x0 = c.get_double("x0", p.x0);
   p.v0 = c.get_double("v0", p.v0);
+  p.pitch_angles = c.get_double_list("pitch_angles", "equal pitch");
+  if (p.pitch_angles.empty()) return MillingModel(p);
+  if (!c.has("teeth")) p.teeth = static_cast<int>(std::min<size_t>(p.pitch_angles.size(), MillingModel::kMaxTeeth + 1));
+  const VariablePitchMillingModel variable(p);  // (checks the angles against the teeth)
+  if (variable.distinct_pitches() > 1) return variable;
+  p.pitch_angles.clear();
   return MillingModel(p);
 }
 
@@ -126,7 +134,7 @@ const std::vector<BuiltinModel>& builtin_models() {
       {"linear", [](Config& c) -> AnyModel { return read_linear(c); }, false, {"x"}},
       {"mathieu", [](Config& c) -> AnyModel { return read_mathieu(c); }, true, {"x", "v"}},
       {"mackey-glass", [](Config& c) -> AnyModel { return read_mackey_glass(c); }, false, {"x"}},
-      {"milling", [](Config& c) -> AnyModel { return read_milling(c); }, true, {"x", "v"}},
+      {"milling", read_milling, true, {"x", "v"}},
   };
   return table;
 }

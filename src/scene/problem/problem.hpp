@@ -21,12 +21,14 @@
 #include "delayspec/model_mathieu.hpp"
 #include "delayspec/model_analyses.hpp"
 #include "delayspec/model_milling.hpp"
+#include "delayspec/model_milling_variable_pitch.hpp"
 #include "delayspec/stepper.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec::cli {
 
-using AnyModel = std::variant<ImpactModel, LinearModel, MathieuModel, MackeyGlassModel, MillingModel>;
+using AnyModel =
+    std::variant<ImpactModel, LinearModel, MathieuModel, MackeyGlassModel, MillingModel, VariablePitchMillingModel>;
 
 struct Problem {
   std::string model_name;
