@@ -104,12 +104,12 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
       {"eps", "Mathieu: amplitude of the periodic stiffness eps cos t"},
       {"gamma", "mackey-glass: decay rate"},
       {"n", "mackey-glass: exponent of the nonlinearity x_tau^n"},
-      {"spindle_rpm", "milling: spindle speed Omega (rpm); tau = T = 60 / (teeth Omega)"},
+      {"spindle_rpm", "milling: spindle speed Omega (rpm); equal pitch: tau = T = 60 / (teeth Omega)"},
       {"depth", "milling: axial depth of cut a_p (m), >= 0"},
       {"radial_immersion", "milling: radial immersion a/D, in (0, 1]"},
       {"teeth", "milling: number of teeth N_t, 1 to 30"},
-      {"pitch_angles", "milling: degrees from each tooth to the next (teeth of them, sum 360): a variable-pitch "
-                       "cutter, one delay per distinct spacing (at most 4); default equal pitch"},
+      {"pitch_angles", "milling: degrees from each tooth to the next, teeth of them summing to 360 (variable pitch: "
+                       "one delay per distinct spacing, at most 4)"},
       {"Kt", "milling: tangential cutting coefficient (N/m^2)"},
       {"Kn", "milling: normal cutting coefficient (N/m^2)"},
       {"omega_n", "milling: natural angular frequency (rad/s)"},

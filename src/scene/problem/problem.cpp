@@ -71,6 +71,7 @@ AnyModel read_milling(Config& c) {
   // The model names the allowed range (1..kMaxTeeth) in its own message; the wide range here
   // only keeps the cast safe.
   p.teeth = static_cast<int>(c.get_int_in_range("teeth", p.teeth, 1, MillingModel::kMaxTeeth));
+  p.pitch_angles = c.get_double_list("pitch_angles", "equal");
   p.Kt = c.get_double("Kt", p.Kt);
   p.Kn = c.get_double("Kn", p.Kn);
   p.omega_n = c.get_double("omega_n", p.omega_n);
@@ -79,7 +80,6 @@ AnyModel read_milling(Config& c) {
   p.direction = c.get_choice("milling", "down", {"down", "up"}) == "up" ? MillingDirection::up : MillingDirection::down;
   p.x0 = c.get_double("x0", p.x0);
   p.v0 = c.get_double("v0", p.v0);
-  p.pitch_angles = c.get_double_list("pitch_angles", "equal pitch");
   if (p.pitch_angles.empty()) return MillingModel(p);
   if (!c.has("teeth")) p.teeth = static_cast<int>(std::min<size_t>(p.pitch_angles.size(), MillingModel::kMaxTeeth + 1));
   const VariablePitchMillingModel variable(p);  // (checks the angles against the teeth)
