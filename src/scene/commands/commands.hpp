@@ -30,6 +30,7 @@ int command_basin(Config& config, const Invocation& inv);
 int command_plot(Config& config, const Invocation& inv);
 int command_simulate(Config& config, const Invocation& inv);
 int command_continue(Config& config, const Invocation& inv);
+int command_boundary(Config& config, const Invocation& inv);
 
 // `run`'s check of a scene before anything computes: the analyses it lists (without `analyses`,
 // the one command that reads all its keys), each run in key-collection mode; every key of the

@@ -8,18 +8,22 @@
 
 namespace delayspec::cli {
 
+void require_parameter_key(const std::string& item, const std::string& key) {
+  // Keys that are not a parameter of the model's equations: the discretisation, the model's name,
+  // the commands' own keys.
+  for (const char* reserved : {"model", "N", "orbit_period", "events", "jacobian", "contact_substeps", "nev", "solver",
+                               "ncv", "tol", "seed", "orbit", "x0", "v0", "pitch_angles"})
+    if (key == reserved) throw BadInput("`" + item + " = " + key + "`: not a model parameter that can be continued");
+  for (const char* prefix : {"continue_", "boundary_"})
+    if (key.rfind(prefix, 0) == 0) throw BadInput("`" + item + " = " + key + "`: not a model parameter");
+}
+
 ContinueSettings read_continue_settings(Config& config) {
   ContinueSettings s;
   if (!config.has("continue_key"))
     throw BadInput("missing key `continue_key` (the model parameter to continue, e.g. k)");
   s.key = config.get_string("continue_key", "");
-  // Keys that are not a parameter of the model's equations: the discretisation, the model's name,
-  // and this command's own keys.
-  for (const char* reserved : {"model", "N", "orbit_period", "events", "jacobian", "contact_substeps", "nev", "solver",
-                               "ncv", "tol", "seed", "orbit", "x0", "v0"})
-    if (s.key == reserved)
-      throw BadInput("`continue_key = " + s.key + "`: not a model parameter that can be continued");
-  if (s.key.rfind("continue_", 0) == 0) throw BadInput("`continue_key = " + s.key + "`: not a model parameter");
+  require_parameter_key("continue_key", s.key);
   ContinuationOptions& o = s.options;
   o.from = config.require_double("continue_from");
   o.to = config.require_double("continue_to");

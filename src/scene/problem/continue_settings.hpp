@@ -17,6 +17,10 @@ struct ContinueSettings {
   bool switch_period_doubling = false;  // continue_switch: the period-2 branch at each period doubling
 };
 
+// BadInput unless `key` (the value of the key `item`) can be a model parameter: not the
+// discretisation's, the model's name or a command's own key.
+void require_parameter_key(const std::string& item, const std::string& key);
+
 // Reads continue_key, continue_from, continue_to (required), continue_step, continue_step_min,
 // continue_step_max, continue_max_points, continue_tolerance, continue_Ns, continue_switch. BadInput naming the key:
 // a missing required key, a key that is not a model parameter (N, model, events, ...), an empty

@@ -1,0 +1,100 @@
+#pragma once
+// Stability boundaries as curves in two parameters (issue 36): the set where the critical
+// multiplier of one bifurcation type is on its condition, g(x, y) = 0, g the type's test function
+// (continuation.hpp: fold mu - 1 of the real positive multiplier nearest 1; period doubling
+// |mu| - 1 of the real negative one nearest -1; Neimark-Sacker |mu| - 1 of the non-real one
+// nearest the unit circle; grazing max H), evaluated on the periodic orbit solved at (x, y): the
+// extended system F(u; x, y) = 0, g = 0 in its nested form (the periodic problem solved inside,
+// the critical condition outside). The caller supplies g (BoundaryFunction): the library follows
+// its zero set.
+//
+// The curve, in the scaled plane X = (u, v) = ((x - x_from) / |x_to - x_from|, (y - y_from) /
+// |y_to - y_from|), by pseudo-arclength: predictor X_i + ds t_i along the unit tangent t_i (grad
+// g turned by 90 degrees, oriented along the curve: <t_new, t_old> > 0, the first toward x_to);
+// corrector Newton (the chord form: grad g at the last accepted point) on
+//
+//   g(X) = 0,   <t_i, X - X_pred> = 0,
+//
+// converged when the correction is <= tolerance. grad g by forward differences with delta = 1e-7
+// in the scaled plane: g is an eigenvalue modulus, accurate to ~1e-12, so the gradient is good
+// to ~1e-5, which only slows the chord's contraction (a point satisfies g = 0 whatever it is).
+// Bordered by the arclength condition the system stays regular where the curve turns in x, so
+// turning points are passed (x goes back). Step control as continue's: <= 3 iterations grow the
+// next step by 1.5, >= 6 shrink it by 0.7, a failure (not converged in 8 iterations, g
+// undefined: no multiplier of the type, the orbit or eigensolver failing; a tangent turning by
+// more than ~37 degrees) halves it; below step_min the curve ends.
+//
+// Ends: at x_to exactly (the predictor shortened to land there, the last point corrected with x
+// fixed); back at x_from after a turn (likewise); where it leaves the y range [y_from, y_to]
+// (the point on the range's edge); at a codim-2 point where a Neimark-Sacker curve's critical
+// pair reaches the real axis (angle 0: 1:1 resonance, angle pi: 1:2 resonance, meeting a fold or
+// period-doubling curve), found as the end of the curve's definition with the last angle within
+// 0.05 rad of 0 or pi; after max_points; or at a failure (step below step_min), named.
+#include <complex>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "delayspec/continuation.hpp"
+
+namespace delayspec {
+
+// The test function at one point.
+struct BoundarySample {
+  bool defined = false;  // an orbit and a critical multiplier of the type exist there
+  double value = NAN;    // g
+  double angle = NAN;    // arg of the critical multiplier, in [0, pi] (grazing: NaN)
+  std::string reason;    // why not defined
+};
+using BoundaryFunction = std::function<BoundarySample(double x, double y)>;
+
+// The test function of `type` from the leading multipliers (and max H for grazing): what
+// continuation locates (continuation_detail::multiplier_test).
+BoundarySample boundary_sample(BifurcationType type, const std::vector<std::complex<double>>& multipliers,
+                               double max_H);
+
+struct BoundaryOptions {
+  double x_from = 0, x_to = 1;  // the curve starts at x_from and ends at x_to
+  double y_from = 0, y_to = 1;  // the y range the curve stays in
+  double step = 0.02;           // initial arclength step in the scaled plane
+  double step_min = 1e-6, step_max = 0.1;
+  int max_points = 1000;
+  double tolerance = 1e-10;  // of a point, in the scaled plane
+};
+
+struct BoundaryPoint {
+  double x = 0, y = 0;
+  double angle = NAN;  // the critical multiplier's
+  int iterations = 0;  // corrector iterations
+};
+
+enum class BoundaryEnd { to, from, y_range, codim2, max_points, failure };
+// "to", "from", "y_range", "codim2", "max_points", "failure".
+std::string to_string(BoundaryEnd end);
+
+// Where a curve changes character.
+struct Codim2Point {
+  std::string kind;  // "1:1 resonance" (angle 0), "1:2 resonance" (angle pi)
+  double x = 0, y = 0, angle = 0;
+};
+
+struct BoundaryCurve {
+  std::vector<BoundaryPoint> points;
+  BoundaryEnd end = BoundaryEnd::max_points;
+  std::string note;  // where and why it ended (y_range, failure, codim2)
+  std::vector<Codim2Point> codim2;
+  long evaluations = 0;  // of g
+};
+
+// The curve of g = 0 from (x_from, y_start), g(x_from, y_start) = 0 to the tolerance (the caller
+// located it). BadInput: an empty range, a step <= 0, step_min > step_max, max_points < 2;
+// NumericalFailure: g undefined at the start, or the start not on the curve (|correction| above
+// 1e-6 of the range).
+BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options);
+
+// The y with g(x, y) = 0 near y_guess at fixed x, by the secant method from y_guess and y_guess +
+// step, to |dy| <= tolerance (absolute); NaN when it does not converge in 30 evaluations or g is
+// undefined (e.g. the same point at another N where the curve is nearly parallel to y).
+double boundary_y_at(const BoundaryFunction& g, double x, double y_guess, double step, double tolerance);
+
+}  // namespace delayspec

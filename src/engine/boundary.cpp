@@ -1,0 +1,269 @@
+#include "delayspec/boundary.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <optional>
+
+#include "delayspec/detail/bifurcation_locator.hpp"  // multiplier_test
+#include "delayspec/errors.hpp"
+
+namespace delayspec {
+
+std::string to_string(BoundaryEnd end) {
+  switch (end) {
+    case BoundaryEnd::to: return "to";
+    case BoundaryEnd::from: return "from";
+    case BoundaryEnd::y_range: return "y_range";
+    case BoundaryEnd::codim2: return "codim2";
+    case BoundaryEnd::max_points: return "max_points";
+    case BoundaryEnd::failure: return "failure";
+  }
+  return "?";
+}
+
+BoundarySample boundary_sample(BifurcationType type, const std::vector<std::complex<double>>& multipliers,
+                               double max_H) {
+  BoundarySample s;
+  if (type == BifurcationType::grazing) {
+    s.value = max_H;
+    s.defined = std::isfinite(max_H);
+    if (!s.defined) s.reason = "no max H (the model does not switch in the state)";
+    return s;
+  }
+  std::complex<double> critical;
+  s.value = continuation_detail::multiplier_test(type, multipliers, &critical);
+  s.defined = std::isfinite(s.value);
+  if (s.defined) s.angle = std::abs(std::arg(critical));
+  else s.reason = "no " + to_string(type) + " candidate among the " + std::to_string(multipliers.size()) +
+                  " leading multipliers";
+  return s;
+}
+
+namespace {
+
+using Vec2 = std::array<double, 2>;
+
+double dot(const Vec2& a, const Vec2& b) { return a[0] * b[0] + a[1] * b[1]; }
+double norm(const Vec2& a) { return std::sqrt(dot(a, a)); }
+
+// The curve in the scaled plane: g at a scaled point, counted.
+class ScaledCurve {
+ public:
+  ScaledCurve(const BoundaryFunction& g, const BoundaryOptions& o, long& evaluations)
+      : g_(g), o_(o), evaluations_(evaluations) {}
+  double x(const Vec2& X) const { return o_.x_from + X[0] * (o_.x_to - o_.x_from); }
+  double y(const Vec2& X) const { return o_.y_from + X[1] * (o_.y_to - o_.y_from); }
+  BoundarySample at(const Vec2& X) const {
+    ++evaluations_;
+    try {
+      return g_(x(X), y(X));
+    } catch (const NumericalFailure& e) {
+      BoundarySample s;
+      s.reason = e.what();
+      return s;
+    }
+  }
+  // grad g at X (g(X) = g0 known) by forward differences; nullopt where g is undefined.
+  std::optional<Vec2> gradient(const Vec2& X, double g0, std::string& reason) const {
+    constexpr double kDelta = 1e-7;
+    Vec2 grad{};
+    for (int k = 0; k < 2; ++k) {
+      Vec2 Y = X;
+      Y[k] += kDelta;
+      const BoundarySample s = at(Y);
+      if (!s.defined) {
+        reason = s.reason;
+        return std::nullopt;
+      }
+      grad[k] = (s.value - g0) / kDelta;
+    }
+    if (!(norm(grad) > 0) || !std::isfinite(norm(grad))) {
+      reason = "the test function's gradient is zero or not finite";
+      return std::nullopt;
+    }
+    return grad;
+  }
+
+ private:
+  const BoundaryFunction& g_;
+  const BoundaryOptions& o_;
+  long& evaluations_;
+};
+
+// A point on the curve with what the next step needs.
+struct CurveState {
+  Vec2 X;
+  BoundarySample sample;
+  Vec2 grad;  // grad g there
+  Vec2 t;     // unit tangent along the curve
+  int iterations = 0;
+};
+
+// The unit tangent for the gradient `grad`, oriented along `along`.
+Vec2 tangent_of(const Vec2& grad, const Vec2& along) {
+  Vec2 t{-grad[1], grad[0]};
+  const double n = norm(t);
+  t = {t[0] / n, t[1] / n};
+  if (dot(t, along) < 0) t = {-t[0], -t[1]};
+  return t;
+}
+
+// Chord Newton from X0 on g = 0 and c(X) = <row, X> - rhs = 0 (the arclength condition, or u or
+// v fixed), with the gradient `grad` of the last accepted point. nullopt and the reason on failure.
+std::optional<CurveState> correct(const ScaledCurve& curve, Vec2 X, const Vec2& grad, const Vec2& row, double rhs,
+                                  double tolerance, std::string& reason) {
+  const double det = grad[0] * row[1] - grad[1] * row[0];
+  if (!(std::abs(det) > 1e-14 * norm(grad) * norm(row))) {
+    reason = "the corrector's matrix is singular";
+    return std::nullopt;
+  }
+  for (int it = 1; it <= 8; ++it) {
+    const BoundarySample s = curve.at(X);
+    if (!s.defined) {
+      reason = s.reason;
+      return std::nullopt;
+    }
+    const double r0 = s.value, r1 = dot(row, X) - rhs;
+    // [grad; row] dX = -(r0, r1)
+    const Vec2 dX{-(r0 * row[1] - r1 * grad[1]) / det, -(grad[0] * r1 - row[0] * r0) / det};
+    X = {X[0] + dX[0], X[1] + dX[1]};
+    if (norm(dX) <= tolerance) {
+      CurveState state;
+      state.X = X;
+      state.sample = curve.at(X);
+      if (!state.sample.defined) {
+        reason = state.sample.reason;
+        return std::nullopt;
+      }
+      state.iterations = it;
+      return state;
+    }
+    if (!std::isfinite(X[0]) || !std::isfinite(X[1])) break;
+  }
+  reason = "the corrector did not converge in 8 iterations";
+  return std::nullopt;
+}
+
+}  // namespace
+
+BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options) {
+  const BoundaryOptions& o = options;
+  if (!std::isfinite(o.x_from) || !std::isfinite(o.x_to) || o.x_from == o.x_to)
+    throw BadInput("boundary: the x range is empty or not finite");
+  if (!std::isfinite(o.y_from) || !std::isfinite(o.y_to) || o.y_from == o.y_to)
+    throw BadInput("boundary: the y range is empty or not finite");
+  if (!(o.step > 0) || !(o.step_min > 0) || !(o.step_max >= o.step_min) || !(o.tolerance > 0))
+    throw BadInput("boundary: steps and tolerance must be > 0, step_min <= step_max");
+  if (o.max_points < 2) throw BadInput("boundary: max_points must be >= 2");
+
+  BoundaryCurve curve;
+  const ScaledCurve scaled(g, o, curve.evaluations);
+  const auto finish_point = [&](const CurveState& s) {
+    curve.points.push_back({scaled.x(s.X), scaled.y(s.X), s.sample.angle, s.iterations});
+  };
+  std::string reason;
+  // The start: on the line u = 0 (y located by the caller, corrected here with x fixed).
+  const Vec2 X0{0, (y_start - o.y_from) / (o.y_to - o.y_from)};
+  const BoundarySample s0 = scaled.at(X0);
+  if (!s0.defined) throw NumericalFailure("boundary: the test function is not defined at the start: " + s0.reason);
+  const std::optional<Vec2> grad0 = scaled.gradient(X0, s0.value, reason);
+  if (!grad0) throw NumericalFailure("boundary: at the start: " + reason);
+  std::optional<CurveState> start = correct(scaled, X0, *grad0, {1, 0}, 0, o.tolerance, reason);
+  if (!start || std::abs(start->X[1] - X0[1]) > 1e-6)
+    throw NumericalFailure("boundary: the start (x = " + format_number(o.x_from) + ", y = " + format_number(y_start) +
+                           ") is not on the curve" + (start ? "" : ": " + reason));
+  CurveState current = *start;
+  current.grad = *grad0;
+  current.t = tangent_of(current.grad, {1, 0});
+  finish_point(current);
+
+  double ds = std::clamp(o.step, o.step_min, o.step_max);
+  while (static_cast<int>(curve.points.size()) < o.max_points) {
+    // The predictor, shortened to land on u = 1 (x_to), u = 0 (back at x_from) or the y range's edge.
+    Vec2 P{current.X[0] + ds * current.t[0], current.X[1] + ds * current.t[1]};
+    Vec2 row = current.t;
+    double rhs = dot(current.t, P);
+    BoundaryEnd landing = BoundaryEnd::max_points;  // (none)
+    const auto land = [&](int k, double edge, BoundaryEnd end) {
+      const double s = (edge - current.X[k]) / current.t[k];
+      if (!(s > 0 && s <= ds)) return;
+      ds = s;
+      P = {current.X[0] + ds * current.t[0], current.X[1] + ds * current.t[1]};
+      P[k] = edge;
+      row = k == 0 ? Vec2{1, 0} : Vec2{0, 1};
+      rhs = edge;
+      landing = end;
+    };
+    if (P[0] > 1) land(0, 1, BoundaryEnd::to);
+    else if (P[0] < 0) land(0, 0, BoundaryEnd::from);
+    if (P[1] > 1) land(1, 1, BoundaryEnd::y_range);
+    else if (P[1] < 0) land(1, 0, BoundaryEnd::y_range);
+
+    std::optional<CurveState> next = correct(scaled, P, current.grad, row, rhs, o.tolerance, reason);
+    std::optional<Vec2> grad;
+    if (next) grad = scaled.gradient(next->X, next->sample.value, reason);
+    if (next && grad) {
+      next->grad = *grad;
+      next->t = tangent_of(*grad, current.t);
+      if (dot(next->t, current.t) < 0.8) {
+        next.reset();
+        reason = "the tangent turned by more than 37 degrees";
+      }
+    }
+    if (!next || !grad) {
+      ds *= 0.5;
+      if (ds >= o.step_min) continue;
+      // The end of the curve's definition: a codim-2 point where the critical pair met the real axis.
+      const double angle = current.sample.angle;
+      if (std::isfinite(angle) && (angle < 0.05 || angle > std::numbers::pi - 0.05)) {
+        const bool one_to_one = angle < 0.05;
+        curve.codim2.push_back({one_to_one ? "1:1 resonance" : "1:2 resonance", scaled.x(current.X),
+                                scaled.y(current.X), angle});
+        curve.end = BoundaryEnd::codim2;
+        curve.note = std::string("the critical pair reached the real axis (angle ") + format_number(angle, 3) +
+                     "): " + (one_to_one ? "1:1" : "1:2") + " resonance at x = " + format_number(scaled.x(current.X)) +
+                     ", y = " + format_number(scaled.y(current.X));
+      } else {
+        curve.end = BoundaryEnd::failure;
+        curve.note = "at x = " + format_number(scaled.x(current.X)) + ", y = " + format_number(scaled.y(current.X)) +
+                     ": " + reason;
+      }
+      return curve;
+    }
+    current = *next;
+    finish_point(current);
+    if (landing != BoundaryEnd::max_points) {
+      curve.end = landing;
+      if (landing == BoundaryEnd::y_range)
+        curve.note = "left the y range at x = " + format_number(curve.points.back().x) + ", y = " +
+                     format_number(curve.points.back().y);
+      return curve;
+    }
+    if (current.iterations <= 3) ds = std::min(ds * 1.5, o.step_max);
+    else if (current.iterations >= 6) ds = std::max(ds * 0.7, o.step_min);
+  }
+  curve.end = BoundaryEnd::max_points;
+  curve.note = "after " + std::to_string(o.max_points) + " points";
+  return curve;
+}
+
+double boundary_y_at(const BoundaryFunction& g, double x, double y_guess, double step, double tolerance) {
+  double y0 = y_guess, y1 = y_guess + step;
+  BoundarySample s0 = g(x, y0);
+  if (!s0.defined) return NAN;
+  for (int it = 0; it < 30; ++it) {
+    const BoundarySample s1 = g(x, y1);
+    if (!s1.defined || s1.value == s0.value) return NAN;
+    const double y2 = y1 - s1.value * (y1 - y0) / (s1.value - s0.value);
+    if (!std::isfinite(y2)) return NAN;
+    if (std::abs(y2 - y1) <= tolerance) return y2;
+    y0 = y1;
+    s0 = s1;
+    y1 = y2;
+  }
+  return NAN;
+}
+
+}  // namespace delayspec

@@ -1,0 +1,342 @@
+// delayspec boundary: a stability boundary as a curve in two model keys, each point with its
+// distance to the N -> infinity curve (issue 36; boundary.hpp; docs/continuation.md,
+// "Stability boundaries as curves").
+//
+// The start: `continue` in boundary_y over [boundary_y_from, boundary_y_to] at x = boundary_x_from
+// (the finest N) locates the bifurcations there; the first of boundary_type (any: the first of
+// any type but grazing) starts the curve. The curve is then followed at the finest N
+// (trace_boundary), the test function at each (x, y) evaluated on the orbit solved there (linear
+// models: the zero orbit; nonlinear: Newton from the last orbit). With boundary_Ns, each point's y
+// is located again at every coarser N at the same x (boundary_y_at) and extrapolated (Richardson,
+// h = 1 / N): `y_extrapolated` and `error_estimate` (null where the levels do not show their
+// order, or where the curve is parallel to y and y at fixed x is not found).
+//
+// Files with --out DIR: boundary.csv (metadata header; one row per point: x, y, angle,
+// y_extrapolated, error_estimate, y at each N) and boundary.json (the --json result).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "delayspec/boundary.hpp"
+#include "delayspec/richardson.hpp"
+#include "scene/commands/commands.hpp"
+#include "scene/output/metadata.hpp"
+#include "scene/output/output.hpp"
+#include "scene/output/output_directory.hpp"
+#include "scene/output/progress.hpp"
+#include "scene/problem/continue_settings.hpp"
+#include "scene/problem/floquet_settings.hpp"
+#include "scene/problem/orbit_settings.hpp"
+#include "scene/problem/problem.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+using nlohmann::json;
+
+struct BoundaryRun {
+  std::string x_key, y_key;
+  BoundaryOptions options;
+  std::optional<BifurcationType> type;  // none: any (the first found at x_from)
+  std::vector<int> Ns;                  // boundary_Ns, or the one level N
+  OrbitSettings orbit_settings;
+  FloquetOptions floquet;
+  Problem problem;  // at (x_from, y_from)
+};
+
+BoundaryRun read_boundary_run(Config& config) {
+  BoundaryRun run;
+  for (const char* key : {"boundary_x", "boundary_y"})
+    if (!config.has(key)) throw BadInput(std::string("missing key `") + key + "` (a model parameter, e.g. depth)");
+  run.x_key = config.get_string("boundary_x", "");
+  run.y_key = config.get_string("boundary_y", "");
+  require_parameter_key("boundary_x", run.x_key);
+  require_parameter_key("boundary_y", run.y_key);
+  if (run.x_key == run.y_key)
+    throw BadInput("`boundary_x = boundary_y = " + run.x_key + "`: two different model keys are needed");
+  BoundaryOptions& o = run.options;
+  o.x_from = config.require_double("boundary_x_from");
+  o.x_to = config.require_double("boundary_x_to");
+  o.y_from = config.require_double("boundary_y_from");
+  o.y_to = config.require_double("boundary_y_to");
+  if (o.x_from == o.x_to) throw BadInput("`boundary_x_from = boundary_x_to = " + format_number(o.x_from) + "`: an empty range");
+  if (o.y_from == o.y_to) throw BadInput("`boundary_y_from = boundary_y_to = " + format_number(o.y_from) + "`: an empty range");
+  const std::string type = config.get_choice("boundary_type", "any",
+                                             {"any", "neimark-sacker", "period-doubling", "fold", "grazing"});
+  if (type == "grazing")
+    throw BadInput("`boundary_type = grazing`: grazing curves are not followed by `boundary` yet; `continue` locates a "
+                   "grazing in one key, with error bars");
+  for (BifurcationType t : {BifurcationType::neimark_sacker, BifurcationType::period_doubling, BifurcationType::fold})
+    if (type == to_string(t)) run.type = t;
+  o.step = config.get_double("boundary_step", 0.02);
+  o.step_min = config.get_double("boundary_step_min", 1e-6);
+  o.step_max = config.get_double("boundary_step_max", 0.1);
+  for (const auto& [name, value] : {std::pair{"boundary_step", o.step}, std::pair{"boundary_step_min", o.step_min},
+                                    std::pair{"boundary_step_max", o.step_max}})
+    if (!(value > 0) || !std::isfinite(value))
+      throw BadInput("`" + std::string(name) + " = " + format_number(value) + "`: must be > 0");
+  if (o.step_min > o.step_max)
+    throw BadInput("`boundary_step_min = " + format_number(o.step_min) + "` exceeds `boundary_step_max = " +
+                   format_number(o.step_max) + "`");
+  o.max_points = static_cast<int>(config.get_int_in_range("boundary_max_points", 500, 2, 10'000'000));
+  o.tolerance = config.get_double("boundary_tolerance", 1e-10);
+  if (!(o.tolerance > 0) || !std::isfinite(o.tolerance))
+    throw BadInput("`boundary_tolerance = " + format_number(o.tolerance) + "`: must be > 0");
+  for (long N : config.get_int_list("boundary_Ns", {})) {
+    if (N < 1 || N > 10'000'000) throw BadInput("`boundary_Ns`: N = " + std::to_string(N) + " must be between 1 and 1e7");
+    if (!run.Ns.empty() && N <= run.Ns.back())
+      throw BadInput("`boundary_Ns`: must be increasing (" + std::to_string(run.Ns.back()) + ", " + std::to_string(N) + ")");
+    run.Ns.push_back(static_cast<int>(N));
+  }
+  run.orbit_settings = read_orbit_settings(config);
+  run.floquet = read_floquet_options(config);
+  config.set(run.x_key, format_number(o.x_from), "boundary_x_from");
+  config.set(run.y_key, format_number(o.y_from), "boundary_y_from");
+  run.problem = read_problem(config, 100);
+  config.check_all_used();
+  if (run.Ns.empty()) run.Ns = {run.problem.N};
+  return run;
+}
+
+// The test function of `type` at (x, y) at one N: the scene with both keys set, its orbit and
+// leading multipliers. A nonlinear model's orbit is found by Newton from the last one found.
+class TestFunctionAt {
+ public:
+  TestFunctionAt(const Config& base, const BoundaryRun& run, BifurcationType type, int N)
+      : base_(base), run_(run), type_(type) {
+    base_.set("N", std::to_string(N), "boundary_Ns");
+  }
+  BoundarySample operator()(double x, double y) const {
+    Config c = base_;
+    c.set(run_.x_key, format_number(x), "boundary");
+    c.set(run_.y_key, format_number(y), "boundary");
+    try {
+      const Problem p = read_problem(c, 100);
+      OrbitRequest request;
+      request.sequence = !p.analyses->is_linear();
+      if (last_orbit_.size() > 0) request.newton_guess = &last_orbit_;
+      const LinearisedOrbit at = p.analyses->linearised_orbit(p.map_settings(), run_.orbit_settings, request);
+      const FloquetResult r = floquet_multipliers(*at.monodromy, run_.floquet);
+      if (at.sequence.size() > 0) last_orbit_ = at.sequence;
+      return boundary_sample(type_, r.multipliers, at.contacts.max_H);
+    } catch (const BadInput& e) {  // a value the model rejects
+      return undefined(e.what());
+    } catch (const NumericalFailure& e) {  // an orbit or an eigensolver that fails
+      return undefined(e.what());
+    }
+  }
+
+ private:
+  static BoundarySample undefined(const std::string& reason) {
+    BoundarySample s;
+    s.reason = reason;
+    return s;
+  }
+  Config base_;
+  const BoundaryRun& run_;
+  BifurcationType type_;
+  mutable Eigen::VectorXd last_orbit_;
+};
+
+// The start at x_from: the bifurcations `continue` locates in y there (the finest N).
+struct Start {
+  BifurcationType type;
+  double y;
+  double angle;
+};
+Start find_start(const Config& config, const BoundaryRun& run) {
+  Config at_x = config;
+  at_x.set("N", std::to_string(run.Ns.back()), "boundary_Ns");
+  at_x.set(run.x_key, format_number(run.options.x_from), "boundary_x_from");
+  at_x.set(run.y_key, format_number(run.options.y_from), "boundary_y_from");
+  const Problem problem = read_problem(at_x, 100);
+  ContinuationOptions search;
+  search.from = run.options.y_from;
+  search.to = run.options.y_to;
+  search.tolerance = run.options.tolerance * std::abs(run.options.y_to - run.options.y_from);
+  search.N = run.Ns.back();
+  search.periods_per_map = problem.orbit_period;
+  search.step_options = step_options(problem);
+  search.floquet = run.floquet;
+  search.newton.tolerance = run.orbit_settings.newton.tolerance;
+  search.start_iterations = run.orbit_settings.newton.max_iterations;
+  const ContinuationResult branch =
+      problem.analyses->continue_orbit(analyses_with_key(at_x, run.y_key), run.orbit_settings, search);
+  std::string found;
+  for (const Bifurcation& b : branch.bifurcations) {
+    found += (found.empty() ? "" : ", ") + to_string(b.type) + " at " + format_number(b.parameter);
+    if (b.type == BifurcationType::grazing) continue;
+    if (!run.type || *run.type == b.type) return {b.type, b.parameter, b.angle};
+  }
+  throw NumericalFailure("boundary: no " + (run.type ? to_string(*run.type) : std::string("bifurcation")) + " of the orbit for " +
+                         run.y_key + " in [" + format_number(run.options.y_from) + ", " + format_number(run.options.y_to) +
+                         "] at " + run.x_key + " = " + format_number(run.options.x_from) +
+                         " (N = " + std::to_string(run.Ns.back()) + "; found: " + (found.empty() ? "none" : found) +
+                         (branch.failure.empty() ? "" : "; the branch ended: " + branch.failure) + ")");
+}
+
+// One point of the curve with its y at every N and the extrapolation.
+struct PointStudy {
+  std::vector<double> y_by_N;  // NaN where not found
+  double extrapolated = NAN, error_estimate = NAN;
+};
+
+std::vector<PointStudy> study_points(const Config& config, const BoundaryRun& run, BifurcationType type,
+                                     const BoundaryCurve& curve, Progress& progress) {
+  std::vector<PointStudy> out(curve.points.size());
+  const double y_range = std::abs(run.options.y_to - run.options.y_from);
+  RichardsonOptions richardson;
+  if (run.problem.analyses->switches_in_state() && run.problem.events == EventMode::off)
+    richardson.order = richardson.order_step = 1;  // design.md 1.5
+  std::vector<TestFunctionAt> coarser;
+  for (size_t i = 0; i + 1 < run.Ns.size(); ++i) coarser.emplace_back(config, run, type, run.Ns[i]);
+  for (size_t k = 0; k < curve.points.size(); ++k) {
+    const BoundaryPoint& pt = curve.points[k];
+    PointStudy& s = out[k];
+    for (size_t i = 0; i < coarser.size(); ++i) {
+      const BoundaryFunction g = std::cref(coarser[i]);
+      s.y_by_N.push_back(boundary_y_at(g, pt.x, pt.y, 1e-6 * y_range, run.options.tolerance * y_range));
+    }
+    s.y_by_N.push_back(pt.y);
+    progress.add();
+    if (run.Ns.size() < 2) continue;
+    std::vector<double> h;
+    std::vector<std::complex<double>> y;
+    for (size_t i = 0; i < run.Ns.size(); ++i)
+      if (std::isfinite(s.y_by_N[i])) {
+        h.push_back(1.0 / run.Ns[i]);
+        y.push_back(s.y_by_N[i]);
+      }
+    if (y.size() < 2) continue;
+    const Extrapolation e = richardson_extrapolate(h, y, richardson);
+    if (std::isfinite(e.error_estimate)) {
+      s.extrapolated = e.value.real();
+      s.error_estimate = e.error_estimate;
+    }
+  }
+  return out;
+}
+
+json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json boundary_json(const BoundaryRun& run, BifurcationType type, const BoundaryCurve& curve,
+                   const std::vector<PointStudy>& studies, double seconds) {
+  json j;
+  j["model"] = run.problem.model_name;
+  j["boundary_x"] = run.x_key;
+  j["boundary_y"] = run.y_key;
+  j["N"] = run.Ns.back();
+  j["Ns"] = run.Ns;
+  json c;
+  c["type"] = to_string(type);
+  c["end"] = to_string(curve.end);
+  c["note"] = curve.note;
+  c["points"] = json::array();
+  for (size_t k = 0; k < curve.points.size(); ++k) {
+    const BoundaryPoint& p = curve.points[k];
+    json by_N = json::array();
+    for (double y : studies[k].y_by_N) by_N.push_back(number_or_null(y));
+    c["points"].push_back({{"x", p.x},
+                           {"y", p.y},
+                           {"angle", number_or_null(p.angle)},
+                           {"by_N", by_N},
+                           {"y_extrapolated", number_or_null(studies[k].extrapolated)},
+                           {"error_estimate", number_or_null(studies[k].error_estimate)}});
+  }
+  c["codim2"] = json::array();
+  for (const Codim2Point& q : curve.codim2)
+    c["codim2"].push_back({{"kind", q.kind}, {"x", q.x}, {"y", q.y}, {"angle", q.angle}});
+  j["curves"] = json::array({c});
+  j["evaluations"] = curve.evaluations;
+  j["seconds"] = seconds;
+  return j;
+}
+
+std::string boundary_csv(const std::string& header, const BoundaryRun& run, const BoundaryCurve& curve,
+                         const std::vector<PointStudy>& studies) {
+  std::string text = header + "x,y,angle,y_extrapolated,error_estimate";
+  for (int N : run.Ns) text += ",y_N" + std::to_string(N);
+  text += "\n";
+  char buffer[64];
+  const auto cell = [&](double v) {
+    std::snprintf(buffer, sizeof buffer, "%.17g", v);
+    return std::isfinite(v) ? std::string(buffer) : std::string();
+  };
+  for (size_t k = 0; k < curve.points.size(); ++k) {
+    const BoundaryPoint& p = curve.points[k];
+    text += cell(p.x) + "," + cell(p.y) + "," + cell(p.angle) + "," + cell(studies[k].extrapolated) + "," +
+            cell(studies[k].error_estimate);
+    for (double y : studies[k].y_by_N) text += "," + cell(y);
+    text += "\n";
+  }
+  return text;
+}
+
+void print_boundary(std::ostream& os, const BoundaryRun& run, BifurcationType type, const BoundaryCurve& curve,
+                    const std::vector<PointStudy>& studies, double seconds) {
+  char line[256];
+  os << "delayspec boundary: model " << run.problem.model_name << ", " << to_string(type) << " curve in ("
+     << run.x_key << ", " << run.y_key << "), N = ";
+  for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
+  os << "\n" << curve.points.size() << " points, ended at `" << to_string(curve.end) << "`"
+     << (curve.note.empty() ? "" : ": " + curve.note) << "\n";
+  std::snprintf(line, sizeof line, "  %16s  %16s  %18s  %10s  %8s\n", run.x_key.c_str(), run.y_key.c_str(),
+                "extrapolated", "+-", "angle/pi");
+  os << line;
+  for (size_t k = 0; k < curve.points.size(); ++k) {
+    const BoundaryPoint& p = curve.points[k];
+    std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %18.12g  %10.2g  %8.4f\n", p.x, p.y, studies[k].extrapolated,
+                  studies[k].error_estimate, p.angle / std::numbers::pi);
+    os << line;
+  }
+  for (const Codim2Point& q : curve.codim2)
+    os << "codim 2: " << q.kind << " at " << run.x_key << " = " << format_number(q.x) << ", " << run.y_key << " = "
+       << format_number(q.y) << "\n";
+  os << "time: " << seconds << " s (" << curve.evaluations << " evaluations of the test function at N = "
+     << run.Ns.back() << ")\n";
+}
+
+}  // namespace
+
+int command_boundary(Config& config, const Invocation& inv) {
+  const auto start_time = std::chrono::steady_clock::now();
+  const BoundaryRun run = read_boundary_run(config);
+  const Start start = find_start(config, run);
+  const TestFunctionAt finest(config, run, start.type, run.Ns.back());
+  BoundaryCurve curve = trace_boundary(std::cref(finest), start.y, run.options);
+  Progress progress(inv.err, "boundary", static_cast<long>(curve.points.size()), inv.quiet);
+  const std::vector<PointStudy> studies = study_points(config, run, start.type, curve, progress);
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  const json j = boundary_json(run, start.type, curve, studies, seconds);
+  if (inv.out_dir) {
+    const std::filesystem::path dir(*inv.out_dir);
+    OutputMetadata metadata = make_metadata("boundary", inv.scene, config, j, seconds);
+    metadata.parameters.erase(run.x_key);
+    metadata.parameters.erase(run.y_key);
+    std::string header = metadata_comment_lines(metadata);
+    if (curve.end == BoundaryEnd::failure) header += "# INCOMPLETE: the curve ended in a failure: " + curve.note + "\n";
+    write_output(inv, dir / "boundary.csv", boundary_csv(header, run, curve, studies));
+    json file = j;
+    file["metadata"] = metadata_json(metadata);
+    write_output(inv, dir / "boundary.json", file.dump(2) + "\n");
+  }
+  if (curve.end == BoundaryEnd::failure) {
+    inv.err << "delayspec boundary: numerical failure: the curve ended " << curve.note
+            << (inv.out_dir ? "; the curve so far is in " + *inv.out_dir : std::string()) << "\n";
+    return 3;
+  }
+  if (inv.json) {
+    inv.out << j.dump(2) << "\n";
+    return 0;
+  }
+  print_boundary(inv.out, run, start.type, curve, studies, seconds);
+  return 0;
+}
+
+}  // namespace delayspec::cli

@@ -1,0 +1,181 @@
+// `delayspec boundary` (boundary.hpp, command_boundary.cpp) against what it did not produce:
+// - the linear DDE x' = a x + b x(t - 1), T = 1: its Neimark-Sacker curve in (a, b) is the exact
+//   Hopf curve a = w cot w, b = -w / sin w (w in (0, pi), the multiplier's angle), computed here
+//   by bisection; each point's extrapolation (N = 50 .. 400) is within its error estimate of it;
+//   the finest level is off by O(h^2);
+// - the delayed Mathieu equation: the curves pass through the points that one-parameter
+//   `continue` locates at fixed delta, to 1e-9 at equal N; a curve that leaves the y range ends
+//   there with exit 0;
+// - a circle, u^2 + v^2 = 1 (an equations model whose fold is exactly there at any N): followed
+//   through its turning point in x;
+// - bad input (exit 2) and no bifurcation at the start (exit 3 with what was found).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_test_support.hpp"
+#include "delayspec/errors.hpp"
+#include "delayspec_test_paths.hpp"
+
+namespace {
+
+using delayspec::testing::CliResult;
+using delayspec::testing::contains;
+using delayspec::testing::run;
+using delayspec::testing::with_sets;
+using std::numbers::pi;
+
+// The Hopf curve of x' = a x + b x(t - 1): w cot w = a (decreasing in w on (0, pi)), by bisection.
+double hopf_frequency(double a) {
+  double lo = 1e-12, hi = pi - 1e-12;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (mid / std::tan(mid) > a ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+nlohmann::json boundary_json(std::vector<std::string> sets) {
+  const CliResult r = run(with_sets({"boundary", "--json"}, std::move(sets)));
+  EXPECT_EQ(r.status, 0) << r.err;
+  return r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
+}
+
+TEST(BoundaryCli, TheLinearNeimarkSackerCurveIsTheExactHopfCurve) {
+  const auto j = boundary_json({"model=linear", "tau=1", "period=1", "boundary_x=a", "boundary_y=b",
+                                "boundary_x_from=-1", "boundary_x_to=0.5", "boundary_y_from=-0.5", "boundary_y_to=-4",
+                                "boundary_type=neimark-sacker", "N=400", "boundary_Ns=50,100,200,400"});
+  ASSERT_FALSE(j.is_null());
+  const auto& curve = j["curves"][0];
+  EXPECT_EQ(curve["type"], "neimark-sacker");
+  EXPECT_EQ(curve["end"], "to");
+  const auto& points = curve["points"];
+  ASSERT_GE(points.size(), 10u);
+  EXPECT_EQ(points.front()["x"].get<double>(), -1.0);  // starts and lands exactly on the range's ends
+  EXPECT_EQ(points.back()["x"].get<double>(), 0.5);
+  for (const auto& p : points) {
+    const double a = p["x"], w = hopf_frequency(a), b = -w / std::sin(w);
+    const double finest = p["y"], extrapolated = p["y_extrapolated"], bar = p["error_estimate"];
+    // The discrete curve at N = 400 is off by O(h^2): 1.1e-5 at N = 200 measured, so < 1e-5 here.
+    EXPECT_LT(std::abs(finest - b), 1e-5) << a;
+    EXPECT_GT(std::abs(finest - b), 1e-8) << a << ": the discretisation error is not zero";
+    // The extrapolation is within its error estimate of the exact curve, and the estimate is small
+    // (four levels: the h^4 column checked, so the bar is the h^6 column's correction).
+    EXPECT_LE(std::abs(extrapolated - b), bar + 1e-12) << a;
+    EXPECT_LT(bar, 1e-7) << a;
+    // The multiplier's angle is the Hopf frequency times T = 1, to O(h^2).
+    EXPECT_NEAR(p["angle"].get<double>(), w, 1e-4) << a;
+    // Order 2 between the two finest levels: the error quarters.
+    const double y200 = p["by_N"][2], y400 = p["by_N"][3];
+    EXPECT_NEAR(std::log2(std::abs(y200 - b) / std::abs(y400 - b)), 2.0, 0.05) << a;
+  }
+}
+
+// The Mathieu curves against `continue` in b at fixed delta (the same discrete problem, N = 200).
+TEST(BoundaryCli, TheMathieuCurvesPassThroughThePointsContinueLocates) {
+  const std::vector<std::string> mathieu = {"model=mathieu", "kappa=0.1", "eps=1", "N=200"};
+  for (const char* type : {"neimark-sacker", "period-doubling"}) {
+    std::vector<std::string> sets = mathieu;
+    for (const char* s : {"boundary_x=delta", "boundary_y=b", "boundary_x_from=2", "boundary_x_to=2.6",
+                          "boundary_y_from=-1.5", "boundary_y_to=1.5"})
+      sets.push_back(s);
+    sets.push_back(std::string("boundary_type=") + type);
+    const auto j = boundary_json(sets);
+    ASSERT_FALSE(j.is_null());
+    const auto& points = j["curves"][0]["points"];
+    ASSERT_GE(points.size(), 3u) << type;
+    if (std::string(type) == "period-doubling") {  // it leaves b >= -1.5 before delta = 2.6
+      EXPECT_EQ(j["curves"][0]["end"], "y_range");
+      EXPECT_TRUE(contains(j["curves"][0]["note"].get<std::string>(), "left the y range")) << j["curves"][0]["note"];
+      EXPECT_NEAR(points.back()["y"].get<double>(), -1.5, 1e-12);
+    }
+    for (size_t k : {size_t{0}, points.size() / 2, points.size() - 1}) {
+      const double delta = points[k]["x"], b = points[k]["y"];
+      std::vector<std::string> c = mathieu;
+      for (const std::string& s : std::vector<std::string>{"continue_key=b", "continue_from=" + std::to_string(b - 0.05),
+                                                           "continue_to=" + std::to_string(b + 0.05),
+                                                           "continue_tolerance=1e-12"})
+        c.push_back(s);
+      c.push_back("delta=" + delayspec::format_number(delta));
+      const CliResult r = run(with_sets({"continue", "--json"}, c));
+      ASSERT_EQ(r.status, 0) << r.err;
+      double nearest = INFINITY;
+      const nlohmann::json located = nlohmann::json::parse(r.out);
+      for (const auto& bif : located["bifurcations"]) {
+        const double at = bif["by_N"].back()["parameter"];  // (one level: N = 200)
+        if (bif["type"] == type && std::abs(at - b) < std::abs(nearest - b)) nearest = at;
+      }
+      // Both locate the same zero of the same test function at the same N, each to ~1e-10.
+      EXPECT_NEAR(nearest, b, 1e-9) << type << " at delta = " << delta;
+    }
+  }
+}
+
+// u^2 + v^2 = 1 as a fold: x' = (u^2 + v^2 - 1) x + (x(t - 1) - x) / 1000 keeps a constant history
+// constant (multiplier 1) exactly when u^2 + v^2 = 1, at any N. From u = 0.6 the curve starts at
+// v = -0.8 (the first fold in v from -1.2), goes right to the turning point u = 1 and comes back
+// to u = 0.6 on the upper half.
+TEST(BoundaryCli, ACurveIsFollowedThroughItsTurningPoint) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("delayspec_test_boundary_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "circle.toml").string();
+  std::ofstream(scene) << "model = \"equations\"\n[equations]\nstate = [\"x\"]\nparameters = { u = 0.6, v = 0 }\n"
+                          "period = \"1\"\ndelay = \"1\"\nrhs = [\"(u^2 + v^2 - 1)*x + (x_tau - x)/1000\"]\n";
+  const CliResult r = run(with_sets({"boundary", scene, "--json"},
+                                    {"N=20", "solver=dense", "nev=2", "boundary_x=u", "boundary_y=v",
+                                     "boundary_x_from=0.6", "boundary_x_to=1.5", "boundary_y_from=-1.2",
+                                     "boundary_y_to=1.2", "boundary_type=fold",
+                                     std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& points = j["curves"][0]["points"];
+  EXPECT_EQ(j["curves"][0]["end"], "from");
+  double x_max = 0;
+  for (const auto& p : points) {
+    const double u = p["x"], v = p["y"];
+    x_max = std::max(x_max, u);
+    // Each point to the tolerance 1e-10 of the scaled plane (ranges 0.9 and 2.4) and rounding.
+    EXPECT_NEAR(u * u + v * v, 1.0, 1e-8) << u << " " << v;
+  }
+  EXPECT_GT(x_max, 0.999);  // through the turning point u = 1
+  EXPECT_NEAR(points.front()["y"].get<double>(), -0.8, 1e-9);
+  EXPECT_EQ(points.back()["x"].get<double>(), 0.6);
+  EXPECT_NEAR(points.back()["y"].get<double>(), 0.8, 1e-9);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(BoundaryCli, BadInputAndNoBifurcationAtTheStart) {
+  const std::vector<std::string> linear = {"model=linear", "tau=1", "period=1", "boundary_x_from=-1",
+                                           "boundary_x_to=0.5", "boundary_y_from=-0.5", "boundary_y_to=-4"};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> s = linear;
+    s.insert(s.end(), extra.begin(), extra.end());
+    return run(with_sets({"boundary"}, s));
+  };
+  CliResult r = with({"boundary_x=a", "boundary_y=a"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "`boundary_x = boundary_y = a`")) << r.err;
+  r = with({"boundary_x=N", "boundary_y=b"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "`boundary_x = N`: not a model parameter")) << r.err;
+  r = with({"boundary_x=a", "boundary_y=b", "boundary_y_to=-0.5"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "an empty range")) << r.err;
+  r = with({"boundary_x=a", "boundary_y=b", "boundary_type=grazing"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "grazing")) << r.err;
+  // b from -0.5 to -4 at a = -1 crosses the Hopf curve (NS) only: no period doubling there.
+  r = with({"boundary_x=a", "boundary_y=b", "boundary_type=period-doubling"});
+  EXPECT_EQ(r.status, 3);
+  EXPECT_TRUE(contains(r.err, "no period-doubling")) << r.err;
+  EXPECT_TRUE(contains(r.err, "found: neimark-sacker at ")) << r.err;
+}
+
+}  // namespace
