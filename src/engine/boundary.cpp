@@ -146,6 +146,39 @@ std::optional<CurveState> correct(const ScaledCurve& curve, Vec2 X, const Vec2& 
   return std::nullopt;
 }
 
+// A codim-2 point passed between the last three points a, b, c (scaled positions, arclengths
+// s, angles): the critical pair's angle runs through pi (or 0) as the multipliers pass -1 (or +1)
+// along the circle, so |arg mu| folds there: a V with its vertex between a and c, the angle's
+// largest (smallest) value at b. The vertex from the two straight sides: on the side of b away
+// from the vertex the slope is that of the pair's motion; the side whose prediction of the third
+// point fits better. Nothing when the angle does not turn at b within 0.1 of pi or 0.
+std::optional<Codim2Point> passed_resonance(const std::array<Vec2, 3>& X, const std::array<double, 3>& s,
+                                            const std::array<double, 3>& angle) {
+  for (double a : angle)
+    if (!std::isfinite(a)) return std::nullopt;
+  const double d1 = angle[1] - angle[0], d2 = angle[2] - angle[1];
+  if (!(d1 * d2 < 0)) return std::nullopt;
+  const bool at_pi = d1 > 0;  // a maximum: the angle folds at pi; a minimum: at 0
+  const double edge = at_pi ? std::numbers::pi : 0.0;
+  if (std::abs(angle[1] - edge) > 0.1) return std::nullopt;
+  const double left = std::abs(d1) / (s[1] - s[0]), right = std::abs(d2) / (s[2] - s[1]);
+  const double gap = std::abs(edge - angle[1]);
+  // Vertex right of b (the left side's slope continues to it), or left of b.
+  const double s_right = s[1] + gap / left, s_left = s[1] - gap / right;
+  const double miss_right = std::abs(std::abs(edge - angle[2]) - left * std::abs(s[2] - s_right));
+  const double miss_left = std::abs(std::abs(edge - angle[0]) - right * std::abs(s_left - s[0]));
+  double vertex = miss_right < miss_left ? s_right : s_left;
+  vertex = std::clamp(vertex, s[0], s[2]);
+  const int k = vertex <= s[1] ? 0 : 1;  // the segment holding it
+  const double w = (vertex - s[k]) / (s[k + 1] - s[k]);
+  Codim2Point q;
+  q.kind = at_pi ? "1:2 resonance" : "1:1 resonance";
+  q.x = X[k][0] + w * (X[k + 1][0] - X[k][0]);  // (scaled; the caller maps to x, y)
+  q.y = X[k][1] + w * (X[k + 1][1] - X[k][1]);
+  q.angle = edge;
+  return q;
+}
+
 }  // namespace
 
 BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options) {
@@ -178,6 +211,9 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
   current.grad = *grad0;
   current.t = tangent_of(current.grad, {1, 0});
   finish_point(current);
+  // The last three points (scaled), their arclengths and angles: codim-2 points passed.
+  std::array<Vec2, 3> last_X{current.X, current.X, current.X};
+  std::array<double, 3> last_s{0, 0, 0}, last_angle{NAN, NAN, current.sample.angle};
 
   double ds = std::clamp(o.step, o.step_min, o.step_max);
   while (static_cast<int>(curve.points.size()) < o.max_points) {
@@ -232,8 +268,18 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
       }
       return curve;
     }
+    const double moved = norm({next->X[0] - current.X[0], next->X[1] - current.X[1]});
     current = *next;
     finish_point(current);
+    last_X = {last_X[1], last_X[2], current.X};
+    last_s = {last_s[1], last_s[2], last_s[2] + moved};
+    last_angle = {last_angle[1], last_angle[2], current.sample.angle};
+    if (std::optional<Codim2Point> q = passed_resonance(last_X, last_s, last_angle)) {
+      const Vec2 at{q->x, q->y};
+      q->x = scaled.x(at);
+      q->y = scaled.y(at);
+      curve.codim2.push_back(*q);
+    }
     if (landing != BoundaryEnd::max_points) {
       curve.end = landing;
       if (landing == BoundaryEnd::y_range)

@@ -151,6 +151,23 @@ TEST(BoundaryCli, ACurveIsFollowedThroughItsTurningPoint) {
   std::filesystem::remove_all(dir);
 }
 
+// With T = 2 the same curve's multiplier e^{i w T} passes -1 where w = pi / 2: a = 0, b = -pi / 2,
+// a 1:2 resonance, which the curve passes and reports. Its location is the vertex of |arg mu|
+// interpolated between curve points (within a step, 0.045 in a here; measured 1e-4), plus the
+// discretisation's O(h^2) (5e-5 at N = 400): 1e-3.
+TEST(BoundaryCli, ANeimarkSackerCurveReportsTheStrongResonanceItPasses) {
+  const auto j = boundary_json({"model=linear", "tau=1", "period=2", "boundary_x=a", "boundary_y=b",
+                                "boundary_x_from=-1", "boundary_x_to=0.5", "boundary_y_from=-0.5", "boundary_y_to=-4",
+                                "boundary_type=neimark-sacker", "N=400"});
+  ASSERT_FALSE(j.is_null());
+  const auto& codim2 = j["curves"][0]["codim2"];
+  ASSERT_EQ(codim2.size(), 1u) << codim2;
+  EXPECT_EQ(codim2[0]["kind"], "1:2 resonance");
+  EXPECT_NEAR(codim2[0]["x"].get<double>(), 0.0, 1e-3);
+  EXPECT_NEAR(codim2[0]["y"].get<double>(), -pi / 2, 1e-3);
+  EXPECT_EQ(j["curves"][0]["end"], "to");
+}
+
 TEST(BoundaryCli, BadInputAndNoBifurcationAtTheStart) {
   const std::vector<std::string> linear = {"model=linear", "tau=1", "period=1", "boundary_x_from=-1",
                                            "boundary_x_to=0.5", "boundary_y_from=-0.5", "boundary_y_to=-4"};
