@@ -263,6 +263,22 @@ class ContinueResult(SweepResult):
     docs/continuation.md)."""
 
 
+class BoundaryResult(Result):
+    """`boundary`: the curve's points stacked (`x`, `y`, `angle`, `y_extrapolated`,
+    `error_estimate`: nan where null; `by_N`: points x levels), and the CLI's fields (`curves`,
+    `Ns`, ...; see docs/continuation.md)."""
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        if name in self._data:
+            return super().__getattr__(name)
+        rows = self._data.get("curves", [{}])[0].get("points", [])
+        if any(name in row for row in rows):
+            return _stack(rows, name)
+        return super().__getattr__(name)
+
+
 def _run(command, result_type, scene, keys, out=None, resume=False, progress=False):
     data, arrays, status, stderr = _delayspec.run(command, scene, keys, None if out is None else str(out), resume,
                                                   bool(progress))
@@ -309,13 +325,18 @@ def continue_(scene=None, *, out=None, progress=False, **keys):
     return _run("continue", ContinueResult, scene, keys, out, progress=progress)
 
 
+def boundary(scene=None, *, out=None, progress=False, **keys):
+    return _run("boundary", BoundaryResult, scene, keys, out, progress=progress)
+
+
 def keys_help(command):
     """The keys `command` reads, with their defaults and meanings (as `delayspec COMMAND --help`)."""
     return _delayspec.keys_help(command)
 
 
 _RESULT_TYPES = {floquet: FloquetResult, equilibrium: EquilibriumResult, lyapunov: Result, converge: ConvergeResult, simulate: SimulateResult,
-                 sweep: SweepResult, chart: GridResult, basin: GridResult, continue_: ContinueResult}
+                 sweep: SweepResult, chart: GridResult, basin: GridResult, continue_: ContinueResult,
+                 boundary: BoundaryResult}
 
 
 def _document():

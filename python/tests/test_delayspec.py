@@ -207,6 +207,17 @@ def test_continue_from_a_hopf_point_equals_cli_json():
     assert abs(orbits["points"][0]["period"] - r["bifurcations"][0]["period"]) < 1e-12 * orbits["points"][0]["period"]
 
 
+def test_boundary_equals_cli_json():
+    # the linear DDE's Neimark-Sacker curve in (a, b) (the exact Hopf curve, test_cli_boundary.cpp)
+    keys = dict(model="linear", tau=1, period=1, boundary_x="a", boundary_y="b", boundary_x_from=-1,
+                boundary_x_to=0.5, boundary_y_from=-0.5, boundary_y_to=-4, boundary_type="neimark-sacker", N=100,
+                boundary_Ns=[50, 100])
+    r = delayspec.boundary(**keys)
+    same_as_cli(r, "boundary", **keys)
+    assert r.x.shape == r.y.shape == (len(r["curves"][0]["points"]),)
+    assert r.x[0] == -1 and r.x[-1] == 0.5 and r.by_N.shape == (len(r.x), 2)
+
+
 # ---- numpy views -----------------------------------------------------------------------------
 
 def test_floquet_arrays_hold_the_json_numbers():

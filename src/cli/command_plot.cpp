@@ -30,6 +30,7 @@
 #include "scene/commands/commands.hpp"
 #include "delayspec/errors.hpp"
 #include "cli/gnuplot_script.hpp"
+#include "cli/plot_boundary.hpp"
 #include "cli/plot_continuation.hpp"
 #include "cli/plot_inputs.hpp"
 
@@ -469,6 +470,7 @@ int command_plot(Config& config, const Invocation& inv) {
   if (present(dir, "impacts.csv")) plot_impacts(renderer, dir);
   if (present(dir, "branch.csv")) plot_continuation(renderer, dir);
   if (present(dir, "equilibria.csv")) plot_equilibria(renderer, dir);
+  if (present(dir, "boundary.csv")) plot_boundary(renderer, dir);
   if (present(dir, "converge.json")) {
     converge = read_json_file(dir / "converge.json");
     const JsonField j(converge, "converge.json", "");

@@ -95,7 +95,7 @@ TEST(UnreadKey, KeyOfAnotherCommandSaysItIsNotRead) {
   CliResult r = run({"lyapunov", "--set", "nev=4", "--set", "model=linear"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err,
-                       "`nev` (= 4, from --set) is not read by lyapunov (it is a key of bench, chart, continue, "
+                       "`nev` (= 4, from --set) is not read by lyapunov (it is a key of bench, boundary, chart, continue, "
                        "converge, floquet"))
       << r.err;
   EXPECT_TRUE(contains(r.err, "`delayspec lyapunov --help` lists the keys it reads")) << r.err;
@@ -206,6 +206,7 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"continue_pwsdde_k", "continue"},
                                                        {"milling_lobes", "chart"},
                                                        {"milling_lobes_full", "chart"},
+                                                       {"milling_variable_pitch", "chart"},
                                                        {"milling_point", "converge"},
                                                        {"equations_impact", "floquet"},
                                                        {"equations_two_oscillators", "floquet"},

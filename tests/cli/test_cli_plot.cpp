@@ -384,3 +384,35 @@ TEST(PlotCli, NonRegularInputIsBadInput) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("chart.csv`: not a regular file"), std::string::npos) << r.err;
 }
+
+// boundary: the curve with its extrapolated points and bars, the codim-2 point named, the axes
+// the two keys; a legend entry only for what is drawn (one level: no bars, no entry for them).
+TEST(PlotCli, BoundaryDrawsTheCurveItsBarsAndItsResonance) {
+  const std::vector<std::string> linear = {"--set", "model=linear", "--set", "tau=1", "--set", "boundary_x=a",
+                                           "--set", "boundary_y=b", "--set", "boundary_x_from=-1", "--set",
+                                           "boundary_x_to=0.5", "--set", "boundary_y_from=-0.5", "--set",
+                                           "boundary_y_to=-4", "--set", "boundary_type=neimark-sacker"};
+  const auto boundary = [&](const fs::path& dir, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"boundary", "--out", dir.string(), "--quiet"};
+    args.insert(args.end(), linear.begin(), linear.end());
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  };
+  const fs::path dir = fresh_plot_dir("boundary");
+  ASSERT_EQ(boundary(dir, {"--set", "period=2", "--set", "N=100", "--set", "boundary_Ns=25,50,100"}).status, 0);
+  CliResult p = run({"plot", dir.string(), "--set", "plot_width=300", "--set", "plot_height=200"});
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_EQ(head(dir / "plots" / "boundary.png", 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const std::string gp = read(dir / "plots" / "boundary.gp");
+  EXPECT_NE(gp.find("set xlabel 'a'\n"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("set ylabel 'b'\n"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("'1:2 resonance'"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("with yerrorbars"), std::string::npos) << gp;
+
+  const fs::path one = fresh_plot_dir("boundary_one_level");
+  ASSERT_EQ(boundary(one, {"--set", "period=1", "--set", "N=50"}).status, 0);
+  ASSERT_EQ(run({"plot", one.string(), "--set", "plot_width=300", "--set", "plot_height=200"}).status, 0);
+  const std::string gp1 = read(one / "plots" / "boundary.gp");
+  EXPECT_EQ(gp1.find("with yerrorbars"), std::string::npos) << gp1;
+  EXPECT_EQ(gp1.find("codim 2"), std::string::npos) << gp1;
+}

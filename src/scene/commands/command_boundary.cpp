@@ -12,7 +12,8 @@
 // order, or where the curve is parallel to y and y at fixed x is not found).
 //
 // Files with --out DIR: boundary.csv (metadata header; one row per point: x, y, angle,
-// y_extrapolated, error_estimate, y at each N) and boundary.json (the --json result).
+// y_extrapolated, error_estimate, y at each N; nan where there is none) and boundary.json (the
+// --json result).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -265,13 +266,13 @@ std::string boundary_csv(const std::string& header, const BoundaryRun& run, cons
   char buffer[64];
   const auto cell = [&](double v) {
     std::snprintf(buffer, sizeof buffer, "%.17g", v);
-    return std::isfinite(v) ? std::string(buffer) : std::string();
+    return std::isfinite(v) ? std::string(buffer) : std::string("nan");
   };
   for (size_t k = 0; k < curve.points.size(); ++k) {
     const BoundaryPoint& p = curve.points[k];
     text += cell(p.x) + "," + cell(p.y) + "," + cell(p.angle) + "," + cell(studies[k].extrapolated) + "," +
             cell(studies[k].error_estimate);
-    for (double y : studies[k].y_by_N) text += "," + cell(y);
+    for (double y : studies[k].y_by_N) text.append(",").append(cell(y));  // (append: GCC 12's false -Wrestrict)
     text += "\n";
   }
   return text;
