@@ -125,7 +125,7 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
      << gnuplot_string("Spectral radius |{/Symbol m}_1|, model " + t.metadata_text("model", "?") +
                        ", N = " + title_N(t) + " (white line: |{/Symbol m}_1| = 1)")
      << "\n";
-  gp << "set xlabel " << gnuplot_label(t.columns[0]) << "\nset ylabel " << gnuplot_label(t.columns[1]) << "\n";
+  gp << "set xlabel " << key_axis_label(t.columns[0]) << "\nset ylabel " << key_axis_label(t.columns[1]) << "\n";
   gp << "set cblabel '|{/Symbol m}_1| (clipped at 2)'\nset cbrange [0:2]\n"
         "set palette defined (0 '#08306b', 0.5 '#4292c6', 0.999 '#c6dbef', 1.001 '#fee391', 1.5 '#fb6a4a', 2 '#67000d')\n";
   gp << "set autoscale fix\n" << (any_undecided ? "set key top right opaque\n" : "set key off\n");
@@ -173,7 +173,7 @@ void plot_basin(FigureRenderer& renderer, const fs::path& file) {
      << gnuplot_string("Basins of attraction, model " + t.metadata_text("model", "?") +
                        ", k = " + gnuplot_number(t.metadata_number("k", 0)) + ", N = " + title_N(t))
      << "\n";
-  gp << "set xlabel " << gnuplot_label(t.columns[0]) << "\nset ylabel " << gnuplot_label(t.columns[1]) << "\n";
+  gp << "set xlabel " << key_axis_label(t.columns[0]) << "\nset ylabel " << key_axis_label(t.columns[1]) << "\n";
   gp << "set autoscale fix\nset key outside right top box opaque\nset style fill solid 1.0\n";
   std::ostringstream legend;
   for (const auto& [period, n] : present) {

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -39,6 +40,13 @@ std::string gnuplot_label(const std::string& text) {
     escaped += c;
   }
   return gnuplot_string(escaped);
+}
+
+std::string key_axis_label(const std::string& key) {
+  static const std::map<std::string, std::string> units = {
+      {"spindle_rpm", "rpm"}, {"depth", "m"}, {"omega_n", "rad/s"}, {"Kt", "N/m^2"}, {"Kn", "N/m^2"}, {"mass", "kg"}};
+  const auto it = units.find(key);
+  return gnuplot_label(it == units.end() ? key : key + " (" + it->second + ")");
 }
 
 std::string gnuplot_datablock(const std::string& name, const std::string& rows) {

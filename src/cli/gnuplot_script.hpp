@@ -28,6 +28,11 @@ std::string gnuplot_string(const std::string& text);
 // (_ ^ { } @ & ~) are escaped, so that `spindle_rpm` is not drawn as spindle with subscript r.
 std::string gnuplot_label(const std::string& text);
 
+// The axis label of a model key: gnuplot_label of the key with its unit where the key has one
+// ("spindle_rpm (rpm)", "depth (m)"; the milling keys, whose units the key registry's meanings
+// state), else of the key alone.
+std::string key_axis_label(const std::string& key);
+
 // A datablock: $name << EOD, the rows (numbers only), EOD.
 std::string gnuplot_datablock(const std::string& name, const std::string& rows);
 

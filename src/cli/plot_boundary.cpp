@@ -1,57 +1,128 @@
 #include "cli/plot_boundary.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli/plot_inputs.hpp"
+#include "delayspec/errors.hpp"
 
 namespace delayspec::cli {
 
+namespace {
+
+// The lowest curve point above each of `samples` values of x (linear between a curve's points;
+// y_to where no curve passes): the edge of the region on the y_from side of every curve.
+std::string lower_envelope(const std::vector<std::vector<std::pair<double, double>>>& curves, double x0, double x1,
+                           double y_from, double y_to, int samples) {
+  std::string rows;
+  const bool up = y_to > y_from;
+  for (int i = 0; i < samples; ++i) {
+    const double x = x0 + (x1 - x0) * i / (samples - 1);
+    double edge = y_to;
+    for (const auto& c : curves)
+      for (size_t k = 1; k < c.size(); ++k) {
+        const auto &a = c[k - 1], &b = c[k];
+        if ((x - a.first) * (x - b.first) > 0 || a.first == b.first) continue;
+        const double y = a.second + (b.second - a.second) * (x - a.first) / (b.first - a.first);
+        edge = up ? std::min(edge, y) : std::max(edge, y);
+      }
+    rows += gnuplot_number(x) + " " + gnuplot_number(y_from) + " " + gnuplot_number(edge) + "\n";
+  }
+  return rows;
+}
+
+}  // namespace
+
 void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
   const ResultTable t = read_result_table(dir / "boundary.csv", [](const std::string& column) {
-    return column != "x" && column != "y";  // (no extrapolation, no level: nan)
+    return column != "curve" && column != "x" && column != "y";  // (no extrapolation, no level: nan)
   });
-  t.require_header({"x", "y", "angle", "y_extrapolated", "error_estimate"});
+  t.require_header({"curve", "x", "y", "angle", "y_extrapolated", "error_estimate"});
   t.require_rows();
   const nlohmann::json j = read_json_file(dir / "boundary.json");
   const JsonField root(j, "boundary.json", "");
   const std::string x_key = root.at("boundary_x").text(), y_key = root.at("boundary_y").text();
-  const JsonField curve = root.at("curves").elements().at(0);
-  const std::string type = curve.at("type").text();
-  std::string line, bars, marks, labels;
-  int bar_count = 0;
-  for (const auto& row : t.rows) {
+  const std::vector<JsonField> curves = root.at("curves").elements();
+  // The points of each curve (rows in order, column `curve` from 1).
+  std::vector<std::vector<std::pair<double, double>>> points(curves.size());
+  std::string bars;
+  for (size_t r = 0; r < t.rows.size(); ++r) {
+    const auto& row = t.rows[r];
     if (row.empty()) continue;
-    line += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + "\n";
-    if (std::isfinite(row[3]) && std::isfinite(row[4])) {
-      bars += gnuplot_number(row[0]) + " " + gnuplot_number(row[3]) + " " + gnuplot_number(row[4]) + "\n";
-      ++bar_count;
+    const double index = row[0];
+    if (!(index >= 1 && index <= static_cast<double>(curves.size()) && index == std::floor(index)))
+      throw BadInput(t.where(r) + ": `curve` = " + gnuplot_number(index) + " is not a curve of boundary.json (1.." +
+                     std::to_string(curves.size()) + ")");
+    points[static_cast<size_t>(index) - 1].emplace_back(row[1], row[2]);
+    if (std::isfinite(row[4]) && std::isfinite(row[5]))
+      bars += gnuplot_number(row[1]) + " " + gnuplot_number(row[4]) + " " + gnuplot_number(row[5]) + "\n";
+  }
+  // One datablock per type (curves separated by blank lines), so that each type has one colour
+  // and one legend entry.
+  std::map<std::string, std::string> by_type;
+  std::string marks, labels;
+  std::vector<std::pair<double, double>> marked;
+  const std::vector<JsonField> x_range = root.at("x_range").elements(), y_range = root.at("y_range").elements();
+  const double x_span = std::abs(x_range.at(1).number() - x_range.at(0).number()),
+               y_span = std::abs(y_range.at(1).number() - y_range.at(0).number());
+  int index = 0;
+  for (size_t i = 0; i < curves.size(); ++i) {
+    std::string& block = by_type[curves[i].at("type").text()];
+    for (const auto& [x, y] : points[i]) block += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
+    block += "\n";
+    for (const JsonField& q : curves[i].at("codim2").elements()) {
+      const double x = q.at("x").number(), y = q.at("y").number();
+      // The curves that meet at a codim-2 point both report it: one mark (within 1 % of the ranges).
+      bool seen = false;
+      for (const auto& [px, py] : marked) seen = seen || (std::abs(px - x) <= 0.01 * x_span && std::abs(py - y) <= 0.01 * y_span);
+      if (seen) continue;
+      marked.emplace_back(x, y);
+      marks += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
+      labels += "set label " + std::to_string(++index) + " " + gnuplot_string(q.at("kind").text()) + " at " +
+                gnuplot_number(x) + "," + gnuplot_number(y) + " offset 1,-1 front boxed font ',9'\n";
     }
   }
-  int index = 0;
-  for (const JsonField& q : curve.at("codim2").elements()) {
-    const double x = q.at("x").number(), y = q.at("y").number();
-    marks += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
-    labels += "set label " + std::to_string(++index) + " " + gnuplot_string(q.at("kind").text()) + " at " +
-              gnuplot_number(x) + "," + gnuplot_number(y) + " offset 1,-1 font ',9'\n";
+  // The stable side, shaded when the run found the orbit stable at y_from wherever it searched.
+  std::string region;
+  if (const auto side = root.find("stable_side"); side && side->text() == "y_from") {
+    double x0 = INFINITY, x1 = -INFINITY;
+    for (const auto& c : points)
+      for (const auto& p : c) x0 = std::min(x0, p.first), x1 = std::max(x1, p.first);
+    region = lower_envelope(points, x0, x1, y_range.at(0).number(), y_range.at(1).number(), 600);
   }
   const std::string N = std::to_string(static_cast<long>(root.at("N").number()));
   std::ostringstream gp;
-  gp << gnuplot_datablock("curve", line) << gnuplot_datablock("bars", bars.empty() ? "nan nan nan\n" : bars)
-     << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
-  gp << "set title " << gnuplot_string("Stability boundary: " + type + " curve") << "\n";
-  gp << "set xlabel " << gnuplot_label(x_key) << "\nset ylabel " << gnuplot_label(y_key)
-     << "\nset grid\nset key top left\n"
+  int block_index = 0;
+  for (const auto& [type, block] : by_type) gp << gnuplot_datablock("curves" + std::to_string(++block_index), block);
+  gp << gnuplot_datablock("bars", bars.empty() ? "nan nan nan\n" : bars)
+     << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks)
+     << gnuplot_datablock("region", region.empty() ? "nan nan nan\n" : region);
+  gp << "set title " << gnuplot_string("Stability boundary (N = " + N + ")") << "\n";
+  gp << "set xlabel " << key_axis_label(x_key) << "\nset ylabel " << key_axis_label(y_key)
+     << "\nset grid\nset key outside bottom center horizontal\nset style textbox opaque noborder\n"
      << labels;
   // A legend entry only for what is drawn.
-  gp << "plot $curve using 1:2 with lines lw 2 lc rgb '#1f77b4' title " << gnuplot_string("N = " + N);
-  if (bar_count > 0)
-    gp << ", \\\n     $bars using 1:2:3 with yerrorbars pt 7 ps 0.4 lc rgb '#d62728' title "
-       << gnuplot_string("extrapolated, with its error estimate");
-  if (!marks.empty())
-    gp << ", \\\n     $marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'codim 2'";
-  gp << "\n";
+  std::string plot = "plot ";
+  const auto add = [&](const std::string& item) {
+    plot += (plot == "plot " ? "" : ", \\\n     ") + item;
+  };
+  if (!region.empty()) add("$region using 1:2:3 with filledcurves lc rgb '#c7e9c0' title 'stable'");
+  const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
+  block_index = 0;
+  for (const auto& [type, block] : by_type) {
+    add("$curves" + std::to_string(block_index + 1) + " using 1:2 with lines lw 2 lc rgb '" + colours[block_index % 4] +
+        "' title " + gnuplot_string(type));
+    ++block_index;
+  }
+  if (!bars.empty())
+    add("$bars using 1:2:3 with yerrorbars pt 7 ps 0.4 lc rgb '#000000' title " +
+        gnuplot_string("extrapolated, with its error estimate"));
+  if (!marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'codim 2'");
+  gp << plot << "\n";
   renderer.figure("boundary", gp.str());
 }
 

@@ -168,6 +168,53 @@ TEST(BoundaryCli, ANeimarkSackerCurveReportsTheStrongResonanceItPasses) {
   EXPECT_EQ(j["curves"][0]["end"], "to");
 }
 
+// boundary_starts = scan: a start at each of the scanned speeds, each curve followed once, both
+// ways from its start. Milling at a/D = 0.05 between 9000 and 13000 rpm holds the right side of a
+// Neimark-Sacker lobe, a period-doubling lobe and another Neimark-Sacker lobe (the chart's
+// boundary, docs/milling.md); every curve passes through the depths `continue` locates at its
+// speeds (the same N), and the orbit is stable below them.
+TEST(BoundaryCli, AScanFollowsEveryLobeOnceThroughThePointsContinueLocates) {
+  const std::vector<std::string> milling = {"model=milling", "radial_immersion=0.05", "N=100"};
+  std::vector<std::string> sets = milling;
+  for (const char* s : {"boundary_x=spindle_rpm", "boundary_y=depth", "boundary_x_from=9000", "boundary_x_to=13000",
+                        "boundary_y_from=1e-5", "boundary_y_to=5e-3", "boundary_starts=scan", "boundary_scan_points=8"})
+    sets.push_back(s);
+  const auto j = boundary_json(sets);
+  ASSERT_FALSE(j.is_null());
+  EXPECT_EQ(j["stable_side"], "y_from");
+  std::vector<std::string> types;
+  for (const auto& curve : j["curves"]) types.push_back(curve["type"]);
+  EXPECT_EQ(types, (std::vector<std::string>{"neimark-sacker", "period-doubling", "neimark-sacker"}));
+  for (const auto& curve : j["curves"]) {
+    const auto& points = curve["points"];
+    for (size_t k : {size_t{0}, points.size() / 2, points.size() - 1}) {
+      const double rpm = points[k]["x"], depth = points[k]["y"];
+      if (depth >= 5e-3 * (1 - 1e-9)) continue;  // (where it left the range: no crossing below 5 mm there)
+      std::vector<std::string> c = milling;
+      for (const std::string& s : std::vector<std::string>{"continue_key=depth", "continue_from=1e-5",
+                                                           "continue_to=5e-3", "continue_tolerance=1e-16"})
+        c.push_back(s);
+      c.push_back("spindle_rpm=" + delayspec::format_number(rpm));
+      const CliResult r = run(with_sets({"continue", "--json"}, c));
+      ASSERT_EQ(r.status, 0) << r.err;
+      const nlohmann::json located = nlohmann::json::parse(r.out);
+      double nearest = INFINITY;
+      for (const auto& bif : located["bifurcations"]) {
+        const double at = bif["by_N"].back()["parameter"];
+        if (bif["type"] == curve["type"] && std::abs(at - depth) < std::abs(nearest - depth)) nearest = at;
+      }
+      // Both to ~1e-10 of the 5 mm range: 1e-9 of it.
+      EXPECT_NEAR(nearest, depth, 5e-12) << curve["type"] << " at " << rpm << " rpm";
+    }
+  }
+  // The linear DDE's one Neimark-Sacker curve, scanned at ten values of a: found once.
+  const auto linear = boundary_json({"model=linear", "tau=1", "period=1", "boundary_x=a", "boundary_y=b",
+                                     "boundary_x_from=-1", "boundary_x_to=0.5", "boundary_y_from=-0.5",
+                                     "boundary_y_to=-4", "N=50", "boundary_starts=scan", "boundary_scan_points=10"});
+  ASSERT_FALSE(linear.is_null());
+  EXPECT_EQ(linear["curves"].size(), 1u);
+}
+
 TEST(BoundaryCli, BadInputAndNoBifurcationAtTheStart) {
   const std::vector<std::string> linear = {"model=linear", "tau=1", "period=1", "boundary_x_from=-1",
                                            "boundary_x_to=0.5", "boundary_y_from=-0.5", "boundary_y_to=-4"};
@@ -192,7 +239,7 @@ TEST(BoundaryCli, BadInputAndNoBifurcationAtTheStart) {
   r = with({"boundary_x=a", "boundary_y=b", "boundary_type=period-doubling"});
   EXPECT_EQ(r.status, 3);
   EXPECT_TRUE(contains(r.err, "no period-doubling")) << r.err;
-  EXPECT_TRUE(contains(r.err, "found: neimark-sacker at ")) << r.err;
+  EXPECT_TRUE(contains(r.err, "found: a = -1: neimark-sacker at ")) << r.err;
 }
 
 }  // namespace

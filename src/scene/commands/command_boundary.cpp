@@ -4,7 +4,10 @@
 //
 // The start: `continue` in boundary_y over [boundary_y_from, boundary_y_to] at x = boundary_x_from
 // (the finest N) locates the bifurcations there; the first of boundary_type (any: the first of
-// any type but grazing) starts the curve. The curve is then followed at the finest N
+// any type but grazing) starts the curve. With boundary_starts = scan, the same search at
+// boundary_scan_points values of x gives a start at each, and every start not on a curve already
+// followed starts another (followed both ways from it): the lobes of a lobe diagram. A curve is
+// followed at the finest N
 // (trace_boundary), the test function at each (x, y) evaluated on the orbit solved there (linear
 // models: the zero orbit; nonlinear: Newton from the last orbit). With boundary_Ns, each point's y
 // is located again at every coarser N at the same x (boundary_y_at) and extrapolated (Richardson,
@@ -45,6 +48,7 @@ struct BoundaryRun {
   BoundaryOptions options;
   std::optional<BifurcationType> type;  // none: any (the first found at x_from)
   std::vector<int> Ns;                  // boundary_Ns, or the one level N
+  int scan_points = 0;                  // boundary_starts = scan: the x values searched; 0: the first start only
   OrbitSettings orbit_settings;
   FloquetOptions floquet;
   Problem problem;  // at (x_from, y_from)
@@ -74,6 +78,8 @@ BoundaryRun read_boundary_run(Config& config) {
                    "grazing in one key, with error bars");
   for (BifurcationType t : {BifurcationType::neimark_sacker, BifurcationType::period_doubling, BifurcationType::fold})
     if (type == to_string(t)) run.type = t;
+  if (config.get_choice("boundary_starts", "first", {"first", "scan"}) == "scan")
+    run.scan_points = static_cast<int>(config.get_int_in_range("boundary_scan_points", 20, 2, 100000));
   o.step = config.get_double("boundary_step", 0.02);
   o.step_min = config.get_double("boundary_step_min", 1e-6);
   o.step_max = config.get_double("boundary_step_max", 0.1);
@@ -144,16 +150,23 @@ class TestFunctionAt {
   mutable Eigen::VectorXd last_orbit_;
 };
 
-// The start at x_from: the bifurcations `continue` locates in y there (the finest N).
+// A curve's start: a bifurcation `continue` located in y at x (the finest N).
 struct Start {
   BifurcationType type;
-  double y;
-  double angle;
+  double x, y;
 };
-Start find_start(const Config& config, const BoundaryRun& run) {
+
+// The bifurcations in y at x of the wanted type (any: every type but grazing), in the order of y
+// from y_from, and whether the orbit is stable at y_from; `found` lists all it located.
+struct Search {
+  std::vector<Start> starts;
+  bool stable_at_y_from = false;
+  std::string found, failure;
+};
+Search search_at(const Config& config, const BoundaryRun& run, double x) {
   Config at_x = config;
   at_x.set("N", std::to_string(run.Ns.back()), "boundary_Ns");
-  at_x.set(run.x_key, format_number(run.options.x_from), "boundary_x_from");
+  at_x.set(run.x_key, format_number(x), "boundary");
   at_x.set(run.y_key, format_number(run.options.y_from), "boundary_y_from");
   const Problem problem = read_problem(at_x, 100);
   ContinuationOptions search;
@@ -168,17 +181,103 @@ Start find_start(const Config& config, const BoundaryRun& run) {
   search.start_iterations = run.orbit_settings.newton.max_iterations;
   const ContinuationResult branch =
       problem.analyses->continue_orbit(analyses_with_key(at_x, run.y_key), run.orbit_settings, search);
-  std::string found;
+  Search out;
+  out.stable_at_y_from = !branch.points.empty() && branch.points.front().stable();
+  out.failure = branch.failure;
   for (const Bifurcation& b : branch.bifurcations) {
-    found += (found.empty() ? "" : ", ") + to_string(b.type) + " at " + format_number(b.parameter);
-    if (b.type == BifurcationType::grazing) continue;
-    if (!run.type || *run.type == b.type) return {b.type, b.parameter, b.angle};
+    out.found += (out.found.empty() ? "" : ", ") + to_string(b.type) + " at " + format_number(b.parameter);
+    if (b.type != BifurcationType::grazing && (!run.type || *run.type == b.type))
+      out.starts.push_back({b.type, x, b.parameter});
   }
-  throw NumericalFailure("boundary: no " + (run.type ? to_string(*run.type) : std::string("bifurcation")) + " of the orbit for " +
-                         run.y_key + " in [" + format_number(run.options.y_from) + ", " + format_number(run.options.y_to) +
-                         "] at " + run.x_key + " = " + format_number(run.options.x_from) +
-                         " (N = " + std::to_string(run.Ns.back()) + "; found: " + (found.empty() ? "none" : found) +
-                         (branch.failure.empty() ? "" : "; the branch ended: " + branch.failure) + ")");
+  return out;
+}
+
+// Whether (x, y) lies on one of the curves (within 1e-3 of the y range, between two points).
+bool on_a_curve(const std::vector<BoundaryCurve>& curves, double x, double y, double y_range) {
+  for (const BoundaryCurve& c : curves)
+    for (size_t i = 1; i < c.points.size(); ++i) {
+      const BoundaryPoint &a = c.points[i - 1], &b = c.points[i];
+      if ((x - a.x) * (x - b.x) > 0 || a.x == b.x) continue;
+      const double y_here = a.y + (b.y - a.y) * (x - a.x) / (b.x - a.x);
+      if (std::abs(y_here - y) <= 1e-3 * y_range) return true;
+    }
+  return false;
+}
+
+// The starts of the curves: the first bifurcation of the type at x_from (boundary_starts = first),
+// or (scan) the first one in y at each of scan_points values of x, less those on a curve already
+// followed (`follow` is called for each start in turn). stable_below: the orbit is stable at y_from
+// at every x searched (the side of the curves a chart would call stable). NumericalFailure when
+// there is no start at all, with what was found.
+template <class Follow>
+bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<BoundaryCurve>& curves,
+                   std::vector<BifurcationType>& types, Follow follow) {
+  const BoundaryOptions& o = run.options;
+  const int count = run.scan_points > 0 ? run.scan_points : 1;
+  bool stable_below = true;
+  std::string found;
+  for (int i = 0; i < count; ++i) {
+    const double x = count == 1 ? o.x_from : o.x_from + (o.x_to - o.x_from) * i / (count - 1);
+    Search search;
+    try {
+      search = search_at(config, run, x);
+    } catch (const NumericalFailure& e) {  // (one x of a scan: the others may still start curves)
+      if (count == 1) throw;
+      found += (found.empty() ? "" : "; ") + run.x_key + " = " + format_number(x) + ": " + e.what();
+      stable_below = false;
+      continue;
+    }
+    stable_below = stable_below && search.stable_at_y_from;
+    if (!search.found.empty())
+      found += (found.empty() ? "" : "; ") + run.x_key + " = " + format_number(x) + ": " + search.found;
+    if (search.starts.empty()) continue;
+    const Start& start = search.starts.front();  // the first in y: where the orbit loses (or gains) stability
+    if (on_a_curve(curves, start.x, start.y, std::abs(o.y_to - o.y_from))) continue;
+    curves.push_back(follow(start));
+    types.push_back(start.type);
+  }
+  if (curves.empty())
+    throw NumericalFailure("boundary: no " + (run.type ? to_string(*run.type) : std::string("bifurcation")) +
+                           " of the orbit for " + run.y_key + " in [" + format_number(o.y_from) + ", " +
+                           format_number(o.y_to) + "] at " + run.x_key + " = " + format_number(o.x_from) +
+                           (count > 1 ? " .. " + format_number(o.x_to) : std::string()) + " (N = " +
+                           std::to_string(run.Ns.back()) + "; found: " + (found.empty() ? "none" : found) + ")");
+  return stable_below;
+}
+
+// The curve through `start`: followed from its x to x_to and, when it starts inside the range, also
+// back to x_from, the two halves joined (x_from's half reversed). Steps and tolerance are those of
+// the whole range's scaled plane.
+BoundaryCurve follow_curve(const BoundaryFunction& g, const BoundaryOptions& whole, const Start& start) {
+  const auto half = [&](double x_end) {
+    BoundaryOptions o = whole;
+    o.x_from = start.x;
+    o.x_to = x_end;
+    const double factor = std::abs(whole.x_to - whole.x_from) / std::abs(x_end - start.x);
+    o.step *= factor, o.step_min *= factor, o.step_max *= factor, o.tolerance *= factor;
+    return trace_boundary(g, start.y, o);
+  };
+  const double edge = 1e-12 * std::abs(whole.x_to - whole.x_from);
+  const bool forward = std::abs(whole.x_to - start.x) > edge, backward = std::abs(start.x - whole.x_from) > edge;
+  BoundaryCurve ahead = forward ? half(whole.x_to) : BoundaryCurve{};
+  if (!backward || ahead.end == BoundaryEnd::from) return ahead;  // (closed: back at its start)
+  BoundaryCurve behind = half(whole.x_from);
+  if (!forward) return behind;
+  // behind reversed, then ahead without its first point (the start, in both)
+  BoundaryCurve joined = ahead;
+  joined.points.assign(behind.points.rbegin(), behind.points.rend());
+  joined.points.insert(joined.points.end(), ahead.points.begin() + 1, ahead.points.end());
+  joined.codim2.insert(joined.codim2.begin(), behind.codim2.begin(), behind.codim2.end());
+  joined.evaluations += behind.evaluations;
+  if (behind.end == BoundaryEnd::failure || behind.end == BoundaryEnd::codim2) {
+    joined.end = behind.end;  // the worse end of the two halves is the curve's
+    joined.note = "towards " + format_number(whole.x_from) + ": " + behind.note +
+                  (ahead.note.empty() ? "" : "; towards " + format_number(whole.x_to) + ": " + ahead.note);
+  } else if (!behind.note.empty()) {
+    joined.note = "towards " + format_number(whole.x_from) + ": " + behind.note +
+                  (ahead.note.empty() ? "" : "; towards " + format_number(whole.x_to) + ": " + ahead.note);
+  }
+  return joined;
 }
 
 // One point of the curve with its y at every N and the extrapolation.
@@ -225,42 +324,82 @@ std::vector<PointStudy> study_points(const Config& config, const BoundaryRun& ru
 
 json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-json boundary_json(const BoundaryRun& run, BifurcationType type, const BoundaryCurve& curve,
-                   const std::vector<PointStudy>& studies, double seconds) {
+// The curves found, each with its type and its points' studies.
+struct Outcome {
+  std::vector<BoundaryCurve> curves;
+  std::vector<BifurcationType> types;
+  std::vector<std::vector<PointStudy>> studies;
+  bool stable_below = false;  // stable at y_from wherever the starts were searched
+  long evaluations = 0;
+  std::string failures;  // the curves that ended in a failure, named
+};
+
+Outcome compute_boundary(const Config& config, const BoundaryRun& run, const Invocation& inv) {
+  Outcome out;
+  out.stable_below = follow_starts(config, run, out.curves, out.types, [&](const Start& start) {
+    const TestFunctionAt finest(config, run, start.type, run.Ns.back());
+    return follow_curve(std::cref(finest), run.options, start);
+  });
+  long points = 0;
+  for (const BoundaryCurve& c : out.curves) points += static_cast<long>(c.points.size());
+  Progress progress(inv.err, "boundary", points, inv.quiet);
+  for (size_t i = 0; i < out.curves.size(); ++i) {
+    out.studies.push_back(study_points(config, run, out.types[i], out.curves[i], progress));
+    out.evaluations += out.curves[i].evaluations;
+    if (out.curves[i].end == BoundaryEnd::failure)
+      out.failures += (out.failures.empty() ? "" : "; ") + std::string("curve ") + std::to_string(i + 1) + " " +
+                      out.curves[i].note;
+  }
+  progress.finish();
+  return out;
+}
+
+json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
   json j;
   j["model"] = run.problem.model_name;
   j["boundary_x"] = run.x_key;
   j["boundary_y"] = run.y_key;
   j["N"] = run.Ns.back();
   j["Ns"] = run.Ns;
-  json c;
-  c["type"] = to_string(type);
-  c["end"] = to_string(curve.end);
-  c["note"] = curve.note;
-  c["points"] = json::array();
-  for (size_t k = 0; k < curve.points.size(); ++k) {
-    const BoundaryPoint& p = curve.points[k];
-    json by_N = json::array();
-    for (double y : studies[k].y_by_N) by_N.push_back(number_or_null(y));
-    c["points"].push_back({{"x", p.x},
-                           {"y", p.y},
-                           {"angle", number_or_null(p.angle)},
-                           {"by_N", by_N},
-                           {"y_extrapolated", number_or_null(studies[k].extrapolated)},
-                           {"error_estimate", number_or_null(studies[k].error_estimate)}});
+  j["x_range"] = {run.options.x_from, run.options.x_to};
+  j["y_range"] = {run.options.y_from, run.options.y_to};
+  j["curves"] = json::array();
+  for (size_t i = 0; i < out.curves.size(); ++i) {
+    const BoundaryCurve& curve = out.curves[i];
+    const std::vector<PointStudy>& studies = out.studies[i];
+    json c;
+    c["type"] = to_string(out.types[i]);
+    c["end"] = to_string(curve.end);
+    c["note"] = curve.note;
+    c["points"] = json::array();
+    for (size_t k = 0; k < curve.points.size(); ++k) {
+      const BoundaryPoint& p = curve.points[k];
+      json by_N = json::array();
+      for (double y : studies[k].y_by_N) by_N.push_back(number_or_null(y));
+      c["points"].push_back({{"x", p.x},
+                             {"y", p.y},
+                             {"angle", number_or_null(p.angle)},
+                             {"by_N", by_N},
+                             {"y_extrapolated", number_or_null(studies[k].extrapolated)},
+                             {"error_estimate", number_or_null(studies[k].error_estimate)}});
+    }
+    c["codim2"] = json::array();
+    for (const Codim2Point& q : curve.codim2)
+      c["codim2"].push_back({{"kind", q.kind}, {"x", q.x}, {"y", q.y}, {"angle", q.angle}});
+    j["curves"].push_back(c);
   }
-  c["codim2"] = json::array();
-  for (const Codim2Point& q : curve.codim2)
-    c["codim2"].push_back({{"kind", q.kind}, {"x", q.x}, {"y", q.y}, {"angle", q.angle}});
-  j["curves"] = json::array({c});
-  j["evaluations"] = curve.evaluations;
+  // Where the orbit is stable, when the search found it stable at y_from everywhere: below the
+  // curves (the side of y_from).
+  j["stable_side"] = out.stable_below ? json("y_from") : json(nullptr);
+  if (!out.failures.empty()) j["failure"] = out.failures;
+  j["evaluations"] = out.evaluations;
   j["seconds"] = seconds;
   return j;
 }
 
-std::string boundary_csv(const std::string& header, const BoundaryRun& run, const BoundaryCurve& curve,
-                         const std::vector<PointStudy>& studies) {
-  std::string text = header + "x,y,angle,y_extrapolated,error_estimate";
+// One row per point: its curve's index (from 1), then the point.
+std::string boundary_csv(const std::string& header, const BoundaryRun& run, const Outcome& out) {
+  std::string text = header + "curve,x,y,angle,y_extrapolated,error_estimate";
   for (int N : run.Ns) text += ",y_N" + std::to_string(N);
   text += "\n";
   char buffer[64];
@@ -268,37 +407,42 @@ std::string boundary_csv(const std::string& header, const BoundaryRun& run, cons
     std::snprintf(buffer, sizeof buffer, "%.17g", v);
     return std::isfinite(v) ? std::string(buffer) : std::string("nan");
   };
-  for (size_t k = 0; k < curve.points.size(); ++k) {
-    const BoundaryPoint& p = curve.points[k];
-    text += cell(p.x) + "," + cell(p.y) + "," + cell(p.angle) + "," + cell(studies[k].extrapolated) + "," +
-            cell(studies[k].error_estimate);
-    for (double y : studies[k].y_by_N) text.append(",").append(cell(y));  // (append: GCC 12's false -Wrestrict)
-    text += "\n";
-  }
+  for (size_t i = 0; i < out.curves.size(); ++i)
+    for (size_t k = 0; k < out.curves[i].points.size(); ++k) {
+      const BoundaryPoint& p = out.curves[i].points[k];
+      const PointStudy& study = out.studies[i][k];
+      text += std::to_string(i + 1) + "," + cell(p.x) + "," + cell(p.y) + "," + cell(p.angle) + "," +
+              cell(study.extrapolated) + "," + cell(study.error_estimate);
+      for (double y : study.y_by_N) text.append(",").append(cell(y));  // (append: GCC 12's false -Wrestrict)
+      text += "\n";
+    }
   return text;
 }
 
-void print_boundary(std::ostream& os, const BoundaryRun& run, BifurcationType type, const BoundaryCurve& curve,
-                    const std::vector<PointStudy>& studies, double seconds) {
+void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out, double seconds) {
   char line[256];
-  os << "delayspec boundary: model " << run.problem.model_name << ", " << to_string(type) << " curve in ("
-     << run.x_key << ", " << run.y_key << "), N = ";
+  os << "delayspec boundary: model " << run.problem.model_name << ", " << out.curves.size() << " curve"
+     << (out.curves.size() == 1 ? "" : "s") << " in (" << run.x_key << ", " << run.y_key << "), N = ";
   for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
-  os << "\n" << curve.points.size() << " points, ended at `" << to_string(curve.end) << "`"
-     << (curve.note.empty() ? "" : ": " + curve.note) << "\n";
-  std::snprintf(line, sizeof line, "  %16s  %16s  %18s  %10s  %8s\n", run.x_key.c_str(), run.y_key.c_str(),
-                "extrapolated", "+-", "angle/pi");
-  os << line;
-  for (size_t k = 0; k < curve.points.size(); ++k) {
-    const BoundaryPoint& p = curve.points[k];
-    std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %18.12g  %10.2g  %8.4f\n", p.x, p.y, studies[k].extrapolated,
-                  studies[k].error_estimate, p.angle / std::numbers::pi);
+  os << "\n";
+  for (size_t i = 0; i < out.curves.size(); ++i) {
+    const BoundaryCurve& curve = out.curves[i];
+    os << "curve " << i + 1 << ": " << to_string(out.types[i]) << ", " << curve.points.size() << " points, ended at `"
+       << to_string(curve.end) << "`" << (curve.note.empty() ? "" : ": " + curve.note) << "\n";
+    std::snprintf(line, sizeof line, "  %16s  %16s  %18s  %10s  %8s\n", run.x_key.c_str(), run.y_key.c_str(),
+                  "extrapolated", "+-", "angle/pi");
     os << line;
+    for (size_t k = 0; k < curve.points.size(); ++k) {
+      const BoundaryPoint& p = curve.points[k];
+      std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %18.12g  %10.2g  %8.4f\n", p.x, p.y,
+                    out.studies[i][k].extrapolated, out.studies[i][k].error_estimate, p.angle / std::numbers::pi);
+      os << line;
+    }
+    for (const Codim2Point& q : curve.codim2)
+      os << "  codim 2: " << q.kind << " at " << run.x_key << " = " << format_number(q.x) << ", " << run.y_key
+         << " = " << format_number(q.y) << "\n";
   }
-  for (const Codim2Point& q : curve.codim2)
-    os << "codim 2: " << q.kind << " at " << run.x_key << " = " << format_number(q.x) << ", " << run.y_key << " = "
-       << format_number(q.y) << "\n";
-  os << "time: " << seconds << " s (" << curve.evaluations << " evaluations of the test function at N = "
+  os << "time: " << seconds << " s (" << out.evaluations << " evaluations of the test function at N = "
      << run.Ns.back() << ")\n";
 }
 
@@ -307,36 +451,31 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, BifurcationType ty
 int command_boundary(Config& config, const Invocation& inv) {
   const auto start_time = std::chrono::steady_clock::now();
   const BoundaryRun run = read_boundary_run(config);
-  const Start start = find_start(config, run);
-  const TestFunctionAt finest(config, run, start.type, run.Ns.back());
-  BoundaryCurve curve = trace_boundary(std::cref(finest), start.y, run.options);
-  Progress progress(inv.err, "boundary", static_cast<long>(curve.points.size()), inv.quiet);
-  const std::vector<PointStudy> studies = study_points(config, run, start.type, curve, progress);
-  progress.finish();
+  const Outcome out = compute_boundary(config, run, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-  const json j = boundary_json(run, start.type, curve, studies, seconds);
+  const json j = boundary_json(run, out, seconds);
   if (inv.out_dir) {
     const std::filesystem::path dir(*inv.out_dir);
     OutputMetadata metadata = make_metadata("boundary", inv.scene, config, j, seconds);
     metadata.parameters.erase(run.x_key);
     metadata.parameters.erase(run.y_key);
     std::string header = metadata_comment_lines(metadata);
-    if (curve.end == BoundaryEnd::failure) header += "# INCOMPLETE: the curve ended in a failure: " + curve.note + "\n";
-    write_output(inv, dir / "boundary.csv", boundary_csv(header, run, curve, studies));
+    if (!out.failures.empty()) header += "# INCOMPLETE: a curve ended in a failure: " + out.failures + "\n";
+    write_output(inv, dir / "boundary.csv", boundary_csv(header, run, out));
     json file = j;
     file["metadata"] = metadata_json(metadata);
     write_output(inv, dir / "boundary.json", file.dump(2) + "\n");
   }
-  if (curve.end == BoundaryEnd::failure) {
-    inv.err << "delayspec boundary: numerical failure: the curve ended " << curve.note
-            << (inv.out_dir ? "; the curve so far is in " + *inv.out_dir : std::string()) << "\n";
+  if (!out.failures.empty()) {
+    inv.err << "delayspec boundary: numerical failure: " << out.failures
+            << (inv.out_dir ? "; the curves so far are in " + *inv.out_dir : std::string()) << "\n";
     return 3;
   }
   if (inv.json) {
     inv.out << j.dump(2) << "\n";
     return 0;
   }
-  print_boundary(inv.out, run, start.type, curve, studies, seconds);
+  print_boundary(inv.out, run, out, seconds);
   return 0;
 }
 
