@@ -92,9 +92,11 @@ struct BoundaryCurve {
 // 1e-6 of the range).
 BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options);
 
-// The y with g(x, y) = 0 near y_guess at fixed x, by the secant method from y_guess and y_guess +
-// step, to |dy| <= tolerance (absolute); NaN when it does not converge in 30 evaluations or g is
-// undefined (e.g. the same point at another N where the curve is nearly parallel to y).
-double boundary_y_at(const BoundaryFunction& g, double x, double y_guess, double step, double tolerance);
+// The s nearest 0 with g((x, y) + s (dx, dy)) = 0, by the secant method from s = 0 and s = step,
+// to |ds| <= tolerance; NaN when it does not converge in 30 evaluations or g is undefined. Along
+// the curve's normal (another N's curve near a point of this one) the secant is well conditioned
+// wherever the curve goes, steep or flat.
+double boundary_offset_along(const BoundaryFunction& g, double x, double y, double dx, double dy, double step,
+                             double tolerance);
 
 }  // namespace delayspec

@@ -41,7 +41,7 @@ void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
   const ResultTable t = read_result_table(dir / "boundary.csv", [](const std::string& column) {
     return column != "curve" && column != "x" && column != "y";  // (no extrapolation, no level: nan)
   });
-  t.require_header({"curve", "x", "y", "angle", "y_extrapolated", "error_estimate"});
+  t.require_header({"curve", "x", "y", "angle", "y_extrapolated", "error_estimate", "x_extrapolated", "x_error_estimate"});
   t.require_rows();
   const nlohmann::json j = read_json_file(dir / "boundary.json");
   const JsonField root(j, "boundary.json", "");
@@ -58,8 +58,9 @@ void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
       throw BadInput(t.where(r) + ": `curve` = " + gnuplot_number(index) + " is not a curve of boundary.json (1.." +
                      std::to_string(curves.size()) + ")");
     points[static_cast<size_t>(index) - 1].emplace_back(row[1], row[2]);
-    if (std::isfinite(row[4]) && std::isfinite(row[5]))
-      bars += gnuplot_number(row[1]) + " " + gnuplot_number(row[4]) + " " + gnuplot_number(row[5]) + "\n";
+    if (std::isfinite(row[4]) && std::isfinite(row[5]) && std::isfinite(row[6]) && std::isfinite(row[7]))
+      bars += gnuplot_number(row[6]) + " " + gnuplot_number(row[4]) + " " + gnuplot_number(row[7]) + " " +
+              gnuplot_number(row[5]) + "\n";
   }
   // One datablock per type (curves separated by blank lines), so that each type has one colour
   // and one legend entry.
@@ -98,7 +99,7 @@ void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
   std::ostringstream gp;
   int block_index = 0;
   for (const auto& [type, block] : by_type) gp << gnuplot_datablock("curves" + std::to_string(++block_index), block);
-  gp << gnuplot_datablock("bars", bars.empty() ? "nan nan nan\n" : bars)
+  gp << gnuplot_datablock("bars", bars.empty() ? "nan nan nan nan\n" : bars)
      << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks)
      << gnuplot_datablock("region", region.empty() ? "nan nan nan\n" : region);
   gp << "set title " << gnuplot_string("Stability boundary (N = " + N + ")") << "\n";
@@ -119,7 +120,7 @@ void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
     ++block_index;
   }
   if (!bars.empty())
-    add("$bars using 1:2:3 with yerrorbars pt 7 ps 0.4 lc rgb '#000000' title " +
+    add("$bars using 1:2:3:4 with xyerrorbars pt 7 ps 0.4 lc rgb '#000000' title " +
         gnuplot_string("extrapolated, with its error estimate"));
   if (!marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'codim 2'");
   gp << plot << "\n";

@@ -295,19 +295,21 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
   return curve;
 }
 
-double boundary_y_at(const BoundaryFunction& g, double x, double y_guess, double step, double tolerance) {
-  double y0 = y_guess, y1 = y_guess + step;
-  BoundarySample s0 = g(x, y0);
-  if (!s0.defined) return NAN;
+double boundary_offset_along(const BoundaryFunction& g, double x, double y, double dx, double dy, double step,
+                             double tolerance) {
+  const auto at = [&](double s) { return g(x + s * dx, y + s * dy); };
+  double s0 = 0, s1 = step;
+  BoundarySample g0 = at(s0);
+  if (!g0.defined) return NAN;
   for (int it = 0; it < 30; ++it) {
-    const BoundarySample s1 = g(x, y1);
-    if (!s1.defined || s1.value == s0.value) return NAN;
-    const double y2 = y1 - s1.value * (y1 - y0) / (s1.value - s0.value);
-    if (!std::isfinite(y2)) return NAN;
-    if (std::abs(y2 - y1) <= tolerance) return y2;
-    y0 = y1;
+    const BoundarySample g1 = at(s1);
+    if (!g1.defined || g1.value == g0.value) return NAN;
+    const double s2 = s1 - g1.value * (s1 - s0) / (g1.value - g0.value);
+    if (!std::isfinite(s2)) return NAN;
+    if (std::abs(s2 - s1) <= tolerance) return s2;
     s0 = s1;
-    y1 = y2;
+    g0 = g1;
+    s1 = s2;
   }
   return NAN;
 }

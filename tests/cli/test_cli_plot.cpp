@@ -407,12 +407,12 @@ TEST(PlotCli, BoundaryDrawsTheCurveItsBarsAndItsResonance) {
   EXPECT_NE(gp.find("set xlabel 'a'\n"), std::string::npos) << gp;
   EXPECT_NE(gp.find("set ylabel 'b'\n"), std::string::npos) << gp;
   EXPECT_NE(gp.find("'1:2 resonance'"), std::string::npos) << gp;
-  EXPECT_NE(gp.find("with yerrorbars"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("with xyerrorbars"), std::string::npos) << gp;
 
   const fs::path one = fresh_plot_dir("boundary_one_level");
   ASSERT_EQ(boundary(one, {"--set", "period=1", "--set", "N=50"}).status, 0);
   ASSERT_EQ(run({"plot", one.string(), "--set", "plot_width=300", "--set", "plot_height=200"}).status, 0);
   const std::string gp1 = read(one / "plots" / "boundary.gp");
-  EXPECT_EQ(gp1.find("with yerrorbars"), std::string::npos) << gp1;
+  EXPECT_EQ(gp1.find("with xyerrorbars"), std::string::npos) << gp1;
   EXPECT_EQ(gp1.find("codim 2"), std::string::npos) << gp1;
 }

@@ -9,10 +9,10 @@
 // followed starts another (followed both ways from it): the lobes of a lobe diagram. A curve is
 // followed at the finest N
 // (trace_boundary), the test function at each (x, y) evaluated on the orbit solved there (linear
-// models: the zero orbit; nonlinear: Newton from the last orbit). With boundary_Ns, each point's y
-// is located again at every coarser N at the same x (boundary_y_at) and extrapolated (Richardson,
-// h = 1 / N): `y_extrapolated` and `error_estimate` (null where the levels do not show their
-// order, or where the curve is parallel to y and y at fixed x is not found).
+// models: the zero orbit; nonlinear: Newton from the last orbit). With boundary_Ns, each point's
+// curve at every coarser N is found along the curve's normal (boundary_offset_along) and the
+// offsets extrapolated (Richardson, h = 1 / N): `x_extrapolated`, `y_extrapolated` and their error
+// estimates (null where the levels do not show their order or a level is not found).
 //
 // Files with --out DIR: boundary.csv (metadata header; one row per point: x, y, angle,
 // y_extrapolated, error_estimate, y at each N; nan where there is none) and boundary.json (the
@@ -90,7 +90,7 @@ BoundaryRun read_boundary_run(Config& config) {
   if (o.step_min > o.step_max)
     throw BadInput("`boundary_step_min = " + format_number(o.step_min) + "` exceeds `boundary_step_max = " +
                    format_number(o.step_max) + "`");
-  o.max_points = static_cast<int>(config.get_int_in_range("boundary_max_points", 500, 2, 10'000'000));
+  o.max_points = static_cast<int>(config.get_int_in_range("boundary_max_points", 5000, 2, 10'000'000));
   o.tolerance = config.get_double("boundary_tolerance", 1e-10);
   if (!(o.tolerance > 0) || !std::isfinite(o.tolerance))
     throw BadInput("`boundary_tolerance = " + format_number(o.tolerance) + "`: must be > 0");
@@ -280,44 +280,58 @@ BoundaryCurve follow_curve(const BoundaryFunction& g, const BoundaryOptions& who
   return joined;
 }
 
-// One point of the curve with its y at every N and the extrapolation.
+// One point of the curve with the curves of the other N near it: each found on the line through
+// the point along the curve's normal (in the plane scaled by the ranges), where it is well
+// conditioned whether the curve is flat or steep; the offsets along that line extrapolated to
+// N -> infinity (Richardson in h = 1 / N), and the extrapolated point with its error estimate in
+// x and in y (the estimate along the normal, projected).
 struct PointStudy {
-  std::vector<double> y_by_N;  // NaN where not found
-  double extrapolated = NAN, error_estimate = NAN;
+  std::vector<double> x_by_N, y_by_N;  // the point of each N's curve on the normal; NaN where not found
+  double x_extrapolated = NAN, y_extrapolated = NAN;
+  double x_error_estimate = NAN, y_error_estimate = NAN;
 };
 
 std::vector<PointStudy> study_points(const Config& config, const BoundaryRun& run, BifurcationType type,
                                      const BoundaryCurve& curve, Progress& progress) {
   std::vector<PointStudy> out(curve.points.size());
-  const double y_range = std::abs(run.options.y_to - run.options.y_from);
+  const BoundaryOptions& o = run.options;
+  const double dx = o.x_to - o.x_from, dy = o.y_to - o.y_from;  // (scaled unit -> physical)
   RichardsonOptions richardson;
   if (run.problem.analyses->switches_in_state() && run.problem.events == EventMode::off)
     richardson.order = richardson.order_step = 1;  // design.md 1.5
   std::vector<TestFunctionAt> coarser;
   for (size_t i = 0; i + 1 < run.Ns.size(); ++i) coarser.emplace_back(config, run, type, run.Ns[i]);
-  for (size_t k = 0; k < curve.points.size(); ++k) {
+  const size_t n = curve.points.size();
+  for (size_t k = 0; k < n; ++k) {
     const BoundaryPoint& pt = curve.points[k];
     PointStudy& s = out[k];
-    for (size_t i = 0; i < coarser.size(); ++i) {
-      const BoundaryFunction g = std::cref(coarser[i]);
-      s.y_by_N.push_back(boundary_y_at(g, pt.x, pt.y, 1e-6 * y_range, run.options.tolerance * y_range));
-    }
-    s.y_by_N.push_back(pt.y);
-    progress.add();
-    if (run.Ns.size() < 2) continue;
+    // The unit normal in the scaled plane, from the neighbours (one-sided at the ends).
+    const BoundaryPoint& a = curve.points[k > 0 ? k - 1 : k];
+    const BoundaryPoint& b = curve.points[k + 1 < n ? k + 1 : k];
+    const double tu = (b.x - a.x) / dx, tv = (b.y - a.y) / dy, norm = std::hypot(tu, tv);
+    const double nu = norm > 0 ? -tv / norm : 0, nv = norm > 0 ? tu / norm : 1;
     std::vector<double> h;
-    std::vector<std::complex<double>> y;
-    for (size_t i = 0; i < run.Ns.size(); ++i)
-      if (std::isfinite(s.y_by_N[i])) {
+    std::vector<std::complex<double>> offsets;
+    for (size_t i = 0; i < run.Ns.size(); ++i) {
+      double offset = 0;  // (the finest N: the point itself)
+      if (i < coarser.size())
+        offset = boundary_offset_along(std::cref(coarser[i]), pt.x, pt.y, nu * dx, nv * dy, 1e-6, o.tolerance);
+      s.x_by_N.push_back(pt.x + offset * nu * dx);
+      s.y_by_N.push_back(pt.y + offset * nv * dy);
+      if (std::isfinite(offset)) {
         h.push_back(1.0 / run.Ns[i]);
-        y.push_back(s.y_by_N[i]);
+        offsets.push_back(offset);
       }
-    if (y.size() < 2) continue;
-    const Extrapolation e = richardson_extrapolate(h, y, richardson);
-    if (std::isfinite(e.error_estimate)) {
-      s.extrapolated = e.value.real();
-      s.error_estimate = e.error_estimate;
     }
+    progress.add();
+    if (offsets.size() < 2) continue;
+    const Extrapolation e = richardson_extrapolate(h, offsets, richardson);
+    if (!std::isfinite(e.error_estimate)) continue;
+    const double offset = e.value.real();
+    s.x_extrapolated = pt.x + offset * nu * dx;
+    s.y_extrapolated = pt.y + offset * nv * dy;
+    s.x_error_estimate = e.error_estimate * std::abs(nu * dx);
+    s.y_error_estimate = e.error_estimate * std::abs(nv * dy);
   }
   return out;
 }
@@ -374,14 +388,18 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
     c["points"] = json::array();
     for (size_t k = 0; k < curve.points.size(); ++k) {
       const BoundaryPoint& p = curve.points[k];
+      const PointStudy& st = studies[k];
       json by_N = json::array();
-      for (double y : studies[k].y_by_N) by_N.push_back(number_or_null(y));
+      for (size_t l = 0; l < st.y_by_N.size(); ++l)
+        by_N.push_back({{"N", run.Ns[l]}, {"x", number_or_null(st.x_by_N[l])}, {"y", number_or_null(st.y_by_N[l])}});
       c["points"].push_back({{"x", p.x},
                              {"y", p.y},
                              {"angle", number_or_null(p.angle)},
                              {"by_N", by_N},
-                             {"y_extrapolated", number_or_null(studies[k].extrapolated)},
-                             {"error_estimate", number_or_null(studies[k].error_estimate)}});
+                             {"x_extrapolated", number_or_null(st.x_extrapolated)},
+                             {"y_extrapolated", number_or_null(st.y_extrapolated)},
+                             {"x_error_estimate", number_or_null(st.x_error_estimate)},
+                             {"error_estimate", number_or_null(st.y_error_estimate)}});
     }
     c["codim2"] = json::array();
     for (const Codim2Point& q : curve.codim2)
@@ -399,8 +417,8 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
 
 // One row per point: its curve's index (from 1), then the point.
 std::string boundary_csv(const std::string& header, const BoundaryRun& run, const Outcome& out) {
-  std::string text = header + "curve,x,y,angle,y_extrapolated,error_estimate";
-  for (int N : run.Ns) text += ",y_N" + std::to_string(N);
+  std::string text = header + "curve,x,y,angle,y_extrapolated,error_estimate,x_extrapolated,x_error_estimate";
+  for (int N : run.Ns) text += ",x_N" + std::to_string(N) + ",y_N" + std::to_string(N);
   text += "\n";
   char buffer[64];
   const auto cell = [&](double v) {
@@ -412,8 +430,10 @@ std::string boundary_csv(const std::string& header, const BoundaryRun& run, cons
       const BoundaryPoint& p = out.curves[i].points[k];
       const PointStudy& study = out.studies[i][k];
       text += std::to_string(i + 1) + "," + cell(p.x) + "," + cell(p.y) + "," + cell(p.angle) + "," +
-              cell(study.extrapolated) + "," + cell(study.error_estimate);
-      for (double y : study.y_by_N) text.append(",").append(cell(y));  // (append: GCC 12's false -Wrestrict)
+              cell(study.y_extrapolated) + "," + cell(study.y_error_estimate) + "," + cell(study.x_extrapolated) +
+              "," + cell(study.x_error_estimate);
+      for (size_t l = 0; l < study.y_by_N.size(); ++l)  // (append: GCC 12's false -Wrestrict)
+        text.append(",").append(cell(study.x_by_N[l])).append(",").append(cell(study.y_by_N[l]));
       text += "\n";
     }
   return text;
@@ -435,7 +455,7 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out
     for (size_t k = 0; k < curve.points.size(); ++k) {
       const BoundaryPoint& p = curve.points[k];
       std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %18.12g  %10.2g  %8.4f\n", p.x, p.y,
-                    out.studies[i][k].extrapolated, out.studies[i][k].error_estimate, p.angle / std::numbers::pi);
+                    out.studies[i][k].y_extrapolated, out.studies[i][k].y_error_estimate, p.angle / std::numbers::pi);
       os << line;
     }
     for (const Codim2Point& q : curve.codim2)
