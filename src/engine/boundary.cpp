@@ -179,6 +179,107 @@ std::optional<Codim2Point> passed_resonance(const std::array<Vec2, 3>& X, const 
   return q;
 }
 
+// The start: on the line u = 0 (y located by the caller, corrected here with x fixed), with its
+// gradient and its tangent toward x_to. NumericalFailure when g is undefined there or the
+// corrector moves y by more than 1e-6 of the range (the caller's point is not on the curve).
+CurveState start_of_curve(const ScaledCurve& scaled, double y_start, const BoundaryOptions& o) {
+  std::string reason;
+  const Vec2 X0{0, (y_start - o.y_from) / (o.y_to - o.y_from)};
+  const BoundarySample s0 = scaled.at(X0);
+  if (!s0.defined) throw NumericalFailure("boundary: the test function is not defined at the start: " + s0.reason);
+  const std::optional<Vec2> grad0 = scaled.gradient(X0, s0.value, reason);
+  if (!grad0) throw NumericalFailure("boundary: at the start: " + reason);
+  std::optional<CurveState> start = correct(scaled, X0, *grad0, {1, 0}, 0, o.tolerance, reason);
+  if (!start || std::abs(start->X[1] - X0[1]) > 1e-6)
+    throw NumericalFailure("boundary: the start (x = " + format_number(o.x_from) + ", y = " + format_number(y_start) +
+                           ") is not on the curve" + (start ? "" : ": " + reason));
+  start->grad = *grad0;
+  start->t = tangent_of(start->grad, {1, 0});
+  return *start;
+}
+
+// The predictor from `at` by ds along its tangent, with the corrector's second equation: the
+// arclength condition, or, where the step would pass u = 1 (x_to), u = 0 (back at x_from) or the
+// y range's edge, the step shortened to land there and that coordinate fixed (`landing` names it).
+struct Predictor {
+  Vec2 P, row;
+  double rhs = 0, ds = 0;
+  BoundaryEnd landing = BoundaryEnd::max_points;  // (max_points: none)
+};
+Predictor predict(const CurveState& at, double ds) {
+  const auto along = [&](double step) { return Vec2{at.X[0] + step * at.t[0], at.X[1] + step * at.t[1]}; };
+  Predictor p{along(ds), at.t, 0, ds, BoundaryEnd::max_points};
+  p.rhs = dot(at.t, p.P);
+  const auto land = [&](int k, double edge, BoundaryEnd end) {
+    const double s = (edge - at.X[k]) / at.t[k];
+    if (!(s > 0 && s <= p.ds)) return;
+    p.ds = s;
+    p.P = along(s);
+    p.P[k] = edge;
+    p.row = k == 0 ? Vec2{1, 0} : Vec2{0, 1};
+    p.rhs = edge;
+    p.landing = end;
+  };
+  if (p.P[0] > 1) land(0, 1, BoundaryEnd::to);
+  else if (p.P[0] < 0) land(0, 0, BoundaryEnd::from);
+  if (p.P[1] > 1) land(1, 1, BoundaryEnd::y_range);
+  else if (p.P[1] < 0) land(1, 0, BoundaryEnd::y_range);
+  return p;
+}
+
+// The corrected point of the predictor with its gradient and tangent; nullopt and the reason when
+// the corrector fails, g is undefined, or the tangent turns by more than ~37 degrees.
+std::optional<CurveState> next_point(const ScaledCurve& scaled, const CurveState& current, const Predictor& p,
+                                     double tolerance, std::string& reason) {
+  std::optional<CurveState> next = correct(scaled, p.P, current.grad, p.row, p.rhs, tolerance, reason);
+  if (!next) return std::nullopt;
+  const std::optional<Vec2> grad = scaled.gradient(next->X, next->sample.value, reason);
+  if (!grad) return std::nullopt;
+  next->grad = *grad;
+  next->t = tangent_of(*grad, current.t);
+  if (dot(next->t, current.t) < 0.8) {
+    reason = "the tangent turned by more than 37 degrees";
+    return std::nullopt;
+  }
+  return next;
+}
+
+// The end of a curve that cannot go on from `last` (step below step_min): a codim-2 point where a
+// critical pair met the real axis (the last angle within 0.05 of 0 or pi), else a failure.
+void end_where_it_stops(BoundaryCurve& curve, const ScaledCurve& scaled, const CurveState& last,
+                        const std::string& reason) {
+  const double angle = last.sample.angle, x = scaled.x(last.X), y = scaled.y(last.X);
+  if (std::isfinite(angle) && (angle < 0.05 || angle > std::numbers::pi - 0.05)) {
+    const bool one_to_one = angle < 0.05;
+    curve.codim2.push_back({one_to_one ? "1:1 resonance" : "1:2 resonance", x, y, angle});
+    curve.end = BoundaryEnd::codim2;
+    curve.note = std::string("the critical pair reached the real axis (angle ") + format_number(angle, 3) + "): " +
+                 (one_to_one ? "1:1" : "1:2") + " resonance at x = " + format_number(x) + ", y = " + format_number(y);
+  } else {
+    curve.end = BoundaryEnd::failure;
+    curve.note = "at x = " + format_number(x) + ", y = " + format_number(y) + ": " + reason;
+  }
+}
+
+// The last three points (scaled), their arclengths and angles, for the resonances passed.
+struct ResonanceWatch {
+  std::array<Vec2, 3> X{};
+  std::array<double, 3> s{0, 0, 0}, angle{NAN, NAN, NAN};
+  std::optional<Codim2Point> add(const Vec2& next, double next_angle, const ScaledCurve& scaled) {
+    const double moved = norm({next[0] - X[2][0], next[1] - X[2][1]});
+    X = {X[1], X[2], next};
+    s = {s[1], s[2], s[2] + moved};
+    angle = {angle[1], angle[2], next_angle};
+    std::optional<Codim2Point> q = passed_resonance(X, s, angle);
+    if (q) {
+      const Vec2 at{q->x, q->y};
+      q->x = scaled.x(at);
+      q->y = scaled.y(at);
+    }
+    return q;
+  }
+};
+
 }  // namespace
 
 BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options) {
@@ -193,96 +294,31 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
 
   BoundaryCurve curve;
   const ScaledCurve scaled(g, o, curve.evaluations);
-  const auto finish_point = [&](const CurveState& s) {
+  const auto add_point = [&](const CurveState& s) {
     curve.points.push_back({scaled.x(s.X), scaled.y(s.X), s.sample.angle, s.iterations});
   };
-  std::string reason;
-  // The start: on the line u = 0 (y located by the caller, corrected here with x fixed).
-  const Vec2 X0{0, (y_start - o.y_from) / (o.y_to - o.y_from)};
-  const BoundarySample s0 = scaled.at(X0);
-  if (!s0.defined) throw NumericalFailure("boundary: the test function is not defined at the start: " + s0.reason);
-  const std::optional<Vec2> grad0 = scaled.gradient(X0, s0.value, reason);
-  if (!grad0) throw NumericalFailure("boundary: at the start: " + reason);
-  std::optional<CurveState> start = correct(scaled, X0, *grad0, {1, 0}, 0, o.tolerance, reason);
-  if (!start || std::abs(start->X[1] - X0[1]) > 1e-6)
-    throw NumericalFailure("boundary: the start (x = " + format_number(o.x_from) + ", y = " + format_number(y_start) +
-                           ") is not on the curve" + (start ? "" : ": " + reason));
-  CurveState current = *start;
-  current.grad = *grad0;
-  current.t = tangent_of(current.grad, {1, 0});
-  finish_point(current);
-  // The last three points (scaled), their arclengths and angles: codim-2 points passed.
-  std::array<Vec2, 3> last_X{current.X, current.X, current.X};
-  std::array<double, 3> last_s{0, 0, 0}, last_angle{NAN, NAN, current.sample.angle};
-
+  CurveState current = start_of_curve(scaled, y_start, o);
+  add_point(current);
+  ResonanceWatch resonances;
+  resonances.add(current.X, current.sample.angle, scaled);
   double ds = std::clamp(o.step, o.step_min, o.step_max);
   while (static_cast<int>(curve.points.size()) < o.max_points) {
-    // The predictor, shortened to land on u = 1 (x_to), u = 0 (back at x_from) or the y range's edge.
-    Vec2 P{current.X[0] + ds * current.t[0], current.X[1] + ds * current.t[1]};
-    Vec2 row = current.t;
-    double rhs = dot(current.t, P);
-    BoundaryEnd landing = BoundaryEnd::max_points;  // (none)
-    const auto land = [&](int k, double edge, BoundaryEnd end) {
-      const double s = (edge - current.X[k]) / current.t[k];
-      if (!(s > 0 && s <= ds)) return;
-      ds = s;
-      P = {current.X[0] + ds * current.t[0], current.X[1] + ds * current.t[1]};
-      P[k] = edge;
-      row = k == 0 ? Vec2{1, 0} : Vec2{0, 1};
-      rhs = edge;
-      landing = end;
-    };
-    if (P[0] > 1) land(0, 1, BoundaryEnd::to);
-    else if (P[0] < 0) land(0, 0, BoundaryEnd::from);
-    if (P[1] > 1) land(1, 1, BoundaryEnd::y_range);
-    else if (P[1] < 0) land(1, 0, BoundaryEnd::y_range);
-
-    std::optional<CurveState> next = correct(scaled, P, current.grad, row, rhs, o.tolerance, reason);
-    std::optional<Vec2> grad;
-    if (next) grad = scaled.gradient(next->X, next->sample.value, reason);
-    if (next && grad) {
-      next->grad = *grad;
-      next->t = tangent_of(*grad, current.t);
-      if (dot(next->t, current.t) < 0.8) {
-        next.reset();
-        reason = "the tangent turned by more than 37 degrees";
-      }
-    }
-    if (!next || !grad) {
+    const Predictor p = predict(current, ds);
+    ds = p.ds;
+    std::string reason;
+    std::optional<CurveState> next = next_point(scaled, current, p, o.tolerance, reason);
+    if (!next) {
       ds *= 0.5;
       if (ds >= o.step_min) continue;
-      // The end of the curve's definition: a codim-2 point where the critical pair met the real axis.
-      const double angle = current.sample.angle;
-      if (std::isfinite(angle) && (angle < 0.05 || angle > std::numbers::pi - 0.05)) {
-        const bool one_to_one = angle < 0.05;
-        curve.codim2.push_back({one_to_one ? "1:1 resonance" : "1:2 resonance", scaled.x(current.X),
-                                scaled.y(current.X), angle});
-        curve.end = BoundaryEnd::codim2;
-        curve.note = std::string("the critical pair reached the real axis (angle ") + format_number(angle, 3) +
-                     "): " + (one_to_one ? "1:1" : "1:2") + " resonance at x = " + format_number(scaled.x(current.X)) +
-                     ", y = " + format_number(scaled.y(current.X));
-      } else {
-        curve.end = BoundaryEnd::failure;
-        curve.note = "at x = " + format_number(scaled.x(current.X)) + ", y = " + format_number(scaled.y(current.X)) +
-                     ": " + reason;
-      }
+      end_where_it_stops(curve, scaled, current, reason);
       return curve;
     }
-    const double moved = norm({next->X[0] - current.X[0], next->X[1] - current.X[1]});
     current = *next;
-    finish_point(current);
-    last_X = {last_X[1], last_X[2], current.X};
-    last_s = {last_s[1], last_s[2], last_s[2] + moved};
-    last_angle = {last_angle[1], last_angle[2], current.sample.angle};
-    if (std::optional<Codim2Point> q = passed_resonance(last_X, last_s, last_angle)) {
-      const Vec2 at{q->x, q->y};
-      q->x = scaled.x(at);
-      q->y = scaled.y(at);
-      curve.codim2.push_back(*q);
-    }
-    if (landing != BoundaryEnd::max_points) {
-      curve.end = landing;
-      if (landing == BoundaryEnd::y_range)
+    add_point(current);
+    if (std::optional<Codim2Point> q = resonances.add(current.X, current.sample.angle, scaled)) curve.codim2.push_back(*q);
+    if (p.landing != BoundaryEnd::max_points) {
+      curve.end = p.landing;
+      if (p.landing == BoundaryEnd::y_range)
         curve.note = "left the y range at x = " + format_number(curve.points.back().x) + ", y = " +
                      format_number(curve.points.back().y);
       return curve;

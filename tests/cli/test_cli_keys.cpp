@@ -207,6 +207,7 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"milling_lobes", "chart"},
                                                        {"milling_lobes_full", "chart"},
                                                        {"milling_variable_pitch", "chart"},
+                                                       {"milling_lobes_curves", "boundary"},
                                                        {"milling_point", "converge"},
                                                        {"equations_impact", "floquet"},
                                                        {"equations_two_oscillators", "floquet"},

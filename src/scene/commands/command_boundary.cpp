@@ -78,8 +78,9 @@ BoundaryRun read_boundary_run(Config& config) {
                    "grazing in one key, with error bars");
   for (BifurcationType t : {BifurcationType::neimark_sacker, BifurcationType::period_doubling, BifurcationType::fold})
     if (type == to_string(t)) run.type = t;
-  if (config.get_choice("boundary_starts", "first", {"first", "scan"}) == "scan")
-    run.scan_points = static_cast<int>(config.get_int_in_range("boundary_scan_points", 20, 2, 100000));
+  const bool scan = config.get_choice("boundary_starts", "first", {"first", "scan"}) == "scan";
+  const int scan_points = static_cast<int>(config.get_int_in_range("boundary_scan_points", 20, 2, 100000));
+  if (scan) run.scan_points = scan_points;
   o.step = config.get_double("boundary_step", 0.02);
   o.step_min = config.get_double("boundary_step_min", 1e-6);
   o.step_max = config.get_double("boundary_step_max", 0.1);
