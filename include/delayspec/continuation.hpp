@@ -205,6 +205,10 @@ struct BifurcationEstimate {
   double error_estimate = INFINITY;  // of `extrapolated`; infinity with one level
   double observed_order = NAN;       // log(d1 / d2) / log(r) of the last three levels
   double angle = 0;                  // at the finest N
+  // Neimark-Sacker: the angle at each level extrapolated as the location is (NaN otherwise, and
+  // the estimate infinite with one level): the angle of the N -> infinity point.
+  std::vector<double> angles;  // at each of Ns
+  double angle_extrapolated = NAN, angle_error_estimate = INFINITY;
   std::string note;
 };
 

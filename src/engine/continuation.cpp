@@ -167,6 +167,7 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
       if (!match) continue;
       e.Ns.push_back(Ns[level]);
       e.parameters.push_back(match->parameter);
+      e.angles.push_back(match->angle);
       h.push_back(1.0 / Ns[level]);
       values.push_back(match->parameter);
     }
@@ -185,6 +186,13 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
       e.extrapolated = ex.value.real();
       e.error_estimate = ex.error_estimate;
       e.note += ex.note;
+      // The Neimark-Sacker angle converges as the location does (the same expansion in h).
+      if (e.type == BifurcationType::neimark_sacker) {
+        const std::vector<std::complex<double>> angles(e.angles.begin(), e.angles.end());
+        const Extrapolation ea = richardson_extrapolate(h, angles, richardson);
+        e.angle_extrapolated = ea.value.real();
+        e.angle_error_estimate = ea.error_estimate;
+      }
     } else {
       e.extrapolated = b.parameter;
       e.note += "one level: no error estimate";

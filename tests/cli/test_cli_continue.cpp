@@ -98,6 +98,11 @@ TEST(ContinueCli, NeimarkSackerOfLinearDdeWithErrorBars) {
   // honest: the extrapolated boundary within its estimate of -2, the estimate <= 1e-8
   EXPECT_LE(std::abs(b["extrapolated"].get<double>() + 2), b["error_estimate"].get<double>());
   EXPECT_LE(b["error_estimate"].get<double>(), 1e-8);
+  // the angle extrapolated with the location (issue 32): within its estimate of 2 pi / 3, which is
+  // far below the finest level's own O(h^2) error
+  const double angle = b["angle_extrapolated"], angle_bar = b["angle_error_estimate"];
+  EXPECT_LE(std::abs(angle - 2 * pi / 3), angle_bar + 1e-12);
+  EXPECT_LT(angle_bar, 1e-2 * std::abs(b["angle"].get<double>() - 2 * pi / 3));
   // |mu| = 1 at the located point, to the location tolerance times d|mu|/db = O(1)
   EXPECT_NEAR(b["multipliers"][0]["abs"].get<double>(), 1, 1e-11);
 }

@@ -337,8 +337,6 @@ std::vector<PointStudy> study_points(const Config& config, const BoundaryRun& ru
   return out;
 }
 
-json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
 // The curves found, each with its type and its points' studies.
 struct Outcome {
   std::vector<BoundaryCurve> curves;
@@ -421,11 +419,7 @@ std::string boundary_csv(const std::string& header, const BoundaryRun& run, cons
   std::string text = header + "curve,x,y,angle,y_extrapolated,error_estimate,x_extrapolated,x_error_estimate";
   for (int N : run.Ns) text += ",x_N" + std::to_string(N) + ",y_N" + std::to_string(N);
   text += "\n";
-  char buffer[64];
-  const auto cell = [&](double v) {
-    std::snprintf(buffer, sizeof buffer, "%.17g", v);
-    return std::isfinite(v) ? std::string(buffer) : std::string("nan");
-  };
+  const auto cell = csv_number;  // (the shortest exact spelling, nan where there is none)
   for (size_t i = 0; i < out.curves.size(); ++i)
     for (size_t k = 0; k < out.curves[i].points.size(); ++k) {
       const BoundaryPoint& p = out.curves[i].points[k];

@@ -57,6 +57,10 @@ json bifurcations_json(const std::vector<BifurcationEstimate>& estimates, const 
     bj["extrapolated"] = e.extrapolated;
     bj["error_estimate"] = e.error_estimate;  // infinity (one level): null
     bj["observed_order"] = e.observed_order;
+    if (e.type == BifurcationType::neimark_sacker) {  // the angle extrapolated as the location is
+      bj["angle_extrapolated"] = e.angle_extrapolated;     // NaN with one level: null
+      bj["angle_error_estimate"] = e.angle_error_estimate;  // infinity with one level: null
+    }
     bj["bracket"] = finest.bracket;
     if (!e.note.empty() || !finest.note.empty()) bj["note"] = finest.note + (finest.note.empty() ? "" : "; ") + e.note;
     list.push_back(bj);
