@@ -121,10 +121,9 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
   gp << gnuplot_datablock("chart", rows);
   gp << "set table $boundary\nset contour base\nset cntrparam levels discrete 1.0\nunset surface\n"
         "splot $chart using 1:2:3 with lines\nunset table\nunset contour\nset surface\n";
-  gp << "set title "
-     << gnuplot_string("Spectral radius |{/Symbol m}_1|, model " + t.metadata_text("model", "?") +
-                       ", N = " + title_N(t) + " (white line: |{/Symbol m}_1| = 1)")
-     << "\n";
+  gp << figure_title(t.metadata_text("title", ""), "Spectral radius |{/Symbol m}_1|, model " +
+                                                       t.metadata_text("model", "?") + ", N = " + title_N(t) +
+                                                       " (white line: |{/Symbol m}_1| = 1)");
   gp << "set xlabel " << key_axis_label(t.columns[0]) << "\nset ylabel " << key_axis_label(t.columns[1]) << "\n";
   gp << "set cblabel '|{/Symbol m}_1| (clipped at 2)'\nset cbrange [0:2]\n"
         "set palette defined (0 '#08306b', 0.5 '#4292c6', 0.999 '#c6dbef', 1.001 '#fee391', 1.5 '#fb6a4a', 2 '#67000d')\n";

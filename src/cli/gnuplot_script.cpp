@@ -42,6 +42,13 @@ std::string gnuplot_label(const std::string& text) {
   return gnuplot_string(escaped);
 }
 
+std::string figure_title(const std::string& scene_title, const std::string& description) {
+  if (scene_title.empty()) return "set title " + gnuplot_string(description) + "\n";
+  // gnuplot sets the title just above the graph: the description there, the scene's title above it.
+  return "set title " + gnuplot_string(description) + " font ',10'\nset label 99 " + gnuplot_label(scene_title) +
+         " at screen 0.5, screen 0.955 center front font ',13'\nset tmargin 5\n";
+}
+
 std::string key_axis_label(const std::string& key) {
   static const std::map<std::string, std::string> units = {
       {"spindle_rpm", "rpm"}, {"depth", "m"}, {"omega_n", "rad/s"}, {"Kt", "N/m^2"}, {"Kn", "N/m^2"}, {"mass", "kg"}};

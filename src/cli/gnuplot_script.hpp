@@ -28,6 +28,11 @@ std::string gnuplot_string(const std::string& text);
 // (_ ^ { } @ & ~) are escaped, so that `spindle_rpm` is not drawn as spindle with subscript r.
 std::string gnuplot_label(const std::string& text);
 
+// A figure's title: the scene's own title (a run's `title`, from the result file's metadata) on
+// top and `description` (enhanced text, what is drawn) in smaller type below it; the description
+// alone when the scene has no title. gnuplot commands, each line ending in a newline.
+std::string figure_title(const std::string& scene_title, const std::string& description);
+
 // The axis label of a model key: gnuplot_label of the key with its unit where the key has one
 // ("spindle_rpm (rpm)", "depth (m)"; the milling keys, whose units the key registry's meanings
 // state), else of the key alone.

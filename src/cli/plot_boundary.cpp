@@ -102,9 +102,15 @@ void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
   gp << gnuplot_datablock("bars", bars.empty() ? "nan nan nan nan\n" : bars)
      << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks)
      << gnuplot_datablock("region", region.empty() ? "nan nan nan\n" : region);
-  gp << "set title " << gnuplot_string("Stability boundary (N = " + N + ")") << "\n";
+  gp << figure_title(t.metadata_text("title", ""), "Stability boundary, N = " + N);
   gp << "set xlabel " << key_axis_label(x_key) << "\nset ylabel " << key_axis_label(y_key)
      << "\nset grid\nset key outside bottom center horizontal\nset style textbox opaque noborder\n"
+     // The ranges the run searched (error bars may reach past them), and bars without end caps:
+     // a bar as long as its estimate, invisible where it is below the line's width.
+     << "set xrange [" << gnuplot_number(std::min(x_range.at(0).number(), x_range.at(1).number())) << ":"
+     << gnuplot_number(std::max(x_range.at(0).number(), x_range.at(1).number())) << "]\nset yrange ["
+     << gnuplot_number(std::min(y_range.at(0).number(), y_range.at(1).number())) << ":"
+     << gnuplot_number(std::max(y_range.at(0).number(), y_range.at(1).number())) << "]\nset bars 0\n"
      << labels;
   // A legend entry only for what is drawn.
   std::string plot = "plot ";
@@ -120,7 +126,7 @@ void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
     ++block_index;
   }
   if (!bars.empty())
-    add("$bars using 1:2:3:4 with xyerrorbars pt 7 ps 0.4 lc rgb '#000000' title " +
+    add("$bars using 1:2:3:4 with xyerrorbars pt 7 ps 0.25 lc rgb '#000000' title " +
         gnuplot_string("extrapolated, with its error estimate"));
   if (!marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'codim 2'");
   gp << plot << "\n";
