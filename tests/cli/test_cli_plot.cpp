@@ -399,7 +399,10 @@ TEST(PlotCli, BoundaryDrawsTheCurveItsBarsAndItsResonance) {
     return run(args);
   };
   const fs::path dir = fresh_plot_dir("boundary");
-  ASSERT_EQ(boundary(dir, {"--set", "period=2", "--set", "N=100", "--set", "boundary_Ns=25,50,100"}).status, 0);
+  ASSERT_EQ(boundary(dir, {"--set", "period=2", "--set", "N=100", "--set", "boundary_Ns=25,50,100", "--set",
+                           "title=A test's curve"})
+                .status,
+            0);
   CliResult p = run({"plot", dir.string(), "--set", "plot_width=300", "--set", "plot_height=200"});
   ASSERT_EQ(p.status, 0) << p.err;
   EXPECT_EQ(head(dir / "plots" / "boundary.png", 8), std::string("\x89PNG\r\n\x1a\n", 8));
@@ -407,6 +410,7 @@ TEST(PlotCli, BoundaryDrawsTheCurveItsBarsAndItsResonance) {
   EXPECT_NE(gp.find("set xlabel 'a'\n"), std::string::npos) << gp;
   EXPECT_NE(gp.find("set ylabel 'b'\n"), std::string::npos) << gp;
   EXPECT_NE(gp.find("'1:2 resonance'"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("A test\u2019s curve"), std::string::npos) << gp;  // the scene's title (its quote typographic)
   EXPECT_NE(gp.find("with xyerrorbars"), std::string::npos) << gp;
 
   const fs::path one = fresh_plot_dir("boundary_one_level");
