@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "delayspec/continuation.hpp"
+#include "delayspec/richardson.hpp"
 
 namespace delayspec {
 
@@ -91,6 +92,32 @@ struct BoundaryCurve {
 // NumericalFailure: g undefined at the start, or the start not on the curve (|correction| above
 // 1e-6 of the range).
 BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options);
+
+// The curve through (x_start, y_start), a point on it with x_start in [x_from, x_to] of `whole`:
+// traced from there to x_to and, when it starts inside the range, also back to x_from, the two
+// halves joined (x_from's half reversed; the curve's end and note are the worse half's, a failure
+// or a resonance before a range's edge). Steps and tolerance are those of the whole range's scaled
+// plane. A curve that comes back to its start (closed) is traced once.
+BoundaryCurve trace_boundary_both_ways(const BoundaryFunction& g, const BoundaryOptions& whole, double x_start,
+                                       double y_start);
+
+// Whether (x, y) lies on one of the curves: within `y_tolerance` of a segment's y at that x.
+bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, double y, double y_tolerance);
+
+// A point of a curve against the curves of coarser N (`coarser[i]`: the test function at Ns[i],
+// Ns increasing, the last the curve's own): each found on the line through the point along the
+// curve's normal in the plane scaled by `scale`'s ranges (boundary_offset_along: well conditioned
+// whether the curve is flat or steep), the offsets extrapolated to N -> infinity (Richardson in
+// h = 1 / N), and the extrapolated point with its error estimate in x and in y (the estimate along
+// the normal, projected). NaN where the levels do not show their order or a level finds no curve.
+struct BoundaryPointStudy {
+  std::vector<double> x_by_N, y_by_N;  // the point of each N's curve on the normal (the last: the point)
+  double x_extrapolated = NAN, y_extrapolated = NAN;
+  double x_error_estimate = NAN, y_error_estimate = NAN;
+};
+BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, const std::vector<BoundaryFunction>& coarser,
+                                        const std::vector<int>& Ns, const BoundaryOptions& scale,
+                                        const RichardsonOptions& richardson);
 
 // The s nearest 0 with g((x, y) + s (dx, dy)) = 0, by the secant method from s = 0 and s = step,
 // to |ds| <= tolerance; NaN when it does not converge in 30 evaluations or g is undefined. Along

@@ -331,6 +331,82 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
   return curve;
 }
 
+BoundaryCurve trace_boundary_both_ways(const BoundaryFunction& g, const BoundaryOptions& whole, double x_start,
+                                       double y_start) {
+  const auto half = [&](double x_end) {
+    BoundaryOptions o = whole;
+    o.x_from = x_start;
+    o.x_to = x_end;
+    const double factor = std::abs(whole.x_to - whole.x_from) / std::abs(x_end - x_start);
+    o.step *= factor, o.step_min *= factor, o.step_max *= factor, o.tolerance *= factor;
+    return trace_boundary(g, y_start, o);
+  };
+  const double edge = 1e-12 * std::abs(whole.x_to - whole.x_from);
+  const bool forward = std::abs(whole.x_to - x_start) > edge, backward = std::abs(x_start - whole.x_from) > edge;
+  BoundaryCurve ahead = forward ? half(whole.x_to) : BoundaryCurve{};
+  if (!backward || ahead.end == BoundaryEnd::from) return ahead;  // (closed: back at its start)
+  BoundaryCurve behind = half(whole.x_from);
+  if (!forward) return behind;
+  // behind reversed, then ahead without its first point (the start, in both)
+  BoundaryCurve joined = ahead;
+  joined.points.assign(behind.points.rbegin(), behind.points.rend());
+  joined.points.insert(joined.points.end(), ahead.points.begin() + 1, ahead.points.end());
+  joined.codim2.insert(joined.codim2.begin(), behind.codim2.begin(), behind.codim2.end());
+  joined.evaluations += behind.evaluations;
+  if (behind.end == BoundaryEnd::failure || behind.end == BoundaryEnd::codim2) joined.end = behind.end;
+  if (!behind.note.empty())
+    joined.note = "towards " + format_number(whole.x_from) + ": " + behind.note +
+                  (ahead.note.empty() ? "" : "; towards " + format_number(whole.x_to) + ": " + ahead.note);
+  return joined;
+}
+
+bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, double y, double y_tolerance) {
+  for (const BoundaryCurve& c : curves)
+    for (size_t i = 1; i < c.points.size(); ++i) {
+      const BoundaryPoint &a = c.points[i - 1], &b = c.points[i];
+      if ((x - a.x) * (x - b.x) > 0 || a.x == b.x) continue;
+      const double y_here = a.y + (b.y - a.y) * (x - a.x) / (b.x - a.x);
+      if (std::abs(y_here - y) <= y_tolerance) return true;
+    }
+  return false;
+}
+
+BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, const std::vector<BoundaryFunction>& coarser,
+                                        const std::vector<int>& Ns, const BoundaryOptions& scale,
+                                        const RichardsonOptions& richardson) {
+  BoundaryPointStudy s;
+  const size_t n = curve.points.size();
+  const BoundaryPoint& pt = curve.points.at(k);
+  const double dx = scale.x_to - scale.x_from, dy = scale.y_to - scale.y_from;  // (scaled unit -> physical)
+  // The unit normal in the scaled plane, from the neighbours (one-sided at the ends).
+  const BoundaryPoint& a = curve.points[k > 0 ? k - 1 : k];
+  const BoundaryPoint& b = curve.points[k + 1 < n ? k + 1 : k];
+  const double tu = (b.x - a.x) / dx, tv = (b.y - a.y) / dy, length = std::hypot(tu, tv);
+  const double nu = length > 0 ? -tv / length : 0, nv = length > 0 ? tu / length : 1;
+  std::vector<double> h;
+  std::vector<std::complex<double>> offsets;
+  for (size_t i = 0; i < Ns.size(); ++i) {
+    double offset = 0;  // (the finest N: the point itself)
+    if (i < coarser.size())
+      offset = boundary_offset_along(coarser[i], pt.x, pt.y, nu * dx, nv * dy, 1e-6, scale.tolerance);
+    s.x_by_N.push_back(pt.x + offset * nu * dx);
+    s.y_by_N.push_back(pt.y + offset * nv * dy);
+    if (std::isfinite(offset)) {
+      h.push_back(1.0 / Ns[i]);
+      offsets.push_back(offset);
+    }
+  }
+  if (offsets.size() < 2) return s;
+  const Extrapolation e = richardson_extrapolate(h, offsets, richardson);
+  if (!std::isfinite(e.error_estimate)) return s;
+  const double offset = e.value.real();
+  s.x_extrapolated = pt.x + offset * nu * dx;
+  s.y_extrapolated = pt.y + offset * nv * dy;
+  s.x_error_estimate = e.error_estimate * std::abs(nu * dx);
+  s.y_error_estimate = e.error_estimate * std::abs(nv * dy);
+  return s;
+}
+
 double boundary_offset_along(const BoundaryFunction& g, double x, double y, double dx, double dy, double step,
                              double tolerance) {
   const auto at = [&](double s) { return g(x + s * dx, y + s * dy); };

@@ -7,16 +7,14 @@
 // any type but grazing) starts the curve. With boundary_starts = scan, the same search at
 // boundary_scan_points values of x gives a start at each, and every start not on a curve already
 // followed starts another (followed both ways from it): the lobes of a lobe diagram. A curve is
-// followed at the finest N
-// (trace_boundary), the test function at each (x, y) evaluated on the orbit solved there (linear
-// models: the zero orbit; nonlinear: Newton from the last orbit). With boundary_Ns, each point's
-// curve at every coarser N is found along the curve's normal (boundary_offset_along) and the
-// offsets extrapolated (Richardson, h = 1 / N): `x_extrapolated`, `y_extrapolated` and their error
-// estimates (null where the levels do not show their order or a level is not found).
+// followed at the finest N (trace_boundary_both_ways), the test function at each (x, y)
+// evaluated on the orbit solved there (linear models: the zero orbit; nonlinear: Newton from the
+// last orbit). With boundary_Ns, each point is studied against the coarser N's curves
+// (boundary_point_study): `x_extrapolated`, `y_extrapolated` and their error estimates.
 //
-// Files with --out DIR: boundary.csv (metadata header; one row per point: x, y, angle,
-// y_extrapolated, error_estimate, y at each N; nan where there is none) and boundary.json (the
-// --json result).
+// Files with --out DIR: boundary.csv (metadata header; one row per point: curve, x, y, angle,
+// the extrapolations and their estimates, x and y at each N; nan where there is none) and
+// boundary.json (the --json result).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -193,18 +191,6 @@ Search search_at(const Config& config, const BoundaryRun& run, double x) {
   return out;
 }
 
-// Whether (x, y) lies on one of the curves (within 1e-3 of the y range, between two points).
-bool on_a_curve(const std::vector<BoundaryCurve>& curves, double x, double y, double y_range) {
-  for (const BoundaryCurve& c : curves)
-    for (size_t i = 1; i < c.points.size(); ++i) {
-      const BoundaryPoint &a = c.points[i - 1], &b = c.points[i];
-      if ((x - a.x) * (x - b.x) > 0 || a.x == b.x) continue;
-      const double y_here = a.y + (b.y - a.y) * (x - a.x) / (b.x - a.x);
-      if (std::abs(y_here - y) <= 1e-3 * y_range) return true;
-    }
-  return false;
-}
-
 // The starts of the curves: the first bifurcation of the type at x_from (boundary_starts = first),
 // or (scan) the first one in y at each of scan_points values of x, less those on a curve already
 // followed (`follow` is called for each start in turn). stable_below: the orbit is stable at y_from
@@ -233,7 +219,7 @@ bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<Bou
       found += (found.empty() ? "" : "; ") + run.x_key + " = " + format_number(x) + ": " + search.found;
     if (search.starts.empty()) continue;
     const Start& start = search.starts.front();  // the first in y: where the orbit loses (or gains) stability
-    if (on_a_curve(curves, start.x, start.y, std::abs(o.y_to - o.y_from))) continue;
+    if (on_boundary_curve(curves, start.x, start.y, 1e-3 * std::abs(o.y_to - o.y_from))) continue;
     curves.push_back(follow(start));
     types.push_back(start.type);
   }
@@ -246,93 +232,19 @@ bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<Bou
   return stable_below;
 }
 
-// The curve through `start`: followed from its x to x_to and, when it starts inside the range, also
-// back to x_from, the two halves joined (x_from's half reversed). Steps and tolerance are those of
-// the whole range's scaled plane.
-BoundaryCurve follow_curve(const BoundaryFunction& g, const BoundaryOptions& whole, const Start& start) {
-  const auto half = [&](double x_end) {
-    BoundaryOptions o = whole;
-    o.x_from = start.x;
-    o.x_to = x_end;
-    const double factor = std::abs(whole.x_to - whole.x_from) / std::abs(x_end - start.x);
-    o.step *= factor, o.step_min *= factor, o.step_max *= factor, o.tolerance *= factor;
-    return trace_boundary(g, start.y, o);
-  };
-  const double edge = 1e-12 * std::abs(whole.x_to - whole.x_from);
-  const bool forward = std::abs(whole.x_to - start.x) > edge, backward = std::abs(start.x - whole.x_from) > edge;
-  BoundaryCurve ahead = forward ? half(whole.x_to) : BoundaryCurve{};
-  if (!backward || ahead.end == BoundaryEnd::from) return ahead;  // (closed: back at its start)
-  BoundaryCurve behind = half(whole.x_from);
-  if (!forward) return behind;
-  // behind reversed, then ahead without its first point (the start, in both)
-  BoundaryCurve joined = ahead;
-  joined.points.assign(behind.points.rbegin(), behind.points.rend());
-  joined.points.insert(joined.points.end(), ahead.points.begin() + 1, ahead.points.end());
-  joined.codim2.insert(joined.codim2.begin(), behind.codim2.begin(), behind.codim2.end());
-  joined.evaluations += behind.evaluations;
-  if (behind.end == BoundaryEnd::failure || behind.end == BoundaryEnd::codim2) {
-    joined.end = behind.end;  // the worse end of the two halves is the curve's
-    joined.note = "towards " + format_number(whole.x_from) + ": " + behind.note +
-                  (ahead.note.empty() ? "" : "; towards " + format_number(whole.x_to) + ": " + ahead.note);
-  } else if (!behind.note.empty()) {
-    joined.note = "towards " + format_number(whole.x_from) + ": " + behind.note +
-                  (ahead.note.empty() ? "" : "; towards " + format_number(whole.x_to) + ": " + ahead.note);
-  }
-  return joined;
-}
-
-// One point of the curve with the curves of the other N near it: each found on the line through
-// the point along the curve's normal (in the plane scaled by the ranges), where it is well
-// conditioned whether the curve is flat or steep; the offsets along that line extrapolated to
-// N -> infinity (Richardson in h = 1 / N), and the extrapolated point with its error estimate in
-// x and in y (the estimate along the normal, projected).
-struct PointStudy {
-  std::vector<double> x_by_N, y_by_N;  // the point of each N's curve on the normal; NaN where not found
-  double x_extrapolated = NAN, y_extrapolated = NAN;
-  double x_error_estimate = NAN, y_error_estimate = NAN;
-};
-
-std::vector<PointStudy> study_points(const Config& config, const BoundaryRun& run, BifurcationType type,
-                                     const BoundaryCurve& curve, Progress& progress) {
-  std::vector<PointStudy> out(curve.points.size());
-  const BoundaryOptions& o = run.options;
-  const double dx = o.x_to - o.x_from, dy = o.y_to - o.y_from;  // (scaled unit -> physical)
+// Each point's study (boundary_point_study) against the curves of the coarser N.
+std::vector<BoundaryPointStudy> study_points(const Config& config, const BoundaryRun& run, BifurcationType type,
+                                             const BoundaryCurve& curve, Progress& progress) {
   RichardsonOptions richardson;
   if (run.problem.analyses->switches_in_state() && run.problem.events == EventMode::off)
     richardson.order = richardson.order_step = 1;  // design.md 1.5
-  std::vector<TestFunctionAt> coarser;
-  for (size_t i = 0; i + 1 < run.Ns.size(); ++i) coarser.emplace_back(config, run, type, run.Ns[i]);
-  const size_t n = curve.points.size();
-  for (size_t k = 0; k < n; ++k) {
-    const BoundaryPoint& pt = curve.points[k];
-    PointStudy& s = out[k];
-    // The unit normal in the scaled plane, from the neighbours (one-sided at the ends).
-    const BoundaryPoint& a = curve.points[k > 0 ? k - 1 : k];
-    const BoundaryPoint& b = curve.points[k + 1 < n ? k + 1 : k];
-    const double tu = (b.x - a.x) / dx, tv = (b.y - a.y) / dy, norm = std::hypot(tu, tv);
-    const double nu = norm > 0 ? -tv / norm : 0, nv = norm > 0 ? tu / norm : 1;
-    std::vector<double> h;
-    std::vector<std::complex<double>> offsets;
-    for (size_t i = 0; i < run.Ns.size(); ++i) {
-      double offset = 0;  // (the finest N: the point itself)
-      if (i < coarser.size())
-        offset = boundary_offset_along(std::cref(coarser[i]), pt.x, pt.y, nu * dx, nv * dy, 1e-6, o.tolerance);
-      s.x_by_N.push_back(pt.x + offset * nu * dx);
-      s.y_by_N.push_back(pt.y + offset * nv * dy);
-      if (std::isfinite(offset)) {
-        h.push_back(1.0 / run.Ns[i]);
-        offsets.push_back(offset);
-      }
-    }
+  std::vector<TestFunctionAt> at_N;
+  for (size_t i = 0; i + 1 < run.Ns.size(); ++i) at_N.emplace_back(config, run, type, run.Ns[i]);
+  std::vector<BoundaryFunction> coarser(at_N.begin(), at_N.end());
+  std::vector<BoundaryPointStudy> out;
+  for (size_t k = 0; k < curve.points.size(); ++k) {
+    out.push_back(boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson));
     progress.add();
-    if (offsets.size() < 2) continue;
-    const Extrapolation e = richardson_extrapolate(h, offsets, richardson);
-    if (!std::isfinite(e.error_estimate)) continue;
-    const double offset = e.value.real();
-    s.x_extrapolated = pt.x + offset * nu * dx;
-    s.y_extrapolated = pt.y + offset * nv * dy;
-    s.x_error_estimate = e.error_estimate * std::abs(nu * dx);
-    s.y_error_estimate = e.error_estimate * std::abs(nv * dy);
   }
   return out;
 }
@@ -341,7 +253,7 @@ std::vector<PointStudy> study_points(const Config& config, const BoundaryRun& ru
 struct Outcome {
   std::vector<BoundaryCurve> curves;
   std::vector<BifurcationType> types;
-  std::vector<std::vector<PointStudy>> studies;
+  std::vector<std::vector<BoundaryPointStudy>> studies;
   bool stable_below = false;  // stable at y_from wherever the starts were searched
   long evaluations = 0;
   std::string failures;  // the curves that ended in a failure, named
@@ -351,7 +263,7 @@ Outcome compute_boundary(const Config& config, const BoundaryRun& run, const Inv
   Outcome out;
   out.stable_below = follow_starts(config, run, out.curves, out.types, [&](const Start& start) {
     const TestFunctionAt finest(config, run, start.type, run.Ns.back());
-    return follow_curve(std::cref(finest), run.options, start);
+    return trace_boundary_both_ways(std::cref(finest), run.options, start.x, start.y);
   });
   long points = 0;
   for (const BoundaryCurve& c : out.curves) points += static_cast<long>(c.points.size());
@@ -379,7 +291,7 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
   j["curves"] = json::array();
   for (size_t i = 0; i < out.curves.size(); ++i) {
     const BoundaryCurve& curve = out.curves[i];
-    const std::vector<PointStudy>& studies = out.studies[i];
+    const std::vector<BoundaryPointStudy>& studies = out.studies[i];
     json c;
     c["type"] = to_string(out.types[i]);
     c["end"] = to_string(curve.end);
@@ -387,7 +299,7 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
     c["points"] = json::array();
     for (size_t k = 0; k < curve.points.size(); ++k) {
       const BoundaryPoint& p = curve.points[k];
-      const PointStudy& st = studies[k];
+      const BoundaryPointStudy& st = studies[k];
       json by_N = json::array();
       for (size_t l = 0; l < st.y_by_N.size(); ++l)
         by_N.push_back({{"N", run.Ns[l]}, {"x", number_or_null(st.x_by_N[l])}, {"y", number_or_null(st.y_by_N[l])}});
@@ -423,7 +335,7 @@ std::string boundary_csv(const std::string& header, const BoundaryRun& run, cons
   for (size_t i = 0; i < out.curves.size(); ++i)
     for (size_t k = 0; k < out.curves[i].points.size(); ++k) {
       const BoundaryPoint& p = out.curves[i].points[k];
-      const PointStudy& study = out.studies[i][k];
+      const BoundaryPointStudy& study = out.studies[i][k];
       text += std::to_string(i + 1) + "," + cell(p.x) + "," + cell(p.y) + "," + cell(p.angle) + "," +
               cell(study.y_extrapolated) + "," + cell(study.y_error_estimate) + "," + cell(study.x_extrapolated) +
               "," + cell(study.x_error_estimate);
