@@ -35,9 +35,18 @@ std::string lower_envelope(const std::vector<std::vector<std::pair<double, doubl
   return rows;
 }
 
-}  // namespace
+// What the figure draws, read from boundary.csv and boundary.json.
+struct BoundaryFigure {
+  std::string x_key, y_key, N, title;
+  double x0 = 0, x1 = 0, y_from = 0, y_to = 0;  // the run's ranges
+  std::vector<std::vector<std::pair<double, double>>> points;  // by curve
+  std::vector<std::string> types;                              // by curve
+  std::string bars;                                            // "x y dx dy" of the extrapolated points
+  std::string marks, labels;                                   // the codim-2 points, each once
+  bool stable_below = false;
+};
 
-void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
+BoundaryFigure read_boundary_figure(const std::filesystem::path& dir) {
   const ResultTable t = read_result_table(dir / "boundary.csv", [](const std::string& column) {
     return column != "curve" && column != "x" && column != "y";  // (no extrapolation, no level: nan)
   });
@@ -45,78 +54,82 @@ void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
   t.require_rows();
   const nlohmann::json j = read_json_file(dir / "boundary.json");
   const JsonField root(j, "boundary.json", "");
-  const std::string x_key = root.at("boundary_x").text(), y_key = root.at("boundary_y").text();
+  BoundaryFigure f;
+  f.x_key = root.at("boundary_x").text();
+  f.y_key = root.at("boundary_y").text();
+  f.N = std::to_string(static_cast<long>(root.at("N").number()));
+  f.title = t.metadata_text("title", "");
+  const std::vector<JsonField> x_range = root.at("x_range").elements(), y_range = root.at("y_range").elements();
+  f.x0 = std::min(x_range.at(0).number(), x_range.at(1).number());
+  f.x1 = std::max(x_range.at(0).number(), x_range.at(1).number());
+  f.y_from = y_range.at(0).number();
+  f.y_to = y_range.at(1).number();
   const std::vector<JsonField> curves = root.at("curves").elements();
-  // The points of each curve (rows in order, column `curve` from 1).
-  std::vector<std::vector<std::pair<double, double>>> points(curves.size());
-  std::string bars;
-  for (size_t r = 0; r < t.rows.size(); ++r) {
+  f.points.resize(curves.size());
+  for (size_t r = 0; r < t.rows.size(); ++r) {  // (rows in order, column `curve` from 1)
     const auto& row = t.rows[r];
     if (row.empty()) continue;
     const double index = row[0];
     if (!(index >= 1 && index <= static_cast<double>(curves.size()) && index == std::floor(index)))
       throw BadInput(t.where(r) + ": `curve` = " + gnuplot_number(index) + " is not a curve of boundary.json (1.." +
                      std::to_string(curves.size()) + ")");
-    points[static_cast<size_t>(index) - 1].emplace_back(row[1], row[2]);
+    f.points[static_cast<size_t>(index) - 1].emplace_back(row[1], row[2]);
     if (std::isfinite(row[4]) && std::isfinite(row[5]) && std::isfinite(row[6]) && std::isfinite(row[7]))
-      bars += gnuplot_number(row[6]) + " " + gnuplot_number(row[4]) + " " + gnuplot_number(row[7]) + " " +
-              gnuplot_number(row[5]) + "\n";
+      f.bars += gnuplot_number(row[6]) + " " + gnuplot_number(row[4]) + " " + gnuplot_number(row[7]) + " " +
+                gnuplot_number(row[5]) + "\n";
   }
-  // One datablock per type (curves separated by blank lines), so that each type has one colour
-  // and one legend entry.
-  std::map<std::string, std::string> by_type;
-  std::string marks, labels;
+  // The curves that meet at a codim-2 point both report it: one mark (within 1 % of the ranges).
   std::vector<std::pair<double, double>> marked;
-  const std::vector<JsonField> x_range = root.at("x_range").elements(), y_range = root.at("y_range").elements();
-  const double x_span = std::abs(x_range.at(1).number() - x_range.at(0).number()),
-               y_span = std::abs(y_range.at(1).number() - y_range.at(0).number());
-  int index = 0;
-  for (size_t i = 0; i < curves.size(); ++i) {
-    std::string& block = by_type[curves[i].at("type").text()];
-    for (const auto& [x, y] : points[i]) block += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
-    block += "\n";
-    for (const JsonField& q : curves[i].at("codim2").elements()) {
+  for (const JsonField& c : curves) {
+    f.types.push_back(c.at("type").text());
+    for (const JsonField& q : c.at("codim2").elements()) {
       const double x = q.at("x").number(), y = q.at("y").number();
-      // The curves that meet at a codim-2 point both report it: one mark (within 1 % of the ranges).
       bool seen = false;
-      for (const auto& [px, py] : marked) seen = seen || (std::abs(px - x) <= 0.01 * x_span && std::abs(py - y) <= 0.01 * y_span);
+      for (const auto& [px, py] : marked)
+        seen = seen || (std::abs(px - x) <= 0.01 * (f.x1 - f.x0) && std::abs(py - y) <= 0.01 * std::abs(f.y_to - f.y_from));
       if (seen) continue;
       marked.emplace_back(x, y);
-      marks += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
-      labels += "set label " + std::to_string(++index) + " " + gnuplot_string(q.at("kind").text()) + " at " +
-                gnuplot_number(x) + "," + gnuplot_number(y) + " offset 1,-1 front boxed font ',9'\n";
+      f.marks += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
+      f.labels += "set label " + std::to_string(marked.size()) + " " + gnuplot_string(q.at("kind").text()) + " at " +
+                  gnuplot_number(x) + "," + gnuplot_number(y) + " offset 1,-1 front boxed font ',9'\n";
     }
   }
-  // The stable side, shaded when the run found the orbit stable at y_from wherever it searched.
-  std::string region;
-  if (const auto side = root.find("stable_side"); side && side->text() == "y_from") {
-    double x0 = INFINITY, x1 = -INFINITY;
-    for (const auto& c : points)
-      for (const auto& p : c) x0 = std::min(x0, p.first), x1 = std::max(x1, p.first);
-    region = lower_envelope(points, x0, x1, y_range.at(0).number(), y_range.at(1).number(), 600);
+  const auto side = root.find("stable_side");
+  f.stable_below = side && side->text() == "y_from";
+  return f;
+}
+
+}  // namespace
+
+void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
+  const BoundaryFigure f = read_boundary_figure(dir);
+  // One datablock per type (curves separated by blank lines): one colour and one legend entry each.
+  std::map<std::string, std::string> by_type;
+  for (size_t i = 0; i < f.points.size(); ++i) {
+    std::string& block = by_type[f.types[i]];
+    for (const auto& [x, y] : f.points[i]) block += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
+    block += "\n";
   }
-  const std::string N = std::to_string(static_cast<long>(root.at("N").number()));
+  // The stable side, shaded when the run found the orbit stable at y_from wherever it searched.
+  const std::string region = f.stable_below ? lower_envelope(f.points, f.x0, f.x1, f.y_from, f.y_to, 600) : "";
   std::ostringstream gp;
   int block_index = 0;
   for (const auto& [type, block] : by_type) gp << gnuplot_datablock("curves" + std::to_string(++block_index), block);
-  gp << gnuplot_datablock("bars", bars.empty() ? "nan nan nan nan\n" : bars)
-     << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks)
+  gp << gnuplot_datablock("bars", f.bars.empty() ? "nan nan nan nan\n" : f.bars)
+     << gnuplot_datablock("marks", f.marks.empty() ? "nan nan\n" : f.marks)
      << gnuplot_datablock("region", region.empty() ? "nan nan nan\n" : region);
-  gp << figure_title(t.metadata_text("title", ""), "Stability boundary, N = " + N);
-  gp << "set xlabel " << key_axis_label(x_key) << "\nset ylabel " << key_axis_label(y_key)
+  gp << figure_title(f.title, "Stability boundary, N = " + f.N);
+  gp << "set xlabel " << key_axis_label(f.x_key) << "\nset ylabel " << key_axis_label(f.y_key)
      << "\nset grid\nset key outside bottom center horizontal\nset style textbox opaque noborder\n"
      // The ranges the run searched (error bars may reach past them), and bars without end caps:
      // a bar as long as its estimate, invisible where it is below the line's width.
-     << "set xrange [" << gnuplot_number(std::min(x_range.at(0).number(), x_range.at(1).number())) << ":"
-     << gnuplot_number(std::max(x_range.at(0).number(), x_range.at(1).number())) << "]\nset yrange ["
-     << gnuplot_number(std::min(y_range.at(0).number(), y_range.at(1).number())) << ":"
-     << gnuplot_number(std::max(y_range.at(0).number(), y_range.at(1).number())) << "]\nset bars 0\n"
-     << labels;
+     << "set xrange [" << gnuplot_number(f.x0) << ":" << gnuplot_number(f.x1) << "]\nset yrange ["
+     << gnuplot_number(std::min(f.y_from, f.y_to)) << ":" << gnuplot_number(std::max(f.y_from, f.y_to))
+     << "]\nset bars 0\n"
+     << f.labels;
   // A legend entry only for what is drawn.
   std::string plot = "plot ";
-  const auto add = [&](const std::string& item) {
-    plot += (plot == "plot " ? "" : ", \\\n     ") + item;
-  };
+  const auto add = [&](const std::string& item) { plot += (plot == "plot " ? "" : ", \\\n     ") + item; };
   if (!region.empty()) add("$region using 1:2:3 with filledcurves lc rgb '#c7e9c0' title 'stable'");
   const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
   block_index = 0;
@@ -125,10 +138,10 @@ void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
         "' title " + gnuplot_string(type));
     ++block_index;
   }
-  if (!bars.empty())
+  if (!f.bars.empty())
     add("$bars using 1:2:3:4 with xyerrorbars pt 7 ps 0.25 lc rgb '#000000' title " +
         gnuplot_string("extrapolated, with its error estimate"));
-  if (!marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'codim 2'");
+  if (!f.marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'codim 2'");
   gp << plot << "\n";
   renderer.figure("boundary", gp.str());
 }
