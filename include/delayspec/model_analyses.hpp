@@ -166,7 +166,7 @@ class ModelAnalysesFor final : public ModelAnalyses {
     // A model whose derivative is infinite on the orbit (x^(1/3) at 0) gives a monodromy that
     // no eigensolver can use: say at which step, once here (a pass over K small matrices).
     if (!all_finite(at_orbit)) map.throw_first_non_finite_step(out.orbit.history, 1, "the map at the periodic orbit");
-    out.contacts = orbit_contacts(model_, std::move(at_orbit.states));
+    out.contacts = orbit_contacts(map, std::move(at_orbit.states));
     out.monodromy = std::make_unique<Monodromy<D, DW>>(map.grid(), std::move(at_orbit.maps));
     return out;
   }

@@ -2,8 +2,9 @@
 // Contact summary of a periodic orbit: how the periodic sequence of states u_0 .. u_{K-1}
 // (one stroboscopic map, periodic) sits against the switching surface H = 0.
 //
-// Only the grid nodes are inspected: a contact that starts and ends between two nodes (shorter
-// than a step, possible at coarse N near grazing) is not seen. Models without switching: zero.
+// contact_summary inspects only the grid nodes: a contact that starts and ends between two nodes
+// (shorter than a step, possible at coarse N near grazing) is not seen there; orbit_contacts
+// (orbit_search.hpp) adds those from the interpolant. Models without switching: zero.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -13,9 +14,11 @@
 namespace delayspec {
 
 struct ContactSummary {
-  int contacts = 0;           // maximal runs of consecutive nodes in region 1 (H > 0), cyclically
+  int contacts = 0;           // maximal runs of consecutive nodes in region 1 (H > 0), cyclically,
+                              // and (orbit_contacts) the contacts inside a step between two nodes
   long nodes_in_contact = 0;  // nodes with H > 0
-  double max_H = -INFINITY;   // max of H over the nodes (the penetration when > 0)
+  double max_H = -INFINITY;   // max of H over the nodes (orbit_contacts: over the interpolant)
+  long steps_with_inner_contact = 0;  // (orbit_contacts) steps whose contact lies between their nodes
 };
 
 template <class Model>

@@ -14,6 +14,7 @@
 //   Newton on the discrete periodic problem at N (orbit_newton.hpp, sparse LU).
 #include <string>
 
+#include "delayspec/detail/cubic_hermite.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/orbit_contacts.hpp"
 #include "delayspec/orbit_newton.hpp"
@@ -94,11 +95,39 @@ PeriodicOrbit find_orbit(const Model& model, const Map& map, const OrbitSettings
   }
 }
 
-// Contacts of the orbit with H = 0, from the states of one map at the orbit (u_0 .. u_K).
-template <class Model>
-ContactSummary orbit_contacts(const Model& model, std::vector<Vec<Model::d>> states) {
+// Contacts of the orbit with H = 0, from the states of one map at the orbit (u_0 .. u_K): the runs
+// of grid nodes in region 1 (contact_summary), and, between two nodes outside it, a contact that
+// starts and ends inside the step (shorter than a step: near grazing at coarse N), seen by the
+// cubic Hermite interpolant of H(y(t)) with the slopes dH/dt = grad H . f at the step's nodes
+// (H affine, model.hpp; continuation's max H, periodic_branch.hpp): counted as a contact, and
+// every step's largest interpolated H in max_H. The delayed states from the grid's taps, the
+// orbit repeated periodically into the past.
+template <class Model, class Stepper>
+ContactSummary orbit_contacts(const StroboscopicMap<Model, Stepper>& map, std::vector<Vec<Model::d>> states) {
+  using V = Vec<Model::d>;
+  const Model& model = map.stepper().model();
   states.pop_back();  // u_K = u_0 on a periodic orbit
-  return contact_summary(model, states);
+  ContactSummary s = contact_summary(model, states);
+  if constexpr (Model::has_switching) {
+    const HistoryGrid& g = map.grid();
+    const long K = static_cast<long>(states.size()), M = g.M;
+    const auto u = [&](long l) { return states[static_cast<size_t>(((l % K) + K) % K)]; };
+    const auto slot = [&](long i) { return u(i - M); };
+    for (long l = 0; l < K; ++l) {
+      const auto [w0, w1, t] = g.template delay_taps<Model::d, DelayedVec<Model>>(l, slot);
+      const V a = u(l), b = u(l + 1);
+      const double Ha = model.H(a), Hb = model.H(b);
+      const V grad = model.grad_H(a);
+      const double top = detail::hermite_maximum(Ha, Hb, grad.dot(model.f(region_of(model, a), t, a, w0)),
+                                                 grad.dot(model.f(region_of(model, b), t + g.h, b, w1)), g.h);
+      s.max_H = std::max(s.max_H, top);
+      if (!(Ha > 0) && !(Hb > 0) && top > 0) {
+        ++s.contacts;
+        ++s.steps_with_inner_contact;
+      }
+    }
+  }
+  return s;
 }
 
 }  // namespace delayspec

@@ -114,17 +114,6 @@ double multiplier_test(BifurcationType type, const std::vector<std::complex<doub
   return value;
 }
 
-double hermite_maximum(double g0, double g1, double s0, double s1, double h) {
-  // g(u) on u in [0, 1], slopes in u: h s0, h s1; its largest value at an end or a turning point.
-  const detail::CubicHermite g(g0, g1, h * s0, h * s1);
-  double best = std::max(g0, g1);
-  double roots[2];
-  const int n = g.turning_points(roots);
-  for (int i = 0; i < n; ++i)
-    if (roots[i] > 0 && roots[i] < 1) best = std::max(best, g(roots[i]));
-  return best;
-}
-
 }  // namespace continuation_detail
 
 std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>& Ns,

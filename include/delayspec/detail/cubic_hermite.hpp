@@ -1,7 +1,8 @@
 #pragma once
 // The cubic Hermite interpolant on [0, 1] and its interior turning points: one home for the
 // event test's excursion check (event_step.hpp: hermite_extremum_within) and continuation's
-// largest value of a test function between two points (continuation.cpp: hermite_maximum).
+// largest value of a test function between two points (hermite_maximum: continuation's max H
+// and the orbit's contacts, orbit_search.hpp).
 //
 // p(tau) = ga + c1 tau + c2 tau^2 + c3 tau^3 with p(0) = ga, p(1) = gL, p'(0) = d0, p'(1) = d1:
 //   c1 = d0, c2 = -3 ga - 2 d0 + 3 gL - d1, c3 = 2 ga + d0 - 2 gL + d1.
@@ -9,6 +10,7 @@
 // form q = -(qb + sign(qb) sqrt(qb^2 - 4 qa qc)) / 2, roots q / qa and qc / q (no cancellation
 // between -qb and the square root); a quadratic coefficient below 1e-14 of the others is a
 // linear p' (its root -qc / qb), since q / qa would then be rounding divided by rounding.
+#include <algorithm>
 #include <cmath>
 
 namespace delayspec::detail {
@@ -40,5 +42,17 @@ struct CubicHermite {
     return n;
   }
 };
+
+// The maximum of the cubic Hermite interpolant on [0, h] of values g0, g1 and slopes s0, s1 (in
+// the variable on [0, h]): at an end or at an interior turning point.
+inline double hermite_maximum(double g0, double g1, double s0, double s1, double h) {
+  const CubicHermite g(g0, g1, h * s0, h * s1);
+  double best = std::max(g0, g1);
+  double roots[2];
+  const int n = g.turning_points(roots);
+  for (int i = 0; i < n; ++i)
+    if (roots[i] > 0 && roots[i] < 1) best = std::max(best, g(roots[i]));
+  return best;
+}
 
 }  // namespace delayspec::detail

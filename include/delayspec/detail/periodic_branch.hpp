@@ -20,6 +20,7 @@
 #include "delayspec/grid.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/detail/branch_corrector.hpp"
+#include "delayspec/detail/cubic_hermite.hpp"
 #include "delayspec/stepper.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 
@@ -32,8 +33,7 @@ class ProblemSizeChanged : public BadInput {
   using BadInput::BadInput;
 };
 
-// The maximum of the cubic Hermite interpolant on [0, h] of values g0, g1 and slopes s0, s1.
-double hermite_maximum(double g0, double g1, double s0, double s1, double h);
+using detail::hermite_maximum;  // (cubic_hermite.hpp)
 
 // The problem F(x, p) = 0 of one model factory and one discretisation (the options' N,
 // periods_per_map, step options), with the weighted inner product of continuation.hpp.
