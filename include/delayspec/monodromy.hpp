@@ -25,7 +25,8 @@
 // so one Monodromy must not be applied from two threads at once. Copy it instead.
 //
 // Several delays (model.hpp): DW = D n rows of delayed values, D x DW blocks Q and R; the steps
-// run through block_kernel.hpp's multi_delay_steps on the linear layout (portable code).
+// run through block_kernel.hpp's multi_delay_steps on the linear layout, blocks of k > 1 with the
+// AVX2 + FMA code and transposes where the shape has them (kernel_dispatch.hpp's kMultiDelayAvx2).
 //
 // A LinearOperator (linear_operator.hpp): the eigensolvers take it for any d. The bodies are
 // here, so a model of any d instantiates them; d = 1 and 2 are compiled once in the library.
@@ -79,8 +80,9 @@ class Monodromy final : public LinearOperator {
   KernelPath kernel_path() const { return path_; }
 
   // The widest path compiled in the library for D: the AVX-512 kernel is d = 2's streaming one,
-  // AVX2 + FMA code exists for D = 1, 2; another D (compiled outside the library) is portable.
-  static constexpr KernelPath kWidestPath = DW != D   ? KernelPath::baseline
+  // AVX2 + FMA code exists for D = 1, 2 and their shapes with 2-4 delays; another shape (compiled
+  // outside the library) is portable.
+  static constexpr KernelPath kWidestPath = DW != D   ? (detail::kMultiDelayAvx2<D, DW> ? KernelPath::avx2 : KernelPath::baseline)
                                             : D == 2 ? KernelPath::avx512
                                             : D == 1 ? KernelPath::avx2
                                                      : KernelPath::baseline;
@@ -141,7 +143,7 @@ void Monodromy<D, DW>::perform_op(const double* x, double* y) const {
 
 template <int D, int DW>
 void Monodromy<D, DW>::run_block_steps(long l0, long count, double* u, const double* delayed, long k) const {
-  if constexpr (kHasAvx2Kernel) {
+  if constexpr (kHasAvx2Kernel && DW == D) {
     if (runs_avx2_code(path_)) {
       detail::block_steps_avx2(maps_.data() + l0, count, u, delayed, grid_.theta, k);
       return;
@@ -219,8 +221,16 @@ void Monodromy<D, DW>::apply_block_linear(const double* X, long ldx, long k, dou
   double* b = block_work_.data();
   // b[(j D + r) k + v] = X(j D + r, v); K steps; the result (slots K .. K + M) back into Y
   to_slots(X, ldx, n_, k, b);
-  if constexpr (DW != D) multi_delay_steps<D, DW>(maps_.data(), K, M, grid_.delays, b, k);
-  else run_block_steps(0, K, b + M * stride, b + grid_.delayed_slot(0) * stride, k);
+  if constexpr (DW != D) {
+    if constexpr (kHasAvx2Kernel) {
+      if (runs_avx2_code(path_)) detail::multi_delay_steps_avx2(maps_.data(), K, M, grid_.delays, b, k);
+      else multi_delay_steps<D, DW>(maps_.data(), K, M, grid_.delays, b, k);
+    } else {
+      multi_delay_steps<D, DW>(maps_.data(), K, M, grid_.delays, b, k);
+    }
+  } else {
+    run_block_steps(0, K, b + M * stride, b + grid_.delayed_slot(0) * stride, k);
+  }
   from_slots(b + K * stride, n_, k, Y, ldy);
 }
 

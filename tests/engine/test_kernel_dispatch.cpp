@@ -26,6 +26,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <optional>
 #include <random>
@@ -383,4 +384,109 @@ TEST(KernelDispatch, GuardPageAfterTheLastColumn) {
       if (path == KernelPath::avx512)  // 16 vectors side by side, then 8
         expect_guarded_kernel_matches(path, detail::stream_steps_avx512, grid, {8, 24, 40, 16, 32});
     }
+}
+
+// Several delays (block_kernel.hpp's multi_delay_steps; AVX2 + FMA code for the shapes of
+// kMultiDelayAvx2): every path against the definition (grid.delay_taps, one vector at a time)
+// and the baseline's dense matrix, k = 1 .. 33, on grids with every delay fractional, one delay
+// aligned, and a delay shorter than the map (computed slots read back). A shape without AVX2
+// code (D = 3 with 2 delays, D = 1 with 5) reports and runs the baseline path on every request.
+namespace {
+
+template <int D, int DW>
+std::vector<StepMap<D, DW>> random_multi_maps(long K, int N, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  const double h = 1.0 / N;
+  std::vector<StepMap<D, DW>> maps(static_cast<size_t>(K));
+  for (StepMap<D, DW>& s : maps) {
+    for (int r = 0; r < D; ++r)
+      for (int c = 0; c < D; ++c) s.P(r, c) = (r == c ? 1 : 0) + h * g(rng);
+    for (int r = 0; r < D; ++r)
+      for (int c = 0; c < DW; ++c) s.Q(r, c) = 0.5 * h * g(rng), s.R(r, c) = 0.5 * h * g(rng);
+  }
+  return maps;
+}
+
+// y = M x by the definition: b[M+l+1] = P b[M+l] + Q w0 + R w1, (w0, w1) = grid.delay_taps.
+template <int D, int DW>
+Eigen::VectorXd reference_multi_apply(const HistoryGrid& grid, const std::vector<StepMap<D, DW>>& maps,
+                                      const Eigen::VectorXd& x) {
+  std::vector<Vec<D>> b(static_cast<size_t>(grid.M + 1 + grid.K));
+  for (long j = 0; j <= grid.M; ++j) b[j] = x.segment<D>(j * D);
+  auto slot = [&b](long i) -> const Vec<D>& { return b[i]; };
+  for (long l = 0; l < grid.K; ++l) {
+    const DelayTap<Vec<DW>> tap = grid.delay_taps<D, Vec<DW>>(l, slot);
+    const StepMap<D, DW>& s = maps[l];
+    b[grid.M + l + 1] = s.P * b[grid.M + l] + s.Q * tap.w0 + s.R * tap.w1;
+  }
+  Eigen::VectorXd y(x.size());
+  for (long j = 0; j <= grid.M; ++j) y.segment<D>(j * D) = b[grid.K + j];
+  return y;
+}
+
+template <int D, int DW>
+void check_multi_delay_paths(const HistoryGrid& grid) {
+  const auto maps = random_multi_maps<D, DW>(grid.K, grid.N, 11 + DW);
+  std::optional<Monodromy<D, DW>> baseline;
+  {
+    KernelEnv env("baseline");
+    baseline.emplace(grid, maps);
+  }
+  ASSERT_EQ(baseline->kernel_path(), KernelPath::baseline);
+  const Eigen::MatrixXd dense = baseline->to_dense();
+  const KernelPath widest = detail::kMultiDelayAvx2<D, DW> ? KernelPath::avx2 : KernelPath::baseline;
+  for (KernelPath path : cpu_paths()) {
+    KernelEnv env(kernel_path_name(path));
+    const Monodromy<D, DW> op(grid, maps);
+    ASSERT_EQ(op.kernel_path(), std::min(path, widest)) << kernel_path_name(path);
+    for (long k : {1L, 2L, 3L, 4L, 5L, 8L, 16L, 33L}) {
+      SCOPED_TRACE("D = " + std::to_string(D) + ", DW = " + std::to_string(DW) + ", k = " + std::to_string(k) +
+                   ", path " + kernel_path_name(op.kernel_path()));
+      const Eigen::MatrixXd X = random_matrix(op.rows(), k, 200 + static_cast<unsigned>(k));
+      Eigen::MatrixXd Y;
+      op.apply_block(X, Y);
+      using Layout = typename Monodromy<D, DW>::BlockLayout;
+      EXPECT_EQ(op.last_block_layout(), k == 1 ? Layout::single : Layout::linear);
+      Eigen::MatrixXd reference(op.rows(), k);
+      for (long v = 0; v < k; ++v) reference.col(v) = reference_multi_apply<D, DW>(grid, maps, X.col(v));
+      EXPECT_LE((Y - reference).norm(), kTol * reference.norm());
+      const Eigen::MatrixXd by_dense = dense * X;
+      EXPECT_LE((Y - by_dense).norm(), kTol * by_dense.norm());
+    }
+    EXPECT_LE((op.to_dense() - dense).norm(), kTol * dense.norm());
+  }
+}
+
+// Grids with n delays, at least one fractional (theta != 0: slot j - 1 is read) and one shorter
+// than the map (K > m_i: the steps read back slots they computed).
+HistoryGrid several_delay_grid(const std::vector<double>& taus, int N) {
+  HistoryGrid g = make_grid(taus, 1.0, N);
+  EXPECT_EQ(g.delays.size(), taus.size());
+  bool fractional = false, short_delay = false;
+  for (const auto& p : g.delays) fractional = fractional || p.theta > 0, short_delay = short_delay || g.K > p.m;
+  EXPECT_TRUE(fractional);
+  EXPECT_TRUE(short_delay);
+  return g;
+}
+// The ratios irrational (sqrt 2, sqrt 0.5, sqrt 0.3); N a multiple of 13 and 11 where the longest
+// delay is 1.3 or 1.1 periods (a period is a whole number of steps).
+HistoryGrid two_delay_grid() { return several_delay_grid({0.7, 0.7 * std::sqrt(2.0)}, 40); }
+HistoryGrid three_delay_grid() { return several_delay_grid({1.3, 0.45, std::sqrt(0.5)}, 39); }
+HistoryGrid four_delay_grid() { return several_delay_grid({0.25, 1.1, std::sqrt(0.3), 0.9}, 44); }
+HistoryGrid five_delay_grid() { return several_delay_grid({0.25, 1.1, std::sqrt(0.3), 0.9, 0.6}, 44); }
+
+}  // namespace
+
+TEST(KernelDispatch, SeveralDelaysEveryPathAgreesWithTheDefinition) {
+  check_multi_delay_paths<1, 2>(two_delay_grid());
+  check_multi_delay_paths<2, 4>(two_delay_grid());
+  check_multi_delay_paths<1, 3>(three_delay_grid());
+  check_multi_delay_paths<2, 6>(three_delay_grid());
+  check_multi_delay_paths<1, 4>(four_delay_grid());
+  check_multi_delay_paths<2, 8>(four_delay_grid());
+}
+TEST(KernelDispatch, SeveralDelaysOfAShapeWithoutWideCodeRunThePortablePath) {
+  check_multi_delay_paths<3, 6>(two_delay_grid());
+  check_multi_delay_paths<1, 5>(five_delay_grid());
 }

@@ -247,7 +247,8 @@ inline void single_steps(const StepMap<D>* maps, long K, long M, long first_dela
 // j_i = current - m_i, Q_i and R_i the D x D column blocks of delay i. The same single pass over
 // the k vectors as step_block, D accumulators per vector, the delayed part first and P u0 last;
 // the interpolation is done for every delay (theta_i = 0 multiplies a valid slot by 0), so the
-// loop over the vectors has no branch and vectorises. NT = DW / D delays, KC as in step_block.
+// loop over the vectors has no branch and vectorises. NT = DW / D delays, KC and Target as in
+// step_block (the AVX2 + FMA instantiations: src/engine/kernels/block_kernel_avx2.cpp).
 template <int NT>
 struct DelayPlaces {
   long m[NT];
@@ -258,7 +259,7 @@ struct DelayPlaces {
   }
 };
 
-template <int D, int DW, int KC = 0>
+template <int D, int DW, int KC = 0, class Target = detail::PortableTarget>
 inline void multi_delay_block(const Mat<D>& P, const RectMat<D, DW>& Q, const RectMat<D, DW>& R, const double* b,
                               long current, const DelayPlaces<DW / D>& places, long k_runtime,
                               double* __restrict out) {
@@ -309,10 +310,10 @@ inline void multi_delay_block(const Mat<D>& P, const RectMat<D, DW>& Q, const Re
 
 // A step's derivative, formed or factored (S^{-1} [L u0 + Bl w0 + Br w1]: the same pass with L,
 // Bl, Br, then S^{-1} per vector), applied to k interleaved vectors.
-template <int D, int DW, int KC = 0>
+template <int D, int DW, int KC = 0, class Target = detail::PortableTarget>
 inline void multi_delay_step(const StepMap<D, DW>& s, const double* b, long current,
                              const DelayPlaces<DW / D>& places, long k, double* __restrict out) {
-  multi_delay_block<D, DW, KC>(s.P, s.Q, s.R, b, current, places, k, out);
+  multi_delay_block<D, DW, KC, Target>(s.P, s.Q, s.R, b, current, places, k, out);
 }
 template <int D, int DW, int KC = 0>
 inline void multi_delay_step(const StepLinearisation<D, DW>& s, const double* b, long current,
@@ -330,14 +331,14 @@ inline void multi_delay_step(const StepLinearisation<D, DW>& s, const double* b,
 
 // The K steps of one map (formed step maps) on k interleaved vectors of the linear history b:
 // step l reads slot M + l and the taps, writes slot M + l + 1. k = 1, 2, 4, 8, 16 at compile time.
-template <int D, int DW>
+template <int D, int DW, class Target = detail::PortableTarget>
 inline void multi_delay_steps(const StepMap<D, DW>* maps, long K, long M,
                               const std::vector<HistoryGrid::DelayPosition>& delays, double* b, long k) {
   const DelayPlaces<DW / D> places(delays);
   const long stride = static_cast<long>(D) * k;
   auto run = [&]<int KC>() {
     for (long l = 0; l < K; ++l)
-      multi_delay_step<D, DW, KC>(maps[l], b, M + l, places, k, b + (M + l + 1) * stride);
+      multi_delay_step<D, DW, KC, Target>(maps[l], b, M + l, places, k, b + (M + l + 1) * stride);
   };
   switch (k) {
     case 1: return run.template operator()<1>();

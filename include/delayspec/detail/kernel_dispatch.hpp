@@ -11,13 +11,17 @@
 // every path against the others; BadInput when the CPU cannot run it); unset, empty or `auto`
 // takes the widest path the CPU supports (__builtin_cpu_supports: avx512f for avx512, avx2 and
 // fma for both wide paths). Either way the choice is capped at the widest path compiled for the
-// caller: avx512 for D = 2, avx2 for D = 1 and the Gram-Schmidt passes, baseline for a model of
-// another D compiled outside the library (an equation model). Any other value is BadInput naming it.
+// caller: avx512 for D = 2, avx2 for D = 1, for D = 1, 2 with 2-4 delays (kMultiDelayAvx2) and
+// the Gram-Schmidt passes, baseline for a model of another shape (an equation model's, compiled
+// outside the library). Any other value is BadInput naming it.
 // The Gram-Schmidt passes of the Krylov-Schur backend and GMRES (src/engine/kernels/gram_schmidt_chunks.hpp)
 // make the same choice per call, with their AVX2 + FMA code in src/engine/kernels/gram_schmidt_avx2.cpp.
 //
 // The paths compute the same sums; FMA rounds a*b + c once instead of twice, so they agree to
 // rounding (tests/engine/test_kernel_dispatch.cpp), not bit for bit.
+#include <vector>
+
+#include "delayspec/grid.hpp"
 #include "delayspec/step_map.hpp"
 
 namespace delayspec {
@@ -54,6 +58,23 @@ void stream_steps_avx2(const StepMap<2>* maps, long K, long M, long j0, double t
                        double* Y, long ldy);
 void stream_steps_portable(const StepMap<2>* maps, long K, long M, long j0, double theta, const double* X, long ldx,
                            long k, double* Y, long ldy);
+// The AVX2 + FMA instantiations of multi_delay_steps (block_kernel.hpp) on k > 1 vectors for the
+// shapes with several delays that have them (kMultiDelayAvx2: D = 1, 2 with 2-4 delays, the
+// variable-pitch cutter's D = 2 with 4 among them). One vector runs the portable code, as above.
+template <int D, int DW>
+inline constexpr bool kMultiDelayAvx2 = (D == 1 || D == 2) && DW != D && DW % D == 0 && DW / D <= 4;
+void multi_delay_steps_avx2(const StepMap<1, 2>* maps, long K, long M, const std::vector<HistoryGrid::DelayPosition>& delays,
+                            double* b, long k);
+void multi_delay_steps_avx2(const StepMap<1, 3>* maps, long K, long M, const std::vector<HistoryGrid::DelayPosition>& delays,
+                            double* b, long k);
+void multi_delay_steps_avx2(const StepMap<1, 4>* maps, long K, long M, const std::vector<HistoryGrid::DelayPosition>& delays,
+                            double* b, long k);
+void multi_delay_steps_avx2(const StepMap<2, 4>* maps, long K, long M, const std::vector<HistoryGrid::DelayPosition>& delays,
+                            double* b, long k);
+void multi_delay_steps_avx2(const StepMap<2, 6>* maps, long K, long M, const std::vector<HistoryGrid::DelayPosition>& delays,
+                            double* b, long k);
+void multi_delay_steps_avx2(const StepMap<2, 8>* maps, long K, long M, const std::vector<HistoryGrid::DelayPosition>& delays,
+                            double* b, long k);
 // dst[c ldd + r] = src[r lds + c] (r < rows, c < cols): interleave(X, ldx, n, k, b) is
 // transpose_avx2(X, ldx, k, n, b, k), deinterleave(b, n, k, Y, ldy) is transpose_avx2(b, k, n, k, Y, ldy).
 void transpose_avx2(const double* src, long lds, long rows, long cols, double* dst, long ldd);

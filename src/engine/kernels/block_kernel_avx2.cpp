@@ -34,6 +34,22 @@ void block_steps_avx2(const StepMap<2>* maps, long K, double* u, const double* d
   block_steps<2, Avx2Target>(maps, K, u, delayed, theta, k);
 }
 
+// Several delays: the same template as the portable path (multi_delay_steps), one overload per
+// shape (kernel_dispatch.hpp's kMultiDelayAvx2), each local to this file through Avx2Target.
+#define DELAYSPEC_MULTI_DELAY_AVX2(D, DW)                                                                  \
+  void multi_delay_steps_avx2(const StepMap<D, DW>* maps, long K, long M,                                  \
+                              const std::vector<HistoryGrid::DelayPosition>& delays, double* b, long k) {  \
+    static_assert(kMultiDelayAvx2<D, DW>);                                                                 \
+    multi_delay_steps<D, DW, Avx2Target>(maps, K, M, delays, b, k);                                        \
+  }
+DELAYSPEC_MULTI_DELAY_AVX2(1, 2)
+DELAYSPEC_MULTI_DELAY_AVX2(1, 3)
+DELAYSPEC_MULTI_DELAY_AVX2(1, 4)
+DELAYSPEC_MULTI_DELAY_AVX2(2, 4)
+DELAYSPEC_MULTI_DELAY_AVX2(2, 6)
+DELAYSPEC_MULTI_DELAY_AVX2(2, 8)
+#undef DELAYSPEC_MULTI_DELAY_AVX2
+
 // The streaming apply_block for d = 2 and k a multiple of 4, fused with its transposes
 // (stream_steps_avx2, kernel_dispatch.hpp). Math as in block_kernel.hpp: step l (slot
 // j = j0 + l) computes
