@@ -45,6 +45,11 @@ namespace delayspec {
 struct OrbitByNewtonOptions {
   double tolerance = 1e-12;  // accept |F|_inf <= tolerance (1 + |x|_inf)
   int max_iterations = 30;   // Newton steps (linear solves) before giving up
+  // Newton steps taken even when the guess meets the tolerance. A guess from a nearby parameter
+  // (a curve's last point) can meet it while off by the parameter change times the orbit's
+  // sensitivity (|F| is one step's residual, the orbit's error up to K times more); one step
+  // leaves O(|F|^2). `boundary` takes 1: without it its grazing test function was noisy at 5e-10.
+  int min_iterations = 0;
 };
 
 // The discrete periodic problem of one stroboscopic map of `map` (its stepper and grid).
@@ -168,7 +173,8 @@ PeriodicOrbit orbit_by_newton(const Map& map, Eigen::VectorXd x, const OrbitByNe
                             " iterations, |F|_inf = " + format_number(r) + " (tolerance " +
                             format_number(opt.tolerance * (1 + x.lpNorm<Eigen::Infinity>())) + ")");
   };
-  while (!(r <= opt.tolerance * (1 + x.lpNorm<Eigen::Infinity>()))) {
+  const auto converged = [&] { return r <= opt.tolerance * (1 + x.lpNorm<Eigen::Infinity>()); };
+  while (orbit.newton_iterations < opt.min_iterations || !converged()) {
     if (!std::isfinite(r)) throw failure("non-finite residual");
     if (orbit.newton_iterations >= opt.max_iterations) throw failure("not converged");
     SparseLU lu = [&] {
@@ -206,6 +212,7 @@ PeriodicOrbit orbit_by_newton(const Map& map, Eigen::VectorXd x, const OrbitByNe
         orbit.newton_residuals.push_back(r);
       }
     }
+    if (!accepted && converged()) break;  // a step asked for by min_iterations, from round-off already
     if (!accepted) throw failure("stalled (no step along the Newton direction reduces the residual)");
   }
   orbit.history = problem.history(x);

@@ -113,13 +113,15 @@ ContactSummary orbit_contacts(const StroboscopicMap<Model, Stepper>& map, std::v
     const long K = static_cast<long>(states.size()), M = g.M;
     const auto u = [&](long l) { return states[static_cast<size_t>(((l % K) + K) % K)]; };
     const auto slot = [&](long i) { return u(i - M); };
+    const int fixed = map.stepper().options().fixed_region;  // one field throughout (step_options.hpp)
+    const auto region = [&](const V& y) { return fixed != 0 ? fixed : region_of(model, y); };
     for (long l = 0; l < K; ++l) {
       const auto [w0, w1, t] = g.template delay_taps<Model::d, DelayedVec<Model>>(l, slot);
       const V a = u(l), b = u(l + 1);
       const double Ha = model.H(a), Hb = model.H(b);
       const V grad = model.grad_H(a);
-      const double top = detail::hermite_maximum(Ha, Hb, grad.dot(model.f(region_of(model, a), t, a, w0)),
-                                                 grad.dot(model.f(region_of(model, b), t + g.h, b, w1)), g.h);
+      const double top = detail::hermite_maximum(Ha, Hb, grad.dot(model.f(region(a), t, a, w0)),
+                                                 grad.dot(model.f(region(b), t + g.h, b, w1)), g.h);
       s.max_H = std::max(s.max_H, top);
       if (!(Ha > 0) && !(Hb > 0) && top > 0) {
         ++s.contacts;

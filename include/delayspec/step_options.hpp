@@ -23,6 +23,13 @@ struct StepOptions {
   // it by m^2. On the paper's orbit m = 1 converges erratically (observed order -0.1 between
   // N = 1600 and 3200), m = 4 with order 1.95 (docs/events.md), at no measurable cost there.
   int contact_substeps = 4;
+  // 0: each node in the region of its state (the switched system). 1 or 2 (models that switch in
+  // the state): that region's field everywhere, H ignored and no event located: the orbit of one
+  // smooth field, which stays smooth in the parameters where the switched orbit's is not. Its
+  // max H = 0 is the grazing of the switched orbit (the two coincide while max H <= 0): what
+  // `boundary` follows as a grazing curve (a switched orbit that barely touches has a contact
+  // whose length grows as a square root, and Newton stalls there).
+  int fixed_region = 0;
 };
 
 // What happened inside one step (filled by step() when asked; events off: always empty).

@@ -48,10 +48,13 @@ class TrapezoidStepper {
   using W = DelayedVec<Model>;  // the delayed argument
   using M = Mat<D>;
 
-  // BadInput when options.contact_substeps < 1.
+  // BadInput when options.contact_substeps < 1 or fixed_region is not 0, 1 or 2.
   explicit TrapezoidStepper(const Model& model, const StepOptions& options = {}) : model_(model), options_(options) {
     if (options.contact_substeps < 1)
       throw BadInput("`contact_substeps = " + std::to_string(options.contact_substeps) + "`: must be >= 1");
+    if (options.fixed_region < 0 || options.fixed_region > 2)
+      throw BadInput("TrapezoidStepper: fixed_region = " + std::to_string(options.fixed_region) +
+                     " (0: the regions of the states, 1 or 2: that region's field)");
   }
 
   // One sub-step (*) from (t0, z0) over dt. left_region is used at the left node;
@@ -115,6 +118,13 @@ class TrapezoidStepper {
   [[gnu::always_inline]] inline V step(double t, double h, const V& u0, const W& w0, const W& w1,
                                        StepLinearisation<D, DW>& linearisation, StepEvents* events = nullptr) const {
     if constexpr (Model::has_switching) {
+      if (options_.fixed_region != 0) {  // one field throughout (step_options.hpp)
+        if (events) events->count = 0;
+        int right_region;
+        linearisation.factored = true;
+        return factored_sub_step(t, h, u0, w0, w1, options_.fixed_region, options_.fixed_region, linearisation.sub,
+                                 right_region);
+      }
       if (options_.events != EventMode::off) return event_step(*this, t, h, u0, w0, w1, linearisation, events);
     }
     if (events) events->count = 0;

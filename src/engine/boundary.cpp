@@ -399,11 +399,18 @@ BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, co
   if (offsets.size() < 2) return s;
   const Extrapolation e = richardson_extrapolate(h, offsets, richardson);
   if (!std::isfinite(e.error_estimate)) return s;
+  // Each offset is known to the location tolerance (the secant's last step; the finest N's 0 to
+  // the corrector's), and the extrapolation adds them with weights of sum ~1.5 (h^2 .. h^6
+  // eliminated, step ratio 2): the estimate never goes below 2 tolerances. Without this floor a
+  // curve located to 1e-10 claimed 2e-12 for an error of 1.6e-10 (the exact grazing curve,
+  // tests/cli/test_cli_boundary.cpp). Passed to the tableau as input errors instead, the
+  // tolerance (a bound, far above the secant's actual accuracy) would read as a plateau.
+  const double estimate = std::max(e.error_estimate, 2 * scale.tolerance);
   const double offset = e.value.real();
   s.x_extrapolated = pt.x + offset * nu * dx;
   s.y_extrapolated = pt.y + offset * nv * dy;
-  s.x_error_estimate = e.error_estimate * std::abs(nu * dx);
-  s.y_error_estimate = e.error_estimate * std::abs(nv * dy);
+  s.x_error_estimate = estimate * std::abs(nu * dx);
+  s.y_error_estimate = estimate * std::abs(nv * dy);
   return s;
 }
 

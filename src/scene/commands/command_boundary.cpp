@@ -4,7 +4,8 @@
 //
 // The start: `continue` in boundary_y over [boundary_y_from, boundary_y_to] at x = boundary_x_from
 // (the finest N) locates the bifurcations there; the first of boundary_type (any: the first of
-// any type but grazing) starts the curve. With boundary_starts = scan, the same search at
+// any type but grazing) starts the curve. A grazing curve's test function is the orbit's max H
+// (orbit_contacts: over the steps' interpolants), zero where the orbit touches the switching surface. With boundary_starts = scan, the same search at
 // boundary_scan_points values of x gives a start at each, and every start not on a curve already
 // followed starts another (followed both ways from it): the lobes of a lobe diagram. A curve is
 // followed at the finest N (trace_boundary_both_ways), the test function at each (x, y)
@@ -71,10 +72,8 @@ BoundaryRun read_boundary_run(Config& config) {
   if (o.y_from == o.y_to) throw BadInput("`boundary_y_from = boundary_y_to = " + format_number(o.y_from) + "`: an empty range");
   const std::string type = config.get_choice("boundary_type", "any",
                                              {"any", "neimark-sacker", "period-doubling", "fold", "grazing"});
-  if (type == "grazing")
-    throw BadInput("`boundary_type = grazing`: grazing curves are not followed by `boundary` yet; `continue` locates a "
-                   "grazing in one key, with error bars");
-  for (BifurcationType t : {BifurcationType::neimark_sacker, BifurcationType::period_doubling, BifurcationType::fold})
+  for (BifurcationType t : {BifurcationType::neimark_sacker, BifurcationType::period_doubling, BifurcationType::fold,
+                            BifurcationType::grazing})
     if (type == to_string(t)) run.type = t;
   const bool scan = config.get_choice("boundary_starts", "first", {"first", "scan"}) == "scan";
   const int scan_points = static_cast<int>(config.get_int_in_range("boundary_scan_points", 20, 2, 100000));
@@ -104,6 +103,9 @@ BoundaryRun read_boundary_run(Config& config) {
   config.set(run.x_key, format_number(o.x_from), "boundary_x_from");
   config.set(run.y_key, format_number(o.y_from), "boundary_y_from");
   run.problem = read_problem(config, 100);
+  if (run.type == BifurcationType::grazing && !run.problem.analyses->switches_in_state())
+    throw BadInput("`boundary_type = grazing`: model " + run.problem.model_name +
+                   " has no switching surface H(y) = 0 for its orbit to graze");
   config.check_all_used();
   if (run.Ns.empty()) run.Ns = {run.problem.N};
   return run;
@@ -114,8 +116,10 @@ BoundaryRun read_boundary_run(Config& config) {
 class TestFunctionAt {
  public:
   TestFunctionAt(const Config& base, const BoundaryRun& run, BifurcationType type, int N)
-      : base_(base), run_(run), type_(type) {
+      : base_(base), run_(run), type_(type), orbit_settings_(run.orbit_settings) {
     base_.set("N", std::to_string(N), "boundary_Ns");
+    // From the last point's orbit: one Newton step even when it meets the tolerance (orbit_newton.hpp)
+    orbit_settings_.newton.min_iterations = 1;
   }
   BoundarySample operator()(double x, double y) const {
     Config c = base_;
@@ -123,13 +127,13 @@ class TestFunctionAt {
     c.set(run_.y_key, format_number(y), "boundary");
     try {
       const Problem p = read_problem(c, 100);
-      OrbitRequest request;
-      request.sequence = !p.analyses->is_linear();
-      if (last_orbit_.size() > 0) request.newton_guess = &last_orbit_;
-      const LinearisedOrbit at = p.analyses->linearised_orbit(p.map_settings(), run_.orbit_settings, request);
-      const FloquetResult r = floquet_multipliers(*at.monodromy, run_.floquet);
-      if (at.sequence.size() > 0) last_orbit_ = at.sequence;
-      return boundary_sample(type_, r.multipliers, at.contacts.max_H);
+      if (last_orbit_.size() > 0) {
+        try {
+          return sample(p, &last_orbit_);
+        } catch (const NumericalFailure&) {  // Newton from the last orbit: the search from scratch below
+        }
+      }
+      return sample(p, nullptr);
     } catch (const BadInput& e) {  // a value the model rejects
       return undefined(e.what());
     } catch (const NumericalFailure& e) {  // an orbit or an eigensolver that fails
@@ -138,6 +142,23 @@ class TestFunctionAt {
   }
 
  private:
+  // The test function on the orbit found by Newton from `guess` (the last orbit found), or
+  // (nullptr) by the orbit search of the scene's settings.
+  BoundarySample sample(const Problem& p, const Eigen::VectorXd* guess) const {
+    OrbitRequest request;
+    request.sequence = !p.analyses->is_linear();
+    request.newton_guess = guess;
+    // A grazing curve: the orbit of the field below the surface (step_options.hpp's
+    // fixed_region), smooth where the switched orbit starts to touch; the same orbit where max H <= 0.
+    MapSettings map = p.map_settings();
+    const bool grazing = type_ == BifurcationType::grazing;
+    if (grazing) map.step.fixed_region = 2;
+    const LinearisedOrbit at = p.analyses->linearised_orbit(map, orbit_settings_, request);
+    // (grazing: max H alone; no multipliers)
+    const FloquetResult r = grazing ? FloquetResult{} : floquet_multipliers(*at.monodromy, run_.floquet);
+    if (at.sequence.size() > 0) last_orbit_ = at.sequence;
+    return boundary_sample(type_, r.multipliers, at.contacts.max_H);
+  }
   static BoundarySample undefined(const std::string& reason) {
     BoundarySample s;
     s.reason = reason;
@@ -146,6 +167,7 @@ class TestFunctionAt {
   Config base_;
   const BoundaryRun& run_;
   BifurcationType type_;
+  OrbitSettings orbit_settings_;
   mutable Eigen::VectorXd last_orbit_;
 };
 
@@ -155,8 +177,9 @@ struct Start {
   double x, y;
 };
 
-// The bifurcations in y at x of the wanted type (any: every type but grazing), in the order of y
-// from y_from, and whether the orbit is stable at y_from; `found` lists all it located.
+// The bifurcations in y at x of the wanted type (any: every type but grazing, which bounds no
+// stability region), in the order of y from y_from, and whether the orbit is stable at y_from;
+// `found` lists all it located.
 struct Search {
   std::vector<Start> starts;
   bool stable_at_y_from = false;
@@ -185,7 +208,7 @@ Search search_at(const Config& config, const BoundaryRun& run, double x) {
   out.failure = branch.failure;
   for (const Bifurcation& b : branch.bifurcations) {
     out.found += (out.found.empty() ? "" : ", ") + to_string(b.type) + " at " + format_number(b.parameter);
-    if (b.type != BifurcationType::grazing && (!run.type || *run.type == b.type))
+    if (run.type ? *run.type == b.type : b.type != BifurcationType::grazing)
       out.starts.push_back({b.type, x, b.parameter});
   }
   return out;
@@ -318,8 +341,9 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
     j["curves"].push_back(c);
   }
   // Where the orbit is stable, when the search found it stable at y_from everywhere: below the
-  // curves (the side of y_from).
-  j["stable_side"] = out.stable_below ? json("y_from") : json(nullptr);
+  // curves (the side of y_from). A grazing curve bounds the orbits in contact, not a stable region.
+  const bool stability_curves = run.type != BifurcationType::grazing;
+  j["stable_side"] = out.stable_below && stability_curves ? json("y_from") : json(nullptr);
   if (!out.failures.empty()) j["failure"] = out.failures;
   j["evaluations"] = out.evaluations;
   j["seconds"] = seconds;
