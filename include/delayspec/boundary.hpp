@@ -109,7 +109,8 @@ bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, doubl
 // curve's normal in the plane scaled by `scale`'s ranges (boundary_offset_along: well conditioned
 // whether the curve is flat or steep), the offsets extrapolated to N -> infinity (Richardson in
 // h = 1 / N), and the extrapolated point with its error estimate in x and in y (the estimate along
-// the normal, projected). NaN where the levels do not show their order or a level finds no curve.
+// the normal, projected), never below twice `scale.tolerance` (a point and each level's offset
+// are located to it). NaN where the levels do not show their order or a level finds no curve.
 struct BoundaryPointStudy {
   std::vector<double> x_by_N, y_by_N;  // the point of each N's curve on the normal (the last: the point)
   double x_extrapolated = NAN, y_extrapolated = NAN;
