@@ -214,7 +214,7 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"boundary_x_to", "boundary: where the curve ends (x), landed on exactly"},
       {"boundary_y_from", "boundary: start of the y range (the start is searched by continue in y over the range)"},
       {"boundary_y_to", "boundary: end of the y range (a curve that leaves it ends there)"},
-      {"boundary_type", "boundary: neimark-sacker, period-doubling, fold, or any (the first found at x_from)"},
+      {"boundary_type", "boundary: neimark-sacker, period-doubling, fold, grazing (max H = 0), or any (the first found at x_from but grazing)"},
       {"boundary_starts", "boundary: first (the first bifurcation in y at x_from) or scan (the first in y at each of "
                           "boundary_scan_points values of x: every curve met, e.g. the lobes of a speed range)"},
       {"boundary_scan_points", "boundary: values of x searched for starts with boundary_starts = scan, 2..1e5"},
