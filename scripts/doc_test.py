@@ -4,14 +4,16 @@ quote are what it computes.
 
     doc_test.py --delayspec BUILD/delayspec --source SOURCE_DIR [FILE.md ...]
 
-(ctest runs it as `doc_test`; default files: README.md, docs/tutorial.md, docs/cli.md and
-docs/autonomous.md.)
+(ctest runs it as `doc_test`; default files: README.md and every page of docs/, in DOCS_IN_ORDER's
+order: the tutorial and the key reference first, then the pages as README.md lists them. A page
+added to docs/ and not to that list is a failure.)
 
 What is run. Fenced code blocks tagged `sh` (```sh). In them, every line (after joining `\\`
 continuations and dropping a trailing `# comment`) that starts with `build/delayspec`, or with
 `$ build/delayspec` (a transcript: the lines up to the next `$ ` or the end of the block are the
 expected output), is run with the built program, no shell involved: the line is split with
-shlex and passed as arguments. Every other line (git, sudo bash scripts/..., cmake) is shown
+shlex and passed as arguments; `mpirun ARGS build/delayspec ...` runs under the MPI build's
+launcher (--mpirun) with the page's ARGS. Every other line (git, sudo bash scripts/..., cmake) is shown
 to the reader only. `cp -r SRC DST && build/delayspec ...` is supported (the copy is done here,
 inside the scratch directory). Commands run in order, one document after the other, all in one
 fresh scratch directory (a reader at the repository root,
@@ -55,6 +57,11 @@ import time
 MARKER = re.compile(r"<!--\s*doc-test(?P<expect> expect)?:\s*(?P<body>.*?)\s*-->")
 EXPECT = re.compile(r"^(?P<file>\S+)\s+(?P<path>\S+)\s*=\s*(?P<value>\S+)\s*\+-\s*(?P<tol>\S+)$")
 PROGRAM = "build/delayspec"
+# Reading order: what a newcomer runs first, then the pages in README.md's order.
+DOCS_IN_ORDER = ["README.md", "docs/tutorial.md", "docs/cli.md", "docs/autonomous.md", "docs/design.md",
+                 "docs/models.md", "docs/formats.md", "docs/events.md", "docs/continuation.md", "docs/lyapunov.md",
+                 "docs/parallel.md", "docs/milling.md", "docs/python.md", "docs/fuzzing.md",
+                 "docs/floquet-results.md", "docs/benchmarks.md"]
 
 
 class Block:
@@ -145,8 +152,10 @@ def commands_of(body):
     return runnable
 
 
-def run_command(words, extra, program, scratch, expected_exit, have_gnuplot, log):
-    """Runs one documented line: (error text or None, output)."""
+def run_command(words, extra, program, scratch, expected_exit, have_gnuplot, log, mpirun=None):
+    """Runs one documented line: (error text or None, output). `mpirun ARGS build/delayspec ...`
+    runs under `mpirun` (the MPI build's launcher, --mpirun) with the page's ARGS; without one
+    it is logged as not run."""
     output = ""
     for step in split_and(words):
         if step[:2] == ["cp", "-r"] and len(step) == 4:
@@ -157,8 +166,16 @@ def run_command(words, extra, program, scratch, expected_exit, have_gnuplot, log
             os.makedirs(os.path.dirname(dst), exist_ok=True)
             shutil.copytree(src, dst)
             continue
+        launch = []
+        if step and step[0] == "mpirun" and PROGRAM in step:
+            if not mpirun:
+                log.append(f"  (no MPI build: not run) {' '.join(step)}")
+                continue
+            launch = [mpirun] + step[1:step.index(PROGRAM)]
+            step = step[step.index(PROGRAM):]
         if not step or step[0] != PROGRAM:
-            return f"not a delayspec command (only `{PROGRAM} ...` and `cp -r` run here): {' '.join(step)}", output
+            return (f"not a delayspec command (only `{PROGRAM} ...`, `mpirun ... {PROGRAM} ...` and `cp -r` run "
+                    f"here): {' '.join(step)}"), output
         if step[1:2] == ["plot"] and not have_gnuplot:
             log.append(f"  (gnuplot missing: not run) delayspec {' '.join(step[1:])}")
             continue
@@ -166,8 +183,9 @@ def run_command(words, extra, program, scratch, expected_exit, have_gnuplot, log
         if step[1:2] != ["plot"]:
             args += [a for only, kv in extra if only in " ".join(step) for a in ("--set", kv)]
         start = time.monotonic()
-        p = subprocess.run([program] + args, cwd=scratch, capture_output=True, text=True, timeout=600)
-        log.append(f"  {time.monotonic() - start:6.1f} s  delayspec {' '.join(args)}  -> exit {p.returncode}")
+        p = subprocess.run(launch + [program] + args, cwd=scratch, capture_output=True, text=True, timeout=600)
+        shown = " ".join((launch[1:] if launch else []) + ["delayspec"] + args)
+        log.append(f"  {time.monotonic() - start:6.1f} s  {'mpirun ' if launch else ''}{shown}  -> exit {p.returncode}")
         output += p.stdout + p.stderr
         if p.returncode != expected_exit:
             return (f"exit {p.returncode} (expected {expected_exit}): delayspec {' '.join(args)}\n"
@@ -229,11 +247,16 @@ def main():
                         help="rewrite the help blocks (docs/cli.md) from the program, run nothing")
     parser.add_argument("--keep", metavar="DIR",
                         help="copy the scratch directory (the files the documents' commands wrote) to DIR")
-    parser.add_argument("docs", nargs="*", default=["README.md", "docs/tutorial.md", "docs/cli.md", "docs/autonomous.md"])
+    parser.add_argument("--mpirun", help="the MPI launcher of an MPI build: the pages' mpirun lines run with it")
+    parser.add_argument("docs", nargs="*", default=DOCS_IN_ORDER)
     a = parser.parse_args()
     program = os.path.abspath(a.delayspec)
     have_gnuplot = shutil.which("gnuplot") is not None
     failures, log = [], []
+    # Every page is in the reading order (a new page must say where a reader meets it).
+    pages = sorted(os.path.join("docs", f) for f in os.listdir(os.path.join(a.source, "docs")) if f.endswith(".md"))
+    failures += [f"{page}: not in doc_test.py's DOCS_IN_ORDER (add it where a reader meets it)"
+                 for page in pages if page not in DOCS_IN_ORDER]
     for doc in a.docs:
         where = os.path.join(a.source, doc)
         helps = [item for kind, _, item in parse(where) if kind == "help"]
@@ -272,7 +295,8 @@ def main():
                     log.append(f"  block at line {line} skipped: {block.skip}")
                     continue
                 for words, expected in block.commands:
-                    error, output = run_command(words, block.extra, program, scratch, block.exit, have_gnuplot, log)
+                    error, output = run_command(words, block.extra, program, scratch, block.exit, have_gnuplot, log,
+                                                a.mpirun)
                     if error:
                         failures.append(f"{doc}:{line}: {error}")
                         continue
