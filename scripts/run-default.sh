@@ -1,9 +1,16 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds (Release) only the program, and runs the default scene: the
-# leading Floquet multipliers of the soft-impact oscillator's period-1 orbit (paper parameters).
-# Extra arguments go to `delayspec floquet` (e.g. --json).
+# Installs what is missing, builds (Release) the program and, where pybind11 is installed, the
+# Python module, and runs the default scene: the leading Floquet multipliers of the soft-impact
+# oscillator's period-1 orbit (paper parameters). Extra arguments go to `delayspec floquet`
+# (e.g. --json). How long it takes on a fresh clone: scripts/first_number_time.py (README.md).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 "$here/scripts/setup-debian.sh"
 DELAYSPEC_TARGETS=delayspec_cli "$here/scripts/build.sh" "$here/build"
 "$here/build/delayspec" floquet "$here/data/scenes/default.toml" "$@"
+# The Python module after the first number (it shares the program's compiled scene layer).
+if grep -q '^DELAYSPEC_PYTHON:BOOL=ON' "$here/build/CMakeCache.txt"; then
+  cmake --build "$here/build" -j "$(nproc)" --target delayspec_python >/dev/null
+  PYTHONPATH="$here/build/python" /usr/bin/python3 -c "import delayspec" &&
+    echo "python: PYTHONPATH=$here/build/python /usr/bin/python3 -c 'import delayspec' works (docs/python.md)"
+fi

@@ -45,7 +45,7 @@ void write_points(std::ostream& s, const std::string& columns, const std::vector
   }
 }
 
-nlohmann::json points_json(const std::vector<double>& t, const std::vector<Eigen::VectorXd>& y) {
+nlohmann::json trajectory_json(const std::vector<double>& t, const std::vector<Eigen::VectorXd>& y) {
   nlohmann::json a = nlohmann::json::array();
   for (size_t i = 0; i < t.size(); ++i) {
     nlohmann::json row = {t[i]};
@@ -120,7 +120,7 @@ int command_simulate(Config& config, const Invocation& inv) {
     impacts.commit();
     files = {traj.path().string(), poincare.path().string(), impacts.path().string()};
   }
-  if (inv.arrays) (*inv.arrays)["trajectory"] = points_json(rec.t, rec.y);
+  if (inv.arrays) (*inv.arrays)["trajectory"] = trajectory_json(rec.t, rec.y);
   if (inv.json) {
     json["model"] = problem.model_name;
     json["N"] = problem.N;
@@ -134,7 +134,7 @@ int command_simulate(Config& config, const Invocation& inv) {
     json["events_before_control"] = to_string(before_problem.events);
     json["impacts"] = rec.impact_times.size();
     json["impact_times"] = rec.impact_times;
-    json["poincare"] = points_json(rec.poincare_t, rec.poincare_y);
+    json["poincare"] = trajectory_json(rec.poincare_t, rec.poincare_y);
     json["columns"] = columns(problem);
     json["samples"] = rec.t.size();
     if (switching) json["max_H"] = rec.max_H;
