@@ -82,7 +82,8 @@ class Monodromy final : public LinearOperator {
   // The widest path compiled in the library for D: the AVX-512 kernel is d = 2's streaming one,
   // AVX2 + FMA code exists for D = 1, 2 and their shapes with 2-4 delays; another shape (compiled
   // outside the library) is portable.
-  static constexpr KernelPath kWidestPath = DW != D   ? (detail::kMultiDelayAvx2<D, DW> ? KernelPath::avx2 : KernelPath::baseline)
+  static constexpr KernelPath kWidestPath = DW != D   ? (detail::kMultiDelayAvx2<D, DW> ? KernelPath::avx2
+                                                                                   : KernelPath::baseline)
                                             : D == 2 ? KernelPath::avx512
                                             : D == 1 ? KernelPath::avx2
                                                      : KernelPath::baseline;

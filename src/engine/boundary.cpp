@@ -132,11 +132,12 @@ std::optional<CurveState> correct(const ScaledCurve& curve, Vec2 X, const Vec2& 
       return std::nullopt;
     }
     const double r0 = s.value, r1 = dot(row, X) - rhs;
-    if (it > 1) {
-      const double dd = dot(last_dX, last_dX), miss = (r0 - last_g) - dot(G, last_dX);
+    const double dd = dot(last_dX, last_dX);  // (0 before the first step)
+    if (dd > 0) {
+      const double miss = (r0 - last_g) - dot(G, last_dX);
       const Vec2 updated{G[0] + miss * last_dX[0] / dd, G[1] + miss * last_dX[1] / dd};
       const double updated_det = updated[0] * row[1] - updated[1] * row[0];
-      if (dd > 0 && std::abs(updated_det) > 1e-14 * norm(updated) * norm(row)) G = updated, D = updated_det;
+      if (std::abs(updated_det) > 1e-14 * norm(updated) * norm(row)) G = updated, D = updated_det;
     }
     // [G; row] dX = -(r0, r1)
     const Vec2 dX{-(r0 * row[1] - r1 * G[1]) / D, -(G[0] * r1 - row[0] * r0) / D};
@@ -379,7 +380,10 @@ bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, doubl
     const size_t n = c.points.size();
     // The curve's extent: segments and turning angles are measured in the box it spans.
     double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-    for (const BoundaryPoint& p : c.points) x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+    for (const BoundaryPoint& p : c.points) {
+      x0 = std::min(x0, p.x), x1 = std::max(x1, p.x);
+      y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+    }
     const double wx = x1 > x0 ? x1 - x0 : 1, wy = y1 > y0 ? y1 - y0 : 1;
     const auto segment = [&](size_t i) {  // points i - 1 -> i, in the box
       return Vec2{(c.points[i].x - c.points[i - 1].x) / wx, (c.points[i].y - c.points[i - 1].y) / wy};

@@ -5,12 +5,13 @@
 // The start: `continue` in boundary_y over [boundary_y_from, boundary_y_to] at x = boundary_x_from
 // (the finest N) locates the bifurcations there; the first of boundary_type (any: the first of
 // any type but grazing) starts the curve. A grazing curve's test function is the orbit's max H
-// (orbit_contacts: over the steps' interpolants), zero where the orbit touches the switching surface. With boundary_starts = scan, the same search at
-// boundary_scan_points values of x gives a start at each, and every start not on a curve already
-// followed starts another (followed both ways from it): the lobes of a lobe diagram. A curve is
-// followed at the finest N (trace_boundary_both_ways), the test function at each (x, y)
-// evaluated on the orbit solved there (linear models: the zero orbit; nonlinear: Newton from the
-// last orbit). With boundary_Ns, each point is studied against the coarser N's curves
+// (orbit_contacts: over the steps' interpolants), zero where the orbit touches the switching
+// surface. With boundary_starts = scan, the same search at boundary_scan_points values of x
+// gives a start at each, and every start not on a curve already followed starts another
+// (followed both ways from it): the lobes of a lobe diagram. A curve is followed at the finest N
+// (trace_boundary_both_ways), the test function at each (x, y) evaluated on the orbit solved
+// there (linear models: the zero orbit; nonlinear: at least one Newton step from the last orbit,
+// the scene's orbit search where that fails). With boundary_Ns, each point is studied against the coarser N's curves
 // (boundary_point_study): `x_extrapolated`, `y_extrapolated` and their error estimates.
 //
 // Files with --out DIR: boundary.csv (metadata header; one row per point: curve, x, y, angle,
