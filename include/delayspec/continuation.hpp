@@ -61,12 +61,14 @@
 //   neimark-sacker   the number of non-real multipliers outside the circle changes and so does
 //                    the number of unstable ones (a real pair becoming complex outside the
 //                    circle changes the first only);
-//   grazing          switching models: the sign of max H over the orbit changes.
+//   grazing          switching models: the sign of max H over the orbit changes, or, on an orbit
+//                    in contact, the sign of the second hump's max H (a second contact region,
+//                    OrbitMeasures::second_max_H; the bifurcation's note says which).
 // Location: on the segment's own curve s -> X(s) (the corrector from X_a + s t_a on the
 // hyperplane <t_a, X - X_a - s t_a>_w = 0, s in [0, s_b]), the zero of the test function
 //   fold: dp/ds at a turning point, else mu - 1 for the real positive multiplier nearest 1;
 //   period doubling: |mu| - 1 for the real negative one nearest -1; Neimark-Sacker: |mu| - 1 for
-//   the non-real one nearest the circle; grazing: max H,
+//   the non-real one nearest the circle; grazing: max H (a second region: second_max_H),
 // first by bisection on the detection counts until the test function changes sign (a long
 // segment may also hold a collision), then by the Illinois variant of regula falsi until the
 // bracket's two ends differ by <= tolerance in p (a test function crossing transversally:
@@ -115,6 +117,11 @@ struct OrbitMeasures {
   // time per map spent in region 1 (H > 0), from the event times of each step.
   double max_H = NAN;
   double contact_time = NAN;
+  // The highest hump of H apart from the highest one, separated from it by free flight
+  // (detail/contact_peaks.hpp; -infinity when there is none): on an orbit in contact its rise
+  // through 0 is the grazing of a second contact region. contact_regions: the regions in contact.
+  double second_max_H = NAN;
+  int contact_regions = 0;
 };
 
 struct ContinuationPoint {
@@ -215,8 +222,9 @@ struct BifurcationEstimate {
 // Matches the bifurcations found at each N (by_N[i] at Ns[i], Ns increasing) to those at the
 // finest N (same type, nearest parameter, each used once) and extrapolates each to h -> 0
 // (h = 1 / N; the trapezoid rule's expansion h^2, h^4, ...: `richardson`). location_accuracy:
-// the absolute accuracy of each location (the continuation tolerance), the floor of the error
-// estimate. BadInput: sizes differ, Ns not increasing.
+// the absolute accuracy of each location (the continuation tolerance; a location whose bracket
+// stayed wider is known to its bracket), the floor of the error estimate. BadInput: sizes
+// differ, Ns not increasing.
 std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>& Ns,
                                                           const std::vector<std::vector<Bifurcation>>& by_N,
                                                           double location_accuracy,

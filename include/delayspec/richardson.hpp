@@ -39,17 +39,24 @@
 //     |T[L-1][J] - T[L-1][J-1]| (the error of T[L-1][J-1]) still exceeds the remaining error
 //     of T[L-1][J] by 2x or more: that is the error estimate when column J is consistent or
 //     unchecked (the textbook estimate), never below the round-off of T[L-1][J].
-//   * When column J itself is inconsistent, its error is estimated from its own last entries:
-//     E = max(d_last, d_prev r^{-q}), q = e_J the order eliminated last (0 for J = 0). If the
-//     column converges at least at first order from here on (each later difference at most
-//     half the previous one, r = 2), its remaining error is <= d_last; the second term stops a
-//     d_last that is small by an accidental cancellation from passing as accuracy (the column
-//     cannot shrink faster than the slowest order its terms can have, e_J). When the column's
-//     differences grow (d_last > d_prev, above round-off), no estimate is possible: infinity.
-//     Nor when, in the column's last two triples, a difference falls far faster than the expansion allows
-//     (pair order > 2 e_J + 1), to round-off after one above it, or jumps up after a flat stretch
-//     (pair order < -1): a plateau, whose small last
-//     differences say nothing of the next jump (the impact orbit with events = off).
+//   * When column 0 itself is inconsistent, its error is estimated from its own last entries:
+//     E = max(d_last, d_prev). If the column converges at least at first order from here on
+//     (each later difference at most half the previous one, r = 2), its remaining error is
+//     <= d_last; d_prev stops a d_last that is small by an accidental cancellation from passing
+//     as accuracy. When its differences grow (d_last > d_prev, above round-off), no estimate is
+//     possible: infinity. Nor when, in its last two triples, a difference falls far faster than
+//     the expansion allows (pair order > 2 e_1 + 1), to round-off after one above it, or jumps
+//     up after a flat stretch (pair order < -1): a plateau, whose small last differences say
+//     nothing of the next jump (the impact orbit with events = off).
+//   * When column J >= 1 is inconsistent, column J - 1 showed its order q = e_J: the data have
+//     an h^q term, but its coefficient is not constant (an event's place in the grid changes it
+//     from level to level: the impact orbit's raw order wanders over 1.89 .. 2.10). Column J
+//     removed its mean and kept the wandering part, T[i][J] = x0 + delta_i h_i^q, |delta_i| <=
+//     Delta, whose differences can grow, shrink or jump. Its error is bounded by the spread:
+//     E = max over the column's entries of |T[i][J] - T[i-1][J]| (h_{L-1} / h_i)^q, each
+//     difference scaled to the finest step like h^q (of the size Delta h_{L-1}^q; the .cpp says
+//     how often it covers the error). Checked against the impact orbit's exact multipliers at
+//     tau = T (tests/cli/test_cli_converge.cpp).
 //   With check_orders = false the highest column is used with the textbook estimate.
 //
 // Example:
@@ -87,9 +94,9 @@ struct Extrapolation {
   std::complex<double> value;          // the finest entry of the column used: T[L-1][J] (J: header comment)
   double error_estimate = 0;           // max(|T[L-1][J] - T[L-1][J-1]|, the correction the last column made,
                                        //     sum_i |w_i| a_i, the amplified accuracy of the inputs);
-                                       // when column J is inconsistent: max(that column's tail estimate,
-                                       // round-off); infinity when J = 0 and column 0 cannot be checked, or
-                                       // when column J's differences grow
+                                       // when column J is inconsistent: max(its tail (J = 0) or spread
+                                       // (J >= 1) estimate, round-off); infinity when J = 0 and column 0
+                                       // cannot be checked, its differences grow, or it is a plateau
   std::vector<double> column_orders;   // per column: order from its last three entries, the p with
                                        // rho(p) = d2 / d1 (log(d1 / d2) / log r for equal ratios r; NaN
                                        // with fewer than three entries or a zero difference)

@@ -61,26 +61,47 @@ void insert_bifurcation_row(ResultTable& t, double p, int yc, double y, int extr
 }
 
 // One figure of a branch: column y of t against column 0, stable solid and unstable dashed, the
-// bifurcations (`marks`, "x y" lines, with their `labels`) and a reference line (a gnuplot
-// expression with its legend) when given; a legend entry only for what is drawn.
+// bifurcations (`marks`, "x y" lines, with their `labels`), a reference line (a gnuplot
+// expression with its legend) when given, and open circles on the points whose verdict is
+// undecided (column `undecided`, continue with continue_Ns: branch_verdicts.hpp); a legend entry
+// only for what is drawn.
 struct BranchFigure {
   std::string name, title, key, ylabel, marks, labels, reference, reference_title;
-  int y = 0, stable = 0;
+  int y = 0, stable = 0, undecided = -1;
 };
 void branch_figure(FigureRenderer& renderer, const ResultTable& t, const BranchFigure& f) {
-  std::string solid, dashed;
+  std::string solid, dashed, open;
   stable_and_unstable(t, 0, f.y, f.stable, solid, dashed);
+  size_t points = 0, undecided = 0;
+  if (f.undecided >= 0)
+    for (const auto& row : t.rows)
+      if (!row.empty()) {
+        ++points;
+        if (row[static_cast<size_t>(f.undecided)] != 1) continue;
+        ++undecided;
+        open += gnuplot_number(row[0]) + " " + gnuplot_number(row[static_cast<size_t>(f.y)]) + "\n";
+      }
+  // Every point undecided (fewer than three levels): one word in the title, not a circle on each.
+  const bool none_decided = points > 0 && undecided == points;
+  if (none_decided) open.clear();
   std::ostringstream gp;
   gp << gnuplot_datablock("stable", solid.empty() ? "nan nan\n" : solid)
      << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
-     << gnuplot_datablock("marks", f.marks.empty() ? "nan nan\n" : f.marks);
-  gp << "set title " << gnuplot_string(f.title + " (stable solid, unstable dashed)") << "\n";
+     << gnuplot_datablock("marks", f.marks.empty() ? "nan nan\n" : f.marks)
+     << gnuplot_datablock("undecided", open.empty() ? "nan nan\n" : open);
+  gp << "set title "
+     << gnuplot_string(f.title + " (stable solid, unstable dashed" +
+                       (none_decided ? "; at this N: no N -> infinity verdict without continue_Ns)" : ")"))
+     << "\n";
   gp << "set xlabel " << gnuplot_label(f.key) << "\nset ylabel " << gnuplot_string(f.ylabel)
      << "\nset grid\nset key top left\n"
      << f.labels;
   gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
      << "     $unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable'"
      << (f.marks.empty() ? "" : ", \\\n     $marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'")
+     << (open.empty() ? ""
+                      : ", \\\n     $undecided using 1:2 with points pt 6 ps 1.2 lc rgb '#7f7f7f' title "
+                        "'undecided as N -> infinity'")
      << (f.reference.empty() ? "" : ", \\\n     " + f.reference + " with lines lc rgb '#2ca02c' title '" +
                                         f.reference_title + "'")
      << "\n";
@@ -99,6 +120,7 @@ void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path&
   t.require_header({"parameter", "stable", "unstable", "abs_mu1", "max_y1"});
   t.require_rows();
   const int stable = t.column("stable"), mu1 = t.column("abs_mu1"), max_y1 = t.column("max_y1");
+  const int undecided = t.column("undecided");  // -1: no verdicts (one level, or a Hopf branch)
   const std::string key = t.metadata_text("continue_key", "parameter");
   // The bifurcations: parameter, max y1 at the point, |mu| (1 on the circle; grazing: none).
   std::string marks_y, marks_mu, labels_y, labels_mu;
@@ -122,11 +144,12 @@ void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path&
     }
   }
   const std::string title = what + " of " + t.metadata_text("model", "?") + " against " + key;
-  branch_figure(renderer, t, {name, title, key, "max y_1 over the orbit", marks_y, labels_y, "", "", max_y1, stable});
+  branch_figure(renderer, t,
+                {name, title, key, "max y_1 over the orbit", marks_y, labels_y, "", "", max_y1, stable, undecided});
   if (mu1 >= 0)
     branch_figure(renderer, t,
                   {name + "_mu1", title, key, "|{/Symbol m}_1|", marks_mu, labels_mu, "1", "|{/Symbol m}| = 1", mu1,
-                   stable});
+                   stable, undecided});
 }
 
 }  // namespace

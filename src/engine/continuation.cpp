@@ -136,7 +136,7 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
     e.type = b.type;
     e.parameter = b.parameter;
     e.angle = b.angle;
-    std::vector<double> h, values;
+    std::vector<double> h, values, accuracy;
     for (size_t level = 0; level < Ns.size(); ++level) {
       const Bifurcation* match = nullptr;
       size_t match_index = 0;
@@ -159,6 +159,8 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
       e.angles.push_back(match->angle);
       h.push_back(1.0 / Ns[level]);
       values.push_back(match->parameter);
+      // A location is known to its final bracket when that stayed wider than the tolerance.
+      accuracy.push_back(std::max(location_accuracy, match->bracket));
     }
     if (values.size() < Ns.size())
       e.note = "found at " + std::to_string(values.size()) + " of " + std::to_string(Ns.size()) + " levels; ";
@@ -171,7 +173,7 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
     if (values.size() >= 2) {
       std::vector<std::complex<double>> x(values.begin(), values.end());
       const Extrapolation ex =
-          richardson_extrapolate(h, x, richardson, std::vector<double>(values.size(), location_accuracy));
+          richardson_extrapolate(h, x, richardson, accuracy);
       e.extrapolated = ex.value.real();
       e.error_estimate = ex.error_estimate;
       e.note += ex.note;

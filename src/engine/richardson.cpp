@@ -188,28 +188,49 @@ Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::ve
   e.amplification = amplification[J];
   e.roundoff = noise[J];
   const double roundoff = e.roundoff;
+  if (failed && J >= 1) {
+    // Column J - 1 shows its order q, column J not its own: the term of order q does not have a
+    // constant coefficient (an event's place in the grid changes it from level to level), so
+    // column J removed its mean and kept a wandering part, T[i][J] = x0 + delta_i h_i^q with
+    // |delta_i| <= Delta. Its differences then say how large Delta is:
+    // |T[i][J] - T[i-1][J]| = |delta_i h_i^q - delta_{i-1} h_{i-1}^q|, and each, scaled to the
+    // finest step by (h_{L-1} / h_i)^q, is of the size Delta h_{L-1}^q (up to 1 + r^q times it
+    // when the two deltas have opposite signs). The maximum over all of the column's entries
+    // covers the finest entry's error unless every earlier delta came out well below the finest
+    // one: with deltas drawn independently and uniformly from [-Delta, Delta] it covered it in
+    // 98.1 % of draws with 4 levels, 99.6 % with 5, 99.9 % with 6 (20000 draws each), about 8x
+    // above it at the median. Growing or jumping differences are expected here, not a failure.
+    const double q = tab.remaining_order(J - 1);
+    double spread = 0;
+    for (int i = J + 1; i <= L - 1; ++i)
+      spread = std::max(spread, std::abs(entry(i, J) - entry(i - 1, J)) * std::pow(h[L - 1] / h[i], q));
+    e.error_estimate = std::max(spread, roundoff);
+    e.note = fmt("column %.0f (%.0f levels) shows order %.3g over its last entries, expected %.3g, ", J + 1.0, J + 1.0,
+                 e.column_orders[J], tab.remaining_order(J)) +
+             fmt("while column %.0f shows its order %.3g: ", J + 0.0, q) +
+             (J + 1 <= top ? "higher columns not used; " : "") +
+             fmt("the order-%.3g term's coefficient wanders from level to level (events moving across the grid): "
+                 "error from the spread of column %.0f's last entries, each scaled to the finest step like h^%.3g",
+                 q, J + 1.0, q);
+    return e;
+  }
   if (failed) {
-    // Tail of an inconsistent column: max(d_last, d_prev r^{-q}), q = the order eliminated last.
-    const double d_last = std::abs(entry(L - 1, J) - entry(L - 2, J));
-    const double d_prev = std::abs(entry(L - 2, J) - entry(L - 3, J));
-    const double q = J >= 1 ? tab.remaining_order(J - 1) : 0.0;
-    const double r = h[L - 2] / h[L - 1];
+    // Column 0 itself inconsistent: its tail, max(d_last, d_prev) (the header comment).
+    const double d_last = std::abs(entry(L - 1, 0) - entry(L - 2, 0));
+    const double d_prev = std::abs(entry(L - 2, 0) - entry(L - 3, 0));
     // Growing differences, or a plateau (above): no estimate.
-    if ((d_last > d_prev && d_last > 2 * roundoff) || plateau[J]) {
+    if ((d_last > d_prev && d_last > 2 * roundoff) || plateau[0]) {
       e.error_estimate = std::numeric_limits<double>::infinity();
     } else {
-      e.error_estimate = std::max({d_last, d_prev * std::pow(r, -q), roundoff});
+      e.error_estimate = std::max({d_last, d_prev, roundoff});
     }
-    e.note =
-        fmt(J == 0
-                ? "column %.0f (%.0f level, no extrapolation) shows order %.3g over its last entries, expected %.3g: "
-                : "column %.0f (%.0f levels) shows order %.3g over its last entries, expected %.3g: ",
-            J + 1.0, J + 1.0, e.column_orders[J], tab.remaining_order(J)) +
-        (J + 1 <= top ? "higher columns not used; " : "") +
-        (std::isfinite(e.error_estimate) ? "error from that column's last differences"
-         : plateau[J] ? "its differences fall far faster than that order allows (a plateau, the value moves in jumps): "
-                     "no error estimate"
-                   : "its differences grow: no error estimate");
+    e.note = fmt("column 1 (1 level, no extrapolation) shows order %.3g over its last entries, expected %.3g: ",
+                 e.column_orders[0], tab.remaining_order(0)) +
+             (top >= 1 ? "higher columns not used; " : "") +
+             (std::isfinite(e.error_estimate) ? "error from that column's last differences"
+              : plateau[0] ? "its differences fall far faster than that order allows (a plateau, the value moves in "
+                             "jumps): no error estimate"
+                           : "its differences grow: no error estimate");
     return e;
   }
   if (J == 0) {  // column 0 unchecked (fewer than three levels) or the only one

@@ -476,3 +476,29 @@ TEST(ConvergeCli, APlateauRefusesTheEstimateAndTheTarget) {
   EXPECT_TRUE(j.at("extrapolated")[0].at("error_estimate").is_null()) << j.at("extrapolated")[0];
   EXPECT_FALSE(j.at("target_met").get<bool>());
 }
+
+// Issue 32, item 3: on an impacting orbit the raw order wanders with N (where the contact's ends
+// fall in the grid), so the h^4 column never shows its order; the estimate used to be refused
+// (null) while the value was excellent. The bar now comes from the spread of the h^2-eliminated
+// column (richardson.hpp). Checked against the exact multipliers at tau = T: there the orbit does
+// not depend on k (the control vanishes on it) and mu solves det(Phi(mu) - mu I) = 0 with Phi the
+// monodromy of y' = (A(t) + B / mu) y along it, solved in 40 digits by
+// scripts/impact_exact_multipliers.py (mpmath; no delayspec code): |mu_1| = 0.82557832108367955172
+// at k = 0.55 and 0.93825120174378664294 at k = 1. The bar must cover the actual error and be
+// worth having: below the finest level's own error.
+TEST(ConvergeCli, AnImpactingOrbitGetsAnHonestBarFromTheWanderingSecondOrderColumn) {
+  for (const auto& [k, exact] : {std::pair{"0.55", 0.82557832108367955172}, std::pair{"1.0", 0.93825120174378664294}}) {
+    const CliResult r = run({"converge", "--json", "--set", "tau_over_T=1", "--set", std::string("k=") + k, "--set",
+                             "nev=2", "--set", "events=on", "--set", "Ns=800,1600,3200,6400,12800"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    const auto& e = j.at("extrapolated")[0];
+    ASSERT_FALSE(e.at("error_estimate").is_null()) << e;
+    const double bar = e.at("error_estimate"), error = std::abs(e.at("abs").get<double>() - exact);
+    EXPECT_LE(error, bar) << "k = " << k << ": " << e;
+    const double finest = std::abs(j.at("rows").back().at("multipliers")[0].at("abs").get<double>() - exact);
+    EXPECT_LT(bar, finest) << "k = " << k << ": " << e;
+    EXPECT_NE(e.at("note").get<std::string>().find("spread"), std::string::npos) << e.at("note");
+  }
+}
+

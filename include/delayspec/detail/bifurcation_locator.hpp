@@ -44,6 +44,11 @@ std::vector<BifurcationType> detected_changes(const UnstableCounts& a, const Uns
 double multiplier_test(BifurcationType type, const std::vector<std::complex<double>>& multipliers,
                        std::complex<double>* critical = nullptr);
 
+// The test function a location finds the zero of: the critical multiplier's (multiplier_test),
+// dp/ds at a turning point, max H (grazing), or the second hump's max H (the grazing of a second
+// contact region on an orbit in contact: OrbitMeasures::second_max_H).
+enum class LocatedBy { multiplier, turning_point, max_H, second_max_H };
+
 // One location: a bifurcation of `type` on the segment from `base` (point a, s = 0) along its
 // tangent, on the problem `branch` (branch_corrector.hpp). The corrector iterations, eigen-solves
 // and their times are added to `cost`.
@@ -52,10 +57,9 @@ class BifurcationLocator {
   using State = BranchState;
   static constexpr int kMaxEvaluations = 60;  // corrected points per location, all stages
 
-  // by_tangent: a turning point, located where dp/ds = 0 (not by a multiplier).
-  BifurcationLocator(const BranchProblem& branch, ContinuationResult& cost, BifurcationType type, bool by_tangent,
+  BifurcationLocator(const BranchProblem& branch, ContinuationResult& cost, BifurcationType type, LocatedBy by,
                      const State& base, double tolerance)
-      : branch_(branch), cost_(cost), type_(type), by_tangent_(by_tangent), base_(base), tolerance_(tolerance) {}
+      : branch_(branch), cost_(cost), type_(type), by_(by), base_(base), tolerance_(tolerance) {}
 
   // The bifurcation between a (at base) and b (orbit xb, at arclength s_b along base's tangent);
   // `after`: the index of a on the branch.
@@ -63,6 +67,7 @@ class BifurcationLocator {
                      long after) {
     bif_.type = type_;
     bif_.after_point = after;
+    if (by_ == LocatedBy::second_max_H) bif_.note = "a second contact region";
     neg_ = {0, test(a), a.parameter, a, base_.x};
     pos_ = {s_b, test(b), b.parameter, b, xb};
     if (type_ != BifurcationType::grazing) bisect_on_counts();
@@ -70,8 +75,9 @@ class BifurcationLocator {
     g_neg_ = neg_.g;
     g_pos_ = pos_.g;
     if (!(neg_.g < 0 && pos_.g > 0)) {
-      bif_.note = "the test function does not change sign over the segment (" + format_number(neg_.g) + ", " +
-                  format_number(pos_.g) + "): location by the nearer end";
+      bif_.note += std::string(bif_.note.empty() ? "" : "; ") +
+                   "the test function does not change sign over the segment (" + format_number(neg_.g) + ", " +
+                   format_number(pos_.g) + "): location by the nearer end";
     }
     while (neg_.g < 0 && pos_.g > 0 && bif_.evaluations < kMaxEvaluations)
       if (!illinois_step()) break;
@@ -86,16 +92,20 @@ class BifurcationLocator {
     Eigen::VectorXd x;  // the orbit (a switch at a period doubling starts from it)
   };
 
-  // The test function: max H for grazing, dp/ds at a turning point, else the multiplier's.
+  // The test function (LocatedBy).
   double test(const ContinuationPoint& pt) const {
-    if (type_ == BifurcationType::grazing) return pt.measures.max_H;
-    if (by_tangent_) return pt.tangent_p;  // a turning point: dp/ds through 0
+    switch (by_) {
+      case LocatedBy::max_H: return pt.measures.max_H;
+      case LocatedBy::second_max_H: return pt.measures.second_max_H;
+      case LocatedBy::turning_point: return pt.tangent_p;  // dp/ds through 0
+      case LocatedBy::multiplier: break;
+    }
     return multiplier_test(type_, pt.multipliers);
   }
 
   // Whether the bifurcation is detected between x and y (the counts, or the sign of dp/ds).
   bool changes_here(const ContinuationPoint& x, const ContinuationPoint& y) const {
-    if (by_tangent_) return (x.tangent_p > 0) != (y.tangent_p > 0);
+    if (by_ == LocatedBy::turning_point) return (x.tangent_p > 0) != (y.tangent_p > 0);
     const auto found = detected_changes(unstable_counts(x.multipliers), unstable_counts(y.multipliers));
     return std::find(found.begin(), found.end(), type_) != found.end();
   }
@@ -212,7 +222,7 @@ class BifurcationLocator {
       bif_.angle = NAN;
     } else if (std::isfinite(multiplier_test(type_, best.multipliers, &critical))) {
       bif_.angle = std::abs(std::arg(critical));
-      if (by_tangent_ && std::abs(critical - 1.0) > 1e-3)
+      if (by_ == LocatedBy::turning_point && std::abs(critical - 1.0) > 1e-3)
         bif_.note += std::string(bif_.note.empty() ? "" : "; ") + "a turning point with no multiplier at +1 (nearest " +
                      format_number(critical.real()) + "): a nonsmooth fold";
     }
@@ -222,7 +232,7 @@ class BifurcationLocator {
   const BranchProblem& branch_;
   ContinuationResult& cost_;
   const BifurcationType type_;
-  const bool by_tangent_;
+  const LocatedBy by_;
   const State& base_;
   const double tolerance_;
 

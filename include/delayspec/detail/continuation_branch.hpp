@@ -198,20 +198,30 @@ class BranchTracer {
   // current tangent): the changes of the counts; a turning point of the parameter is a fold,
   // located where dp/ds = 0 (for the discrete problem exactly where F_x is singular: a
   // multiplier +1, or at a corner of a piecewise-smooth branch none); a multiplier through +1
-  // without one (a branch point) by the multiplier; grazing by the sign of max H. Each located.
+  // without one (a branch point) by the multiplier; grazing by the sign of max H, and on an orbit
+  // in contact at both ends the grazing of a second contact region by the sign of the second
+  // hump's max H (OrbitMeasures::second_max_H). Each located.
   void locate_between(const ContinuationPoint& a, const ContinuationPoint& b, const Eigen::VectorXd& xb, double s_b) {
-    std::vector<BifurcationType> found =
-        detected_changes(unstable_counts(a.multipliers), unstable_counts(b.multipliers));
+    std::vector<std::pair<BifurcationType, LocatedBy>> found;
+    for (BifurcationType type : detected_changes(unstable_counts(a.multipliers), unstable_counts(b.multipliers)))
+      found.push_back({type, LocatedBy::multiplier});
     const bool turning = (a.tangent_p > 0) != (b.tangent_p > 0);
-    if (turning && std::find(found.begin(), found.end(), BifurcationType::fold) == found.end())
-      found.push_back(BifurcationType::fold);
-    if (branch_.has_switching())
-      if ((a.measures.max_H > 0) != (b.measures.max_H > 0)) found.push_back(BifurcationType::grazing);
+    if (turning) {  // the fold by dp/ds, whether or not a multiplier went through +1
+      auto fold =
+          std::find_if(found.begin(), found.end(), [](const auto& f) { return f.first == BifurcationType::fold; });
+      if (fold == found.end()) found.push_back({BifurcationType::fold, LocatedBy::turning_point});
+      else fold->second = LocatedBy::turning_point;
+    }
+    if (branch_.has_switching()) {
+      if ((a.measures.max_H > 0) != (b.measures.max_H > 0))
+        found.push_back({BifurcationType::grazing, LocatedBy::max_H});
+      else if (a.measures.max_H > 0 && (a.measures.second_max_H > 0) != (b.measures.second_max_H > 0))
+        found.push_back({BifurcationType::grazing, LocatedBy::second_max_H});
+    }
     const long after = static_cast<long>(result_.points.size()) - 1;
-    for (BifurcationType type : found) {
+    for (const auto& [type, by] : found) {
       const auto locate_start = std::chrono::steady_clock::now();
-      BifurcationLocator locator(branch_, result_, type, turning && type == BifurcationType::fold, *current_,
-                                         o_.tolerance);
+      BifurcationLocator locator(branch_, result_, type, by, *current_, o_.tolerance);
       result_.bifurcations.push_back(locator.locate(a, b, xb, s_b, after));
       result_.locate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - locate_start).count();
     }

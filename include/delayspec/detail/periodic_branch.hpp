@@ -20,6 +20,7 @@
 #include "delayspec/grid.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/detail/branch_corrector.hpp"
+#include "delayspec/detail/contact_peaks.hpp"
 #include "delayspec/detail/cubic_hermite.hpp"
 #include "delayspec/stepper.hpp"
 #include "delayspec/stroboscopic_map.hpp"
@@ -33,6 +34,8 @@ class ProblemSizeChanged : public BadInput {
   using BadInput::BadInput;
 };
 
+using detail::contact_peaks;
+using detail::ContactPeaks;     // (contact_peaks.hpp)
 using detail::hermite_maximum;  // (cubic_hermite.hpp)
 
 // The problem F(x, p) = 0 of one model factory and one discretisation (the options' N,
@@ -69,7 +72,8 @@ class PeriodicBranch final : public BranchProblem {
   std::optional<State> correct(Eigen::VectorXd x, double p, const Eigen::VectorXd& row_x, double row_p, double target,
                                int max_iterations, std::string& why, double& seconds) const override {
     auto linearise = [this](const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
-                            Eigen::VectorXd& Fp, std::string& why) { return linearise_or_reason(x, p, F, Fx, Fp, why); };
+                            Eigen::VectorXd& Fp,
+                            std::string& why) { return linearise_or_reason(x, p, F, Fx, Fp, why); };
     return bordered_corrector(linearise, std::move(x), p, row_x, row_p, target, max_iterations, o_.newton.tolerance,
                               weight_, why, seconds);
   }
@@ -79,8 +83,7 @@ class PeriodicBranch final : public BranchProblem {
   void linearise(const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
                  Eigen::VectorXd& Fp) const {
     F = PeriodicOrbitProblem<Map>(map_at(p)).residual(x, &Fx);
-    Fp = parameter_derivative([&](double q) { return PeriodicOrbitProblem<Map>(map_at(q)).residual(x); }, p, F,
-                              range_);
+    Fp = parameter_derivative([&](double q) { return PeriodicOrbitProblem<Map>(map_at(q)).residual(x); }, p, F, range_);
   }
 
   // Multipliers and measures of the orbit x at p.
@@ -146,14 +149,17 @@ class PeriodicBranch final : public BranchProblem {
     auto slot = [&](long i) { return u(i - M); };
     m.max_H = -INFINITY;
     m.contact_time = 0;
+    std::vector<double> node_H(K_), step_max_H(K_);  // the humps of H (contact_peaks.hpp)
     StepMap<D, delayed_rows<Model>> scratch;
     for (long l = 0; l < K_; ++l) {
       const auto [w0, w1, t] = g.template delay_taps<D, DelayedVec<Model>>(l, slot);
       const V a = u(l), b = u(l + 1);
       const int ja = region_of(model, a), jb = region_of(model, b);
       const V grad = model.grad_H(a);
-      m.max_H = std::max(m.max_H, hermite_maximum(model.H(a), model.H(b), grad.dot(model.f(ja, t, a, w0)),
-                                                  grad.dot(model.f(jb, t + h, b, w1)), h));
+      node_H[l] = model.H(a);
+      step_max_H[l] = hermite_maximum(node_H[l], model.H(b), grad.dot(model.f(ja, t, a, w0)),
+                                      grad.dot(model.f(jb, t + h, b, w1)), h);
+      m.max_H = std::max(m.max_H, step_max_H[l]);
       StepEvents events;
       map.stepper().step(t, h, a, w0, w1, scratch, &events);
       int region = ja;
@@ -165,6 +171,9 @@ class PeriodicBranch final : public BranchProblem {
       }
       if (region == 1) m.contact_time += h - position;
     }
+    const ContactPeaks peaks = contact_peaks(node_H, step_max_H);
+    m.second_max_H = peaks.second_max;
+    m.contact_regions = peaks.regions;
   }
 
   HistoryGrid grid_at(double p) const { return grid_at_model(model_at_(p), p); }

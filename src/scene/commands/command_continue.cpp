@@ -27,6 +27,7 @@
 #include "scene/commands/commands.hpp"
 #include "scene/commands/continue_equilibria.hpp"
 #include "scene/problem/continue_settings.hpp"
+#include "delayspec/branch_verdicts.hpp"
 #include "delayspec/continuation.hpp"
 #include "scene/problem/floquet_settings.hpp"
 #include "scene/output/metadata.hpp"
@@ -65,16 +66,14 @@ ContinuationResult branch_at(const Config& config, const ContinueSettings& setti
                              const OrbitSettings& orbit_settings, ContinuationOptions options, int N,
                              Progress& progress) {
   const Level level = level_at(config, settings.key, options.from, N, options, progress);
-  return level.problem.analyses->continue_orbit(analyses_with_key(level.config, settings.key), orbit_settings,
-                                                options);
+  return level.problem.analyses->continue_orbit(analyses_with_key(level.config, settings.key), orbit_settings, options);
 }
 
 // The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
 ContinuationResult switched_at(const Config& config, const ContinueSettings& settings, ContinuationOptions options,
                                int N, const Bifurcation& pd, Progress& progress) {
   const Level level = level_at(config, settings.key, pd.parameter, N, options, progress);
-  return level.problem.analyses->continue_period_doubled(analyses_with_key(level.config, settings.key), pd,
-                                                         options);
+  return level.problem.analyses->continue_period_doubled(analyses_with_key(level.config, settings.key), pd, options);
 }
 
 // What the command reads and checks before any work; the keys are read in this order (--help lists them so).
@@ -111,6 +110,7 @@ ContinueRun read_continue_run(Config& config) {
 struct ContinueOutcome {
   std::vector<ContinuationResult> levels;  // by N; the reported branch is the last
   std::vector<BifurcationEstimate> estimates;
+  BranchVerdicts verdicts;  // of the finest branch's points
   std::vector<ContinuationResult> switched;
   std::vector<double> switched_from;  // each switched branch's period doubling
   std::string failures;
@@ -126,11 +126,12 @@ ContinueOutcome compute_continue(const Config& config, const ContinueRun& run, c
   for (int N : run.Ns) out.levels.push_back(branch_at(config, run.settings, run.orbit_settings, options, N, progress));
   std::vector<std::vector<Bifurcation>> by_N;
   for (const auto& r : out.levels) by_N.push_back(r.bifurcations);
-  const double tolerance = options.tolerance > 0 ? options.tolerance : 1e-10 * std::abs(options.to - options.from);
+  const double tolerance = continuation_detail::checked_options(options).tolerance;  // its default filled in
   RichardsonOptions richardson;
   if (run.switching && run.problem.events == EventMode::off)
     richardson.order = richardson.order_step = 1;  // design.md 1.5
   out.estimates = extrapolate_bifurcations(run.Ns, by_N, tolerance, richardson);
+  out.verdicts = branch_verdicts(out.branch().points, out.estimates, run.Ns, by_N);
   // continue_switch: the period-2 branch of every period doubling on the finest branch.
   if (run.settings.switch_period_doubling)
     for (const Bifurcation& b : out.branch().bifurcations)
@@ -184,7 +185,8 @@ json continue_json(const ContinueRun& run, const ContinueOutcome& out, double se
   j["jacobian"] = to_string(run.problem.jacobian);
   j["end"] = to_string(branch.end);
   if (!out.failures.empty()) j["failure"] = out.failures;
-  j["points"] = points_json(branch.points);
+  j["points"] = points_json(branch.points, out.verdicts.verdicts);
+  j["verdicts_note"] = out.verdicts.note;
   j["bifurcations"] = bifurcations_json(out.estimates, branch);
   if (run.settings.switch_period_doubling) j["switched"] = switched_json(run, out);
   json cost;
@@ -208,7 +210,8 @@ void write_continue_files(const Invocation& inv, const Config& config, const Con
   metadata.parameters.erase(run.settings.key);  // per row (plot labels the x axis with continue_key)
   std::string header = metadata_comment_lines(metadata);
   if (!out.failures.empty()) header += "# INCOMPLETE: the branch ended in a failure: " + out.failures + "\n";
-  write_output(inv, dir / "branch.csv", branch_csv(header, out.branch(), run.options.floquet.nev));
+  write_output(inv, dir / "branch.csv",
+               branch_csv(header, out.branch(), run.options.floquet.nev, out.verdicts.verdicts));
   write_output(inv, dir / "bifurcations.csv", bifurcations_csv(header, out.estimates, out.branch()));
   json file = j;
   file["metadata"] = metadata_json(metadata);
@@ -225,13 +228,17 @@ void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutc
   for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
   os << "\nbranch (N = " << run.Ns.back() << "): " << branch.points.size() << " points, ended at `"
      << to_string(branch.end) << "`\n";
-  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s\n", key.c_str(), "|mu_1|", "unstable", "max y1");
+  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s  %s\n", key.c_str(), "|mu_1|", "unstable", "max y1",
+                "verdict");
   os << line;
-  for (const auto& p : branch.points) {
-    std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g\n", p.parameter,
-                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0]);
+  for (size_t i = 0; i < branch.points.size(); ++i) {
+    const ContinuationPoint& p = branch.points[i];
+    std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g  %s\n", p.parameter,
+                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0],
+                  to_string(out.verdicts.verdicts.at(i)).c_str());
     os << line;
   }
+  os << "verdicts: " << out.verdicts.note << "\n";
   os << "bifurcations: " << out.estimates.size() << "\n";
   for (size_t b = 0; b < out.estimates.size(); ++b) {
     const BifurcationEstimate& e = out.estimates[b];

@@ -17,17 +17,23 @@ json measures_json(const OrbitMeasures& m) {
   j["min"] = m.min;
   j["max_H"] = m.max_H;  // NaN (no switching) is written as null
   j["contact_time"] = m.contact_time;
+  if (!std::isnan(m.max_H)) {  // switching models: the contact regions (detail/contact_peaks.hpp)
+    j["contact_regions"] = m.contact_regions;
+    j["second_max_H"] = m.second_max_H;  // -infinity (no second hump) is written as null
+  }
   return j;
 }
 
-json points_json(const std::vector<ContinuationPoint>& points) {
+json points_json(const std::vector<ContinuationPoint>& points, const std::vector<StabilityVerdict>& verdicts) {
   json list = json::array();
-  for (const auto& p : points) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const ContinuationPoint& p = points[i];
     json pj;
     pj["parameter"] = p.parameter;
     pj["multipliers"] = multipliers_json(p.multipliers);
     pj["unstable"] = p.unstable;
     pj["stable"] = p.stable();
+    if (!verdicts.empty()) pj["verdict"] = to_string(verdicts.at(i));
     pj["measures"] = measures_json(p.measures);
     pj["newton_iterations"] = p.newton_iterations;
     pj["step"] = p.step;
@@ -57,8 +63,8 @@ json bifurcations_json(const std::vector<BifurcationEstimate>& estimates, const 
     bj["extrapolated"] = e.extrapolated;
     bj["error_estimate"] = e.error_estimate;  // infinity (one level): null
     bj["observed_order"] = e.observed_order;
-    if (e.type == BifurcationType::neimark_sacker) {  // the angle extrapolated as the location is
-      bj["angle_extrapolated"] = e.angle_extrapolated;     // NaN with one level: null
+    if (e.type == BifurcationType::neimark_sacker) {        // the angle extrapolated as the location is
+      bj["angle_extrapolated"] = e.angle_extrapolated;      // NaN with one level: null
       bj["angle_error_estimate"] = e.angle_error_estimate;  // infinity with one level: null
     }
     bj["bracket"] = finest.bracket;
@@ -68,7 +74,8 @@ json bifurcations_json(const std::vector<BifurcationEstimate>& estimates, const 
   return list;
 }
 
-std::string branch_csv(const std::string& header, const ContinuationResult& branch, int nev) {
+std::string branch_csv(const std::string& header, const ContinuationResult& branch, int nev,
+                       const std::vector<StabilityVerdict>& verdicts) {
   std::ostringstream rows;
   rows << header << "parameter,stable,unstable,abs_mu1";
   const size_t d = branch.points.front().measures.max.size();
@@ -78,8 +85,10 @@ std::string branch_csv(const std::string& header, const ContinuationResult& bran
   const bool autonomous = std::isfinite(branch.points.front().period);
   if (autonomous) rows << ",period";
   for (int k = 0; k < nev; ++k) rows << ",mu" << k + 1 << "_re,mu" << k + 1 << "_im";
+  if (!verdicts.empty()) rows << ",undecided";
   rows << "\n";
-  for (const auto& p : branch.points) {
+  for (size_t i = 0; i < branch.points.size(); ++i) {
+    const ContinuationPoint& p = branch.points[i];
     rows << csv_number(p.parameter) << "," << (p.stable() ? 1 : 0) << "," << p.unstable << ","
          << csv_number(p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]));
     for (double v : p.measures.max) rows << "," << csv_number(v);
@@ -92,6 +101,7 @@ std::string branch_csv(const std::string& header, const ContinuationResult& bran
       rows << "," << csv_number(has ? p.multipliers[k].real() : NAN) << ","
            << csv_number(has ? p.multipliers[k].imag() : NAN);
     }
+    if (!verdicts.empty()) rows << "," << (verdicts.at(i) == StabilityVerdict::undecided ? 1 : 0);
     rows << "\n";
   }
   return rows.str();
