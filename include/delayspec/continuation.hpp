@@ -162,6 +162,11 @@ struct BranchRange {
   double step_max = 0;      // 0 = |to - from| / 10
   int max_points = 1000;    // branch points at most (the start included), >= 2
   double tolerance = 0;     // location tolerance in p; 0 = 1e-10 |to - from|
+  // With error bars (the locations extrapolated): once a location's bracket is within
+  // `tolerance`, it is narrowed on towards this while that works, at most 8 more corrected points
+  // and none failing (near a grazing the corrector may not converge on one side); the bracket
+  // reached is the location's accuracy (Bifurcation::bracket). 0: not (orbit branches only).
+  double refine_tolerance = 0;
 };
 // The range with the defaults for 0 filled in, the step clamped to [step_min, step_max].
 // BadInput naming the field: from or to not finite, an empty range, a step or tolerance <= 0,

@@ -259,8 +259,8 @@ class GridResult(Result):
 
 class ContinueResult(SweepResult):
     """`continue`: per-point fields stacked over the branch's points (`parameter`, `multipliers`:
-    points x nev complex128, ...), and the CLI's fields (`bifurcations`, `Ns`, ...; see
-    docs/continuation.md)."""
+    points x nev complex128, `verdict`: "stable", "unstable" or "undecided" for N -> infinity, ...),
+    and the CLI's fields (`bifurcations`, `Ns`, `verdicts_note`, ...; see docs/continuation.md)."""
 
 
 class BoundaryResult(Result):

@@ -194,6 +194,9 @@ def test_continue_equals_cli_json():
     r = delayspec.continue_(scene, **keys)
     same_as_cli(r, "continue", scene, **keys)
     assert r.multipliers.dtype == np.complex128 and r.multipliers.shape == (len(r["points"]), 6)
+    # each point's verdict for N -> infinity (branch_verdicts.hpp): two levels give no bars, so none is decided
+    assert r.verdict.shape == (len(r["points"]),) and set(r.verdict) == {"undecided"}
+    assert "three levels" in r["verdicts_note"]
 
 
 def test_continue_from_a_hopf_point_equals_cli_json():

@@ -46,6 +46,8 @@ BranchRange checked_range(const BranchRange& range) {
   require_positive("BranchRange::step_min", o.step_min);
   require_positive("BranchRange::step_max", o.step_max);
   require_positive("BranchRange::tolerance", o.tolerance);
+  if (!(o.refine_tolerance >= 0) || !std::isfinite(o.refine_tolerance))
+    throw BadInput("`BranchRange::refine_tolerance = " + format_number(o.refine_tolerance) + "`: must be >= 0");
   if (o.step_min > o.step_max)
     throw BadInput("`BranchRange::step_min = " + format_number(o.step_min) + "` exceeds `step_max = " +
                    format_number(o.step_max) + "`" + (range.step_max == 0 ? " (its default, |to - from| / 10)" : ""));
@@ -172,8 +174,7 @@ std::vector<BifurcationEstimate> extrapolate_bifurcations(const std::vector<int>
     }
     if (values.size() >= 2) {
       std::vector<std::complex<double>> x(values.begin(), values.end());
-      const Extrapolation ex =
-          richardson_extrapolate(h, x, richardson, accuracy);
+      const Extrapolation ex = richardson_extrapolate(h, x, richardson, accuracy);
       e.extrapolated = ex.value.real();
       e.error_estimate = ex.error_estimate;
       e.note += ex.note;

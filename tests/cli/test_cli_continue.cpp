@@ -107,6 +107,58 @@ TEST(ContinueCli, NeimarkSackerOfLinearDdeWithErrorBars) {
   EXPECT_NEAR(b["multipliers"][0]["abs"].get<double>(), 1, 1e-11);
 }
 
+// Issue 32, item 3: the location tolerance set a floor under every bar. At the default
+// 1e-10 |to - from| the Neimark-Sacker point of x' = -x + b x(t - tau) (exactly b = -2) over
+// N = 100 .. 1600 got a bar of 1.95e-10 for an error of 4.4e-13; with continue_Ns the locations
+// are now narrowed on towards 1e-13 |to - from| and the bar is 1.95e-13 for 3.0e-14. Covering,
+// below 1e-12, and within 10x of the error or of the location's own floor (1e-13 |to - from|:
+// the extrapolation cannot be vouched for below the accuracy of its inputs). And every point's
+// verdict for N -> infinity: the NS interval is ~1e-13 wide, so none is undecided.
+TEST(ContinueCli, NeimarkSackerBarIsTightAtTheDefaultTolerance) {
+  CliResult r = run(linear_args({"--set", "continue_Ns=100,200,400,800,1600", "--json"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["bifurcations"].size(), 1u);
+  const auto& b = j["bifurcations"][0];
+  const double error = std::abs(b["extrapolated"].get<double>() + 2), bar = b["error_estimate"].get<double>();
+  EXPECT_LE(error, bar) << b;
+  EXPECT_LT(bar, 1e-12) << b;
+  EXPECT_LE(bar, 10 * std::max(error, 1e-13)) << b;
+  for (const auto& p : j["points"])
+    EXPECT_EQ(p["verdict"], p["parameter"].get<double>() > -2 ? "stable" : "unstable") << p["parameter"];
+  EXPECT_NE(j["verdicts_note"].get<std::string>().find("0 of"), std::string::npos) << j["verdicts_note"];
+  // Two levels: no bar, so no point is decided.
+  r = run(linear_args({"--set", "continue_Ns=100,200", "--json"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const auto& p : nlohmann::json::parse(r.out)["points"]) EXPECT_EQ(p["verdict"], "undecided");
+}
+
+// Issue 32, item 4: on the PWSDDE period-2 branch a second contact region appears at k = 0.1767
+// on an orbit already in contact (`floquet data/scenes/pwsdde-period2.toml --set N=800`: 1
+// contact at k = 0.1767, 2 at 0.1768), which the sign of max H does not see: continue reported only
+// the fold after it. It is a grazing of its own now, found at every level, converging at the
+// trapezoid's order 2 (the hump's max from the cubic Hermite interpolant, O(h^4) beyond the orbit's
+// O(h^2)): over N = 100, 200, 400 order 1.95; by hand over 200, 400, 800, 2.08 (0.1767247,
+// 0.1767128, 0.1767099; N = 800 takes 24 s, its sparse LU fills in with the fractional delay).
+TEST(ContinueCli, ASecondContactRegionIsAGrazingThatConvergesAtOrderTwo) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/continue_pwsdde_k.toml";
+  const CliResult r = run({"continue", "--json", scene, "--set", "continue_from=0.1766", "--set", "continue_to=0.1768",
+                           "--set", "k=0.1766", "--set", "orbit_guess_periods=300", "--set", "continue_Ns=100,200,400",
+                           "--set", "continue_step=1e-4", "--set", "continue_step_max=2e-4"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["bifurcations"].size(), 1u) << j["bifurcations"];
+  const auto& b = j["bifurcations"][0];
+  EXPECT_EQ(b["type"], "grazing");
+  EXPECT_NE(b["note"].get<std::string>().find("a second contact region"), std::string::npos) << b["note"];
+  ASSERT_EQ(b["by_N"].size(), 3u);
+  EXPECT_NEAR(b["observed_order"].get<double>(), 2, 0.3) << b;
+  EXPECT_NEAR(b["parameter"].get<double>(), 0.17675, 5e-5);  // between the issue's 0.1767 and 0.1768
+  // one region before it, two after
+  EXPECT_EQ(j["points"].front()["measures"]["contact_regions"], 1);
+  EXPECT_EQ(j["points"].back()["measures"]["contact_regions"], 2);
+}
+
 TEST(ContinueCli, WritesBranchAndBifurcationFilesWithMetadata) {
   const fs::path dir = scratch("files");
   CliResult r = run(linear_args({"--set", "N=200", "--out", dir.string(), "--json"}));

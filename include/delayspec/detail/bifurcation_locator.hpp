@@ -57,9 +57,18 @@ class BifurcationLocator {
   using State = BranchState;
   static constexpr int kMaxEvaluations = 60;  // corrected points per location, all stages
 
+  static constexpr int kRefineEvaluations = 8;  // beyond `tolerance`, towards refine_tolerance
+
+  // refine_tolerance: BranchRange's (0: none).
   BifurcationLocator(const BranchProblem& branch, ContinuationResult& cost, BifurcationType type, LocatedBy by,
-                     const State& base, double tolerance)
-      : branch_(branch), cost_(cost), type_(type), by_(by), base_(base), tolerance_(tolerance) {}
+                     const State& base, double tolerance, double refine_tolerance = 0)
+      : branch_(branch),
+        cost_(cost),
+        type_(type),
+        by_(by),
+        base_(base),
+        tolerance_(tolerance),
+        target_(refine_tolerance > 0 ? std::min(refine_tolerance, tolerance) : tolerance) {}
 
   // The bifurcation between a (at base) and b (orbit xb, at arclength s_b along base's tangent);
   // `after`: the index of a on the branch.
@@ -70,6 +79,8 @@ class BifurcationLocator {
     if (by_ == LocatedBy::second_max_H) bif_.note = "a second contact region";
     neg_ = {0, test(a), a.parameter, a, base_.x};
     pos_ = {s_b, test(b), b.parameter, b, xb};
+    s_b_ = s_b;
+    slope_ = std::max({std::abs(b.parameter - a.parameter) / s_b, std::abs(a.tangent_p), std::abs(b.tangent_p)});
     if (type_ != BifurcationType::grazing) bisect_on_counts();
     if (neg_.g > 0) std::swap(neg_, pos_);
     g_neg_ = neg_.g;
@@ -156,11 +167,25 @@ class BifurcationLocator {
   // from that side). Returns false when done: the bracket is within the tolerance, the secant
   // puts the root within the tolerance of neg (located_), or g = 0 was hit.
   bool illinois_step() {
-    if (std::abs(pos_.p - neg_.p) <= tolerance_) return false;
+    const double width = std::abs(pos_.p - neg_.p), ds = std::abs(pos_.s - neg_.s);
+    if (width <= target_) return false;
+    // The discrete branch jumps between the two ends (near a grazing the discrete problem is not
+    // continuous: the corrected points at s apart by 1e-15 of the segment had p apart by 1e-8 and
+    // the test function jumped from -2.5e-8 to +1e-8, PWSDDE period-2 orbit at N = 200): the
+    // bracket in s has shrunk a millionfold, the one in p has not. The jump is the accuracy.
+    if (ds < 1e-6 * s_b_ && width > 1e3 * slope_ * ds) {
+      bif_.note += std::string(bif_.note.empty() ? "" : "; ") + "the discrete branch jumps by " +
+                   format_number(width) + " in p across the root: located to that";
+      return false;
+    }
+    // Within the tolerance: narrowed on only while it works (BranchRange::refine_tolerance).
+    if (width <= tolerance_ && (one_sided_ || refine_left_-- <= 0)) return false;
     double s_root;
     if (one_sided_secant(s_root)) {
       const double p_root = neg_.p + (s_root - neg_.s) * (neg_.p - prev_neg_->p) / (neg_.s - prev_neg_->s);
-      if (std::abs(p_root - neg_.p) <= tolerance_ && (s_root - neg_.s) * (pos_.s - neg_.s) >= 0) {
+      const double move = std::abs(p_root - neg_.p);
+      const bool close = move <= target_ || (move <= tolerance_ && (one_sided_ || refine_left_ <= 0));
+      if (close && (s_root - neg_.s) * (pos_.s - neg_.s) >= 0) {
         located_ = p_root;
         return false;
       }
@@ -173,11 +198,17 @@ class BifurcationLocator {
     std::optional<Sample> sample = sample_at(s, reason);
     if (!sample || !std::isfinite(sample->g)) {
       // Taken as the positive side (for grazing the side in contact, where the discrete problem
-      // is least smooth); from now on the root comes from the negative side.
+      // is least smooth); from now on the root comes from the negative side. The failed point has
+      // no parameter of its own: p along the segment's chord stands in for it, so that the
+      // bracket in p shrinks with the bisection (before, it kept the last good point's p and a
+      // location near a grazing spent all its evaluations on a bracket that could not narrow).
       one_sided_ = true;
+      pos_.p = neg_.p + (s - neg_.s) * (pos_.p - neg_.p) / (pos_.s - neg_.s);
       pos_.s = s;
       side_ = 1;
-      bif_.note = "located from one side: " + (sample ? std::string("no candidate multiplier") : reason) +
+      // (one note per location: the last failure's; a second contact region's prefix kept)
+      bif_.note = std::string(by_ == LocatedBy::second_max_H ? "a second contact region; " : "") +
+                  "located from one side: " + (sample ? std::string("no candidate multiplier") : reason) +
                   " at s = " + format_number(s);
       return true;
     }
@@ -235,8 +266,11 @@ class BifurcationLocator {
   const LocatedBy by_;
   const State& base_;
   const double tolerance_;
+  const double target_;  // refine_tolerance when given, else tolerance
+  double s_b_ = 0, slope_ = 0;  // the segment's length and a scale of |dp/ds| along it
 
   Bifurcation bif_;
+  int refine_left_ = kRefineEvaluations;
   Sample neg_, pos_;                // the samples on the negative and the positive side of g
   std::optional<Sample> prev_neg_;  // the negative sample before neg_ (the one-sided secant)
   double g_neg_ = 0, g_pos_ = 0;    // Illinois: possibly halved copies of neg_.g, pos_.g

@@ -221,7 +221,7 @@ class BranchTracer {
     const long after = static_cast<long>(result_.points.size()) - 1;
     for (const auto& [type, by] : found) {
       const auto locate_start = std::chrono::steady_clock::now();
-      BifurcationLocator locator(branch_, result_, type, by, *current_, o_.tolerance);
+      BifurcationLocator locator(branch_, result_, type, by, *current_, o_.tolerance, o_.refine_tolerance);
       result_.bifurcations.push_back(locator.locate(a, b, xb, s_b, after));
       result_.locate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - locate_start).count();
     }

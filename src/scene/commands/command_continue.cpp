@@ -126,7 +126,9 @@ ContinueOutcome compute_continue(const Config& config, const ContinueRun& run, c
   for (int N : run.Ns) out.levels.push_back(branch_at(config, run.settings, run.orbit_settings, options, N, progress));
   std::vector<std::vector<Bifurcation>> by_N;
   for (const auto& r : out.levels) by_N.push_back(r.bifurcations);
-  const double tolerance = continuation_detail::checked_options(options).tolerance;  // its default filled in
+  // the floor of the bars: the locations' tolerance (its default filled in), or the refined one
+  const ContinuationOptions checked = continuation_detail::checked_options(options);
+  const double tolerance = checked.refine_tolerance > 0 ? checked.refine_tolerance : checked.tolerance;
   RichardsonOptions richardson;
   if (run.switching && run.problem.events == EventMode::off)
     richardson.order = richardson.order_step = 1;  // design.md 1.5

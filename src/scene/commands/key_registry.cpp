@@ -206,7 +206,8 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"continue_step_max", "continue: largest step; 0 = |to - from| / 10"},
       {"continue_max_points", "continue: branch points at most, 2..1e7"},
       {"continue_tolerance",
-       "continue: bifurcations located to this in the parameter; 0 = 1e-10 |to - from|, with continue_Ns 1e-13 |to - from|"},
+       "continue: bifurcations located to this in the parameter; 0 = 1e-10 |to - from|, narrowed on towards 1e-13 "
+       "|to - from| with continue_Ns where that works"},
       {"continue_Ns", "continue: N list (increasing) for error bars on the bifurcations (none: N only)"},
       {"continue_switch", "continue: true = also the period-2 branch from each period doubling (finest N), or the orbits from each Hopf point"},
       {"boundary_x", "boundary: the model key stepped along the curve (e.g. spindle_rpm)"},

@@ -49,7 +49,7 @@ ContinueSettings read_continue_settings(Config& config) {
   o.tolerance = config.get_double("continue_tolerance", 0);
   if (!(o.tolerance >= 0) || !std::isfinite(o.tolerance))
     throw BadInput("`continue_tolerance = " + format_number(o.tolerance) +
-                   "`: must be > 0 (or 0 for 1e-10 |to - from|, 1e-13 |to - from| with continue_Ns)");
+                   "`: must be > 0 (or 0 for 1e-10 |to - from|)");
   if (config.has("continue_Ns")) {
     for (long N : config.get_int_list("continue_Ns", {})) {
       if (N < 1 || N > 10'000'000)
@@ -63,12 +63,12 @@ ContinueSettings read_continue_settings(Config& config) {
   // With error bars the locations are extrapolated, and a location known only to the library's
   // default 1e-10 |to - from| puts a floor under every bar (about twice the tolerance: the
   // Richardson weights) far above the extrapolation's own error: on x' = -x + b x(t - tau) over
-  // N = 100 .. 1600 a bar of 2e-10 for an error of 4e-13. The bracket is then narrowed to
-  // 1e-13 |to - from| (the regula falsi converges superlinearly: no more evaluations there), which
-  // the test function can still resolve at N <= 10^5 (the multipliers' accuracy, convergence.hpp,
-  // is 1e-14 .. 1e-12 there); a bracket that cannot get there is carried into the bar as it is
-  // (extrapolate_bifurcations).
-  if (o.tolerance == 0 && s.Ns.size() >= 2) o.tolerance = 1e-13 * range;
+  // N = 100 .. 1600 a bar of 2e-10 for an error of 4e-13. Each location is then narrowed on
+  // towards 1e-13 |to - from| while that works (BranchRange::refine_tolerance: the regula falsi
+  // converges superlinearly where the test function is smooth, no more evaluations there; near a
+  // grazing, where the corrector may fail on one side, it stops), and the bracket it reaches is
+  // carried into the bar (extrapolate_bifurcations). A tolerance the user gives is kept as given.
+  if (o.tolerance == 0 && s.Ns.size() >= 2) o.refine_tolerance = 1e-13 * range;
   s.switch_period_doubling = config.get_choice("continue_switch", "false", {"false", "true"}) == "true";
   return s;
 }
