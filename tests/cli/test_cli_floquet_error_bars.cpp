@@ -5,6 +5,7 @@
 // the stability boundary b = -pi/2 (a = 0, tau = 1), where it must be `undecided`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <filesystem>
@@ -12,6 +13,8 @@
 #include <iterator>
 #include <numbers>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -31,12 +34,14 @@ struct LinearCase {
 };
 
 nlohmann::json floquet_json(const LinearCase& c, std::vector<std::string> extra = {}) {
-  std::vector<std::string> args = {"floquet", "--json", "--set", "model=linear", "--set",
-                                   "a=" + delayspec::format_number(c.a), "--set",
-                                   "b=" + delayspec::format_number(c.b), "--set",
-                                   "tau=" + delayspec::format_number(c.tau), "--set",
-                                   "period=" + delayspec::format_number(c.period), "--set",
-                                   "N=" + std::to_string(c.N), "--set", "nev=4"};
+  std::vector<std::string> args = {"floquet", "--json",
+                                   "--set",   "model=linear",
+                                   "--set",   "a=" + delayspec::format_number(c.a),
+                                   "--set",   "b=" + delayspec::format_number(c.b),
+                                   "--set",   "tau=" + delayspec::format_number(c.tau),
+                                   "--set",   "period=" + delayspec::format_number(c.period),
+                                   "--set",   "N=" + std::to_string(c.N),
+                                   "--set",   "nev=4"};
   for (const auto& e : extra) args.insert(args.end(), {"--set", e});
   const CliResult r = run(args);
   EXPECT_EQ(r.status, 0) << r.err;
@@ -92,12 +97,49 @@ TEST(FloquetErrorBars, AtTheStabilityBoundaryTheVerdictIsUndecidedWithTheNThatWo
   EXPECT_EQ(j.at("verdict"), "undecided") << j.dump(1);
   EXPECT_GT(j.at("error_bars").at("deciding_N").get<long>(), c.N);
   // The text says which N would decide it.
-  const CliResult text = run({"floquet", "--set", "model=linear", "--set", "a=0", "--set",
-                              "b=" + delayspec::format_number(c.b), "--set", "tau=1", "--set", "period=1", "--set",
-                              "N=100", "--set", "nev=4"});
+  const CliResult text =
+      run({"floquet", "--set", "model=linear", "--set", "a=0", "--set", "b=" + delayspec::format_number(c.b), "--set",
+           "tau=1", "--set", "period=1", "--set", "N=100", "--set", "nev=4"});
   EXPECT_EQ(text.status, 0) << text.err;
   EXPECT_NE(text.out.find("verdict: undecided"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("would decide it"), std::string::npos) << text.out;
+}
+
+// The impacting orbit against its exact multipliers (issue 32, item 1): the soft-impact oscillator at
+// tau = T, where the orbit does not depend on k and mu solves det(Phi(mu) - mu I) = 0, Phi the
+// monodromy of y' = (A(t) + B / mu) y along it (scripts/impact_exact_multipliers.py, mpmath, 40
+// digits; no delayspec code): the leading two pairs at k = 0.2, 0.55, 1, 1.25. Every bar floquet
+// gives covers its multiplier's actual error, and the verdict is never `unstable` (all are inside
+// the circle). At N = 800 the levels 50, 200, 800 show no order (the contact, 0.062 of T = 7.83,
+// spans 1.3 steps at N = 50): undecided, which is no wrong answer. At N = 12800 every verdict is
+// reached.
+TEST(FloquetErrorBars, AnImpactingOrbitsBarsCoverItsExactMultipliers) {
+  const std::vector<std::pair<const char*, std::vector<cd>>> cases = {
+      {"0.2", {{0.096814909557876245857, 0.61424266920529132777}, {0.05607437538069850761, 0.38658384104508885492}}},
+      {"0.55", {{0.528696903279296839, 0.63408134234199710598}, {0.46171379482072068852, 0.47837924365780227011}}},
+      {"1.0", {{0.77533444278541939677, 0.5283671255900418333}, {0.68054702260737086532, 0.40253185464748169127}}},
+      {"1.25", {{0.84555145568463120188, 0.46936676495443479007}, {0.74476534302504488476, 0.36250497689561499977}}}};
+  for (const auto& [k, pairs] : cases)
+    for (const char* N : {"800", "3200", "12800"}) {
+      const CliResult r = run({"floquet", "--json", "--set", "tau_over_T=1", "--set", std::string("k=") + k, "--set",
+                               std::string("N=") + N, "--set", "nev=4"});
+      ASSERT_EQ(r.status, 0) << r.err;
+      const nlohmann::json j = nlohmann::json::parse(r.out);
+      int barred = 0;
+      for (const auto& m : j.at("multipliers")) {
+        if (m.at("error_estimate").is_null()) continue;
+        ++barred;
+        double actual = INFINITY;  // to the nearest exact multiplier (the pairs and their conjugates)
+        for (const cd& x : pairs)
+          actual = std::min({actual, std::abs(value(m) - x), std::abs(value(m) - std::conj(x))});
+        EXPECT_LE(actual, m.at("error_estimate").get<double>()) << "k = " << k << ", N = " << N << ": " << m;
+      }
+      EXPECT_NE(j.at("verdict"), "unstable") << "k = " << k << ", N = " << N;
+      if (std::string(N) == "12800") {
+        EXPECT_EQ(barred, 4) << "k = " << k << ": " << j.at("error_bars");
+        EXPECT_EQ(j.at("verdict"), "stable") << "k = " << k << ": " << j.at("error_bars");
+      }
+    }
 }
 
 TEST(FloquetErrorBars, OffGivesTheSingleSolveWithoutBarsOrVerdict) {
@@ -126,9 +168,10 @@ using delayspec::testing::fresh_dir;
 TEST(ChartErrorBars, EachPointsVerdictAgreesWithLambertWAndItsBarCoversTheError) {
   // The linear DDE's (a, b) plane at tau = T = 1, N = 200: every point's |mu_1| against the exact
   // one; a verdict is never on the wrong side, and the boundary's points may be undecided only.
-  const CliResult r = run({"chart", "--json", "--set", "model=linear", "--set", "chart_x=a", "--set", "chart_y=b",
-                           "--set", "chart_x_range=-2,0.5", "--set", "chart_y_range=-2,1", "--set", "chart_x_points=6",
-                           "--set", "chart_y_points=5", "--set", "N=200", "--set", "error_bars=on"});
+  const CliResult r = run({"chart", "--json",           "--set", "model=linear",         "--set", "chart_x=a",
+                           "--set", "chart_y=b",        "--set", "chart_x_range=-2,0.5", "--set", "chart_y_range=-2,1",
+                           "--set", "chart_x_points=6", "--set", "chart_y_points=5",     "--set", "N=200",
+                           "--set", "error_bars=on"});
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   long stable = 0, undecided = 0;
@@ -241,8 +284,8 @@ TEST(FloquetRoundOff, MultipliersBelowTheirAccuracyAreNeverPrintedAsValues) {
       EXPECT_FALSE(mu[k].contains("error_estimate")) << solver;
     }
     EXPECT_NE(j.at("verdict"), "stable") << solver;
-    const CliResult text = run({"floquet", "--set", "model=linear", "--set", "a=50", "--set", "b=0.5", "--set",
-                                "N=200", "--set", "nev=3", "--set", std::string("solver=") + solver});
+    const CliResult text = run({"floquet", "--set", "model=linear", "--set", "a=50", "--set", "b=0.5", "--set", "N=200",
+                                "--set", "nev=3", "--set", std::string("solver=") + solver});
     EXPECT_NE(text.out.find("not resolved: |mu| <= "), std::string::npos) << text.out;
     EXPECT_EQ(text.out.find("93948"), std::string::npos) << text.out;
   }
