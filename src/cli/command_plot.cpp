@@ -130,10 +130,11 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
   gp << "set autoscale fix\n" << (any_undecided ? "set key top right opaque\n" : "set key off\n");
   gp << "plot $chart using 1:2:($3 > 2 ? 2 : $3) with image notitle, $boundary using 1:2 with lines lc rgb 'white' lw 2 "
         "notitle";
-  // Points whose error bar holds the unit circle: no verdict there (error_bars.hpp)
+  // Points whose error bar holds the unit circle: no verdict there (error_bars.hpp). The others get
+  // an undefined y, which gnuplot skips (a third `using` column does not: it drew every point).
   if (any_undecided)
-    gp << ", \\\n     $chart using 1:2:($4 == 1 ? 1 : NaN) with points pt 6 ps 0.8 lc rgb 'black' "
-          "title 'undecided (|{/Symbol m}_1| = 1 within its error bar)'";
+    gp << ", \\\n     $chart using 1:($4 == 1 ? $2 : NaN) with points pt 6 ps 0.8 lc rgb 'black' "
+          "title 'undecided (no error bar, or |{/Symbol m}_1| = 1 within it)'";
   gp << "\n";
   renderer.figure("chart", gp.str());
 }

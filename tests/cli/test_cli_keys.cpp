@@ -76,7 +76,8 @@ TEST(CommandHelp, RequiredKeysAndCommandSpecificDefaults) {
   EXPECT_TRUE(contains(sweep.out, "sweep_points = 11")) << sweep.out;
   CliResult chart = run({"chart", "--help"});
   EXPECT_TRUE(contains(chart.out, "nev = 1 ")) << "chart wants only |mu_1|\n" << chart.out;
-  EXPECT_TRUE(contains(chart.out, "N = 40 ")) << chart.out;
+  EXPECT_TRUE(contains(chart.out, "N = 200 ")) << chart.out;
+  EXPECT_TRUE(contains(chart.out, "error_bars = on ")) << "chart gives verdicts by default\n" << chart.out;
   // converge's events default depends on the model (impact: on and off side by side).
   CliResult converge = run({"converge", "--help"});
   EXPECT_TRUE(contains(converge.out, "events = on (linear, mathieu, mackey-glass); on,off (impact, milling)"))

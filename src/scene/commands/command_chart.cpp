@@ -6,9 +6,9 @@
 //
 // Keys: chart_x, chart_y (parameter names, default delta and b), chart_x_range, chart_y_range
 // (two numbers [min, max]), chart_x_points, chart_y_points (>= 2), threads; plus the problem,
-// orbit and eigen-solver keys (nev defaults to 1 here: only |mu_1| is wanted); error_bars (on:
-// each point's |mu_1| with its error bar and verdict, floquet's rule, about 1.4x the time; off
-// by default here, see below).
+// orbit and eigen-solver keys (nev defaults to 1 here: only |mu_1| is wanted; N to 200); error_bars
+// (on, the default: each point's |mu_1| with its error bar and verdict, floquet's rule, about 1.4x
+// the time; off: |mu_1| at N alone).
 // Output: JSON {"x", "y", "x_values", "y_values", "rows": [{"x", "y", "spectral_radius",
 // "error_estimate", "verdict"}], "stable_points", "undecided_points", ...};
 // with --out DIR also DIR/chart.csv: x,y,spectral_radius[,error_estimate,undecided], one block per y value separated by
@@ -55,15 +55,15 @@ ChartSettings read_chart_settings(Config& config) {
   s.y = read_parameter_axis(config, "chart", "y", "b", -1.5, 1.5, 31);
   if (s.x.name == s.y.name) throw BadInput("`chart_x = chart_y = " + s.x.name + "`: the two axes must differ");
   s.threads = read_threads(config);
-  // Read (and validate) the problem once, as every point will.
-  s.problem = read_problem(config, 40);
+  // Read (and validate) the problem once, as every point will. N = 200 by default: the levels of
+  // the error bars, N/8 and N/4, must show the order (at N = 40, 5 and 10 do not: 687 of the
+  // default plane's 961 points were undecided; at N = 200, 20).
+  s.problem = read_problem(config, 200);
   s.orbit_settings = read_orbit_settings(config);
   read_floquet_options(config, 1);
-  // Each point's |mu_1| with its error bar and verdict (floquet's rule: error_bars.hpp). Off by
-  // default here, for now: at the chart's N = 40 the levels N/8 = 5 and N/4 = 10 are too coarse
-  // (Mathieu's default plane: 66 of 100 points undecided; at N = 200, 1; at N = 400, none), and
-  // a default N that gives verdicts changes the charts the docs show (issue 32 stays open on it).
-  s.with_error_bars = config.get_choice("error_bars", "off", {"on", "off"}) == "on";
+  // Each point's |mu_1| with its error bar and verdict (floquet's rule: error_bars.hpp), as floquet
+  // gives them: a chart says which cells it cannot vouch for (undecided, drawn so).
+  s.with_error_bars = config.get_choice("error_bars", "on", {"on", "off"}) == "on";
   require_model_parameter(config, "chart_x", s.x.name, s.problem.model_name);
   require_model_parameter(config, "chart_y", s.y.name, s.problem.model_name);
   config.check_all_used();
