@@ -53,7 +53,7 @@
 //     from level to level: the impact orbit's raw order wanders over 1.89 .. 2.10). Column J
 //     removed its mean and kept the wandering part, T[i][J] = x0 + delta_i h_i^q, |delta_i| <=
 //     Delta, whose differences can grow, shrink or jump. Its error is bounded by the spread:
-//     E = max over the column's entries of |T[i][J] - T[i-1][J]| (h_{L-1} / h_i)^q, each
+//     E = max over the column's last four entries of |T[i][J] - T[i-1][J]| (h_{L-1} / h_i)^q, each
 //     difference scaled to the finest step like h^q (of the size Delta h_{L-1}^q; the .cpp says
 //     how often it covers the error). Checked against the impact orbit's exact multipliers at
 //     tau = T (tests/cli/test_cli_converge.cpp).
