@@ -130,7 +130,8 @@ TEST(ContinueCli, NeimarkSackerBarIsTightAtTheDefaultTolerance) {
   // Two levels: no bar, so no point is decided.
   r = run(linear_args({"--set", "continue_Ns=100,200", "--json"}));
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const auto& p : nlohmann::json::parse(r.out)["points"]) EXPECT_EQ(p["verdict"], "undecided");
+  const auto two = nlohmann::json::parse(r.out);  // kept: a range-for over a temporary's member dangles
+  for (const auto& p : two["points"]) EXPECT_EQ(p["verdict"], "undecided");
 }
 
 // Issue 32, item 4: on the PWSDDE period-2 branch a second contact region appears at k = 0.1767
