@@ -391,17 +391,17 @@ TEST(ConvergeCli, TextOutputSaysWhenOrdersAreNotSettled) {
 
 namespace {
 
-struct BadValue {
+struct ConvergeBadValue {
   const char* key;
   const char* value;
 };
-void PrintTo(const BadValue& b, std::ostream* os) { *os << b.key << "=" << b.value; }
-class ConvergeBadInput : public ::testing::TestWithParam<BadValue> {};
+void PrintTo(const ConvergeBadValue& b, std::ostream* os) { *os << b.key << "=" << b.value; }
+class ConvergeBadInput : public ::testing::TestWithParam<ConvergeBadValue> {};
 
 }  // namespace
 
 TEST_P(ConvergeBadInput, ExitsTwoNamingKeyAndValue) {
-  const BadValue b = GetParam();
+  const ConvergeBadValue b = GetParam();
   CliResult r = run({"converge", "--set", "model=mathieu", "--set", std::string(b.key) + "=" + b.value});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find(std::string("`") + b.key), std::string::npos) << r.err;
@@ -411,15 +411,15 @@ TEST_P(ConvergeBadInput, ExitsTwoNamingKeyAndValue) {
 
 // clang-format off
 INSTANTIATE_TEST_SUITE_P(Keys, ConvergeBadInput, ::testing::Values(
-    BadValue{"Ns", "50,25"}, BadValue{"Ns", "0,10"}, BadValue{"Ns", "ten"}, BadValue{"Ns", "10,,20"},
-    BadValue{"N_min", "0"}, BadValue{"N_max", "-3"}, BadValue{"nev", "0"}, BadValue{"nev", "5000"},
-    BadValue{"reference", "best"}, BadValue{"reference", "exact"}, BadValue{"events", "on,maybe"},
-    BadValue{"events", "on,on"}, BadValue{"solver", "magic"}, BadValue{"extrapolation_order", "-1"},
-    BadValue{"extrapolation_order_step", "nan"}, BadValue{"extrapolation_levels", "0"},
+    ConvergeBadValue{"Ns", "50,25"}, ConvergeBadValue{"Ns", "0,10"}, ConvergeBadValue{"Ns", "ten"}, ConvergeBadValue{"Ns", "10,,20"},
+    ConvergeBadValue{"N_min", "0"}, ConvergeBadValue{"N_max", "-3"}, ConvergeBadValue{"nev", "0"}, ConvergeBadValue{"nev", "5000"},
+    ConvergeBadValue{"reference", "best"}, ConvergeBadValue{"reference", "exact"}, ConvergeBadValue{"events", "on,maybe"},
+    ConvergeBadValue{"events", "on,on"}, ConvergeBadValue{"solver", "magic"}, ConvergeBadValue{"extrapolation_order", "-1"},
+    ConvergeBadValue{"extrapolation_order_step", "nan"}, ConvergeBadValue{"extrapolation_levels", "0"},
     // 2^32 + 1 and 2^32 + 400: each would wrap to a valid int (1, 400) if cast before the range check
-    BadValue{"extrapolation_levels", "4294967297"}, BadValue{"N_max", "4294967696"},
-    BadValue{"converge_target", "-1e-8"}, BadValue{"converge_target", "2"}, BadValue{"converge_target", "0"},
-    BadValue{"converge_max_N", "5000"} /* no target */, BadValue{"converge_max_seconds", "30"} /* no target */));
+    ConvergeBadValue{"extrapolation_levels", "4294967297"}, ConvergeBadValue{"N_max", "4294967696"},
+    ConvergeBadValue{"converge_target", "-1e-8"}, ConvergeBadValue{"converge_target", "2"}, ConvergeBadValue{"converge_target", "0"},
+    ConvergeBadValue{"converge_max_N", "5000"} /* no target */, ConvergeBadValue{"converge_max_seconds", "30"} /* no target */));
 // clang-format on
 
 TEST(ConvergeCli, TargetLimitsOutOfRangeAreBadInput) {

@@ -13,20 +13,20 @@ namespace {
 using delayspec::testing::CliResult;
 using delayspec::testing::run;
 
-struct BadValue {
+struct FloquetBadValue {
   const char* model;
   const char* key;
   const char* value;
 };
 
-void PrintTo(const BadValue& b, std::ostream* os) { *os << b.model << ":" << b.key << "=" << b.value; }
+void PrintTo(const FloquetBadValue& b, std::ostream* os) { *os << b.model << ":" << b.key << "=" << b.value; }
 
-class FloquetBadInput : public ::testing::TestWithParam<BadValue> {};
+class FloquetBadInput : public ::testing::TestWithParam<FloquetBadValue> {};
 
 }  // namespace
 
 TEST_P(FloquetBadInput, ExitsTwoNamingKeyAndValue) {
-  const BadValue b = GetParam();
+  const FloquetBadValue b = GetParam();
   CliResult r = run({"floquet", "--set", std::string("model=") + b.model, "--set", "solver=dense", "--set", "N=8",
                      "--set", std::string(b.key) + "=" + b.value});
   EXPECT_EQ(r.status, 2) << r.err;
@@ -37,26 +37,26 @@ TEST_P(FloquetBadInput, ExitsTwoNamingKeyAndValue) {
 
 // clang-format off
 INSTANTIATE_TEST_SUITE_P(Keys, FloquetBadInput, ::testing::Values(
-    BadValue{"impact", "zeta", "abc"}, BadValue{"impact", "zeta", "nan"}, BadValue{"impact", "zeta", "-1"},
-    BadValue{"impact", "e", "x"}, BadValue{"impact", "e", "inf"},
-    BadValue{"impact", "a", ""}, BadValue{"impact", "a", "1e999"},
-    BadValue{"impact", "beta", "-3"}, BadValue{"impact", "beta", "NaN"},
-    BadValue{"impact", "omega", "0"}, BadValue{"impact", "omega", "-0.8"}, BadValue{"impact", "omega", "fast"},
-    BadValue{"impact", "k", "one"}, BadValue{"impact", "k", "-inf"},
-    BadValue{"impact", "tau_over_T", "0"}, BadValue{"impact", "tau_over_T", "-1"},
-    BadValue{"impact", "tau", "-2"}, BadValue{"impact", "tau", "nan"},
-    BadValue{"impact", "x0", "1,2"}, BadValue{"impact", "v0", "inf"},
-    BadValue{"impact", "orbit_period", "0"}, BadValue{"impact", "orbit_period", "1.5"},
-    BadValue{"impact", "N", "0"}, BadValue{"impact", "N", "-5"}, BadValue{"impact", "N", "ten"},
-    BadValue{"impact", "N", "3.5"}, BadValue{"impact", "N", ""}, BadValue{"impact", "N", "99999999999999999999"},
-    BadValue{"impact", "events", "maybe"}, BadValue{"impact", "jacobian", "exact"},
-    BadValue{"impact", "nev", "0"}, BadValue{"impact", "nev", "100000"}, BadValue{"impact", "nev", "many"},
-    BadValue{"impact", "solver", "magic"}, BadValue{"impact", "orbit", "guess"},
-    BadValue{"impact", "model", "duffing"},
-    BadValue{"linear", "a", "nan"}, BadValue{"linear", "b", "b"}, BadValue{"linear", "tau", "0"},
-    BadValue{"linear", "tau", "-1"}, BadValue{"linear", "period", "0"}, BadValue{"linear", "period", "inf"},
-    BadValue{"mathieu", "kappa", "nan"}, BadValue{"mathieu", "delta", "x"}, BadValue{"mathieu", "eps", "inf"},
-    BadValue{"mathieu", "b", "--"}));
+    FloquetBadValue{"impact", "zeta", "abc"}, FloquetBadValue{"impact", "zeta", "nan"}, FloquetBadValue{"impact", "zeta", "-1"},
+    FloquetBadValue{"impact", "e", "x"}, FloquetBadValue{"impact", "e", "inf"},
+    FloquetBadValue{"impact", "a", ""}, FloquetBadValue{"impact", "a", "1e999"},
+    FloquetBadValue{"impact", "beta", "-3"}, FloquetBadValue{"impact", "beta", "NaN"},
+    FloquetBadValue{"impact", "omega", "0"}, FloquetBadValue{"impact", "omega", "-0.8"}, FloquetBadValue{"impact", "omega", "fast"},
+    FloquetBadValue{"impact", "k", "one"}, FloquetBadValue{"impact", "k", "-inf"},
+    FloquetBadValue{"impact", "tau_over_T", "0"}, FloquetBadValue{"impact", "tau_over_T", "-1"},
+    FloquetBadValue{"impact", "tau", "-2"}, FloquetBadValue{"impact", "tau", "nan"},
+    FloquetBadValue{"impact", "x0", "1,2"}, FloquetBadValue{"impact", "v0", "inf"},
+    FloquetBadValue{"impact", "orbit_period", "0"}, FloquetBadValue{"impact", "orbit_period", "1.5"},
+    FloquetBadValue{"impact", "N", "0"}, FloquetBadValue{"impact", "N", "-5"}, FloquetBadValue{"impact", "N", "ten"},
+    FloquetBadValue{"impact", "N", "3.5"}, FloquetBadValue{"impact", "N", ""}, FloquetBadValue{"impact", "N", "99999999999999999999"},
+    FloquetBadValue{"impact", "events", "maybe"}, FloquetBadValue{"impact", "jacobian", "exact"},
+    FloquetBadValue{"impact", "nev", "0"}, FloquetBadValue{"impact", "nev", "100000"}, FloquetBadValue{"impact", "nev", "many"},
+    FloquetBadValue{"impact", "solver", "magic"}, FloquetBadValue{"impact", "orbit", "guess"},
+    FloquetBadValue{"impact", "model", "duffing"},
+    FloquetBadValue{"linear", "a", "nan"}, FloquetBadValue{"linear", "b", "b"}, FloquetBadValue{"linear", "tau", "0"},
+    FloquetBadValue{"linear", "tau", "-1"}, FloquetBadValue{"linear", "period", "0"}, FloquetBadValue{"linear", "period", "inf"},
+    FloquetBadValue{"mathieu", "kappa", "nan"}, FloquetBadValue{"mathieu", "delta", "x"}, FloquetBadValue{"mathieu", "eps", "inf"},
+    FloquetBadValue{"mathieu", "b", "--"}));
 // clang-format on
 
 TEST(FloquetCli, UnknownKeyIsBadInput) {

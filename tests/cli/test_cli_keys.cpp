@@ -23,14 +23,8 @@ namespace {
 using delayspec::testing::CliResult;
 using delayspec::testing::contains;
 using delayspec::testing::fresh_dir;
+using delayspec::testing::read_text;
 using delayspec::testing::run;
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 }  // namespace
 

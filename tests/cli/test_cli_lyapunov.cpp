@@ -20,32 +20,18 @@ namespace fs = std::filesystem;
 
 using delayspec::testing::CliResult;
 using delayspec::testing::fresh_dir;
+using delayspec::testing::read_text;
 using delayspec::testing::run;
+using delayspec::testing::without_metadata;
 
-std::string read(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// A CSV's table without its "# ..." metadata lines.
-std::string without_metadata(const std::string& csv) {
-  std::string out;
-  std::stringstream ss(csv);
-  for (std::string line; std::getline(ss, line);)
-    if (line.rfind("#", 0) != 0) out += line + "\n";
-  return out;
-}
-
-struct BadValue {
+struct LyapunovBadValue {
   const char* key;
   const char* value;
 };
-void PrintTo(const BadValue& b, std::ostream* os) { *os << b.key << "=" << b.value; }
+void PrintTo(const LyapunovBadValue& b, std::ostream* os) { *os << b.key << "=" << b.value; }
 
-class LyapunovBadInput : public ::testing::TestWithParam<BadValue> {};
-class SweepBadInput : public ::testing::TestWithParam<BadValue> {};
+class LyapunovBadInput : public ::testing::TestWithParam<LyapunovBadValue> {};
+class SweepBadInput : public ::testing::TestWithParam<LyapunovBadValue> {};
 
 const std::vector<std::string> kSmallLinear = {"--set", "model=linear", "--set", "N=10",
                                                "--set", "periods=20",   "--set", "transient=0"};
@@ -53,7 +39,7 @@ const std::vector<std::string> kSmallLinear = {"--set", "model=linear", "--set",
 }  // namespace
 
 TEST_P(LyapunovBadInput, ExitsTwoNamingKeyAndValue) {
-  const BadValue b = GetParam();
+  const LyapunovBadValue b = GetParam();
   auto args = kSmallLinear;
   args.insert(args.begin(), "lyapunov");
   args.insert(args.end(), {"--set", std::string(b.key) + "=" + b.value});
@@ -66,15 +52,15 @@ TEST_P(LyapunovBadInput, ExitsTwoNamingKeyAndValue) {
 
 // clang-format off
 INSTANTIATE_TEST_SUITE_P(Keys, LyapunovBadInput, ::testing::Values(
-    BadValue{"exponents", "0"}, BadValue{"exponents", "12"}, BadValue{"exponents", "two"},
-    BadValue{"periods", "1"}, BadValue{"periods", "-5"}, BadValue{"periods", "1e3"},
-    BadValue{"transient", "-1"}, BadValue{"transient", "x"}, BadValue{"seed", "-3"}, BadValue{"seed", "abc"},
-    BadValue{"qr_every", "0"}, BadValue{"qr_every", "3"}, BadValue{"batches", "1"}, BadValue{"N", "0"},
+    LyapunovBadValue{"exponents", "0"}, LyapunovBadValue{"exponents", "12"}, LyapunovBadValue{"exponents", "two"},
+    LyapunovBadValue{"periods", "1"}, LyapunovBadValue{"periods", "-5"}, LyapunovBadValue{"periods", "1e3"},
+    LyapunovBadValue{"transient", "-1"}, LyapunovBadValue{"transient", "x"}, LyapunovBadValue{"seed", "-3"}, LyapunovBadValue{"seed", "abc"},
+    LyapunovBadValue{"qr_every", "0"}, LyapunovBadValue{"qr_every", "3"}, LyapunovBadValue{"batches", "1"}, LyapunovBadValue{"N", "0"},
     // issue 13: upper bounds checked before anything is allocated (exit 2, not 1 from
     // "cannot create std::vector"), and no wrap in a narrowing cast (2^32 + 2 -> 2)
-    BadValue{"periods", "1000000000000000000"}, BadValue{"transient", "2000000000"},
-    BadValue{"exponents", "4294967298"}, BadValue{"periods", "200000000"}, BadValue{"contact_substeps", "100000"},
-    BadValue{"N", "4294967298"}));
+    LyapunovBadValue{"periods", "1000000000000000000"}, LyapunovBadValue{"transient", "2000000000"},
+    LyapunovBadValue{"exponents", "4294967298"}, LyapunovBadValue{"periods", "200000000"}, LyapunovBadValue{"contact_substeps", "100000"},
+    LyapunovBadValue{"N", "4294967298"}));
 // clang-format on
 
 TEST(LyapunovCli, JsonHasContractKeys) {
@@ -125,7 +111,7 @@ TEST(LyapunovCli, MoreExponentsThanTheRankOfTheMapExitsThree) {
 }
 
 TEST_P(SweepBadInput, ExitsTwoNamingKeyAndValue) {
-  const BadValue b = GetParam();
+  const LyapunovBadValue b = GetParam();
   std::vector<std::string> args = {"sweep", "--set", "sweep_key=b", "--set", "sweep_from=-1", "--set", "sweep_to=1"};
   args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
   args.insert(args.end(), {"--set", std::string(b.key) + "=" + b.value});
@@ -137,9 +123,9 @@ TEST_P(SweepBadInput, ExitsTwoNamingKeyAndValue) {
 
 // clang-format off
 INSTANTIATE_TEST_SUITE_P(Keys, SweepBadInput, ::testing::Values(
-    BadValue{"sweep_key", "periods"}, BadValue{"sweep_key", "model"}, BadValue{"sweep_from", "nan"},
-    BadValue{"sweep_to", "x"}, BadValue{"sweep_points", "0"}, BadValue{"threads", "-2"},
-    BadValue{"section_points", "-1"}, BadValue{"exponents", "0"}));
+    LyapunovBadValue{"sweep_key", "periods"}, LyapunovBadValue{"sweep_key", "model"}, LyapunovBadValue{"sweep_from", "nan"},
+    LyapunovBadValue{"sweep_to", "x"}, LyapunovBadValue{"sweep_points", "0"}, LyapunovBadValue{"threads", "-2"},
+    LyapunovBadValue{"section_points", "-1"}, LyapunovBadValue{"exponents", "0"}));
 // clang-format on
 
 TEST(SweepCli, SweptKeyMustBeAParameterOfTheModel) {
@@ -177,7 +163,7 @@ TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
   EXPECT_EQ(j["points"][1]["section_x"].size(), 4u);
   for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "sweep_settings.json"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
-  const std::string with_metadata = read(dir / "exponents.csv");
+  const std::string with_metadata = read_text(dir / "exponents.csv");
   // the metadata header names the swept key, not its per-point value
   EXPECT_NE(with_metadata.find("\n# sweep_key = b\n"), std::string::npos) << with_metadata;
   EXPECT_EQ(with_metadata.find("\n# b = "), std::string::npos) << with_metadata;
@@ -185,7 +171,7 @@ TEST(SweepCli, PointsEqualSingleRunsAndFilesAreComplete) {
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "parameter,lambda1,lambda2,se1,se2,lambda1_per_time,lambda2_per_time,seconds");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);  // header + 3 points
-  const std::string section = without_metadata(read(dir / "section.csv"));
+  const std::string section = without_metadata(read_text(dir / "section.csv"));
   EXPECT_EQ(std::count(section.begin(), section.end(), '\n'), 1 + 3 * 4);
   // the same directory again is refused: it holds a finished sweep (test_cli_output_dir.cpp has
   // the interrupted case, which advises --resume)
@@ -204,7 +190,7 @@ TEST(SweepCli, ResumeCompletesAnInterruptedSweep) {
                                    "sweep_to=0", "--set",       "sweep_points=5"};
   args.insert(args.end(), kSmallLinear.begin(), kSmallLinear.end());
   ASSERT_EQ(run(args).status, 0);
-  const std::string complete_csv = read(dir / "exponents.csv");
+  const std::string complete_csv = read_text(dir / "exponents.csv");
   // simulate the interruption after points 0 and 3
   for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "points/point_00001.json",
                         "points/point_00002.json", "points/point_00004.json"})
@@ -228,7 +214,7 @@ TEST(SweepCli, ResumeCompletesAnInterruptedSweep) {
       if (line.rfind("#", 0) != 0) out += line.substr(0, line.rfind(',')) + "\n";  // (metadata: times differ)
     return out;
   };
-  EXPECT_EQ(strip_seconds(read(dir / "exponents.csv")), strip_seconds(complete_csv));
+  EXPECT_EQ(strip_seconds(read_text(dir / "exponents.csv")), strip_seconds(complete_csv));
   fs::remove_all(dir);
 }
 

@@ -36,14 +36,9 @@ namespace {
 using delayspec::testing::CliResult;
 using delayspec::testing::contains;
 using delayspec::testing::fresh_dir;
+using delayspec::testing::read_text;
 using delayspec::testing::run;
-
-std::string read(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using delayspec::testing::without_metadata;
 
 std::vector<std::string> with(std::vector<std::string> head, const std::vector<std::string>& tail) {
   head.insert(head.end(), tail.begin(), tail.end());
@@ -80,13 +75,6 @@ std::string without_seconds(const std::string& csv) {
 }
 
 // The data lines of a CSV (the metadata lines carry times and the scene path).
-std::string without_metadata(const std::string& csv) {
-  std::string out, line;
-  std::stringstream ss(csv);
-  while (std::getline(ss, line))
-    if (line.rfind('#', 0) != 0) out += line + "\n";
-  return out;
-}
 
 const std::vector<std::string> kSweep = {"--quiet",         "--set", "model=linear", "--set", "N=10",           "--set",
                                          "periods=20",      "--set", "transient=0",  "--set", "sweep_key=a",    "--set",
@@ -171,7 +159,7 @@ TEST(OutputDirectory, InterruptedMultiFileOutputHasNoCompleteMarker) {
   const std::vector<std::string> args = {"simulate", "--out", dir.string(), "--set", "N=8", "--set", "t_end=2"};
   CliResult r = run(args);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto marker = nlohmann::json::parse(read(dir / "complete.json"));
+  const auto marker = nlohmann::json::parse(read_text(dir / "complete.json"));
   EXPECT_EQ(marker["command"], "simulate");
   EXPECT_EQ(marker["exit_status"], 0);
   EXPECT_EQ(marker["files"], nlohmann::json({"impacts.csv", "poincare.csv", "trajectory.csv"}));
@@ -267,15 +255,15 @@ TEST(OutputDirectory, KilledRunIsIncompleteAndResumesToTheSameTables) {
   CliResult resumed = run({"run", scene.string(), "--out", dir.string(), "--quiet", "--resume"});
   ASSERT_EQ(resumed.status, 0) << resumed.err;
   EXPECT_TRUE(fs::exists(dir / "run.json"));
-  const auto marker = nlohmann::json::parse(read(dir / "complete.json"));
+  const auto marker = nlohmann::json::parse(read_text(dir / "complete.json"));
   EXPECT_EQ(marker["command"], "run");
   EXPECT_TRUE(contains(marker["files"].dump(), "\"run.json\"")) << marker.dump();
-  EXPECT_LE(nlohmann::json::parse(read(dir / "sweep.json"))["points_computed_now"].get<long>(), 200 - seen);
+  EXPECT_LE(nlohmann::json::parse(read_text(dir / "sweep.json"))["points_computed_now"].get<long>(), 200 - seen);
 
   CliResult alone = run({"run", scene.string(), "--out", reference.string(), "--quiet"});  // uninterrupted
   ASSERT_EQ(alone.status, 0) << alone.err;
-  EXPECT_EQ(without_seconds(read(dir / "exponents.csv")), without_seconds(read(reference / "exponents.csv")));
-  EXPECT_EQ(without_metadata(read(dir / "section.csv")), without_metadata(read(reference / "section.csv")));
+  EXPECT_EQ(without_seconds(read_text(dir / "exponents.csv")), without_seconds(read_text(reference / "exponents.csv")));
+  EXPECT_EQ(without_metadata(read_text(dir / "section.csv")), without_metadata(read_text(reference / "section.csv")));
   fs::remove_all(dir);
   fs::remove_all(reference);
   fs::remove(scene);
@@ -315,7 +303,7 @@ TEST(OutputDirectory, ChartAndBasinResumeToTheSameTable) {
   for (const auto& [name, args] : grids) {
     const fs::path dir = fresh_dir("outdir_resume_" + name);
     ASSERT_EQ(run(with(args, {"--out", dir.string()})).status, 0) << name;
-    const std::string complete = without_metadata(read(dir / (name + ".csv")));
+    const std::string complete = without_metadata(read_text(dir / (name + ".csv")));
     EXPECT_TRUE(fs::exists(dir / (name + "_settings.json"))) << name;
     for (int i = 0; i < 6; ++i)
       EXPECT_TRUE(fs::exists(dir / (name + "_points/point_0000" + std::to_string(i) + ".json")));
@@ -334,7 +322,7 @@ TEST(OutputDirectory, ChartAndBasinResumeToTheSameTable) {
     fs::remove(dir / (name + "_points/point_00004.json"));
     CliResult resumed = run(with(args, {"--out", dir.string(), "--resume", "--json"}));
     ASSERT_EQ(resumed.status, 0) << resumed.err;
-    EXPECT_EQ(without_metadata(read(dir / (name + ".csv"))), complete) << name;
+    EXPECT_EQ(without_metadata(read_text(dir / (name + ".csv"))), complete) << name;
     EXPECT_TRUE(fs::exists(dir / (name + "_points/point_00004.json"))) << name;
     fs::remove_all(dir);
   }
@@ -346,7 +334,7 @@ TEST(OutputDirectory, ResumeAcceptsExplicitDefaults) {
   const fs::path dir = fresh_dir("outdir_defaults");
   CliResult full = run(with({"sweep", "--out", dir.string()}, kSweep));
   ASSERT_EQ(full.status, 0) << full.err;
-  const std::string complete_csv = read(dir / "exponents.csv");
+  const std::string complete_csv = read_text(dir / "exponents.csv");
   for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "points/point_00001.json"}) fs::remove(dir / f);
   const fs::path scene = dir.string() + ".toml";
   std::ofstream(scene) << "seed = 1\nevents = \"on\"\nqr_every = 1\n";  // the defaults (lyapunov_settings.cpp)
@@ -354,7 +342,7 @@ TEST(OutputDirectory, ResumeAcceptsExplicitDefaults) {
                          {"--set", "b=0.50", "--set", "sweep_to=0.0", "--set", "tau=1e0"}));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["points_computed_now"], 1);
-  EXPECT_EQ(without_seconds(read(dir / "exponents.csv")), without_seconds(complete_csv));
+  EXPECT_EQ(without_seconds(read_text(dir / "exponents.csv")), without_seconds(complete_csv));
   // A value that differs is still refused, naming the key and both values.
   fs::remove(dir / "points/point_00001.json");
   r = run(with({"sweep", "--out", dir.string(), "--resume", "--set", "b=0.6"}, kSweep));
@@ -444,8 +432,8 @@ TEST(OutputDirectory, ChartAndBasinExitThreeWithFailedPointsRecorded) {
   EXPECT_EQ(j["failed_points"], 4);
   EXPECT_TRUE(j["rows"][0]["spectral_radius"].is_null());
   EXPECT_TRUE(contains(j["rows"][0]["failure"].get<std::string>(), "not settled"));
-  EXPECT_TRUE(contains(read(dir / "chart.csv"), ",nan\n"));
-  EXPECT_EQ(nlohmann::json::parse(read(dir / "complete.json"))["exit_status"], 3);
+  EXPECT_TRUE(contains(read_text(dir / "chart.csv"), ",nan\n"));
+  EXPECT_EQ(nlohmann::json::parse(read_text(dir / "complete.json"))["exit_status"], 3);
   // linear x' = a x + b x(t - 1): a = 10 overflows within the 400-period transient, a = -1 decays
   CliResult basin = run({"basin",
                          "--json",
@@ -474,7 +462,7 @@ TEST(OutputDirectory, ChartAndBasinExitThreeWithFailedPointsRecorded) {
   EXPECT_EQ(j["failed_points"], 2);
   EXPECT_EQ(j["rows"][0]["period"], 1);
   EXPECT_TRUE(j["rows"][1]["period"].is_null());
-  EXPECT_TRUE(contains(read(dir / "basin.csv"), "10,0,nan,nan\n"));
+  EXPECT_TRUE(contains(read_text(dir / "basin.csv"), "10,0,nan,nan\n"));
   fs::remove_all(dir);
 }
 
@@ -496,7 +484,7 @@ TEST(OutputDirectory, RunKeepsGoingAfterAnAnalysisExitsThree) {
                      "--set",      "solver=dense",
                      "--set",      "nev=2"});
   EXPECT_EQ(r.status, 3) << r.err;
-  const auto manifest = nlohmann::json::parse(read(dir / "run.json"));
+  const auto manifest = nlohmann::json::parse(read_text(dir / "run.json"));
   EXPECT_EQ(manifest["analyses"][0]["exit_status"], 3);
   EXPECT_EQ(manifest["analyses"][1]["exit_status"], 0);
   EXPECT_TRUE(fs::exists(dir / "basin.json"));

@@ -26,6 +26,7 @@ fs::path fresh_plot_dir(const std::string& name) {
 }
 
 using delayspec::testing::CliResult;
+using delayspec::testing::read_text;
 using delayspec::testing::run;
 
 std::string head(const fs::path& p, size_t n) {
@@ -128,13 +129,6 @@ namespace {
 
 void write(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // A small valid trajectory (simulate's t,x,v) for the phase figure.
 const char* const kTrajectory = "t,x,v\n0,0,1\n0.1,0.1,0.99\n0.2,0.2,0.96\n";
 
@@ -191,7 +185,7 @@ TEST(PlotCli, MetadataTextIsNeverExecuted) {
     EXPECT_EQ(head(dir / "plots" / (std::string(name) + ".png"), 4), "\x89PNG") << name;
   // Every quote is drawn as U+2019 inside one literal (a label starting with a quote included:
   // gnuplot misreads its own '' escape there); the newline became a space.
-  EXPECT_NE(read(dir / "plots" / "chart.gp").find("set xlabel '\u2019x\u2019; system"), std::string::npos);
+  EXPECT_NE(read_text(dir / "plots" / "chart.gp").find("set xlabel '\u2019x\u2019; system"), std::string::npos);
 }
 
 // A hex-float value (as a run given `--set e=0x1...` records it, at full precision) plots, as
@@ -201,17 +195,17 @@ TEST(PlotCli, HexFloatMetadataPlots) {
   CliResult b = run({"basin", "--out", dir.string(), "--quiet", "--set", "e=0x1.428f5c28f5c29p+0", "--set", "N=10",
                      "--set", "basin_x_points=2", "--set", "basin_y_points=2", "--set", "basin_transient=5"});
   ASSERT_EQ(b.status, 0) << b.err;
-  ASSERT_NE(read(dir / "basin.csv").find("# e = 0x1.428f5c28f5c29p+0\n"), std::string::npos);
+  ASSERT_NE(read_text(dir / "basin.csv").find("# e = 0x1.428f5c28f5c29p+0\n"), std::string::npos);
   CliResult p = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
   ASSERT_EQ(p.status, 0) << p.err;
-  EXPECT_NE(read(dir / "plots" / "basin.gp").find("set arrow from 1.26, graph 0 to 1.26, graph 1"), std::string::npos);
+  EXPECT_NE(read_text(dir / "plots" / "basin.gp").find("set arrow from 1.26, graph 0 to 1.26, graph 1"), std::string::npos);
 
   // The same value in simulate.json's metadata (the phase figure's boundary).
   write(dir / "trajectory.csv", kTrajectory);
   write(dir / "simulate.json", R"({"metadata": {"parameters": {"e": "0x1.428f5c28f5c29p+0"}}})");
   p = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
   ASSERT_EQ(p.status, 0) << p.err;
-  EXPECT_NE(read(dir / "plots" / "phase.gp").find("set arrow from 1.26, graph 0"), std::string::npos);
+  EXPECT_NE(read_text(dir / "plots" / "phase.gp").find("set arrow from 1.26, graph 0"), std::string::npos);
 }
 
 struct BadFile {
@@ -304,7 +298,7 @@ TEST(PlotCli, FailedChartPoints) {
   write(dir / "chart.csv", "x,y,spectral_radius\n0,0,0.5\n1,0,nan\n\n0,1,1.5\n1,1,0.9\n");
   CliResult some = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
   EXPECT_EQ(some.status, 0) << some.err;
-  EXPECT_NE(read(dir / "plots" / "chart.gp").find("1 0 NaN\n"), std::string::npos);
+  EXPECT_NE(read_text(dir / "plots" / "chart.gp").find("1 0 NaN\n"), std::string::npos);
   write(dir / "chart.csv", "x,y,spectral_radius\n0,0,nan\n1,0,nan\n");
   CliResult all = run({"plot", dir.string()});
   EXPECT_EQ(all.status, 3) << all.err;
@@ -364,16 +358,16 @@ TEST(PlotCli, FiguresLabelWhatIsPlotted) {
       {"N": 20, "solver": "dense", "seconds": 0.02, "error": 2e-4}]})");
   CliResult p = run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"});
   ASSERT_EQ(p.status, 0) << p.err;
-  EXPECT_NE(read(dir / "plots" / "exponents.gp").find("set xlabel 'b'\n"), std::string::npos);
-  EXPECT_NE(read(dir / "plots" / "bifurcation.gp").find("set xlabel 'b'\n"), std::string::npos);
-  const std::string speed = read(dir / "plots" / "speed_error.gp");
+  EXPECT_NE(read_text(dir / "plots" / "exponents.gp").find("set xlabel 'b'\n"), std::string::npos);
+  EXPECT_NE(read_text(dir / "plots" / "bifurcation.gp").find("set xlabel 'b'\n"), std::string::npos);
+  const std::string speed = read_text(dir / "plots" / "speed_error.gp");
   EXPECT_NE(speed.find("set xlabel 'relative error of complex {/Symbol m}_1'"), std::string::npos) << speed;
   EXPECT_EQ(speed.find("|{/Symbol m}_1|"), std::string::npos) << speed;
 
   const fs::path old = fresh_plot_dir("labels_old");
   write(old / "section.csv", "parameter,x\n0,0.1\n0.5,0.2\n");
   ASSERT_EQ(run({"plot", old.string(), "--set", "plot_width=200", "--set", "plot_height=150"}).status, 0);
-  EXPECT_NE(read(old / "plots" / "bifurcation.gp").find("set xlabel 'parameter'\n"), std::string::npos);
+  EXPECT_NE(read_text(old / "plots" / "bifurcation.gp").find("set xlabel 'parameter'\n"), std::string::npos);
 }
 
 // A FIFO (or any non-regular file) where a result file is expected would block the read forever.
@@ -406,7 +400,7 @@ TEST(PlotCli, BoundaryDrawsTheCurveItsBarsAndItsResonance) {
   CliResult p = run({"plot", dir.string(), "--set", "plot_width=300", "--set", "plot_height=200"});
   ASSERT_EQ(p.status, 0) << p.err;
   EXPECT_EQ(head(dir / "plots" / "boundary.png", 8), std::string("\x89PNG\r\n\x1a\n", 8));
-  const std::string gp = read(dir / "plots" / "boundary.gp");
+  const std::string gp = read_text(dir / "plots" / "boundary.gp");
   EXPECT_NE(gp.find("set xlabel 'a'\n"), std::string::npos) << gp;
   EXPECT_NE(gp.find("set ylabel 'b'\n"), std::string::npos) << gp;
   EXPECT_NE(gp.find("'1:2 resonance'"), std::string::npos) << gp;
@@ -416,7 +410,7 @@ TEST(PlotCli, BoundaryDrawsTheCurveItsBarsAndItsResonance) {
   const fs::path one = fresh_plot_dir("boundary_one_level");
   ASSERT_EQ(boundary(one, {"--set", "period=1", "--set", "N=50"}).status, 0);
   ASSERT_EQ(run({"plot", one.string(), "--set", "plot_width=300", "--set", "plot_height=200"}).status, 0);
-  const std::string gp1 = read(one / "plots" / "boundary.gp");
+  const std::string gp1 = read_text(one / "plots" / "boundary.gp");
   EXPECT_EQ(gp1.find("with xyerrorbars"), std::string::npos) << gp1;
   EXPECT_EQ(gp1.find("codim 2"), std::string::npos) << gp1;
 }

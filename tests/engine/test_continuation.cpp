@@ -17,7 +17,7 @@ namespace delayspec {
 namespace {
 
 using std::numbers::pi;
-namespace cd = continuation_detail;
+namespace branch_detail = continuation_detail;
 
 // x' = p - x^2 + c (x(t - tau) - x): equilibria x = +-sqrt(p) for every c (the delayed term
 // vanishes on a constant), joined by a fold at p = 0, where the characteristic equation
@@ -59,27 +59,27 @@ ContinuationResult linear_branch(int N, double tolerance) {
 
 TEST(Continuation, HermiteMaximumOfKnownCubics) {
   // g(u) = u (1 - u) on [0, 1] (h = 1): max 1/4 at 1/2; slopes 1 and -1
-  EXPECT_NEAR(cd::hermite_maximum(0, 0, 1, -1, 1), 0.25, 1e-15);
+  EXPECT_NEAR(branch_detail::hermite_maximum(0, 0, 1, -1, 1), 0.25, 1e-15);
   // monotone: the larger end
-  EXPECT_DOUBLE_EQ(cd::hermite_maximum(0, 1, 1, 1, 1), 1.0);
+  EXPECT_DOUBLE_EQ(branch_detail::hermite_maximum(0, 1, 1, 1, 1), 1.0);
   // g(t) = sin(t) sampled at 1 and 2 (h = 1): the cubic's maximum is within h^4 / 384 of 1
-  EXPECT_NEAR(cd::hermite_maximum(std::sin(1.0), std::sin(2.0), std::cos(1.0), std::cos(2.0), 1.0), 1.0, 1.0 / 384);
+  EXPECT_NEAR(branch_detail::hermite_maximum(std::sin(1.0), std::sin(2.0), std::cos(1.0), std::cos(2.0), 1.0), 1.0, 1.0 / 384);
 }
 
 TEST(Continuation, DetectionCountsSeparateCrossingsFromCollisions) {
   using C = std::complex<double>;
-  auto counts = [](std::vector<C> m) { return cd::unstable_counts(m); };
+  auto counts = [](std::vector<C> m) { return branch_detail::unstable_counts(m); };
   // a real multiplier through +1: fold
-  EXPECT_EQ(cd::detected_changes(counts({C(0.9)}), counts({C(1.1)})),
+  EXPECT_EQ(branch_detail::detected_changes(counts({C(0.9)}), counts({C(1.1)})),
             std::vector<BifurcationType>{BifurcationType::fold});
   // through -1: period doubling
-  EXPECT_EQ(cd::detected_changes(counts({C(-0.9)}), counts({C(-1.1)})),
+  EXPECT_EQ(branch_detail::detected_changes(counts({C(-0.9)}), counts({C(-1.1)})),
             std::vector<BifurcationType>{BifurcationType::period_doubling});
   // a pair through the circle: Neimark-Sacker
-  EXPECT_EQ(cd::detected_changes(counts({C(0.5, 0.8), C(0.5, -0.8)}), counts({C(0.6, 0.9), C(0.6, -0.9)})),
+  EXPECT_EQ(branch_detail::detected_changes(counts({C(0.5, 0.8), C(0.5, -0.8)}), counts({C(0.6, 0.9), C(0.6, -0.9)})),
             std::vector<BifurcationType>{BifurcationType::neimark_sacker});
   // two real multipliers > 1 colliding into a pair outside the circle: nothing crosses it
-  EXPECT_TRUE(cd::detected_changes(counts({C(1.5), C(1.4)}), counts({C(1.45, 0.1), C(1.45, -0.1)})).empty());
+  EXPECT_TRUE(branch_detail::detected_changes(counts({C(1.5), C(1.4)}), counts({C(1.45, 0.1), C(1.45, -0.1)})).empty());
 }
 
 TEST(Continuation, NeimarkSackerOfLinearDdeAtExactBoundary) {

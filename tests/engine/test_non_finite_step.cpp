@@ -10,13 +10,14 @@
 #include <string>
 
 #include "delayspec/model_analyses.hpp"
+#include "text_support.hpp"
 #include "delayspec/model_analyses_continuation.hpp"
 
 namespace {
 
 using namespace delayspec;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using delayspec::testing::contains;
 
 // What the two scalar test models share: y' = -y + g(t, y(t - 1)), T = tau = 1, no switching.
 struct ScalarUnitDelay {

@@ -8,24 +8,19 @@
 
 #include "scene/output/atomic_file.hpp"
 #include "delayspec/errors.hpp"
+#include "text_support.hpp"
 
 namespace fs = std::filesystem;
 using delayspec::cli::AtomicFile;
 using delayspec::cli::write_file_atomically;
+using delayspec::testing::read_text;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
+fs::path atomic_scratch_dir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("delayspec_test_atomic_" + name);
   fs::remove_all(dir);
   return dir;
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 size_t entries(const fs::path& dir) {
@@ -37,16 +32,16 @@ size_t entries(const fs::path& dir) {
 }  // namespace
 
 TEST(AtomicFile, WritesCreatesDirectoryAndReplaces) {
-  const fs::path dir = fresh_dir("write");
+  const fs::path dir = atomic_scratch_dir("write");
   write_file_atomically(dir / "sub" / "a.csv", "x,y\n1,2\n");
-  EXPECT_EQ(read(dir / "sub" / "a.csv"), "x,y\n1,2\n");
+  EXPECT_EQ(read_text(dir / "sub" / "a.csv"), "x,y\n1,2\n");
   write_file_atomically(dir / "sub" / "a.csv", "new\n");
-  EXPECT_EQ(read(dir / "sub" / "a.csv"), "new\n");
+  EXPECT_EQ(read_text(dir / "sub" / "a.csv"), "new\n");
   EXPECT_EQ(entries(dir / "sub"), 1u) << "no temporary left behind";
 }
 
 TEST(AtomicFile, UncommittedFileNeverAppears) {
-  const fs::path dir = fresh_dir("uncommitted");
+  const fs::path dir = atomic_scratch_dir("uncommitted");
   fs::create_directories(dir);
   {
     AtomicFile f(dir / "result.json");
@@ -58,11 +53,11 @@ TEST(AtomicFile, UncommittedFileNeverAppears) {
   g.stream() << "{}\n";
   g.commit();
   g.commit();
-  EXPECT_EQ(read(dir / "result.json"), "{}\n");
+  EXPECT_EQ(read_text(dir / "result.json"), "{}\n");
 }
 
 TEST(AtomicFile, UnwritableLocationIsBadInputNamingThePath) {
-  const fs::path dir = fresh_dir("blocked");
+  const fs::path dir = atomic_scratch_dir("blocked");
   fs::create_directories(dir);
   std::ofstream(dir / "file") << "x";  // a regular file where a directory is wanted
   try {
@@ -71,5 +66,5 @@ TEST(AtomicFile, UnwritableLocationIsBadInputNamingThePath) {
   } catch (const delayspec::BadInput& e) {
     EXPECT_NE(std::string(e.what()).find((dir / "file" / "out.csv").string()), std::string::npos) << e.what();
   }
-  EXPECT_EQ(read(dir / "file"), "x");
+  EXPECT_EQ(read_text(dir / "file"), "x");
 }

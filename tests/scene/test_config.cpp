@@ -10,6 +10,7 @@
 #include "scene/keys/config.hpp"
 #include "scene/commands/key_registry.hpp"
 #include "delayspec/errors.hpp"
+#include "text_support.hpp"
 
 using delayspec::BadInput;
 using delayspec::cli::closest_key;
@@ -29,7 +30,7 @@ std::string bad_input_message(F&& f) {
   return "";
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using delayspec::testing::contains;
 
 std::string write_scene(const std::string& name, const std::string& text) {
   const auto path = std::filesystem::temp_directory_path() / ("delayspec_test_config_" + name + ".toml");

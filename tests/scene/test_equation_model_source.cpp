@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "delayspec/errors.hpp"
+#include "text_support.hpp"
 #include "delayspec_test_paths.hpp"
 #include "modules/equations/equation_model_source.hpp"
 #include "modules/equations/equation_model_symbolic.hpp"
@@ -25,7 +26,7 @@ using delayspec::cli::terms_not_finite;
 
 const std::vector<std::string> kEngineKeys = {"N", "nev", "seed", "solver", "tau_over_T"};
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using delayspec::testing::contains;
 
 // The impact model as a table (data/scenes/equations_impact.toml without the history).
 toml::table impact_table() {

@@ -37,6 +37,7 @@ namespace fs = std::filesystem;
 using delayspec::testing::CliResult;
 using delayspec::testing::contains;
 using delayspec::testing::fresh_dir;
+using delayspec::testing::read_text;
 using delayspec::testing::run;
 
 const char* kEquations = R"([equations]
@@ -288,11 +289,6 @@ pid_t start_program(const std::vector<std::string>& args, const std::vector<std:
     ::_exit(127);
   }
   return pid;
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 TEST_F(ModelCache, TheCompilerDiesWithTheProgramAndWithinItsTimeLimit) {

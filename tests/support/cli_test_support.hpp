@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "cli/run_cli.hpp"
+#include "text_support.hpp"
 
 namespace delayspec::testing {
 
@@ -46,8 +47,6 @@ inline std::vector<std::string> with_sets(std::vector<std::string> head, const s
   }
   return head;
 }
-
-inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // One bad-input case of a parameterised test: `COMMAND --set KEY=VALUE` must exit 2 with
 // `expected` in its message.
