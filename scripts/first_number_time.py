@@ -10,21 +10,17 @@ CPU seconds of everything it ran.
 Several --rev values are measured one after the other in the same run (before and after)."""
 import argparse
 import os
-import resource
 import subprocess
-import tempfile
 import time
 
+from fresh_clone import children_cpu_seconds, cold_environment, fresh_clone
 from machine_stamp import machine_stamp
 
 
 def measure(source, rev):
-    with tempfile.TemporaryDirectory(prefix="delayspec_first_number_") as scratch:
-        clone = os.path.join(scratch, "delayspec")
-        subprocess.run(["git", "clone", "--quiet", source, clone], check=True)
-        subprocess.run(["git", "-C", clone, "checkout", "--quiet", rev], check=True)
-        env = dict(os.environ, CCACHE_DISABLE="1")
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    with fresh_clone(source, rev, "delayspec_first_number_") as clone:
+        env = cold_environment()
+        before = children_cpu_seconds()
         start = time.monotonic()
         first = None
         p = subprocess.Popen(["bash", os.path.join(clone, "scripts", "run-default.sh")], env=env,
@@ -34,8 +30,7 @@ def measure(source, rev):
                 first = time.monotonic() - start
         p.wait()
         total = time.monotonic() - start
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        cpu = children_cpu_seconds() - before
         if p.returncode != 0:
             raise SystemExit(f"run-default.sh at {rev} exited {p.returncode}")
         return first, total, cpu

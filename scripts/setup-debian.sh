@@ -6,7 +6,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libspectra-dev libarpack2-dev libsuitesparse-dev
   libopenblas-dev liblapack-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libginac-dev
   gnuplot-nox ccache python3
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest python3-matplotlib

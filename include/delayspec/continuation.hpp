@@ -107,6 +107,10 @@ namespace delayspec {
 enum class BifurcationType { fold, period_doubling, neimark_sacker, grazing };
 // "fold", "period-doubling", "neimark-sacker", "grazing".
 std::string to_string(BifurcationType type);
+// The bifurcation at which the multiplier mu crosses the unit circle: a fold where mu is real and
+// positive, a period doubling where real and negative, a Neimark-Sacker bifurcation where it is
+// not real (real: |Im mu| <= 1e-10 |mu|, the tolerance continuation detects crossings with).
+BifurcationType crossing_type(std::complex<double> mu);
 
 // Measures of one periodic orbit (the states of one map, periodic).
 struct OrbitMeasures {

@@ -177,6 +177,8 @@ def test_chart_equals_cli_json():
     for row in rows:  # spectral_radius[j, i] is the row at (x[i], y[j])
         i, j = list(r.x).index(row["x"]), list(r.y).index(row["y"])
         assert r.spectral_radius[j, i] == row["spectral_radius"]
+        assert r.angle[j, i] == row["angle"]  # abs(arg mu_1): the lobe's type
+    assert np.all((r.angle >= 0) & (r.angle <= np.pi))
 
 
 def test_basin_equals_cli_json():

@@ -6,11 +6,13 @@
 //
 // Figures (input -> output):
 //   floquet.json              -> multipliers: the complex plane, unit circle
-//   chart.csv                 -> chart: spectral radius over the parameter plane, |mu_1| = 1 contour
+//   chart.csv                 -> chart: spectral radius over the parameter plane, |mu_1| = 1 contours
+//                                by lobe type (period doubling, Neimark-Sacker, fold)
 //   basin.csv                 -> basin: attractor period over the initial-history plane, x = e line
 //   converge.json             -> convergence: relative error of mu_1 against h, log-log, with h and
 //                                h^2 guides; speed_error: seconds against that error
-//   bench.json                -> speed_error (bench rows)
+//   bench.json                -> speed_error (bench rows: the fastest of the repeats, bars up to
+//                                the slowest)
 //   exponents.csv (sweep)     -> exponents: against the swept parameter, error bars, zero line
 //   section.csv (sweep)       -> bifurcation: Poincare-section x against the swept parameter
 //   trajectory.csv, poincare.csv (simulate) -> phase: portrait with Poincare points and x = e
@@ -23,11 +25,15 @@
 // quoted gnuplot strings (gnuplot_script.hpp), so no text of a result file is ever executed.
 // Exit status: 0 figures written, 2 bad input, 3 gnuplot failed or is not installed.
 #include <cmath>
+#include <complex>
 #include <filesystem>
+#include <iterator>
 #include <map>
 #include <sstream>
+#include <vector>
 
 #include "scene/commands/commands.hpp"
+#include "delayspec/continuation.hpp"
 #include "delayspec/errors.hpp"
 #include "cli/gnuplot_script.hpp"
 #include "cli/plot_boundary.hpp"
@@ -61,6 +67,15 @@ std::string title_N(const ResultTable& t) {
 
 // ---- the figures ----
 
+// The scene's title of a JSON result (the `title` key among its metadata's parameters), "" when
+// it has none.
+std::string json_scene_title(const JsonField& j) {
+  const auto metadata = j.find("metadata");
+  if (!metadata) return "";
+  const auto parameters = metadata->find("parameters");
+  return parameters ? parameters->text_or("title", "") : "";
+}
+
 // floquet.json: multipliers [{re, im, ...}] -> the complex plane with the unit circle.
 void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   std::string rows;
@@ -77,10 +92,9 @@ void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   const double N = j.number_or("N", NAN);
   std::ostringstream gp;
   gp << gnuplot_datablock("mu", rows);
-  gp << "set title "
-     << gnuplot_string("Floquet multipliers: model " + j.text_or("model", "?") + ", N = " +
-                       (std::isnan(N) ? std::string("?") : gnuplot_number(N)) + ", solver " + j.text_or("solver", "?"))
-     << "\n";
+  gp << figure_title(json_scene_title(j), "Floquet multipliers: model " + j.text_or("model", "?") + ", N = " +
+                                             (std::isnan(N) ? std::string("?") : gnuplot_number(N)) + ", solver " +
+                                             j.text_or("solver", "?"));
   gp << "set size ratio -1\nset grid\nset xlabel 'Re {/Symbol m}'\nset ylabel 'Im {/Symbol m}'\n";
   gp << "set xrange [" << gnuplot_number(-r) << ":" << gnuplot_number(r) << "]\nset yrange [" << gnuplot_number(-r)
      << ":" << gnuplot_number(r) << "]\n";
@@ -90,50 +104,102 @@ void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   renderer.figure("multipliers", gp.str());
 }
 
-// chart.csv: X,Y,spectral_radius[,error_estimate,undecided] (nan: a failed point, left blank) ->
-// image with the |mu_1| = 1 contour, and the undecided points marked.
+// The lobes of a chart by the bifurcation at their boundary: the type of the leading multiplier
+// where it is outside the circle (crossing_type), with the colour and the words of its line.
+struct LobeType {
+  BifurcationType type;
+  const char* colour;
+  const char* dash;
+  const char* words;
+};
+const LobeType kLobeTypes[] = {
+    {BifurcationType::neimark_sacker, "white", "1", "Neimark-Sacker (Hopf) lobes, complex {/Symbol m}_1"},
+    {BifurcationType::period_doubling, "#00e5ff", "2", "period-doubling (flip) lobes, {/Symbol m}_1 < -1"},
+    {BifurcationType::fold, "#7fff00", "3", "fold lobes, {/Symbol m}_1 > 1"}};
+
+// chart.csv: X,Y,spectral_radius[,error_estimate,undecided][,angle] (nan: a failed point, left
+// blank) -> image with the |mu_1| = 1 contours, one per lobe type present, and the undecided
+// points marked.
 void plot_chart(FigureRenderer& renderer, const fs::path& file) {
   const ResultTable t = read_result_table(file, [](const std::string& c) {
-    return c == "spectral_radius" || c == "error_estimate" || c == "undecided";
+    return c == "spectral_radius" || c == "error_estimate" || c == "undecided" || c == "angle";
   });
   t.require_header({"X", "Y", "spectral_radius"});
   t.require_rows();
   t.require_grid();
   const int undecided_column = t.column("undecided");  // charts with error bars (command_chart.cpp)
+  const int angle_column = t.column("angle");          // |arg mu_1|: the lobes' types (older charts: none)
+  // Columns of the data block: x, y, |mu_1|, undecided (0 without error bars), then per lobe type
+  // |mu_1| where the point is stable or unstable by that type, else NaN: the |mu_1| = 1 contour of
+  // that column is the boundary of that type's lobes alone (gnuplot's contours skip NaN cells).
   std::string rows;
   bool any_radius = false, any_undecided = false;
+  std::vector<bool> type_present(std::size(kLobeTypes), false);
   for (const auto& row : t.rows) {
     if (row.empty()) {
       rows += "\n";
       continue;
     }
-    rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(row[2]);
+    const double radius = row[2];
     const double undecided = undecided_column >= 0 ? row[undecided_column] : 0;
-    if (undecided_column >= 0) rows += " " + gnuplot_number(undecided);  // 4th column: charts with error bars
+    rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + " " + gnuplot_number(radius) + " " +
+            gnuplot_number(undecided);
+    if (angle_column >= 0) {
+      const double angle = row[angle_column];
+      for (size_t k = 0; k < std::size(kLobeTypes); ++k) {
+        const bool unstable_by_type =
+            radius > 1 && !std::isnan(angle) && crossing_type(std::polar(1.0, angle)) == kLobeTypes[k].type;
+        type_present[k] = type_present[k] || unstable_by_type;
+        rows += " " + gnuplot_number(radius <= 1 || unstable_by_type ? radius : NAN);
+      }
+    }
     rows += "\n";
-    any_radius = any_radius || !std::isnan(row[2]);
+    any_radius = any_radius || !std::isnan(radius);
     any_undecided = any_undecided || undecided == 1;
   }
   // gnuplot cannot draw a chart without one value: say why instead of its "all points undefined".
   if (!any_radius)
     throw NumericalFailure("`" + file.string() + "`: every point failed (spectral_radius nan): nothing to draw");
-  std::ostringstream gp;
+  std::ostringstream gp, lines;
   gp << gnuplot_datablock("chart", rows);
-  gp << "set table $boundary\nset contour base\nset cntrparam levels discrete 1.0\nunset surface\n"
-        "splot $chart using 1:2:3 with lines\nunset table\nunset contour\nset surface\n";
+  gp << "set contour base\nset cntrparam levels discrete 1.0\nunset surface\n";
+  const auto contour = [&](const std::string& name, int column) {
+    gp << "set table $" << name << "\nsplot $chart using 1:2:" << column << " with lines\nunset table\n";
+  };
+  bool typed = false;
+  int entries = any_undecided ? 1 : 0;  // of the legend
+  for (size_t k = 0; k < std::size(kLobeTypes); ++k) {
+    if (!type_present[k]) continue;  // a line and a legend entry only for the lobes there are
+    const std::string name = "lobes" + std::to_string(k);
+    contour(name, 5 + static_cast<int>(k));
+    lines << ", $" << name << " using 1:2 with lines lc rgb '" << kLobeTypes[k].colour << "' lw 2 dt "
+          << kLobeTypes[k].dash << " title " << gnuplot_string(kLobeTypes[k].words);
+    typed = true;
+    ++entries;
+  }
+  if (!typed) {  // no unstable point, or a chart without angles: one line, |mu_1| = 1
+    contour("boundary", 3);
+    lines << ", $boundary using 1:2 with lines lc rgb 'white' lw 2 notitle";
+  }
+  gp << "unset contour\nset surface\n";
   gp << figure_title(t.metadata_text("title", ""), "Spectral radius |{/Symbol m}_1|, model " +
                                                        t.metadata_text("model", "?") + ", N = " + title_N(t) +
-                                                       " (white line: |{/Symbol m}_1| = 1)");
+                                                       (typed ? "" : " (white line: |{/Symbol m}_1| = 1)"));
   gp << "set xlabel " << key_axis_label(t.columns[0]) << "\nset ylabel " << key_axis_label(t.columns[1]) << "\n";
   gp << "set cblabel '|{/Symbol m}_1| (clipped at 2)'\nset cbrange [0:2]\n"
         "set palette defined (0 '#08306b', 0.5 '#4292c6', 0.999 '#c6dbef', 1.001 '#fee391', 1.5 '#fb6a4a', 2 '#67000d')\n";
-  gp << "set autoscale fix\n" << (any_undecided ? "set key top right opaque\n" : "set key off\n");
-  gp << "plot $chart using 1:2:($3 > 2 ? 2 : $3) with image notitle, $boundary using 1:2 with lines lc rgb 'white' lw 2 "
-        "notitle";
+  // The legend below the graph, one entry per line, on a grey box (its white line must show), with
+  // room made for it under the axis label: gnuplot's own margin let the two overlap.
+  gp << "set autoscale fix\n";
+  if (entries > 0)
+    gp << "set key outside bottom center vertical maxcols 1 box opaque fc rgb '#bbbbbb'\nset bmargin "
+       << 4 + entries << "\n";
+  else gp << "set key off\n";
+  gp << "plot $chart using 1:2:($3 > 2 ? 2 : $3) with image notitle" << lines.str();
   // Points whose error bar holds the unit circle: no verdict there (error_bars.hpp). The others get
   // an undefined y, which gnuplot skips (a third `using` column does not: it drew every point).
   if (any_undecided)
-    gp << ", \\\n     $chart using 1:($4 == 1 ? $2 : NaN) with points pt 6 ps 0.8 lc rgb 'black' "
+    gp << ", \\\n     $chart using 1:($4 == 1 ? $2 : NaN) with points pt 6 ps 0.5 lc rgb 'black' "
           "title 'undecided (no error bar, or |{/Symbol m}_1| = 1 within it)'";
   gp << "\n";
   renderer.figure("chart", gp.str());
@@ -169,10 +235,9 @@ void plot_basin(FigureRenderer& renderer, const fs::path& file) {
   }
   std::ostringstream gp;
   gp << gnuplot_datablock("basin", rows);
-  gp << "set title "
-     << gnuplot_string("Basins of attraction, model " + t.metadata_text("model", "?") +
-                       ", k = " + gnuplot_number(t.metadata_number("k", 0)) + ", N = " + title_N(t))
-     << "\n";
+  gp << figure_title(t.metadata_text("title", ""), "Basins of attraction, model " + t.metadata_text("model", "?") +
+                                                       ", k = " + gnuplot_number(t.metadata_number("k", 0)) +
+                                                       ", N = " + title_N(t));
   gp << "set xlabel " << key_axis_label(t.columns[0]) << "\nset ylabel " << key_axis_label(t.columns[1]) << "\n";
   gp << "set autoscale fix\nset key outside right top box opaque\nset style fill solid 1.0\n";
   std::ostringstream legend;
@@ -252,9 +317,8 @@ void plot_convergence(FigureRenderer& renderer, const JsonField& j) {
     ++block;
   }
   if (block == 0) throw BadInput("`converge.json`: no row with a positive error and h to plot");
-  gp << "set title "
-     << gnuplot_string("Convergence of the leading multiplier (reference: " + j.text_or("reference", "?") + ")")
-     << "\n";
+  gp << figure_title(json_scene_title(j),
+                     "Convergence of the leading multiplier (reference: " + j.text_or("reference", "?") + ")");
   gp << "set logscale xy\nset grid\nset format y '10^{%L}'\nset key bottom right\n";
   gp << "set xlabel " << gnuplot_string(has_h ? "h" : "1/N (h = tau/N)")
      << "\nset ylabel 'relative error of complex {/Symbol m}_1'\n";
@@ -269,31 +333,41 @@ void plot_convergence(FigureRenderer& renderer, const JsonField& j) {
 void plot_speed_error(FigureRenderer& renderer, const std::vector<std::pair<std::string, JsonField>>& sources) {
   std::ostringstream gp, plot;
   int block = 0;
+  bool any_spread = false;
   for (const auto& [source, whole] : sources) {
     std::vector<std::pair<std::string, JsonField>> parts;
     if (source == "converge") parts = convergence_studies(whole);
     else parts.emplace_back(source, whole);
     for (const auto& [label, j] : parts) {
       std::map<std::string, std::string> by_solver;
+      std::map<std::string, bool> spread;  // a series with repeats: bars from the fastest to the slowest
       for (const JsonField& row : j.at("rows").elements()) {
         const double e = first_error(row);
         const double s = row.number_or("seconds", NAN);
         if (!(e > 0) || !(s > 0)) continue;
+        const double slowest = row.number_or("seconds_slowest", NAN);  // bench with repeats
         const std::string solver = source + ": " + row.text_or("solver", label);
-        by_solver[solver] +=
-            gnuplot_number(e) + " " + gnuplot_number(s) + " " + gnuplot_number(row.number_or("N", 0)) + "\n";
+        by_solver[solver] += gnuplot_number(e) + " " + gnuplot_number(s) + " " +
+                             gnuplot_number(row.number_or("N", 0)) + " " +
+                             gnuplot_number(slowest >= s ? slowest : s) + "\n";
+        spread[solver] = spread[solver] || slowest > s;
       }
       for (const auto& [solver, rows] : by_solver) {
         std::string name("s");  // (append: GCC 12 warns falsely on "s" + string)
         name.append(std::to_string(block++));
         gp << gnuplot_datablock(name, rows);
         plot << (plot.tellp() > 0 ? ", \\\n     " : "plot ") << "$" << name
-             << " using 1:2 with linespoints pt 7 lw 2 title " << gnuplot_string(solver);
+             << (spread[solver] ? " using 1:2:2:4 with yerrorlines" : " using 1:2 with linespoints")
+             << " pt 7 lw 2 title " << gnuplot_string(solver);
+        any_spread = any_spread || spread[solver];
       }
     }
   }
   if (block == 0) return;
-  gp << "set title 'Speed against error'\nset logscale xy\nset grid\nset format x '10^{%L}'\n"
+  gp << figure_title(json_scene_title(sources.front().second),
+                     any_spread ? "Speed against error: the fastest of the repeats, bars up to the slowest"
+                                : "Speed against error (one solve per point)")
+     << "set logscale xy\nset grid\nset format x '10^{%L}'\n"
         "set xlabel 'relative error of complex {/Symbol m}_1'\nset ylabel 'seconds'\nset key top right\n";
   gp << plot.str() << "\n";
   renderer.figure("speed_error", gp.str());
@@ -337,7 +411,7 @@ void plot_exponents(FigureRenderer& renderer, const fs::path& dir) {
     plot << (i == 0 ? "plot " : ", \\\n     ") << "$" << name << " using 1:2:3 with yerrorlines pt 7 ps 0.5 lc rgb '"
          << colours[i % 6] << "' title '{/Symbol l}_" << i + 1 << "'";
   }
-  gp << "set title " << gnuplot_string("Lyapunov exponents per period against " + label + " (zero line green)") << "\n";
+  gp << figure_title(t.metadata_text("title", ""), "Lyapunov exponents per period against " + label + " (zero line green)");
   gp << "set xlabel " << gnuplot_label(label) << "\nset ylabel 'exponent per period'\nset grid\nset key bottom right\n";
   gp << plot.str() << ", \\\n     0 with lines lc rgb '#2ca02c' lw 2 title 'zero'\n";
   renderer.figure("exponents", gp.str());
@@ -354,7 +428,7 @@ void plot_bifurcation(FigureRenderer& renderer, const fs::path& dir) {
     if (!row.empty()) rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + "\n";
   std::ostringstream gp;
   gp << gnuplot_datablock("section", rows);
-  gp << "set title " << gnuplot_string("Bifurcation diagram: x on the Poincare section against " + label) << "\n";
+  gp << figure_title(t.metadata_text("title", ""), "Bifurcation diagram: x on the Poincare section against " + label);
   gp << "set xlabel " << gnuplot_label(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
   gp << "plot $section using 1:2 with points pt 7 ps 0.3 lc rgb '#000000'\n";
   renderer.figure("bifurcation", gp.str());
@@ -413,8 +487,8 @@ void plot_phase(FigureRenderer& renderer, const fs::path& dir) {
     }
   }
   const std::string e = gnuplot_number(impact_boundary(dir, trajectory));
-  gp << "set title "
-     << gnuplot_string(std::string("Phase portrait") + (thin ? " (trajectory thinned for drawing)" : "")) << "\n";
+  gp << figure_title(trajectory.metadata_text("title", ""),
+                     std::string("Phase portrait") + (thin ? " (trajectory thinned for drawing)" : ""));
   gp << "set xlabel 'x'\nset ylabel 'v = dx/dt'\nset grid\nset key outside bottom center horizontal\n";
   gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#1f77b4' lw 2 front\n";
   gp << "plot $trajectory using 1:2 with lines lc rgb '#999999' title 'trajectory'" << section_plot
@@ -430,8 +504,8 @@ void plot_impacts(FigureRenderer& renderer, const fs::path& dir) {
   std::ostringstream gp;
   // No impact at all is a result (a flat line at 0), not an error.
   gp << gnuplot_datablock("impacts", t.data_rows() > 0 ? thinned(t, 0, 1, 200000, nullptr) : "0 0\n");
-  gp << "set title 'Number of impacts against time'\nset xlabel 't'\nset ylabel 'impacts (cumulative)'\n"
-        "set grid\nset key off\n";
+  gp << figure_title(t.metadata_text("title", ""), "Number of impacts against time");
+  gp << "set xlabel 't'\nset ylabel 'impacts (cumulative)'\nset grid\nset key off\n";
   gp << "plot $impacts using 1:2 with steps lw 2 lc rgb '#d62728'\n";
   renderer.figure("impacts", gp.str());
 }

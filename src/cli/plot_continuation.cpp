@@ -89,10 +89,9 @@ void branch_figure(FigureRenderer& renderer, const ResultTable& t, const BranchF
      << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
      << gnuplot_datablock("marks", f.marks.empty() ? "nan nan\n" : f.marks)
      << gnuplot_datablock("undecided", open.empty() ? "nan nan\n" : open);
-  gp << "set title "
-     << gnuplot_string(f.title + " (stable solid, unstable dashed" +
-                       (none_decided ? "; at this N: no N -> infinity verdict without continue_Ns)" : ")"))
-     << "\n";
+  gp << figure_title(t.metadata_text("title", ""),
+                     f.title + " (stable solid, unstable dashed" +
+                         (none_decided ? "; at this N: no N -> infinity verdict without continue_Ns)" : ")"));
   gp << "set xlabel " << gnuplot_label(f.key) << "\nset ylabel " << gnuplot_string(f.ylabel)
      << "\nset grid\nset key top left\n"
      << f.labels;

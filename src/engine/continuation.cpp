@@ -21,6 +21,11 @@ std::string to_string(BifurcationType type) {
   return "?";
 }
 
+BifurcationType crossing_type(std::complex<double> mu) {
+  if (!continuation_detail::is_real(mu)) return BifurcationType::neimark_sacker;
+  return mu.real() > 0 ? BifurcationType::fold : BifurcationType::period_doubling;
+}
+
 std::string to_string(BranchEnd end) {
   switch (end) {
     case BranchEnd::to: return "to";

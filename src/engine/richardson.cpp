@@ -82,9 +82,12 @@ Eigen::VectorXd column_weights(const std::vector<double>& h, int last, int j, co
 }
 
 std::string fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, format, a, b, c, d);
-  return buf;
+  // Sized by a first call: a fixed buffer cut the longest note short.
+  const int n = std::snprintf(nullptr, 0, format, a, b, c, d);
+  std::string out(static_cast<size_t>(std::max(n, 0)) + 1, '\0');
+  std::snprintf(out.data(), out.size(), format, a, b, c, d);
+  out.resize(static_cast<size_t>(std::max(n, 0)));
+  return out;
 }
 
 }  // namespace

@@ -74,7 +74,7 @@ TEST(ChartCli, ParallelEqualsSerialAndCsvHasGridBlocks) {
   bool header = false;
   while (std::getline(csv, line)) {
     if (line.empty()) ++blank;
-    else if (line == "delta,b,spectral_radius,error_estimate,undecided") header = true;  // error_bars = on
+    else if (line == "delta,b,spectral_radius,error_estimate,undecided,angle") header = true;  // error_bars = on
     else if (line[0] != '#') ++data;
   }
   EXPECT_TRUE(header);

@@ -22,6 +22,7 @@
 #include "cli_test_support.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/lambert_w.hpp"
+#include "mathieu_ode.hpp"
 
 namespace {
 
@@ -145,38 +146,16 @@ TEST(FloquetErrorBars, AnImpactingOrbitsBarsCoverItsExactMultipliers) {
 
 // The delayed Mathieu equation x'' + kappa x' + (delta + eps cos t) x = b x(t - 2 pi) at b = 0 is
 // the damped Mathieu ODE: its two nonzero multipliers are the eigenvalues of the ODE's monodromy
-// over 2 pi, computed here by classical Runge-Kutta with 20000 steps (error ~ h^4 = 1e-13, far
-// below the bars at N = 200). The default floquet's bars cover them, and its verdict agrees with
+// over 2 pi, by classical Runge-Kutta (mathieu_ode.hpp: error ~ 1e-13, far below the bars at
+// N = 200). The default floquet's bars cover them, and its verdict agrees with
 // the ODE's |mu_1| (the parametric resonance tongues at delta = 1/4 and 1: unstable, |mu_1| = 3.05
 // and 1.29; delta = 0.5 and 3 between them: stable, 0.730 = e^{-pi kappa}).
 TEST(FloquetErrorBars, MathieuWithoutTheDelayTermIsCoveredByItsOdeMultipliers) {
-  const double pi = std::numbers::pi, kappa = 0.1;
+  const double kappa = 0.1;
   for (const auto& [delta, eps] :
        {std::pair{3.0, 1.0}, std::pair{0.5, 0.3}, std::pair{0.25, 0.5}, std::pair{1.0, 1.0}}) {
-    // Monodromy of y' = [[0, 1], [-(delta + eps cos t), -kappa]] y over [0, 2 pi], column by column.
-    auto f = [&](double t, const std::array<double, 2>& y) {
-      return std::array<double, 2>{y[1], -(delta + eps * std::cos(t)) * y[0] - kappa * y[1]};
-    };
-    std::array<std::array<double, 2>, 2> M{};
-    for (int c = 0; c < 2; ++c) {
-      std::array<double, 2> y = {c == 0 ? 1.0 : 0.0, c == 1 ? 1.0 : 0.0};
-      const int steps = 20000;
-      const double h = 2 * pi / steps;
-      for (int i = 0; i < steps; ++i) {
-        const double t = i * h;
-        auto add = [](const std::array<double, 2>& a, const std::array<double, 2>& k, double s) {
-          return std::array<double, 2>{a[0] + s * k[0], a[1] + s * k[1]};
-        };
-        const auto k1 = f(t, y), k2 = f(t + h / 2, add(y, k1, h / 2)), k3 = f(t + h / 2, add(y, k2, h / 2)),
-                   k4 = f(t + h, add(y, k3, h));
-        for (int r = 0; r < 2; ++r) y[r] += h / 6 * (k1[r] + 2 * k2[r] + 2 * k3[r] + k4[r]);
-      }
-      M[0][c] = y[0];
-      M[1][c] = y[1];
-    }
-    const double tr = M[0][0] + M[1][1], det = M[0][0] * M[1][1] - M[0][1] * M[1][0];
-    const cd root = std::sqrt(cd(tr * tr / 4 - det, 0));
-    const std::vector<cd> exact = {tr / 2 + root, tr / 2 - root};
+    const auto multipliers = delayspec::testing::mathieu_ode_multipliers(delta, eps, kappa);
+    const std::vector<cd> exact(multipliers.begin(), multipliers.end());
     const double radius = std::max(std::abs(exact[0]), std::abs(exact[1]));
     const CliResult r =
         run({"floquet", "--json", "--set", "model=mathieu", "--set", "kappa=0.1", "--set",

@@ -169,6 +169,8 @@ TEST(Richardson, AWanderingSecondOrderCoefficientGetsABarFromColumnTwosSpread) {
     ASSERT_TRUE(std::isfinite(e.error_estimate)) << "trial " << trial << ": " << e.note;
     EXPECT_GE(e.error_estimate, std::abs(e.value - x0)) << "trial " << trial << ": " << e.note;
     EXPECT_NE(e.note.find("spread"), std::string::npos) << e.note;
+    // the whole note, to its last words (a fixed buffer once cut it at 160 characters)
+    EXPECT_NE(e.note.find("each scaled to the finest step like h^2"), std::string::npos) << e.note;
     ratios.push_back(e.error_estimate / std::abs(e.value - x0));
   }
   ASSERT_EQ(ratios.size(), 40u);          // every draw reaches the rule (column 0 shows order 2)

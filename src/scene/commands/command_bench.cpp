@@ -10,10 +10,13 @@
 // max_restarts, seed; reference = exact | extrapolated | finest | auto (the reference values:
 // exact multipliers, or Richardson / the finest level of the solver with the most levels);
 // dense_memory_limit_mb (default 2048): a dense row whose matrices would need more is skipped
-// with a message instead of exhausting the machine's memory; repeats (default 1): each solve is
-// timed this often and the fastest is reported (solves over 1 s once); the problem's and orbit's keys.
+// with a message instead of exhausting the machine's memory; repeats (default 3): each solve is
+// timed this often and the fastest is reported, the slowest beside it (solves over 1 s once: a
+// single run at the coarsest N is the noisiest figure of a speed plot); the problem's and orbit's
+// keys.
 //
-// Per row: seconds (the eigen-solve, incl. forming the dense matrix), setup_seconds (orbit and
+// Per row: seconds (the fastest eigen-solve, incl. forming the dense matrix), seconds_slowest (the
+// slowest of the repeats: the spread), setup_seconds (orbit and
 // step maps, shared by the solvers of one N), peak_bytes (memory_probe.hpp: what the solve added
 // at its peak), error (relative, leading multiplier), max_error (over the nev), correct_digits,
 // abs_error (relative error of |mu_1|: what a stability boundary |mu_1| = 1 depends on; the
@@ -51,6 +54,7 @@ struct BenchRow {
   std::string message;
   Multipliers multipliers;
   double seconds = NAN, setup_seconds = NAN;
+  double seconds_slowest = NAN;  // of the repeats
   long peak_bytes = -1;
   long operator_applications = 0;  // of one solve
   int repeats = 0;                 // solves timed (seconds = the fastest)
@@ -89,7 +93,7 @@ struct BenchSettings {
   std::vector<std::string> classic_names;  // their names, in the order listed
   FloquetOptions base;                     // nev, ncv, tol, ... (the solver is set per row)
   ReferenceKind reference_kind = ReferenceKind::automatic;
-  long repeats = 1;
+  long repeats = 3;
   double limit_mb = 2048;
   long classic_max_N = 640;  // the classic rows stop here (O(N^3) each)
   Multipliers exact;         // the exact multipliers when the model has them
@@ -111,7 +115,7 @@ BenchSettings read_bench_settings(Config& config) {
   s.base = read_floquet_options(config, 10);
   s.reference_kind =
       parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
-  s.repeats = config.get_int_in_range("repeats", 1, 1, 1000);
+  s.repeats = config.get_int_in_range("repeats", s.repeats, 1, 1000);
   s.classic_max_N = config.get_int_in_range("classic_max_N", s.classic_max_N, 2, 1'000'000);
   s.limit_mb = config.get_double("dense_memory_limit_mb", 2048);
   require_positive("dense_memory_limit_mb", s.limit_mb);
@@ -155,11 +159,16 @@ BenchSettings read_bench_settings(Config& config) {
 }
 
 // Repeats: the minimum time is the least disturbed by other processes. A solve that took more
-// than a second is not repeated (its noise is relatively small). solve() returns its seconds.
+// than a second is not repeated (its noise is relatively small). solve() returns its seconds;
+// row.seconds holds the first solve's.
 template <class Solve>
 void keep_fastest_of_repeats(BenchRow& row, long repeats, Solve&& solve) {
-  for (row.repeats = 1; row.repeats < repeats && row.seconds < 1.0; ++row.repeats)
-    row.seconds = std::min(row.seconds, solve());
+  row.seconds_slowest = row.seconds;
+  for (row.repeats = 1; row.repeats < repeats && row.seconds < 1.0; ++row.repeats) {
+    const double seconds = solve();
+    row.seconds = std::min(row.seconds, seconds);
+    row.seconds_slowest = std::max(row.seconds_slowest, seconds);
+  }
 }
 
 void record_failure(BenchRow& row, const NumericalFailure& e, const Invocation& inv) {
@@ -331,13 +340,14 @@ void write_bench_csv(const Invocation& inv, const std::filesystem::path& path, c
   csv.stream() << metadata_header;
   csv.stream() << "# delayspec bench: model " << s.problem.model_name << ", nev " << s.base.nev << ", reference "
                << reference.used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
-               << "error,max_error,correct_digits,deviation_from_dense,abs_mu1,abs_error\n";
+               << "error,max_error,correct_digits,deviation_from_dense,abs_mu1,abs_error,seconds_slowest\n";
   csv.stream().precision(10);
   for (const auto& r : rows)
     csv.stream() << r.N << "," << r.n << "," << r.solver << "," << r.status << "," << r.seconds << ","
                  << r.setup_seconds << "," << r.peak_bytes << "," << r.operator_applications << "," << r.error << ","
                  << r.max_error << "," << r.correct_digits << "," << r.deviation_from_dense << ","
-                 << (r.multipliers.empty() ? NAN : std::abs(r.multipliers[0])) << "," << r.abs_error << "\n";
+                 << (r.multipliers.empty() ? NAN : std::abs(r.multipliers[0])) << "," << r.abs_error << ","
+                 << r.seconds_slowest << "\n";
   csv.commit();
 }
 
@@ -358,6 +368,7 @@ nlohmann::json bench_json(const BenchSettings& s, const std::vector<BenchRow>& r
                           {"solver", r.solver},
                           {"status", r.status},
                           {"seconds", number_or_null(r.seconds)},
+                          {"seconds_slowest", number_or_null(r.seconds_slowest)},
                           {"setup_seconds", number_or_null(r.setup_seconds)},
                           {"peak_bytes", r.peak_bytes >= 0 ? nlohmann::json(r.peak_bytes) : nlohmann::json(nullptr)},
                           {"error", number_or_null(r.error)},

@@ -9,10 +9,11 @@
 // orbit and eigen-solver keys (nev defaults to 1 here: only |mu_1| is wanted; N to 200); error_bars
 // (on, the default: each point's |mu_1| with its error bar and verdict, floquet's rule, about 1.4x
 // the time; off: |mu_1| at N alone).
-// Output: JSON {"x", "y", "x_values", "y_values", "rows": [{"x", "y", "spectral_radius",
-// "error_estimate", "verdict"}], "stable_points", "undecided_points", ...};
-// with --out DIR also DIR/chart.csv: x,y,spectral_radius[,error_estimate,undecided], one block per y value separated by
-// a blank line (gnuplot's grid format), metadata as "#" comment lines first. A point that fails numerically (e.g. no
+// Output: JSON {"x", "y", "x_values", "y_values", "rows": [{"x", "y", "spectral_radius", "angle",
+// "error_estimate", "verdict"}], "stable_points", "undecided_points", ...}, angle = |arg mu_1| in
+// [0, pi] (what tells a period-doubling lobe, pi, from a Neimark-Sacker one: crossing_type);
+// with --out DIR also DIR/chart.csv: x,y,spectral_radius[,error_estimate,undecided],angle, one block per y value
+// separated by a blank line (gnuplot's grid format), metadata as "#" comment lines first. A point that fails numerically (e.g. no
 // periodic orbit) is recorded (spectral_radius null, its "failure"; nan in the CSV), the others still run, and the
 // command exits 3 after writing everything, as sweep does.
 #include <chrono>
@@ -75,10 +76,12 @@ ChartSettings read_chart_settings(Config& config) {
 struct ChartPoints {
   explicit ChartPoints(long count)
       : radius(static_cast<size_t>(count), NAN),
+        angle(static_cast<size_t>(count), NAN),
         failure(static_cast<size_t>(count)),
         bar(static_cast<size_t>(count), NAN),
         verdict(static_cast<size_t>(count)) {}
   std::vector<double> radius;
+  std::vector<double> angle;  // |arg mu_1|
   std::vector<std::string> failure;
   std::vector<double> bar;  // error_estimate of |mu_1| (inf: none)
   std::vector<std::string> verdict;
@@ -89,7 +92,8 @@ struct ChartPoints {
 nlohmann::json chart_record(const ChartSettings& s, const ChartPoints& pts, long i) {
   nlohmann::json row = {{"index", i}, {"x", s.x.value(i % s.x.points)}, {"y", s.y.value(i / s.x.points)}};
   row["spectral_radius"] = pts.failure[i].empty() ? nlohmann::json(pts.radius[i]) : nlohmann::json(nullptr);
-  if (!pts.failure[i].empty()) row["failure"] = pts.failure[i];
+  if (pts.failure[i].empty()) row["angle"] = number_or_null(pts.angle[i]);
+  else row["failure"] = pts.failure[i];
   if (s.with_error_bars && pts.failure[i].empty()) {
     row["error_estimate"] = number_or_null(pts.bar[i]);
     row["verdict"] = pts.verdict[i];
@@ -99,8 +103,13 @@ nlohmann::json chart_record(const ChartSettings& s, const ChartPoints& pts, long
 
 // Keeps the result of a record (a resumed point, or a worker's); false: compute it again.
 bool take_chart_record(const ChartSettings& s, ChartPoints& pts, long i, const nlohmann::json& row) {
-  if (row.contains("failure")) pts.failure[i] = row.at("failure").get<std::string>();
-  else pts.radius[i] = row.at("spectral_radius").is_number() ? row["spectral_radius"].get<double>() : NAN;
+  if (row.contains("failure")) {
+    pts.failure[i] = row.at("failure").get<std::string>();
+  } else {
+    if (!row.contains("angle")) return false;  // a point file of an older version: recompute
+    pts.radius[i] = row.at("spectral_radius").is_number() ? row["spectral_radius"].get<double>() : NAN;
+    pts.angle[i] = row["angle"].is_number() ? row["angle"].get<double>() : NAN;
+  }
   if (s.with_error_bars && !row.contains("failure")) {
     if (!row.contains("verdict")) return false;  // a point file of a run without error bars: recompute
     pts.verdict[i] = row.at("verdict").get<std::string>();
@@ -120,6 +129,7 @@ void compute_chart_point(const Config& config, const ChartSettings& s, ChartPoin
     const LinearisedOrbit at_orbit = p.analyses->linearised_orbit(p.map_settings(), s.orbit_settings);
     const FloquetResult result = floquet_multipliers(*at_orbit.monodromy, options);
     pts.radius[i] = std::abs(result.multipliers.at(0));
+    pts.angle[i] = std::abs(std::arg(result.multipliers.at(0)));
     if (s.with_error_bars) {
       double seconds = 0;
       const ErrorBars bars = floquet_error_bars(p, s.orbit_settings, options,
@@ -159,7 +169,7 @@ void write_chart_csv(const Invocation& inv, const Config& config, const ChartSet
   OutputFile csv(inv, std::filesystem::path(*inv.out_dir) / "chart.csv");
   csv.stream() << metadata_comment_lines(make_metadata("chart", inv.scene, config, json, seconds));
   csv.stream() << s.x.name << "," << s.y.name << ",spectral_radius"
-               << (s.with_error_bars ? ",error_estimate,undecided" : "") << "\n";
+               << (s.with_error_bars ? ",error_estimate,undecided" : "") << ",angle\n";
   csv.stream().precision(12);
   for (long i = 0; i < s.count; ++i) {
     if (i > 0 && i % s.x.points == 0) csv.stream() << "\n";  // a blank line ends each y block
@@ -171,7 +181,7 @@ void write_chart_csv(const Invocation& inv, const Config& config, const ChartSet
     if (s.with_error_bars)
       csv.stream() << "," << (ok && std::isfinite(pts.bar[i]) ? pts.bar[i] : NAN) << ","  // nan: no bar
                    << (ok ? (pts.verdict[i] == "undecided" ? "1" : "0") : "nan");
-    csv.stream() << "\n";
+    csv.stream() << "," << (ok ? pts.angle[i] : NAN) << "\n";
   }
   csv.commit();
 }

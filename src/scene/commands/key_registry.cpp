@@ -167,7 +167,7 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
       {"solvers", "bench: solvers compared (comma list; also sdm0, fdm1: classic discretisations)"},
       {"classic_max_N", "bench: the classic discretisations (sdm0, fdm1) run at the listed N up to this one"},
       {"dense_memory_limit_mb", "bench: dense rows needing more memory (3 n^2 doubles) are skipped"},
-      {"repeats", "bench: solves timed per row (the fastest is reported), 1..1000"},
+      {"repeats", "bench: solves timed per row (the fastest is reported, the slowest beside it), 1..1000"},
       // simulate (command_simulate.cpp)
       {"t_end", "end of the simulated time (default 10 periods)"},
       {"t_start", "start of the recorded window"},
