@@ -242,7 +242,7 @@ TEST(ChartErrorBars, UndecidedPointsAreInTheCsvAndMarkedInThePlot) {
       header = line;
       break;
     }
-  EXPECT_EQ(header, "delta,b,spectral_radius,error_estimate,undecided");
+  EXPECT_EQ(header, "delta,b,spectral_radius,error_estimate,undecided,angle");
   const CliResult plot = run({"plot", (dir / "chart").string()});
   ASSERT_EQ(plot.status, 0) << plot.err;
   std::ifstream gp(dir / "chart" / "plots" / "chart.gp");
