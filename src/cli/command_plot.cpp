@@ -367,7 +367,7 @@ void plot_speed_error(FigureRenderer& renderer, const std::vector<std::pair<std:
   gp << figure_title(json_scene_title(sources.front().second),
                      any_spread ? "Speed against error: the fastest of the repeats, bars up to the slowest"
                                 : "Speed against error (one solve per point)")
-     << "set logscale xy\nset grid\nset format x '10^{%L}'\n"
+     << "set logscale xy\nset grid\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
         "set xlabel 'relative error of complex {/Symbol m}_1'\nset ylabel 'seconds'\nset key top right\n";
   gp << plot.str() << "\n";
   renderer.figure("speed_error", gp.str());
