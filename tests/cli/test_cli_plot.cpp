@@ -424,9 +424,11 @@ TEST(PlotCli, BoundaryDrawsTheCurveItsBarsAndItsResonance) {
 namespace {
 
 // A figure as a reader gets it (issue 37, item 5): the PNG opens (libpng) at the size asked for,
-// with several colours and a share of it drawn (the threshold measured: the sparsest figure here,
-// a step line on white, draws 14 % at 400 x 300; an empty canvas 0 %); its script has a title
-// (with the scene's when it has one) and both axes labelled.
+// with several colours and a share of it not background. Measured at 400 x 300: impacts (a step
+// line on white) 5.5 %, bifurcation 6.1 %, basin 7.1 %, exponents 8.3 %, phase 9.9 %, chart
+// 38.5 %; a blank canvas 0 %. So 2 % catches a blank or one-colour image with margin for fonts,
+// not a frame drawn without its data (the scripts' own checks below and in the other tests do
+// that). Its script has a title (with the scene's when it has one) and both axes labelled.
 void expect_figure(const fs::path& dir, const std::string& name, const std::string& scene_title) {
   const delayspec::testing::PngPixels png = delayspec::testing::read_png(dir / "plots" / (name + ".png"));
   ASSERT_TRUE(png.error.empty()) << name << ": " << png.error;
@@ -434,7 +436,7 @@ void expect_figure(const fs::path& dir, const std::string& name, const std::stri
   EXPECT_EQ(png.height, 300) << name;
   const delayspec::testing::PixelSpread spread = delayspec::testing::pixel_spread(png);
   EXPECT_GE(spread.colours, 3u) << name;
-  EXPECT_GE(spread.drawn_fraction, 0.05) << name;
+  EXPECT_GE(spread.drawn_fraction, 0.02) << name;
   const std::string gp = read_text(dir / "plots" / (name + ".gp"));
   EXPECT_TRUE(delayspec::testing::contains(gp, "\nset title '")) << name << "\n" << gp;
   EXPECT_TRUE(delayspec::testing::contains(gp, "\nset xlabel '")) << name << "\n" << gp;
