@@ -5,9 +5,13 @@
 //                    grazing point (e = 1.26063) and the Neimark-Sacker point (e = 1.2545), both
 //                    located. Counters: ms per point, and the share of Newton (corrector: one
 //                    periodic residual with its sparse Jacobian, two residuals for F_p, one
-//                    UMFPACK factorisation of the bordered n + 1 = 801 system per iteration) and
-//                    of Krylov (the nev leading multipliers at every point and location step).
+//                    linear solve of the bordered n + 1 = 801 system per iteration) and of Krylov
+//                    (the nev leading multipliers at every point and location step). Second
+//                    argument: the corrector's solver, 0 = lu (a UMFPACK factorisation per
+//                    iteration), 1 = krylov (GMRES on the system condensed onto the history,
+//                    issue 36): the same branch (test_condensed_bordered.cpp), side by side.
 // Requirement of the issue: < 10 s for the branch on 2 cores (the continuation uses one).
+// The fractional-delay branch where the LU fills in: scripts/continuation_solver_cost.py.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -22,6 +26,8 @@ using namespace delayspec;
 
 void BM_ImpactBranch(benchmark::State& state) {
   const int N = static_cast<int>(state.range(0));
+  const ContinuationSolver solver = state.range(1) == 0 ? ContinuationSolver::lu : ContinuationSolver::krylov;
+  state.SetLabel(to_string(solver));
   const ImpactParameters base{.k = 0.5};
   const double w = base.omega, T = 2 * std::numbers::pi / w, h = T / N;
   // the start: the free forced oscillator's orbit (no contact at e = 1.3), exact up to O(h^2)
@@ -39,6 +45,7 @@ void BM_ImpactBranch(benchmark::State& state) {
   o.max_points = 200;
   o.N = N;
   o.floquet.nev = 6;
+  o.solver = solver;
   auto model_at = [&](double e) {
     ImpactParameters p = base;
     p.e = e;
@@ -57,8 +64,10 @@ void BM_ImpactBranch(benchmark::State& state) {
   state.counters["krylov_share"] = r.krylov_seconds / r.seconds;
   state.counters["newton_iterations"] = static_cast<double>(r.newton_iterations);
   state.counters["krylov_solves"] = static_cast<double>(r.krylov_solves);
+  state.counters["factorisations"] = static_cast<double>(r.factorisations);
+  state.counters["gmres_products"] = static_cast<double>(r.gmres_products);
 }
-BENCHMARK(BM_ImpactBranch)->Arg(400)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_ImpactBranch)->Args({400, 0})->Args({400, 1})->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 

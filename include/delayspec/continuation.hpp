@@ -14,9 +14,14 @@
 //   [ F_x        F_p ] [dx]      [ F ]
 //   [ t_x^T / K  t_p ] [dp]  = - [ g ],      g = <t, X - X_pred>_w,
 //
-// factored whole with UMFPACK (sparse_lu.hpp; the border is one dense row and column, n + 1
-// unknowns). Bordered, the matrix stays regular at a fold, where F_x is singular: the branch
-// passes turning points (p may go back). The tangent at a new point solves the same matrix with
+// solved by GMRES on the system condensed onto the map's history, matrix-free with the step maps
+// of the residual's evaluation (detail/condensed_bordered.hpp: what nested shooting does for
+// M - I, with Eisenstat-Walker forcing terms), or factored whole with UMFPACK (sparse_lu.hpp; the
+// border is one dense row and column, n + 1 unknowns): ContinuationSolver. Both solve the same
+// system, so the Newton iterates and the points agree to the corrector's tolerance; the LU's
+// factors fill in with a fractional delay (the PWSDDE branch at N = 800: 0.24 s per iteration).
+// Bordered, the matrix stays regular at a fold, where F_x is singular: the branch passes turning
+// points (p may go back). The tangent at a new point solves the same matrix with
 // the right-hand side e_{n+1} (orientation kept: <t_new, t_old>_w > 0).
 //
 // F_p. The model concept has no derivative with respect to a parameter, and the parameter may be
@@ -177,8 +182,27 @@ struct BranchRange {
 // step_min > step_max, max_points < 2.
 BranchRange checked_range(const BranchRange& range);
 
+// How the corrector solves its bordered Newton systems (header): a sparse LU of the whole
+// (UMFPACK), GMRES on the system condensed onto the map's history (matrix-free: no matrix is
+// assembled or factored, detail/condensed_bordered.hpp), or automatic: GMRES, and the LU for a
+// solve GMRES fails on (a strongly unstable orbit). Why GMRES first at every size: it was faster
+// at every size measured, from d K = 100 (1.1x, aligned delay) to 3308 (62x, fractional delay;
+// scripts/continuation_solver_cost.py, docs/continuation.md), with the same points.
+enum class ContinuationSolver { automatic, krylov, lu };
+// "auto", "krylov", "lu".
+std::string to_string(ContinuationSolver solver);
+
 struct ContinuationOptions : BranchRange {
   OrbitByNewtonOptions newton{1e-12, 10};  // corrector: relative residual, iterations per point
+  ContinuationSolver solver = ContinuationSolver::automatic;  // forced orbits (orbits of unknown period: LU)
+  // GMRES: Eisenstat-Walker's eta_max. Tighter than nested shooting's 1e-4: an iteration of the
+  // corrector costs three nonlinear residuals (F and F_p's two), more than the few GMRES products
+  // a tighter solve adds, and with 1e-6 the corrector takes the sparse LU's iterations (so the
+  // same steps); measured on the PWSDDE and tau = T/2 branches at N = 800: 1e-4 took 106 iterations
+  // where the LU takes 80, 1e-6 80, in the same time.
+  double forcing_max = 1e-6;
+  int gmres_restart = 40;          // GMRES: basis vectors per cycle
+  int gmres_max_iterations = 400;  // GMRES: products per solve
   int start_iterations = 30;               // Newton iterations allowed for the first point
   FloquetOptions floquet;
   bool locate = true;  // locate the bifurcations detected (false: points only)
@@ -205,8 +229,12 @@ struct ContinuationResult {
   std::vector<Bifurcation> bifurcations;  // by segment along the branch (within one: multiplier types first)
   BranchEnd end = BranchEnd::max_points;
   std::string failure;  // when end == failure: the point reached and the reason
-  // Cost: corrector iterations (each one linearisation + one sparse LU) and Krylov solves.
+  // Cost: corrector iterations (each one linearisation and one linear solve), the sparse LU
+  // factorisations and GMRES products (one linearised map each) of their solves, eigensolves.
+  long unknowns = 0;  // of the discrete problem: d K (an orbit of unknown period: d K + 1)
   long newton_iterations = 0;
+  long factorisations = 0;
+  long gmres_products = 0;
   long krylov_solves = 0;
   double newton_seconds = 0, krylov_seconds = 0, locate_seconds = 0, seconds = 0;
 };

@@ -66,8 +66,11 @@ class PeriodicOrbitProblem {
   long unknowns() const { return static_cast<long>(D) * grid_.K; }
   const HistoryGrid& grid() const { return grid_; }
 
-  // F(x); when jacobian is non-null it receives dF/dx (unknowns() x unknowns(), compressed).
-  Eigen::VectorXd residual(const Eigen::VectorXd& x, Eigen::SparseMatrix<double>* jacobian = nullptr) const {
+  // F(x); when jacobian is non-null it receives dF/dx (unknowns() x unknowns(), compressed); when
+  // step_maps is, the K step maps (P_l, Q_l, R_l) that make it up, for a matrix-free product
+  // (detail/condensed_bordered.hpp).
+  Eigen::VectorXd residual(const Eigen::VectorXd& x, Eigen::SparseMatrix<double>* jacobian = nullptr,
+                           std::vector<StepMap<D, DW>>* step_maps = nullptr) const {
     check_size(x);
     const long K = grid_.K, M = grid_.M;
     auto u = [&](long l) { return x.segment<D>(D * wrap(l)); };
@@ -78,8 +81,10 @@ class PeriodicOrbitProblem {
     Eigen::VectorXd F(unknowns());
     std::vector<Eigen::Triplet<double>> triplets;
     if (jacobian) triplets.reserve(static_cast<size_t>(K) * D * D * (1 + 6 * taps.size()) + K * D);
-    StepMap<D, DW> map;
+    StepMap<D, DW> one_map;
+    if (step_maps) step_maps->resize(static_cast<size_t>(K));
     for (long l = 0; l < K; ++l) {
+      StepMap<D, DW>& map = step_maps ? (*step_maps)[static_cast<size_t>(l)] : one_map;
       const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
       const V next = map_.stepper().step(tap.t, grid_.h, V(u(l)), tap.w0, tap.w1, map);
       F.segment<D>(D * l) = u(l + 1) - next;  // F_l = u_{l+1} - S_l(u_l, w0_l, w1_l)

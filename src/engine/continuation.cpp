@@ -36,6 +36,15 @@ std::string to_string(BranchEnd end) {
   return "?";
 }
 
+std::string to_string(ContinuationSolver solver) {
+  switch (solver) {
+    case ContinuationSolver::automatic: return "auto";
+    case ContinuationSolver::krylov: return "krylov";
+    case ContinuationSolver::lu: return "lu";
+  }
+  return "?";
+}
+
 BranchRange checked_range(const BranchRange& range) {
   BranchRange o = range;
   // Named by the fields: the scene layer checks its keys before (continue_settings.cpp).
@@ -67,6 +76,11 @@ namespace continuation_detail {
 ContinuationOptions checked_options(const ContinuationOptions& options) {
   ContinuationOptions o = options;
   static_cast<BranchRange&>(o) = checked_range(options);
+  if (!(o.forcing_max > 0 && o.forcing_max < 1))
+    throw BadInput("`ContinuationOptions::forcing_max = " + format_number(o.forcing_max) + "`: must be in (0, 1)");
+  if (o.gmres_restart < 1 || o.gmres_max_iterations < 1)
+    throw BadInput("`ContinuationOptions::gmres_restart = " + std::to_string(o.gmres_restart) +
+                   "`, `gmres_max_iterations = " + std::to_string(o.gmres_max_iterations) + "`: must be >= 1");
   return o;
 }
 

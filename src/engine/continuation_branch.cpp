@@ -9,20 +9,71 @@
 #include <limits>
 
 #include "delayspec/detail/continuation_branch.hpp"
+#include "delayspec/orbit_shooting.hpp"
 
 namespace delayspec::continuation_detail {
 
+namespace {
+
+// The bordered matrix factored whole by UMFPACK on its first solve.
+class LuLinearisation final : public BorderedLinearisation {
+ public:
+  LuLinearisation(Eigen::VectorXd residual, Eigen::SparseMatrix<double> G_x, Eigen::VectorXd G_p,
+                  const Eigen::VectorXd& row_x, double row_p, double p)
+      : G_x_(std::move(G_x)), G_p_(std::move(G_p)), row_x_(row_x), row_p_(row_p), p_(p) {
+    G = std::move(residual);
+  }
+
+  std::optional<Eigen::VectorXd> solve(const Eigen::VectorXd& rhs_x, double rhs_p, double /*forcing*/,
+                                       std::string& why) override {
+    if (!lu_) {
+      try {
+        ++factorisations;
+        lu_.emplace(bordered_matrix(G_x_, G_p_, row_x_, row_p_));  // sparse_lu.hpp
+      } catch (const NumericalFailure& e) {
+        why = std::string("bordered matrix singular at parameter ") + format_number(p_) + " (" + e.what() + ")";
+        return std::nullopt;
+      }
+    }
+    Eigen::VectorXd rhs(rhs_x.size() + 1);
+    rhs << rhs_x, rhs_p;
+    return lu_->solve(rhs);
+  }
+
+ private:
+  Eigen::SparseMatrix<double> G_x_;
+  Eigen::VectorXd G_p_;
+  const Eigen::VectorXd& row_x_;
+  double row_p_, p_;
+  std::optional<SparseLU> lu_;
+};
+
+}  // namespace
+
+std::unique_ptr<BorderedLinearisation> lu_linearisation(Eigen::VectorXd G, Eigen::SparseMatrix<double> G_x,
+                                                        Eigen::VectorXd G_p, const Eigen::VectorXd& row_x,
+                                                        double row_p, double p) {
+  return std::make_unique<LuLinearisation>(std::move(G), std::move(G_x), std::move(G_p), row_x, row_p, p);
+}
+
 std::optional<BranchState> bordered_corrector(const Linearise& linearise, Eigen::VectorXd x, double p,
                                               const Eigen::VectorXd& row_x, double row_p, double target,
-                                              int max_iterations, double tolerance, double weight, std::string& why,
-                                              double& seconds) {
+                                              int max_iterations, double tolerance, double weight,
+                                              const CorrectorForcing& forcing, std::string& why, double& seconds,
+                                              CorrectorWork& work) {
   const ScopedSeconds timer(seconds);
   const long n = x.size();
   double first = INFINITY;
+  double eta = forcing.forcing_max, previous_norm = NAN;
+  std::unique_ptr<BorderedLinearisation> lin;
+  auto account = [&] {
+    if (lin) work.factorisations += lin->factorisations, work.products += lin->products;
+  };
   for (int it = 0;; ++it) {
-    Eigen::VectorXd G, Gp;
-    Eigen::SparseMatrix<double> Gx;
-    if (!linearise(x, p, G, Gx, Gp, why)) return std::nullopt;
+    account();
+    lin = linearise(x, p, why);
+    if (!lin) return std::nullopt;
+    const Eigen::VectorXd& G = lin->G;
     const double r = G.lpNorm<Eigen::Infinity>();
     const double g = row_x.dot(x) + row_p * p - target;
     if (!std::isfinite(r)) {
@@ -31,33 +82,35 @@ std::optional<BranchState> bordered_corrector(const Linearise& linearise, Eigen:
     }
     // g is linear: after one Newton step it is at its rounding level, eps times the size of its terms
     const double g_scale = row_x.cwiseAbs().dot(x.cwiseAbs()) + std::abs(row_p * p) + std::abs(target);
-    const bool converged = r <= tolerance * (1 + x.lpNorm<Eigen::Infinity>()) && std::abs(g) <= 1e-12 * (1 + g_scale);
+    const double tol_abs = tolerance * (1 + x.lpNorm<Eigen::Infinity>());
+    const bool converged = r <= tol_abs && std::abs(g) <= 1e-12 * (1 + g_scale);
     if (it == 1) first = r;
     if (!converged && (it >= max_iterations || r > 1e3 * first)) {
       why = (it >= max_iterations ? "not converged in " + std::to_string(it) + " iterations"
                                   : "residual diverging at iteration " + std::to_string(it)) +
             ", |F|_inf = " + format_number(r) + " at parameter " + format_number(p);
+      account();
       return std::nullopt;
     }
-    std::optional<SparseLU> lu;
-    try {
-      lu.emplace(bordered_matrix(Gx, Gp, row_x, row_p));  // sparse_lu.hpp
-    } catch (const NumericalFailure& e) {
-      why = std::string("bordered matrix singular at parameter ") + format_number(p) + " (" + e.what() + ")";
-      return std::nullopt;
-    }
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + 1);
     if (converged) {  // the tangent z: [G_x G_p; row] z = e_{n+1}, z / |z|_w
-      rhs[n] = 1;
-      const Eigen::VectorXd z = lu->solve(rhs);
-      const double norm = std::sqrt(weight * z.head(n).squaredNorm() + z[n] * z[n]);
-      return BranchState{std::move(x), p, z.head(n) / norm, z[n] / norm, it, r};
+      const std::optional<Eigen::VectorXd> z = lin->solve(Eigen::VectorXd::Zero(n), 1, forcing.tangent, why);
+      account();
+      if (!z) return std::nullopt;
+      const double norm = std::sqrt(weight * z->head(n).squaredNorm() + (*z)[n] * (*z)[n]);
+      return BranchState{std::move(x), p, z->head(n) / norm, (*z)[n] / norm, it, r};
     }
-    rhs.head(n) = -G;
-    rhs[n] = -g;
-    const Eigen::VectorXd step = lu->solve(rhs);
-    x += step.head(n);
-    p += step[n];
+    // The forcing's floor from the stricter of the two acceptance tests: |G| to tol_abs, g to its rounding level.
+    const double g_norm = std::hypot(G.norm(), g);
+    eta = shooting_forcing_term(eta, g_norm, previous_norm, std::min(tol_abs, 1e-12 * (1 + g_scale)),
+                                forcing.forcing_max, it == 0);
+    previous_norm = g_norm;
+    const std::optional<Eigen::VectorXd> step = lin->solve(-G, -g, eta, why);
+    if (!step) {
+      account();
+      return std::nullopt;
+    }
+    x += step->head(n);
+    p += (*step)[n];
   }
 }
 
@@ -90,8 +143,12 @@ ContinuationResult trace_branch(const BranchProblem& branch, const Eigen::Vector
                                 const ContinuationOptions& options, const Eigen::VectorXd* start_tangent,
                                 double start_p) {
   const auto run_start = std::chrono::steady_clock::now();
+  const CorrectorWork before = branch.work();
   BranchTracer tracer(branch, options, start_tangent, start_p);
   ContinuationResult result = tracer.trace(guess);
+  result.unknowns = branch.unknowns();
+  result.factorisations = branch.work().factorisations - before.factorisations;
+  result.gmres_products = branch.work().products - before.products;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   return result;
 }

@@ -140,7 +140,8 @@ TEST(ContinueCli, NeimarkSackerBarIsTightAtTheDefaultTolerance) {
 // the fold after it. It is a grazing of its own now, found at every level, converging at the
 // trapezoid's order 2 (the hump's max from the cubic Hermite interpolant, O(h^4) beyond the orbit's
 // O(h^2)): over N = 100, 200, 400 order 1.95; by hand over 200, 400, 800, 2.08 (0.1767247,
-// 0.1767128, 0.1767099; N = 800 takes 24 s, its sparse LU fills in with the fractional delay).
+// 0.1767128, 0.1767099; N = 800 took 24 s when the corrector was a sparse LU, whose factors fill
+// in with the fractional delay; with GMRES on the condensed system, the default, 0.6 s).
 TEST(ContinueCli, ASecondContactRegionIsAGrazingThatConvergesAtOrderTwo) {
   const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/continue_pwsdde_k.toml";
   const CliResult r = run({"continue", "--json", scene, "--set", "continue_from=0.1766", "--set", "continue_to=0.1768",
@@ -158,6 +159,49 @@ TEST(ContinueCli, ASecondContactRegionIsAGrazingThatConvergesAtOrderTwo) {
   // one region before it, two after
   EXPECT_EQ(j["points"].front()["measures"]["contact_regions"], 1);
   EXPECT_EQ(j["points"].back()["measures"]["contact_regions"], 2);
+}
+
+// Issue 36, item 3: the whole PWSDDE branch (fractional delay, impacts, a fold after which the
+// orbits are unstable, two grazings) with each corrector: the same points, multipliers and
+// located bifurcations at every level, to 1e-9 (test_condensed_bordered.cpp says why), and the
+// Krylov path factors no matrix.
+TEST(ContinueCli, KrylovAndLuCorrectorsGiveTheSamePwsddeBranch) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/continue_pwsdde_k.toml";
+  auto branch = [&](const std::string& solver) {
+    const CliResult r =
+        run({"continue", "--json", scene, "--set", "continue_Ns=50,100", "--set", "continue_solver=" + solver});
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  const auto lu = branch("lu"), krylov = branch("krylov");
+  EXPECT_GT(lu["cost_finest_N"]["factorisations"].get<long>(), 0);
+  EXPECT_EQ(lu["cost_finest_N"]["gmres_products"].get<long>(), 0);
+  EXPECT_EQ(krylov["cost_finest_N"]["factorisations"].get<long>(), 0);
+  EXPECT_GT(krylov["cost_finest_N"]["gmres_products"].get<long>(), 0);
+  EXPECT_EQ(krylov["cost_finest_N"]["unknowns"], lu["cost_finest_N"]["unknowns"]);
+  ASSERT_EQ(lu["points"].size(), krylov["points"].size());
+  bool unstable = false;
+  for (size_t i = 0; i < lu["points"].size(); ++i) {
+    const auto &a = lu["points"][i], &b = krylov["points"][i];
+    EXPECT_NEAR(a["parameter"].get<double>(), b["parameter"].get<double>(), 1e-9) << "point " << i;
+    ASSERT_EQ(a["multipliers"].size(), b["multipliers"].size()) << "point " << i;
+    for (size_t m = 0; m < a["multipliers"].size(); ++m) {
+      EXPECT_NEAR(a["multipliers"][m]["re"].get<double>(), b["multipliers"][m]["re"].get<double>(), 1e-9);
+      EXPECT_NEAR(a["multipliers"][m]["im"].get<double>(), b["multipliers"][m]["im"].get<double>(), 1e-9);
+    }
+    unstable = unstable || a["unstable"].get<int>() > 0;
+  }
+  EXPECT_TRUE(unstable);  // past the fold
+  ASSERT_EQ(lu["bifurcations"].size(), krylov["bifurcations"].size());
+  ASSERT_GE(lu["bifurcations"].size(), 2u);  // grazing and fold at least
+  for (size_t i = 0; i < lu["bifurcations"].size(); ++i) {
+    const auto &a = lu["bifurcations"][i], &b = krylov["bifurcations"][i];
+    EXPECT_EQ(a["type"], b["type"]);
+    ASSERT_EQ(a["by_N"].size(), b["by_N"].size());
+    for (size_t k = 0; k < a["by_N"].size(); ++k)
+      EXPECT_NEAR(a["by_N"][k]["parameter"].get<double>(), b["by_N"][k]["parameter"].get<double>(), 1e-9)
+          << a["type"] << " at N = " << a["by_N"][k]["N"];
+  }
 }
 
 TEST(ContinueCli, WritesBranchAndBifurcationFilesWithMetadata) {
@@ -214,6 +258,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_step=-1"}, "`continue_step = -1`"},
         BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_max_points=1"},
                     "`continue_max_points = 1`"},
+        BadContinue{{"continue_key=b", "continue_from=0", "continue_to=1", "continue_solver=qr"}, "continue_solver"},
         // a key that changes the grid (the period of the map: K steps per map)
         BadContinue{{"continue_key=period", "continue_from=1", "continue_to=2", "N=20"},
                     "must not change the size of the discrete problem"}));

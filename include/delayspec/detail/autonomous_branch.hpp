@@ -54,12 +54,17 @@ class AutonomousBranch final : public BranchProblem {
     const long n = unknowns() - 1;
     const Eigen::VectorXd phase = detail::phase_row<D>(x.head(n), K_);
     const double phase_target = phase.dot(x.head(n));
-    auto linearise = [&](const Eigen::VectorXd& xT, double q, Eigen::VectorXd& G, Eigen::SparseMatrix<double>& Gx,
-                         Eigen::VectorXd& Gp, std::string& reason) {
-      return linearise_or_reason(xT, q, phase, phase_target, G, Gx, Gp, reason);
+    // Always the sparse LU: G_x is itself bordered (F_T, the phase row), which the condensation
+    // onto the history (condensed_bordered.hpp) does not take.
+    auto linearise = [&](const Eigen::VectorXd& xT, double q,
+                         std::string& reason) -> std::unique_ptr<BorderedLinearisation> {
+      Eigen::VectorXd G, Gp;
+      Eigen::SparseMatrix<double> Gx;
+      if (!linearise_or_reason(xT, q, phase, phase_target, G, Gx, Gp, reason)) return nullptr;
+      return lu_linearisation(std::move(G), std::move(Gx), std::move(Gp), row_x, row_p, q);
     };
     return bordered_corrector(linearise, std::move(x), p, row_x, row_p, target, max_iterations, o_.newton.tolerance,
-                              weight_, why, seconds);
+                              weight_, CorrectorForcing{}, why, seconds, work_);
   }
 
   // The multipliers but the trivial one, the period and the extremes of the orbit at the point.

@@ -9,6 +9,7 @@
 #include <exception>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,6 +34,13 @@ struct BranchState {
   double residual = 0;
 };
 
+// The linear algebra of Newton corrections: sparse LU factorisations, GMRES products (each one
+// application of the linearised map).
+struct CorrectorWork {
+  long factorisations = 0;
+  long products = 0;
+};
+
 // The discrete problem along a branch, as the tracer and the locator (continuation_branch.cpp)
 // ask it: an abstract class, so that they are compiled once in the library and only the problem
 // (PeriodicBranch, AutonomousBranch) per model: the same work at every corrected point (one
@@ -54,6 +62,9 @@ class BranchProblem {
   double dot(const Eigen::VectorXd& ax, double ap, const Eigen::VectorXd& bx, double bp) const {
     return weight_ * ax.dot(bx) + ap * bp;
   }
+  // The linear algebra of every correction so far (factorisations, GMRES products).
+  const CorrectorWork& work() const { return work_; }
+
   // The corrected point at arclength s from `base` along its tangent: the predictor
   // X_pred = X_base + s t_base, corrected on the hyperplane <t_base, X - X_pred>_w = 0.
   std::optional<BranchState> point_along(const BranchState& base, double s, std::string& reason,
@@ -72,6 +83,7 @@ class BranchProblem {
   BranchProblem& operator=(const BranchProblem&) = default;
   double weight_ = 1;
   int max_iterations_ = 10;
+  mutable CorrectorWork work_;  // one branch is traced by one thread
 };
 
 // Adds the time from construction to destruction to `seconds`.
@@ -82,24 +94,89 @@ struct ScopedSeconds {
   ~ScopedSeconds() { seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
 };
 
+// One Newton iterate of the bordered corrector: G at the iterate and its Newton matrix
+//   [ G_x    G_p   ]
+//   [ row_x  row_p ],
+// ready to solve: factored whole by a sparse LU (lu_linearisation), or condensed onto the map's
+// history and solved matrix-free by GMRES (detail/condensed_bordered.hpp). The work a solve
+// needs (a factorisation) is done by its first solve, so that an iterate the corrector gives up
+// on costs none.
+class BorderedLinearisation {
+ public:
+  virtual ~BorderedLinearisation() = default;
+  Eigen::VectorXd G;  // the residual at the iterate
+  // z = (z_x, z_p) with the matrix times z = (rhs_x, rhs_p). forcing: the relative residual an
+  // iterative solve may stop at (Newton's forcing term; a direct solve ignores it). nullopt and
+  // why when the solve fails (a singular matrix, GMRES without convergence).
+  virtual std::optional<Eigen::VectorXd> solve(const Eigen::VectorXd& rhs_x, double rhs_p, double forcing,
+                                               std::string& why) = 0;
+  // The work so far: sparse LU factorisations, GMRES products (each one application of the
+  // linearised map).
+  long factorisations = 0;
+  long products = 0;
+};
+
+// The sparse-LU linearisation: G with its G_x, G_p and the border (UMFPACK, sparse_lu.hpp, on
+// the (n + 1)-square bordered matrix). p: named when the matrix is singular. In the library.
+std::unique_ptr<BorderedLinearisation> lu_linearisation(Eigen::VectorXd G, Eigen::SparseMatrix<double> G_x,
+                                                        Eigen::VectorXd G_p, const Eigen::VectorXd& row_x,
+                                                        double row_p, double p);
+
+// An iterative linearisation with a direct one to fall back on: a solve the first fails (GMRES
+// without convergence: a strongly unstable orbit, condensed_bordered.hpp) is done again by the
+// second, made on first need (`make_fallback`: the same iterate, e.g. lu_linearisation).
+class FallBackToLu final : public BorderedLinearisation {
+ public:
+  FallBackToLu(std::unique_ptr<BorderedLinearisation> first,
+               std::function<std::unique_ptr<BorderedLinearisation>()> make_fallback)
+      : first_(std::move(first)), make_fallback_(std::move(make_fallback)) {
+    G = first_->G;
+  }
+  std::optional<Eigen::VectorXd> solve(const Eigen::VectorXd& rhs_x, double rhs_p, double forcing,
+                                       std::string& why) override {
+    std::optional<Eigen::VectorXd> z;
+    if (!fallback_) z = first_->solve(rhs_x, rhs_p, forcing, why);
+    if (!z) {
+      if (!fallback_) fallback_ = make_fallback_();
+      z = fallback_->solve(rhs_x, rhs_p, forcing, why);
+    }
+    factorisations = first_->factorisations + (fallback_ ? fallback_->factorisations : 0);
+    products = first_->products + (fallback_ ? fallback_->products : 0);
+    return z;
+  }
+
+ private:
+  std::unique_ptr<BorderedLinearisation> first_, fallback_;
+  std::function<std::unique_ptr<BorderedLinearisation>()> make_fallback_;
+};
+
+// Forcing terms of an iterative corrector (Eisenstat-Walker, as nested shooting: orbit_shooting.hpp).
+struct CorrectorForcing {
+  double forcing_max = 1e-6;  // eta_max (ContinuationOptions::forcing_max)
+  double tangent = 1e-12;     // the tangent's relative residual (it orients the next predictor)
+};
+
 // Newton from (x, p) on G(x, p) = 0 and  row_x . x + row_p p = target:
 //   [ G_x    G_p   ] [dx]     [ G ]
-//   [ row_x  row_p ] [dp] = - [ g ],   g = row_x . x + row_p p - target,
-// one sparse LU per iteration. `linearise(x, p, G, G_x, G_p, why)` gives G and its derivatives,
-// or false and why. Converged when |G|_inf <= tolerance (1 + |x|_inf) and g is at its rounding
-// level; then the tangent solves the same matrix with e_{n+1}, normalised in the norm
-// weight |z_x|^2 + z_p^2. Returns nullopt and the reason on failure: not converged in
-// max_iterations, diverging (the residual 1e3 times above the one after the first step: not any
-// growth, since near grazing the discrete problem is only piecewise smooth and an iterate may
-// raise |G| before converging, and the start may have |G| = 0 with the constraint violated), a
-// singular matrix, a residual that cannot be formed. In the library (continuation_branch.cpp):
-// compiled once, not per model.
-using Linearise = std::function<bool(const Eigen::VectorXd& x, double p, Eigen::VectorXd& G,
-                                     Eigen::SparseMatrix<double>& G_x, Eigen::VectorXd& G_p, std::string& why)>;
+//   [ row_x  row_p ] [dp] = - [ g ],   g = row_x . x + row_p p - target.
+// `linearise(x, p, why)` gives the iterate's BorderedLinearisation (G and the matrix above), or
+// nullptr and why. Each step's solve is asked for the Eisenstat-Walker forcing term of
+// orbit_shooting.hpp from |G|_2 (a direct solve ignores it). Converged when |G|_inf <= tolerance
+// (1 + |x|_inf) and g is at its rounding level; then the tangent solves the same matrix with
+// e_{n+1} (to `forcing.tangent`), normalised in the norm weight |z_x|^2 + z_p^2. Returns nullopt and
+// the reason on failure: not converged in max_iterations, diverging (the residual 1e3 times
+// above the one after the first step: not any growth, since near grazing the discrete problem is
+// only piecewise smooth and an iterate may raise |G| before converging, and the start may have
+// |G| = 0 with the constraint violated), a failed solve, a residual that cannot be formed.
+// `work` accumulates the linearisations' factorisations and products. In the library
+// (continuation_branch.cpp): compiled once, not per model.
+using Linearise =
+    std::function<std::unique_ptr<BorderedLinearisation>(const Eigen::VectorXd& x, double p, std::string& why)>;
 std::optional<BranchState> bordered_corrector(const Linearise& linearise, Eigen::VectorXd x, double p,
                                               const Eigen::VectorXd& row_x, double row_p, double target,
-                                              int max_iterations, double tolerance, double weight, std::string& why,
-                                              double& seconds);
+                                              int max_iterations, double tolerance, double weight,
+                                              const CorrectorForcing& forcing, std::string& why, double& seconds,
+                                              CorrectorWork& work);
 
 // G_p at p by the central difference (G(p + delta) - G(p - delta)) / (2 delta), delta = eps^(1/3)
 // max(|p|, scale) (continuation.hpp: why that is enough). `residual_at(q)` is G at q and throws

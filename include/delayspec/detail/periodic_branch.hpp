@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "delayspec/grid.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/detail/branch_corrector.hpp"
+#include "delayspec/detail/condensed_bordered.hpp"
 #include "delayspec/detail/contact_peaks.hpp"
 #include "delayspec/detail/cubic_hermite.hpp"
 #include "delayspec/stepper.hpp"
@@ -68,14 +70,25 @@ class PeriodicBranch final : public BranchProblem {
     return Map(TrapezoidStepper<Model>(model, o_.step_options), g);
   }
 
-  // Newton from (x, p) on F = 0 and row_x . x + row_p p = target (bordered_corrector).
+  // Newton from (x, p) on F = 0 and row_x . x + row_p p = target (bordered_corrector), each
+  // bordered system solved as the options' solver says (ContinuationSolver).
   std::optional<State> correct(Eigen::VectorXd x, double p, const Eigen::VectorXd& row_x, double row_p, double target,
                                int max_iterations, std::string& why, double& seconds) const override {
-    auto linearise = [this](const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
-                            Eigen::VectorXd& Fp,
-                            std::string& why) { return linearise_or_reason(x, p, F, Fx, Fp, why); };
+    auto linearise = [&](const Eigen::VectorXd& x, double p,
+                         std::string& why) -> std::unique_ptr<BorderedLinearisation> {
+      try {
+        return uses_krylov() ? krylov_linearisation(x, p, row_x, row_p) : lu_linearisation_at(x, p, row_x, row_p);
+      } catch (const NumericalFailure& e) {
+        why = std::string("residual not computable at ") + format_number(p) + " (" + e.what() + ")";
+      } catch (const ProblemSizeChanged&) {
+        throw;
+      } catch (const BadInput& e) {  // p (or p +- delta) outside the model's domain
+        why = std::string("the model rejects parameter ") + format_number(p) + " (" + e.what() + ")";
+      }
+      return nullptr;
+    };
     return bordered_corrector(linearise, std::move(x), p, row_x, row_p, target, max_iterations, o_.newton.tolerance,
-                              weight_, why, seconds);
+                              weight_, CorrectorForcing{o_.forcing_max}, why, seconds, work_);
   }
 
   // F(x, p), F_x and F_p (parameter_derivative: central differences, one-sided at a bound of the
@@ -83,7 +96,7 @@ class PeriodicBranch final : public BranchProblem {
   void linearise(const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
                  Eigen::VectorXd& Fp) const {
     F = PeriodicOrbitProblem<Map>(map_at(p)).residual(x, &Fx);
-    Fp = parameter_derivative([&](double q) { return PeriodicOrbitProblem<Map>(map_at(q)).residual(x); }, p, F, range_);
+    Fp = F_p(x, p, F);
   }
 
   // Multipliers and measures of the orbit x at p.
@@ -117,22 +130,34 @@ class PeriodicBranch final : public BranchProblem {
  private:
   using States = Eigen::Map<const Eigen::Matrix<double, D, Eigen::Dynamic>>;
 
-  // F, F_x, F_p at (x, p), or false and the reason: a residual the stepper cannot compute, or a
-  // parameter (p or p +- delta) outside the model's domain. A change of the problem's size is bad
-  // input and passes through.
-  bool linearise_or_reason(const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
-                           Eigen::VectorXd& Fp, std::string& why) const {
-    try {
-      linearise(x, p, F, Fx, Fp);
-      return true;
-    } catch (const NumericalFailure& e) {
-      why = std::string("residual not computable at ") + format_number(p) + " (" + e.what() + ")";
-    } catch (const ProblemSizeChanged&) {
-      throw;
-    } catch (const BadInput& e) {  // p (or p +- delta) outside the model's domain
-      why = std::string("the model rejects parameter ") + format_number(p) + " (" + e.what() + ")";
-    }
-    return false;
+  bool uses_krylov() const { return o_.solver != ContinuationSolver::lu; }
+  Eigen::VectorXd F_p(const Eigen::VectorXd& x, double p, const Eigen::VectorXd& F) const {
+    return parameter_derivative([&](double q) { return PeriodicOrbitProblem<Map>(map_at(q)).residual(x); }, p, F,
+                                range_);
+  }
+  // The bordered system at (x, p) for the sparse LU: F, F_x, F_p assembled.
+  std::unique_ptr<BorderedLinearisation> lu_linearisation_at(const Eigen::VectorXd& x, double p,
+                                                             const Eigen::VectorXd& row_x, double row_p) const {
+    Eigen::VectorXd F, Fp;
+    Eigen::SparseMatrix<double> Fx;
+    linearise(x, p, F, Fx, Fp);
+    return lu_linearisation(std::move(F), std::move(Fx), std::move(Fp), row_x, row_p, p);
+  }
+  // The bordered system at (x, p) matrix-free: F, the step maps and F_p (condensed_bordered.hpp);
+  // with continue_solver = auto a solve GMRES fails is done again by the sparse LU.
+  std::unique_ptr<BorderedLinearisation> krylov_linearisation(const Eigen::VectorXd& x, double p,
+                                                              const Eigen::VectorXd& row_x, double row_p) const {
+    const Map map = map_at(p);
+    std::vector<StepMap<D, delayed_rows<Model>>> maps;
+    Eigen::VectorXd F = PeriodicOrbitProblem<Map>(map).residual(x, nullptr, &maps);
+    const Eigen::VectorXd Fp = F_p(x, p, F);
+    const GmresLimits limits{o_.gmres_restart, o_.gmres_max_iterations};
+    auto krylov = std::make_unique<CondensedBordered<D, delayed_rows<Model>>>(std::move(F), map.grid(), std::move(maps),
+                                                                             Fp, row_x, row_p, p, limits);
+    if (o_.solver != ContinuationSolver::automatic) return krylov;
+    return std::make_unique<FallBackToLu>(std::move(krylov), [this, x, p, &row_x, row_p] {
+      return lu_linearisation_at(x, p, row_x, row_p);
+    });
   }
 
   // Switching models: over each step [t, t + h] of the orbit, max H from the cubic Hermite

@@ -194,6 +194,9 @@ json continue_json(const ContinueRun& run, const ContinueOutcome& out, double se
   json cost;
   cost["points"] = branch.points.size();
   cost["newton_iterations"] = branch.newton_iterations;
+  cost["unknowns"] = branch.unknowns;
+  cost["factorisations"] = branch.factorisations;
+  cost["gmres_products"] = branch.gmres_products;
   cost["krylov_solves"] = branch.krylov_solves;
   cost["newton_seconds"] = branch.newton_seconds;
   cost["krylov_seconds"] = branch.krylov_seconds;

@@ -210,6 +210,9 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
        "|to - from| with continue_Ns where that works"},
       {"continue_Ns", "continue: N list (increasing) for error bars on the bifurcations (none: N only)"},
       {"continue_switch", "continue: true = also the period-2 branch from each period doubling (finest N), or the orbits from each Hopf point"},
+      {"continue_solver",
+       "continue: the corrector's linear solver: krylov (GMRES on the condensed system, matrix-free), lu (sparse LU), "
+       "auto (krylov, lu where GMRES fails)"},
       {"boundary_x", "boundary: the model key stepped along the curve (e.g. spindle_rpm)"},
       {"boundary_y", "boundary: the model key solved for (e.g. depth)"},
       {"boundary_x_from", "boundary: where the curve starts (x)"},

@@ -22,7 +22,7 @@ struct ContinueSettings {
 void require_parameter_key(const std::string& item, const std::string& key);
 
 // Reads continue_key, continue_from, continue_to (required), continue_step, continue_step_min,
-// continue_step_max, continue_max_points, continue_tolerance, continue_Ns, continue_switch. BadInput naming the key:
+// continue_step_max, continue_max_points, continue_tolerance, continue_Ns, continue_switch, continue_solver. BadInput naming the key:
 // a missing required key, a key that is not a model parameter (N, model, events, ...), an empty
 // range, a non-positive step or tolerance, step_min > step_max, Ns not increasing or out of range.
 // The Floquet and discretisation options are the caller's (read_floquet_options, read_problem).
