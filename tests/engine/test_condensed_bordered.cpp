@@ -90,10 +90,11 @@ struct Border {
 // Solves the bordered system at x both ways and checks them (file comment). The condensed solve
 // is asked for a relative residual of 1e-13 (GMRES' floor); the residual of the assembled system
 // is the condensed one carried through one step (|P|, |Q|, |R| = O(1) at these h) plus the
-// sweep's rounding, K steps of eps |z| each: 1e-10 (|rhs| + |z|) bounds both with room for K <=
-// 2000. The two solutions differ by the condition of the matrix times that: 1e-7 relative
-// leaves 1e3 between the bound and a solve that went wrong (a sign, a block off by one step:
-// O(1) differences).
+// sweep's rounding, about K eps |z| (K <= 700 here): 1e-11 (|rhs| + |z|) bounds both with a
+// factor 10-100 to spare (measured 4e-16 ... 3e-15). The two solutions then differ by at most the
+// matrix's condition times that relative residual, each solution's share: 2e-11 / rcond with
+// UMFPACK's rcond (a crude estimate from U's diagonal, 0.008 ... 0.49 here; the differences
+// measured 8e-16 ... 2e-14, far inside). A wrong solve (a sign, a block one step off) is off by O(1).
 template <class Map>
 void expect_solves_like_lu(const Map& map, const Eigen::VectorXd& x, const Border* given, unsigned seed) {
   constexpr int D = Map::D;
@@ -119,9 +120,10 @@ void expect_solves_like_lu(const Map& map, const Eigen::VectorXd& x, const Borde
   Eigen::VectorXd rhs(n + 1);
   rhs << rhs_x, rhs_p;
   const double residual = (A * *z - rhs).lpNorm<Eigen::Infinity>();
-  EXPECT_LE(residual, 1e-10 * (rhs.lpNorm<Eigen::Infinity>() + z->lpNorm<Eigen::Infinity>()));
-  const Eigen::VectorXd z_lu = SparseLU(A).solve(rhs);
-  EXPECT_LE((*z - z_lu).lpNorm<Eigen::Infinity>(), 1e-7 * z_lu.lpNorm<Eigen::Infinity>())
+  EXPECT_LE(residual, 1e-11 * (rhs.lpNorm<Eigen::Infinity>() + z->lpNorm<Eigen::Infinity>()));
+  const SparseLU lu(A);
+  const Eigen::VectorXd z_lu = lu.solve(rhs);
+  EXPECT_LE((*z - z_lu).lpNorm<Eigen::Infinity>(), 2e-11 / lu.reciprocal_condition() * z_lu.lpNorm<Eigen::Infinity>())
       << "residual " << residual << ", |z| " << z_lu.lpNorm<Eigen::Infinity>();
 }
 
@@ -163,10 +165,12 @@ TEST(CondensedBordered, SolvesAsTheLuAtAFoldWhereFxIsSingular) {
 }
 
 // The branches of one problem by both correctors: the same points (their count, parameters,
-// iterations, multipliers) and bifurcations. Tolerance 1e-9: each point solves F = 0 to
-// |F|_inf <= 1e-12 (1 + |x|) on the same hyperplane, so two points differ by the condition of
-// the bordered matrix times that (the tangents that set the hyperplanes are solved to 1e-12);
-// a bifurcation is located to the options' tolerance (1e-12 below) from either.
+// multipliers) and bifurcations. (Not always the same iterations: where F is affine in x, as in
+// free flight, the LU's first step is exact and GMRES' leaves the forcing term's residual, so the
+// start may take one more; the step control counts <= 3 alike.) Tolerance 1e-9: each point solves
+// F = 0 to |F|_inf <= 1e-12 (1 + |x|) on the same hyperplane, so two points differ by the
+// condition of the bordered matrix times that (the tangents that set the hyperplanes are solved
+// to 1e-12); a bifurcation is located to the options' tolerance (1e-12 below) from either.
 void expect_same_branch(const ContinuationResult& lu, const ContinuationResult& krylov) {
   EXPECT_EQ(lu.end, krylov.end);
   EXPECT_GT(lu.factorisations, 0);
@@ -177,7 +181,6 @@ void expect_same_branch(const ContinuationResult& lu, const ContinuationResult& 
   for (size_t i = 0; i < lu.points.size(); ++i) {
     const ContinuationPoint &a = lu.points[i], &b = krylov.points[i];
     EXPECT_NEAR(a.parameter, b.parameter, 1e-9) << "point " << i;
-    EXPECT_EQ(a.newton_iterations, b.newton_iterations) << "point " << i;
     EXPECT_EQ(a.unstable, b.unstable) << "point " << i;
     ASSERT_EQ(a.multipliers.size(), b.multipliers.size()) << "point " << i;
     for (size_t j = 0; j < a.multipliers.size(); ++j)

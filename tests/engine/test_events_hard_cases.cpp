@@ -13,8 +13,8 @@ namespace {
 
 // One-sided second-order differences err by delta^2/3 |y'''| (plus rounding 2 eps |y| / delta):
 // with |y'''| <~ 1e4 near an impact of speed ~0.05 (test_events.cpp) and delta = 1e-6, ~3e-9.
-constexpr double kDelta = 1e-6;
-constexpr double kTolerance = 1e-6;
+constexpr double kOneSidedDelta = 1e-6;
+constexpr double kOneSidedTolerance = 1e-6;
 constexpr int kForward[6] = {1, 1, 1, 1, 1, 1};
 
 // The orbit's step 24 (N = 100, events on, literal data): starts below the obstacle, rising
@@ -65,7 +65,7 @@ TEST(EventHardCases, CrossingOneTrillionthOfAStepAfterItsStart) {
   // Raising x(0) by more than 1e-14 moves the event out through the step's start: differences
   // lower x; every other input keeps the event inside.
   const int sides[6] = {-1, 1, 1, 1, 1, 1};
-  EXPECT_LE(relative_error(one_sided_differences(stepper, in, kDelta, sides), J), kTolerance);
+  EXPECT_LE(relative_error(one_sided_differences(stepper, in, kOneSidedDelta, sides), J), kOneSidedTolerance);
 }
 
 TEST(EventHardCases, CrossingOneTrillionthOfAStepBeforeItsEnd) {
@@ -81,7 +81,7 @@ TEST(EventHardCases, CrossingOneTrillionthOfAStepBeforeItsEnd) {
   expect_finite(J);
   // Increasing any input (higher x, faster rise, larger delayed speed through k) makes the
   // crossing earlier: forward differences keep it inside the step.
-  EXPECT_LE(relative_error(one_sided_differences(stepper, in, kDelta, kForward), J), kTolerance);
+  EXPECT_LE(relative_error(one_sided_differences(stepper, in, kOneSidedDelta, kForward), J), kOneSidedTolerance);
 }
 
 TEST(EventHardCases, HExactlyZeroAtAGridPointRising) {
@@ -98,11 +98,11 @@ TEST(EventHardCases, HExactlyZeroAtAGridPointRising) {
   expect_finite(J);
   // The step map is the limit from the H < 0 side: lower x(0); the other inputs leave H(u0) = 0.
   const int sides[6] = {-1, 1, 1, 1, 1, 1};
-  EXPECT_LE(relative_error(one_sided_differences(stepper, in, kDelta, sides), J), kTolerance);
+  EXPECT_LE(relative_error(one_sided_differences(stepper, in, kOneSidedDelta, sides), J), kOneSidedTolerance);
   // And it is not the derivative from the other side (the one-sided derivatives differ by
   // O(h^2 beta) ~ 1e-2 here): the check above can tell the sides apart.
   const int other[6] = {1, 1, 1, 1, 1, 1};
-  EXPECT_GT(relative_error(one_sided_differences(stepper, in, kDelta, other), J), 1e3 * kTolerance);
+  EXPECT_GT(relative_error(one_sided_differences(stepper, in, kOneSidedDelta, other), J), 1e3 * kOneSidedTolerance);
 }
 
 TEST(EventHardCases, HExactlyZeroAtAGridPointFalling) {
@@ -117,7 +117,7 @@ TEST(EventHardCases, HExactlyZeroAtAGridPointFalling) {
   EXPECT_EQ(events.count, 0);
   expect_finite(J);
   const int sides[6] = {-1, 1, 1, 1, 1, 1};
-  EXPECT_LE(relative_error(one_sided_differences(stepper, in, kDelta, sides), J), kTolerance);
+  EXPECT_LE(relative_error(one_sided_differences(stepper, in, kOneSidedDelta, sides), J), kOneSidedTolerance);
 }
 
 // A tangential touch: the highest point of the step is exactly on H = 0, or 1e-14 beyond it
@@ -135,7 +135,7 @@ void expect_touch_is_plain_step(double depth) {
   expect_finite(J);
   int sides[6];
   sides_lowering_penetration(model, g.input, sides);
-  EXPECT_LE(relative_error(one_sided_differences(stepper, g.input, kDelta, sides), J), kTolerance);
+  EXPECT_LE(relative_error(one_sided_differences(stepper, g.input, kOneSidedDelta, sides), J), kOneSidedTolerance);
 }
 
 TEST(EventHardCases, TangentialTouchExactlyOnTheSurface) { expect_touch_is_plain_step(0); }
@@ -190,22 +190,22 @@ TEST(EventHardCases, EventsInConsecutiveSteps) {
   const StepJacobian J26 = step_jacobian(stepper, step26, &events);
   ASSERT_EQ(events.count, 1);
   EXPECT_EQ(events.new_region[0], 2);
-  EXPECT_LE(relative_error(central_differences(stepper, step25, kDelta), as_matrix(map25)), kTolerance);
-  EXPECT_LE(relative_error(central_differences(stepper, step26, kDelta), J26), kTolerance);
+  EXPECT_LE(relative_error(central_differences(stepper, step25, kOneSidedDelta), as_matrix(map25)), kOneSidedTolerance);
+  EXPECT_LE(relative_error(central_differences(stepper, step26, kOneSidedDelta), J26), kOneSidedTolerance);
   // The two steps composed, wrt u0 of step 25 (the delayed values are history, fixed):
   // d u(t + 2h) / d u(t) = P26 P25.
   Mat<2> composed_fd;
   for (int c = 0; c < 2; ++c) {
     StepInput p = step25, m = step25;
-    p.u0[c] += kDelta;
-    m.u0[c] -= kDelta;
+    p.u0[c] += kOneSidedDelta;
+    m.u0[c] -= kOneSidedDelta;
     StepInput p26 = step26, m26 = step26;
     p26.u0 = step_value(stepper, p);
     m26.u0 = step_value(stepper, m);
-    composed_fd.col(c) = (step_value(stepper, p26) - step_value(stepper, m26)) / (2 * kDelta);
+    composed_fd.col(c) = (step_value(stepper, p26) - step_value(stepper, m26)) / (2 * kOneSidedDelta);
   }
   const Mat<2> composed = J26.leftCols<2>() * map25.P;
-  EXPECT_LE((composed_fd - composed).lpNorm<Eigen::Infinity>(), kTolerance * composed.lpNorm<Eigen::Infinity>());
+  EXPECT_LE((composed_fd - composed).lpNorm<Eigen::Infinity>(), kOneSidedTolerance * composed.lpNorm<Eigen::Infinity>());
 }
 
 TEST(EventHardCases, EventInTheLastStepOfAPeriod) {
@@ -231,10 +231,10 @@ TEST(EventHardCases, EventInTheLastStepOfAPeriod) {
     const Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(map.dimension(), -1, 1);
     // 40 steps with events: the per-step FD bound, amplified by a product of step maps of
     // norm ~1: 1e-6.
-    const Eigen::VectorXd fd = (map.apply(U + kDelta * v) - map.apply(U - kDelta * v)) / (2 * kDelta);
+    const Eigen::VectorXd fd = (map.apply(U + kOneSidedDelta * v) - map.apply(U - kOneSidedDelta * v)) / (2 * kOneSidedDelta);
     Eigen::VectorXd Mv;
     M.apply(v, Mv);
-    EXPECT_LE((fd - Mv).lpNorm<Eigen::Infinity>(), kTolerance * Mv.lpNorm<Eigen::Infinity>()) << "e = " << params.e;
+    EXPECT_LE((fd - Mv).lpNorm<Eigen::Infinity>(), kOneSidedTolerance * Mv.lpNorm<Eigen::Infinity>()) << "e = " << params.e;
   }
   EXPECT_TRUE(found);
 }
@@ -253,7 +253,7 @@ TEST(EventHardCases, StiffContactBetaTenThousand) {
   ASSERT_GE(events.count, 1);
   expect_finite(J);
   // Entries of the map grow with beta h ~ 1e3; the FD error scales alike (relative check).
-  EXPECT_LE(relative_error(central_differences(stepper, in, kDelta), J), kTolerance);
+  EXPECT_LE(relative_error(central_differences(stepper, in, kOneSidedDelta), J), kOneSidedTolerance);
 
   const GrazingCase g = grazing_case(1e-4, 0.25, 1e4);
   const ImpactModel graze_model(g.parameters);
@@ -261,5 +261,5 @@ TEST(EventHardCases, StiffContactBetaTenThousand) {
   const StepJacobian Jg = step_jacobian(graze_stepper, g.input, &events);
   ASSERT_EQ(events.count, 2);
   expect_finite(Jg);
-  EXPECT_LE(relative_error(central_differences(graze_stepper, g.input, 1e-7), Jg), kTolerance);
+  EXPECT_LE(relative_error(central_differences(graze_stepper, g.input, 1e-7), Jg), kOneSidedTolerance);
 }

@@ -80,10 +80,21 @@ class CondensedBordered final : public BorderedLinearisation {
   std::optional<Eigen::VectorXd> solve(const Eigen::VectorXd& rhs_x, double rhs_p, double forcing,
                                        std::string& why) override {
     const long n = n_, K = grid_.K;
-    sweep(Eigen::VectorXd::Zero(n), &rhs_x);
-    Eigen::VectorXd b(n + 1);
+    // A border that fixes p (row_x = 0: Newton at a given parameter, the start and the end of a
+    // branch) gives dp = r_p / row_p exactly, as the LU does, and leaves (M - I) dU = -e(r_x - dp
+    // F_p): the branch lands exactly on its end.
+    const bool fixes_p = row_x_.isZero(0.0);
+    if (fixes_p && row_p_ == 0) {
+      why = "the bordered system's border is zero";
+      return std::nullopt;
+    }
+    const double dp_fixed = fixes_p ? rhs_p / row_p_ : 0.0;
+    const long m = fixes_p ? n : n + 1;
+    Eigen::VectorXd f = rhs_x - dp_fixed * F_p_;
+    sweep(Eigen::VectorXd::Zero(n), &f);
+    Eigen::VectorXd b(m);
     b.head(n) = -end_history();
-    b[n] = rhs_p - row_x_.dot(sequence());
+    if (!fixes_p) b[n] = rhs_p - row_x_.dot(sequence());
     const double corner = row_p_ - s_p_;
     // `forcing` is relative to the right-hand side as given; the condensed one, b, is it carried
     // through the sweep, and may be larger or smaller (the forced sweep grows or decays with the
@@ -95,8 +106,10 @@ class CondensedBordered final : public BorderedLinearisation {
     const GmresResult g = gmres(
         [&](const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::VectorXd& out) {
           sweep(y.head(n), nullptr);
-          out.resize(n + 1);
-          out.head(n) = end_history() - y.head(n) - y[n] * e_p_;
+          out.resize(m);
+          out.head(n) = end_history() - y.head(n);
+          if (fixes_p) return;
+          out.head(n) -= y[n] * e_p_;
           out[n] = row_x_.dot(sequence()) + y[n] * corner;
         },
         b, GmresOptions{tolerance, limits_.restart, limits_.max_iterations}, &basis_);
@@ -107,8 +120,8 @@ class CondensedBordered final : public BorderedLinearisation {
             " products, asked " + format_number(tolerance) + ")";
       return std::nullopt;
     }
-    const double dp = g.x[n];
-    const Eigen::VectorXd f = rhs_x - dp * F_p_;
+    const double dp = fixes_p ? dp_fixed : g.x[n];
+    f = rhs_x - dp * F_p_;
     sweep(g.x.head(n), &f);
     Eigen::VectorXd z(static_cast<long>(D) * K + 1);
     z.head(static_cast<long>(D) * K) = sequence();
