@@ -8,9 +8,11 @@ machine, per scene and N: the unknowns d K, each solver's branch time (cost_fine
 branch_seconds, median of the runs), the ratio, the factorisations and GMRES products, and how
 far the two branches are apart (largest difference of the points' parameters and of the located
 bifurcations, when both have the same points). Then the whole command with the issue's levels,
-`continue_Ns = 200, 400, 800`, with each solver, and with krylov at 400, 800, 1600, 3200.
+`continue_Ns = 200, 400, 800`, with each solver, and with krylov at 400, 800, 1600, 3200; and
+(--large alone, or in the full run) the PWSDDE branch at 3200, 6400, 12800, 25600 (d K up to
+211644; orbit = auto: nested shooting, no matrix factored above its coarsest level).
 
-    scripts/continuation_solver_cost.py [--delayspec build/delayspec] [--runs 3] [--quick]"""
+    scripts/continuation_solver_cost.py [--delayspec build/delayspec] [--runs 3] [--quick | --large]"""
 import argparse
 import json
 import os
@@ -73,10 +75,13 @@ def main():
     ap.add_argument("--delayspec", default="build/delayspec")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="one run, N up to 400, no whole commands")
+    ap.add_argument("--large", action="store_true", help="only the PWSDDE branch at N up to 25600")
     args = ap.parse_args()
     if args.quick:
         args.runs = 1
     print(machine_stamp(f"{args.runs} run(s) each, the solvers in turn"))
+    if args.large:
+        return large(args)
     Ns = [25, 50, 100, 200, 400] + ([] if args.quick else [800])
     per_N(args, FRACTIONAL, Ns)
     per_N(args, ALIGNED, Ns)
@@ -93,6 +98,20 @@ def main():
     for b in fine["bifurcations"]:
         print(f"    {b['type']:16s} {b['extrapolated']:.12f} +- {b['error_estimate']:.1e} (order {b['observed_order']:.2f})"
               f"   with 200,400,800: +- {next(x['error_estimate'] for x in kr['bifurcations'] if x['type'] == b['type']):.1e}")
+    large(args)
+
+
+def large(args):
+    """The PWSDDE branch with krylov at large N, its bifurcations with their error bars."""
+    Ns = "3200,6400,12800,25600"
+    result, seconds = run(args.delayspec, FRACTIONAL, {"continue_solver": "krylov", "orbit": "auto", "continue_Ns": Ns})
+    cost = result["cost_finest_N"]
+    print(f"# data/scenes/continue_pwsdde_k.toml, continue_Ns = {Ns}, orbit = auto, krylov")
+    print(f"  wall {seconds:.2f} s; finest N: d K = {cost['unknowns']}, branch {cost['branch_seconds']:.2f} s, "
+          f"{cost['newton_iterations']} corrector iterations, {cost['gmres_products']} GMRES products, "
+          f"{cost['factorisations']} factorisations")
+    for b in result["bifurcations"]:
+        print(f"    {b['type']:16s} {b['extrapolated']:.12f} +- {b['error_estimate']:.1e} (order {b['observed_order']:.2f})")
     print(f"# load at the end {os.getloadavg()[0]:.2f}")
 
 
