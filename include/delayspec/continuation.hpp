@@ -19,7 +19,7 @@
 // M - I, with Eisenstat-Walker forcing terms), or factored whole with UMFPACK (sparse_lu.hpp; the
 // border is one dense row and column, n + 1 unknowns): ContinuationSolver. Both solve the same
 // system, so the Newton iterates and the points agree to the corrector's tolerance; the LU's
-// factors fill in with a fractional delay (the PWSDDE branch at N = 800: 0.24 s per iteration).
+// factors fill in with a fractional delay (scripts/continuation_solver_cost.py measures both).
 // Bordered, the matrix stays regular at a fold, where F_x is singular: the branch passes turning
 // points (p may go back). The tangent at a new point solves the same matrix with
 // the right-hand side e_{n+1} (orientation kept: <t_new, t_old>_w > 0).
@@ -194,7 +194,7 @@ std::string to_string(ContinuationSolver solver);
 
 struct ContinuationOptions : BranchRange {
   OrbitByNewtonOptions newton{1e-12, 10};  // corrector: relative residual, iterations per point
-  ContinuationSolver solver = ContinuationSolver::automatic;  // forced orbits (orbits of unknown period: LU)
+  ContinuationSolver solver = ContinuationSolver::automatic;
   // GMRES: Eisenstat-Walker's eta_max. Tighter than nested shooting's 1e-4: an iteration of the
   // corrector costs three nonlinear residuals (F and F_p's two), more than the few GMRES products
   // a tighter solve adds, and with 1e-6 the corrector takes the sparse LU's iterations (so the

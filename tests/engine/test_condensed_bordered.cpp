@@ -24,11 +24,13 @@
 #include "delayspec/model_impact.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "saddle_node_model.hpp"
+#include "same_branch.hpp"
 
 namespace delayspec {
 namespace {
 
 using std::numbers::pi;
+using testing::expect_same_branch;
 using testing::SaddleNodeDelayModel;
 
 // d = 2, two delays, nonlinear and forced: x' = y, y' = -c y - x^3 + k1 x(t - tau1) + k2 sin(y(t -
@@ -107,8 +109,10 @@ void expect_solves_like_lu(const Map& map, const Eigen::VectorXd& x, const Borde
   Border border = given ? *given : Border{random_vector(n, rng), random_vector(n, rng) / n, 0.7};
   const Eigen::VectorXd rhs_x = random_vector(n, rng);
   const double rhs_p = 0.3;
-  continuation_detail::CondensedBordered<D, Map::DW> condensed(F, map.grid(), std::move(maps), border.F_p,
-                                                               border.row_x, border.row_p, 0.0, {});
+  continuation_detail::Borders borders{border.F_p, border.row_x.transpose(),
+                                       Eigen::MatrixXd::Constant(1, 1, border.row_p)};
+  continuation_detail::CondensedBordered<D, Map::DW> condensed(F, map.grid(), std::move(maps), std::move(borders), 0.0,
+                                                               {});
   std::string why;
   const std::optional<Eigen::VectorXd> z = condensed.solve(rhs_x, rhs_p, 1e-13, why);
   ASSERT_TRUE(z) << why;
@@ -162,35 +166,6 @@ TEST(CondensedBordered, SolvesAsTheLuAtAFoldWhereFxIsSingular) {
   EXPECT_LE((F_x * Eigen::VectorXd::Ones(N)).lpNorm<Eigen::Infinity>(), 1e-15);  // singular indeed
   const Border border{Eigen::VectorXd::Constant(N, -map.grid().h), Eigen::VectorXd::Constant(N, 1.0 / N), 0};
   expect_solves_like_lu(map, x, &border, 5u);
-}
-
-// The branches of one problem by both correctors: the same points (their count, parameters,
-// multipliers) and bifurcations. (Not always the same iterations: where F is affine in x, as in
-// free flight, the LU's first step is exact and GMRES' leaves the forcing term's residual, so the
-// start may take one more; the step control counts <= 3 alike.) Tolerance 1e-9: each point solves
-// F = 0 to |F|_inf <= 1e-12 (1 + |x|) on the same hyperplane, so two points differ by the
-// condition of the bordered matrix times that (the tangents that set the hyperplanes are solved
-// to 1e-12); a bifurcation is located to the options' tolerance (1e-12 below) from either.
-void expect_same_branch(const ContinuationResult& lu, const ContinuationResult& krylov) {
-  EXPECT_EQ(lu.end, krylov.end);
-  EXPECT_GT(lu.factorisations, 0);
-  EXPECT_EQ(lu.gmres_products, 0);
-  EXPECT_EQ(krylov.factorisations, 0);  // never a matrix factored
-  EXPECT_GT(krylov.gmres_products, 0);
-  ASSERT_EQ(lu.points.size(), krylov.points.size());
-  for (size_t i = 0; i < lu.points.size(); ++i) {
-    const ContinuationPoint &a = lu.points[i], &b = krylov.points[i];
-    EXPECT_NEAR(a.parameter, b.parameter, 1e-9) << "point " << i;
-    EXPECT_EQ(a.unstable, b.unstable) << "point " << i;
-    ASSERT_EQ(a.multipliers.size(), b.multipliers.size()) << "point " << i;
-    for (size_t j = 0; j < a.multipliers.size(); ++j)
-      EXPECT_LE(std::abs(a.multipliers[j] - b.multipliers[j]), 1e-9) << "point " << i << ", multiplier " << j;
-  }
-  ASSERT_EQ(lu.bifurcations.size(), krylov.bifurcations.size());
-  for (size_t i = 0; i < lu.bifurcations.size(); ++i) {
-    EXPECT_EQ(lu.bifurcations[i].type, krylov.bifurcations[i].type);
-    EXPECT_NEAR(lu.bifurcations[i].parameter, krylov.bifurcations[i].parameter, 1e-9) << lu.bifurcations[i].note;
-  }
 }
 
 template <class Model, class ModelAt>

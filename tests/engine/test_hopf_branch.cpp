@@ -22,6 +22,7 @@
 #include "delayspec/hopf_branch.hpp"
 #include "delayspec/lambert_w.hpp"
 #include "delayspec/model_mackey_glass.hpp"
+#include "same_branch.hpp"
 
 namespace delayspec {
 namespace {
@@ -190,6 +191,25 @@ TEST(HopfBranch, MackeyGlassBranchHasAPeriodDoublingWhereAMultiplierIsMinusOne) 
     if (side < 0) EXPECT_GT(most_negative, -1) << "before the period doubling";
     else EXPECT_LT(most_negative, -1) << "after the period doubling";
   }
+}
+
+// Issue 36, item 3: the corrector's two solvers on an orbit of unknown period, whose bordered
+// system has two borders (F_T and the phase row besides F_p): the same branch, the same period
+// doubling, and no matrix factored by GMRES' corrector.
+TEST(HopfBranch, KrylovAndLuCorrectorsGiveTheSameMackeyGlassBranch) {
+  const MackeyGlassInTau mg_at;
+  ContinuationOptions o;
+  o.from = 4;
+  o.to = 14;
+  o.N = 100;
+  const EquilibriumBifurcation hopf = hopf_at(mg_at.tau_H(), mg_at.omega(), Eigen::VectorXd::Ones(1));
+  o.solver = ContinuationSolver::lu;
+  const ContinuationResult lu = continue_from_hopf<MackeyGlassModel>(mg_at, hopf, o);
+  o.solver = ContinuationSolver::krylov;
+  const ContinuationResult krylov = continue_from_hopf<MackeyGlassModel>(mg_at, hopf, o);
+  ASSERT_EQ(lu.end, BranchEnd::to) << lu.failure;
+  ASSERT_EQ(lu.bifurcations.size(), 1u);
+  testing::expect_same_branch(lu, krylov);
 }
 
 }  // namespace

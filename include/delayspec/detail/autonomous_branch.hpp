@@ -21,6 +21,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +32,7 @@
 #include "delayspec/autonomous_orbit.hpp"
 #include "delayspec/continuation.hpp"
 #include "delayspec/detail/branch_corrector.hpp"
+#include "delayspec/detail/condensed_bordered.hpp"
 
 namespace delayspec::continuation_detail {
 
@@ -54,17 +56,12 @@ class AutonomousBranch final : public BranchProblem {
     const long n = unknowns() - 1;
     const Eigen::VectorXd phase = detail::phase_row<D>(x.head(n), K_);
     const double phase_target = phase.dot(x.head(n));
-    // Always the sparse LU: G_x is itself bordered (F_T, the phase row), which the condensation
-    // onto the history (condensed_bordered.hpp) does not take.
     auto linearise = [&](const Eigen::VectorXd& xT, double q,
                          std::string& reason) -> std::unique_ptr<BorderedLinearisation> {
-      Eigen::VectorXd G, Gp;
-      Eigen::SparseMatrix<double> Gx;
-      if (!linearise_or_reason(xT, q, phase, phase_target, G, Gx, Gp, reason)) return nullptr;
-      return lu_linearisation(std::move(G), std::move(Gx), std::move(Gp), row_x, row_p, q);
+      return linearisation_or_reason(xT, q, phase, phase_target, row_x, row_p, o_.solver, reason);
     };
     return bordered_corrector(linearise, std::move(x), p, row_x, row_p, target, max_iterations, o_.newton.tolerance,
-                              weight_, CorrectorForcing{}, why, seconds, work_);
+                              weight_, CorrectorForcing{o_.forcing_max}, why, seconds, work_);
   }
 
   // The multipliers but the trivial one, the period and the extremes of the orbit at the point.
@@ -96,41 +93,63 @@ class AutonomousBranch final : public BranchProblem {
     return PeriodicOrbitProblem<Map>(detail::scaled_map(model, T, K_, o_.step_options)).residual(x, Fx);
   }
 
-  // G, G_x, G_p at (x, T, p) (header comment), or false and the reason: a period <= 0, a residual
-  // the stepper cannot compute, a parameter or period outside the model's domain (a delay shorter
-  // than one step).
-  bool linearise_or_reason(const Eigen::VectorXd& xT, double p, const Eigen::VectorXd& phase, double phase_target,
-                           Eigen::VectorXd& G, Eigen::SparseMatrix<double>& Gx, Eigen::VectorXd& Gp,
-                           std::string& why) const {
+  // G and its bordered matrix at (x, T, p) (header comment) for `solver` (ContinuationSolver):
+  // G_x = [F_x F_T; phase 0] and G_p = (F_p, 0) assembled for the sparse LU, or for GMRES the step
+  // maps and the borders of condensed_bordered.hpp, two here: columns (F_T, F_p), rows (phase,
+  // row_x's state part), corner [0 0; row_x's T entry, row_p]. nullptr and the reason: a period <=
+  // 0, a residual the stepper cannot compute, a parameter or period outside the model's domain (a
+  // delay shorter than one step).
+  std::unique_ptr<BorderedLinearisation> linearisation_or_reason(const Eigen::VectorXd& xT, double p,
+                                                                 const Eigen::VectorXd& phase, double phase_target,
+                                                                 const Eigen::VectorXd& row_x, double row_p,
+                                                                 ContinuationSolver solver, std::string& why) const {
     const long n = unknowns() - 1;
     const Eigen::VectorXd x = xT.head(n);
     const double T = xT[n];
     if (!(T > 0) || !std::isfinite(T)) {
       why = "the period reached " + format_number(T) + " at parameter " + format_number(p);
-      return false;
+      return nullptr;
     }
     try {
-      Eigen::SparseMatrix<double> Fx;
       const Model model = model_at_(p);  // once for F and F_T
-      const Eigen::VectorXd F = residual(model, x, T, &Fx);
+      const Map map = detail::scaled_map(model, T, K_, o_.step_options);
+      const bool lu = solver == ContinuationSolver::lu;
+      Eigen::SparseMatrix<double> Fx;
+      std::vector<StepMap<D, Map::DW>> maps;
+      const Eigen::VectorXd F = PeriodicOrbitProblem<Map>(map).residual(x, lu ? &Fx : nullptr, lu ? nullptr : &maps);
       const double delta = std::cbrt(std::numeric_limits<double>::epsilon()) * T;
       const Eigen::VectorXd FT = (residual(model, x, T + delta, nullptr) - residual(model, x, T - delta, nullptr)) /
                                  ((T + delta) - (T - delta));
       const Eigen::VectorXd Fp =
           parameter_derivative([&](double q) { return residual(model_at_(q), x, T, nullptr); }, p, F, range_);
-      G.resize(n + 1);
+      Eigen::VectorXd G(n + 1);
       G << F, phase.dot(x) - phase_target;
-      Gx = bordered_matrix(Fx, FT, phase, 0.0);
-      Gp = Eigen::VectorXd::Zero(n + 1);
-      Gp.head(n) = Fp;
-      return true;
+      if (lu) {
+        Eigen::VectorXd Gp = Eigen::VectorXd::Zero(n + 1);
+        Gp.head(n) = Fp;
+        return lu_linearisation(std::move(G), bordered_matrix(Fx, FT, phase, 0.0), std::move(Gp), row_x, row_p, p);
+      }
+      Borders borders;
+      borders.columns.resize(n, 2);
+      borders.columns << FT, Fp;
+      borders.rows.resize(2, n);
+      borders.rows << phase.transpose(), row_x.head(n).transpose();
+      borders.corner = (Eigen::Matrix2d() << 0, 0, row_x[n], row_p).finished();
+      auto krylov = std::make_unique<CondensedBordered<D, Map::DW>>(
+          std::move(G), map.grid(), std::move(maps), std::move(borders), p,
+          GmresLimits{o_.gmres_restart, o_.gmres_max_iterations});
+      if (solver != ContinuationSolver::automatic) return krylov;
+      return std::make_unique<FallBackToLu>(std::move(krylov), [this, xT, p, phase, phase_target, &row_x, row_p] {
+        std::string ignored;  // the same iterate was just evaluated
+        return linearisation_or_reason(xT, p, phase, phase_target, row_x, row_p, ContinuationSolver::lu, ignored);
+      });
     } catch (const NumericalFailure& e) {
       why = std::string("residual not computable at ") + format_number(p) + " (" + e.what() + ")";
     } catch (const BadInput& e) {
       why = std::string("the model rejects parameter ") + format_number(p) + " with period " + format_number(T) +
             " (" + e.what() + ")";
     }
-    return false;
+    return nullptr;
   }
 
   const ModelAt& model_at_;

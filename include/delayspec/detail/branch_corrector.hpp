@@ -124,7 +124,8 @@ std::unique_ptr<BorderedLinearisation> lu_linearisation(Eigen::VectorXd G, Eigen
 
 // An iterative linearisation with a direct one to fall back on: a solve the first fails (GMRES
 // without convergence: a strongly unstable orbit, condensed_bordered.hpp) is done again by the
-// second, made on first need (`make_fallback`: the same iterate, e.g. lu_linearisation).
+// second, made on first need (`make_fallback`: the same iterate, e.g. lu_linearisation; nullptr
+// if it cannot be made, and the solve fails with the first's reason).
 class FallBackToLu final : public BorderedLinearisation {
  public:
   FallBackToLu(std::unique_ptr<BorderedLinearisation> first,
@@ -138,7 +139,7 @@ class FallBackToLu final : public BorderedLinearisation {
     if (!fallback_) z = first_->solve(rhs_x, rhs_p, forcing, why);
     if (!z) {
       if (!fallback_) fallback_ = make_fallback_();
-      z = fallback_->solve(rhs_x, rhs_p, forcing, why);
+      if (fallback_) z = fallback_->solve(rhs_x, rhs_p, forcing, why);
     }
     factorisations = first_->factorisations + (fallback_ ? fallback_->factorisations : 0);
     products = first_->products + (fallback_ ? fallback_->products : 0);

@@ -1,8 +1,8 @@
 #pragma once
 // The bordered Newton matrix of the discrete periodic problem (orbit_newton.hpp, continuation.hpp)
 //
-//   [ F_x    F_p   ] [dx]   [r_x]
-//   [ row_x  row_p ] [dp] = [r_p]
+//   [ F_x  C ] [dx]   [r_x]        C: D K x k columns (F_p; for an orbit of unknown period F_T, F_p)
+//   [ R    E ] [dy] = [r_y]        R: k x D K rows (the arclength row; the phase row), E: k x k
 //
 // solved matrix-free: condensed onto the history of the map and solved by GMRES (gmres.hpp) on
 // the linearised map, as nested shooting solves (M - I) s = -G (orbit_shooting.hpp). No matrix
@@ -21,19 +21,24 @@
 // sequence dx_0 .. dx_{K-1} and the end history E(dU, f) = (dx_{K-M}, ..., dx_K). The sequence is
 // periodic, i.e. solves the rows, exactly when E(dU, f) = dU. By linearity E(dU, f) = M dU + e(f)
 // with M the monodromy at x and e(f) = E(0, f), and the sequence is S dU + s(f). With f = r_x -
-// dp F_p the bordered system becomes, in n + 1 = d (M + 1) + 1 unknowns,
+// C dy the bordered system becomes, in d (M + 1) + k unknowns,
 //
-//   [ M - I      -e(F_p)                 ] [dU]   [ -e(r_x)            ]
-//   [ row_x S    row_p - row_x . s(F_p)  ] [dp] = [ r_p - row_x . s(r_x) ]
+//   [ M - I     -e(C)          ] [dU]   [ -e(r_x)         ]
+//   [ R S       E - R s(C)     ] [dy] = [ r_y - R s(r_x)  ]
 //
-// and dx is the sweep from dU with f = r_x - dp F_p. One GMRES product is one homogeneous sweep
-// (O(K d^2), a few per cent of a map evaluation); each solve adds two forced sweeps. The
-// condensed matrix is regular exactly when the bordered one is (a Schur complement of it), so
-// the corrector passes folds as the sparse-LU one does: at a fold M - I is singular but the
-// border is not.
+// (e(C), s(C): column by column) and dx is the sweep from dU with f = r_x - C dy. One GMRES
+// product is one homogeneous sweep (O(K d^2), a few per cent of a map evaluation); each solve
+// adds two forced sweeps. The condensed matrix is regular exactly when the bordered one is (a
+// Schur complement of it), so the corrector passes folds as the sparse-LU one does: at a fold
+// M - I is singular but the border is not.
+//
+// A last border row that fixes its unknown (R's last row zero, E's last row zero but its
+// diagonal: Newton at a given parameter, the start and the end of a branch) is solved exactly,
+// dy_last = r_y,last / E_last,last, as the LU does, and GMRES takes the rest: the branch lands
+// exactly on its end.
 //
 // Why GMRES converges fast: M is compact-like (its spectrum accumulates at 0), so the matrix is
-// -I plus a few large directions plus the border, a rank-two change: GMRES needs about as many
+// -I plus a few large directions plus the borders, a change of rank 2 k: GMRES needs about as many
 // products as the multipliers above the tolerance, as in shooting. A strongly unstable orbit
 // (|mu| >> 1) makes the condensed system ill-conditioned (the sweep amplifies by |mu|); GMRES then
 // fails to converge and says so (continue_solver = auto falls back to the sparse LU).
@@ -55,62 +60,78 @@
 namespace delayspec::continuation_detail {
 
 struct GmresLimits {
-  int restart = 40;           // basis vectors per cycle
-  int max_iterations = 400;   // products per solve
+  int restart = 40;          // basis vectors per cycle
+  int max_iterations = 400;  // products per solve
+};
+
+// The borders of the condensed system (header): C, R, E.
+struct Borders {
+  Eigen::MatrixXd columns;  // C, D K x k
+  Eigen::MatrixXd rows;     // R, k x D K
+  Eigen::MatrixXd corner;   // E, k x k
 };
 
 template <int D, int DW = D>
 class CondensedBordered final : public BorderedLinearisation {
  public:
-  // The iterate's residual, step maps (one per step, PeriodicOrbitProblem::residual), F_p and
-  // the border. p: named in a failure.
+  // The iterate's residual (D K + k - 1 entries: the tracer's G, the last border row's residual
+  // being the corrector's own g), its step maps (one per step, PeriodicOrbitProblem::residual),
+  // the borders. p: named in a failure.
   CondensedBordered(Eigen::VectorXd residual, const HistoryGrid& grid, std::vector<StepMap<D, DW>> maps,
-                    const Eigen::VectorXd& F_p, const Eigen::VectorXd& row_x, double row_p, double p,
-                    const GmresLimits& limits)
-      : grid_(grid), maps_(std::move(maps)), row_x_(row_x), row_p_(row_p), p_(p), limits_(limits),
-        n_(grid.dimension(D)), work_(static_cast<size_t>((grid.M + 1 + grid.K) * D)), F_p_(F_p) {
+                    Borders borders, double p, const GmresLimits& limits)
+      : grid_(grid), maps_(std::move(maps)), b_(std::move(borders)), p_(p), limits_(limits), n_(grid.dimension(D)),
+        nx_(static_cast<long>(D) * grid.K), k_(b_.columns.cols()),
+        work_(static_cast<size_t>((grid.M + 1 + grid.K) * D)) {
     G = std::move(residual);
-    if (static_cast<long>(maps_.size()) != grid_.K || G.size() != static_cast<long>(D) * grid_.K)
+    if (static_cast<long>(maps_.size()) != grid_.K || G.size() != nx_ + k_ - 1 || b_.columns.rows() != nx_ ||
+        b_.rows.rows() != k_ || b_.rows.cols() != nx_ || b_.corner.rows() != k_ || b_.corner.cols() != k_ || k_ < 1)
       throw BadInput("condensed bordered system: sizes do not match the grid");
-    sweep(Eigen::VectorXd::Zero(n_), &F_p_);
-    e_p_ = end_history();
-    s_p_ = row_x_.dot(sequence());
+    // The last unknown is fixed by its row (header) when that row has nothing but its diagonal.
+    fixes_last_ = b_.rows.row(k_ - 1).isZero(0.0) && b_.corner.row(k_ - 1).head(k_ - 1).isZero(0.0) &&
+                  b_.corner(k_ - 1, k_ - 1) != 0;
+    e_C_.resize(n_, k_);
+    s_C_.resize(k_, k_);
+    for (long j = 0; j < k_; ++j) {
+      const Eigen::VectorXd column = b_.columns.col(j);
+      sweep(Eigen::VectorXd::Zero(n_), &column);
+      e_C_.col(j) = end_history();
+      s_C_.col(j) = b_.rows * sequence();
+    }
   }
 
   std::optional<Eigen::VectorXd> solve(const Eigen::VectorXd& rhs_x, double rhs_p, double forcing,
                                        std::string& why) override {
-    const long n = n_, K = grid_.K;
-    // A border that fixes p (row_x = 0: Newton at a given parameter, the start and the end of a
-    // branch) gives dp = r_p / row_p exactly, as the LU does, and leaves (M - I) dU = -e(r_x - dp
-    // F_p): the branch lands exactly on its end.
-    const bool fixes_p = row_x_.isZero(0.0);
-    if (fixes_p && row_p_ == 0) {
-      why = "the bordered system's border is zero";
-      return std::nullopt;
+    const long n = n_, k = k_;
+    Eigen::VectorXd rhs(nx_ + k);
+    rhs << rhs_x, rhs_p;
+    Eigen::VectorXd r_y = rhs.tail(k);
+    Eigen::VectorXd f = rhs.head(nx_);
+    // kf: the border unknowns GMRES solves for; a fixed last one is eliminated first.
+    const long kf = fixes_last_ ? k - 1 : k;
+    double fixed = 0;
+    if (fixes_last_) {
+      fixed = r_y[k - 1] / b_.corner(k - 1, k - 1);
+      f -= fixed * b_.columns.col(k - 1);
+      r_y.head(kf) -= fixed * b_.corner.col(k - 1).head(kf);
     }
-    const double dp_fixed = fixes_p ? rhs_p / row_p_ : 0.0;
-    const long m = fixes_p ? n : n + 1;
-    Eigen::VectorXd f = rhs_x - dp_fixed * F_p_;
     sweep(Eigen::VectorXd::Zero(n), &f);
-    Eigen::VectorXd b(m);
+    Eigen::VectorXd b(n + kf);
     b.head(n) = -end_history();
-    if (!fixes_p) b[n] = rhs_p - row_x_.dot(sequence());
-    const double corner = row_p_ - s_p_;
+    b.tail(kf) = r_y.head(kf) - b_.rows.topRows(kf) * sequence();
+    const Eigen::MatrixXd corner = b_.corner.topLeftCorner(kf, kf) - s_C_.topLeftCorner(kf, kf);
     // `forcing` is relative to the right-hand side as given; the condensed one, b, is it carried
     // through the sweep, and may be larger or smaller (the forced sweep grows or decays with the
     // orbit's transients): GMRES is asked for the same absolute residual. (The sequence's
     // residual after the solve is the condensed one passed through one step: the periodicity
     // mismatch of the history enters the first rows as the delayed values do.)
-    const double rhs_norm = std::hypot(rhs_x.norm(), rhs_p), b_norm = b.norm();
+    const double rhs_norm = rhs.norm(), b_norm = b.norm();
     const double tolerance = b_norm > 0 ? std::min(0.5, forcing * rhs_norm / b_norm) : forcing;
     const GmresResult g = gmres(
         [&](const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::VectorXd& out) {
           sweep(y.head(n), nullptr);
-          out.resize(m);
-          out.head(n) = end_history() - y.head(n);
-          if (fixes_p) return;
-          out.head(n) -= y[n] * e_p_;
-          out[n] = row_x_.dot(sequence()) + y[n] * corner;
+          out.resize(n + kf);
+          out.head(n) = end_history() - y.head(n) - e_C_.leftCols(kf) * y.tail(kf);
+          out.tail(kf) = b_.rows.topRows(kf) * sequence() + corner * y.tail(kf);
         },
         b, GmresOptions{tolerance, limits_.restart, limits_.max_iterations}, &basis_);
     products += g.iterations;
@@ -120,12 +141,13 @@ class CondensedBordered final : public BorderedLinearisation {
             " products, asked " + format_number(tolerance) + ")";
       return std::nullopt;
     }
-    const double dp = fixes_p ? dp_fixed : g.x[n];
-    f = rhs_x - dp * F_p_;
+    Eigen::VectorXd dy(k);
+    dy.head(kf) = g.x.tail(kf);
+    if (fixes_last_) dy[k - 1] = fixed;
+    f = rhs.head(nx_) - b_.columns * dy;
     sweep(g.x.head(n), &f);
-    Eigen::VectorXd z(static_cast<long>(D) * K + 1);
-    z.head(static_cast<long>(D) * K) = sequence();
-    z[static_cast<long>(D) * K] = dp;
+    Eigen::VectorXd z(nx_ + k);
+    z << sequence(), dy;
     if (!z.allFinite()) {
       why = "the condensed bordered solve is not finite at parameter " + format_number(p_);
       return std::nullopt;
@@ -156,7 +178,7 @@ class CondensedBordered final : public BorderedLinearisation {
     else single_steps<D>(maps_.data() + l0, count, M + l0, grid_.delayed_slot(l0), grid_.theta, b);
   }
   Eigen::Map<const Eigen::VectorXd> sequence() const {  // dx_0 .. dx_{K-1}
-    return {work_.data() + grid_.M * D, static_cast<long>(D) * grid_.K};
+    return {work_.data() + grid_.M * D, nx_};
   }
   Eigen::Map<const Eigen::VectorXd> end_history() const {  // dx_{K-M} .. dx_K
     return {work_.data() + grid_.K * D, n_};
@@ -164,15 +186,15 @@ class CondensedBordered final : public BorderedLinearisation {
 
   HistoryGrid grid_;
   std::vector<StepMap<D, DW>> maps_;
-  const Eigen::VectorXd& row_x_;
-  double row_p_, p_;
+  Borders b_;
+  double p_;
   GmresLimits limits_;
-  long n_;
+  long n_, nx_, k_;
+  bool fixes_last_ = false;
   std::vector<double> work_;  // the sweep's slots, (M + 1 + K) d
-  Eigen::VectorXd F_p_;
-  Eigen::VectorXd e_p_;  // e(F_p)
-  double s_p_ = 0;       // row_x . s(F_p)
-  Eigen::MatrixXd basis_;  // GMRES' workspace, kept between the solves of one iterate
+  Eigen::MatrixXd e_C_;       // e(C), n x k
+  Eigen::MatrixXd s_C_;       // R s(C), k x k
+  Eigen::MatrixXd basis_;     // GMRES' workspace, kept between the solves of one iterate
 };
 
 }  // namespace delayspec::continuation_detail

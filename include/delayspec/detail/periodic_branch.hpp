@@ -6,6 +6,7 @@
 // it; not an interface.
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -150,14 +151,20 @@ class PeriodicBranch final : public BranchProblem {
     const Map map = map_at(p);
     std::vector<StepMap<D, delayed_rows<Model>>> maps;
     Eigen::VectorXd F = PeriodicOrbitProblem<Map>(map).residual(x, nullptr, &maps);
-    const Eigen::VectorXd Fp = F_p(x, p, F);
+    Eigen::VectorXd Fp = F_p(x, p, F);
     const GmresLimits limits{o_.gmres_restart, o_.gmres_max_iterations};
+    Borders borders{std::move(Fp), row_x.transpose(), Eigen::MatrixXd::Constant(1, 1, row_p)};
     auto krylov = std::make_unique<CondensedBordered<D, delayed_rows<Model>>>(std::move(F), map.grid(), std::move(maps),
-                                                                             Fp, row_x, row_p, p, limits);
+                                                                             std::move(borders), p, limits);
     if (o_.solver != ContinuationSolver::automatic) return krylov;
-    return std::make_unique<FallBackToLu>(std::move(krylov), [this, x, p, &row_x, row_p] {
-      return lu_linearisation_at(x, p, row_x, row_p);
-    });
+    return std::make_unique<FallBackToLu>(
+        std::move(krylov), [this, x, p, &row_x, row_p]() -> std::unique_ptr<BorderedLinearisation> {
+          try {
+            return lu_linearisation_at(x, p, row_x, row_p);
+          } catch (const std::exception&) {  // the same iterate was just evaluated: not expected
+            return nullptr;
+          }
+        });
   }
 
   // Switching models: over each step [t, t + h] of the orbit, max H from the cubic Hermite
