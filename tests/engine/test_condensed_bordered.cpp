@@ -23,6 +23,7 @@
 #include "delayspec/detail/sparse_lu.hpp"
 #include "delayspec/model_impact.hpp"
 #include "delayspec/orbit_newton.hpp"
+#include "impact_gap_branch.hpp"
 #include "saddle_node_model.hpp"
 #include "same_branch.hpp"
 
@@ -178,29 +179,17 @@ std::array<ContinuationResult, 2> both_solvers(const ModelAt& model_at, const Ei
 }
 
 TEST(ContinuationSolvers, KrylovAndLuGiveTheSameImpactBranchThroughGrazingAndNeimarkSacker) {
-  // The impact orbit at tau = T continued in the gap e (test_continuation.cpp's grazing test):
-  // stable and free, grazing, in contact, unstable past a Neimark-Sacker point.
+  // The impact orbit at tau = T continued in the gap e (impact_gap_branch.hpp): stable and free,
+  // grazing, in contact, unstable past a Neimark-Sacker point.
   const ImpactParameters base;
-  const double w = base.omega, T = 2 * pi / w;
-  const double A = base.a * w * w / std::hypot(1 - w * w, 2 * base.zeta * w);
-  const double phi = std::atan2(2 * base.zeta * w, 1 - w * w);
   const int N = 100;
-  Eigen::VectorXd guess(2 * N);
-  for (int l = 0; l < N; ++l) {
-    guess[2 * l] = A * std::sin(w * l * T / N - phi);
-    guess[2 * l + 1] = A * w * std::cos(w * l * T / N - phi);
-  }
+  const Eigen::VectorXd guess = testing::free_orbit_sequence(base, N);
   ContinuationOptions o;
   o.from = 1.3;
   o.to = 1.2;
   o.N = N;
   o.tolerance = 1e-12;
-  auto model_at = [&](double e) {
-    ImpactParameters p = base;
-    p.e = e;
-    p.k = 0.5;
-    return ImpactModel(p);
-  };
+  const testing::ImpactInGap model_at{base, 0.5};
   const auto [lu, krylov] = both_solvers<ImpactModel>(model_at, guess, o);
   ASSERT_EQ(lu.end, BranchEnd::to) << lu.failure;
   std::vector<BifurcationType> types;

@@ -11,6 +11,7 @@
 #include "delayspec/model_impact.hpp"
 #include "delayspec/model_linear.hpp"
 #include "delayspec/model_mathieu.hpp"
+#include "impact_gap_branch.hpp"
 #include "saddle_node_model.hpp"
 #include "test_support.hpp"
 
@@ -125,14 +126,10 @@ TEST(Continuation, PassesTheFoldOfAnExactEquilibriumBranch) {
   EXPECT_NEAR(r.points.back().measures.max[0], -1, 1e-10);
 }
 
-// The impact model at tau = T: on a T-periodic orbit the feedback k (v(t - T) - v(t)) vanishes,
-// also for the discrete orbit (v_{l - N} = v_l), so without contact the orbit is the free forced
-// oscillator's, x = A sin(w t - phi), A = a w^2 / sqrt((1 - w^2)^2 + (2 zeta w)^2). It grazes the
-// wall x = e at e = A.
+// The impact model at tau = T continued in the gap: it grazes at e = A (impact_gap_branch.hpp).
 TEST(Continuation, GrazingOfImpactOrbitAtFreeAmplitude) {
   const ImpactParameters base;
-  const double w = base.omega;
-  const double A = base.a * w * w / std::sqrt(std::pow(1 - w * w, 2) + std::pow(2 * base.zeta * w, 2));
+  const double A = testing::free_amplitude(base);
   const std::vector<int> Ns = {100, 200, 400};
   std::vector<std::vector<Bifurcation>> by_N;
   for (int N : Ns) {
@@ -141,19 +138,10 @@ TEST(Continuation, GrazingOfImpactOrbitAtFreeAmplitude) {
     o.to = 1.2;
     o.N = N;
     o.tolerance = 1e-13;
-    auto model_at = [&](double e) {
-      ImpactParameters p = base;
-      p.e = e;
-      p.k = 0.5;
-      return ImpactModel(p);
-    };
+    const testing::ImpactInGap model_at{base, 0.5};
     // the start: the free orbit (no contact at e = 1.3 > A), from the exact solution as a guess
-    const double T = 2 * pi / w, h = T / N, phi = std::atan2(2 * base.zeta * w, 1 - w * w);
-    Eigen::VectorXd guess(2 * N);
-    for (int l = 0; l < N; ++l) {
-      guess[2 * l] = A * std::sin(w * l * h - phi);
-      guess[2 * l + 1] = A * w * std::cos(w * l * h - phi);
-    }
+    const double h = 2 * pi / base.omega / N;
+    const Eigen::VectorXd guess = testing::free_orbit_sequence(base, N);
     const ContinuationResult r = continue_orbit<ImpactModel>(model_at, guess, o);
     ASSERT_EQ(r.end, BranchEnd::to) << r.failure;
     // the branch also loses stability in contact (a Neimark-Sacker point near e = 1.256 with k = 0.5);
