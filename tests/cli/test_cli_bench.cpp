@@ -82,6 +82,16 @@ TEST(BenchCli, TextTableAndCsv) {
   while (std::getline(csv, line))
     if (line.rfind("#", 0) != 0) ++lines;  // the metadata comment lines first (docs/formats.md)
   EXPECT_EQ(lines, 1 + 3 * 2);             // header, 3 N x 2 solvers
+  // bench.json beside it, with the rows and the metadata, so that `plot DIR` draws the speed
+  // figure after a bare `bench --out` (it used to need `run`)
+  std::ifstream json_file(dir / "bench.json");
+  ASSERT_TRUE(json_file) << "no bench.json";
+  const auto j = nlohmann::json::parse(json_file);
+  EXPECT_EQ(j["rows"].size(), 6u);
+  EXPECT_EQ(j["metadata"]["command"], "bench");
+  const CliResult plot = run({"plot", dir.string()});
+  ASSERT_EQ(plot.status, 0) << plot.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "plots" / "speed_error.png")) << plot.out << plot.err;
   std::filesystem::remove_all(dir);
 }
 

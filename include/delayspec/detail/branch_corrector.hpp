@@ -153,8 +153,8 @@ class FallBackToLu final : public BorderedLinearisation {
 
 // Forcing terms of an iterative corrector (Eisenstat-Walker, as nested shooting: orbit_shooting.hpp).
 struct CorrectorForcing {
-  double forcing_max = 1e-6;  // eta_max (ContinuationOptions::forcing_max)
-  double tangent = 1e-12;     // the tangent's relative residual (it orients the next predictor)
+  double forcing_max;      // eta_max: the options' (ContinuationOptions::forcing_max, where its default lives)
+  double tangent = 1e-12;  // the tangent's relative residual (it orients the next predictor)
 };
 
 // Newton from (x, p) on G(x, p) = 0 and  row_x . x + row_p p = target:

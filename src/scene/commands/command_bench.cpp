@@ -426,14 +426,17 @@ int command_bench(Config& config, const Invocation& inv) {
   std::vector<BenchRow> rows = run_bench(settings, inv);       // compute
   const BenchReference reference = bench_reference(settings, rows);
   score_rows(rows, reference);
-  if (inv.out_dir) {  // report
+  const nlohmann::json j = bench_json(settings, rows, reference);
+  if (inv.out_dir) {  // report: bench.csv, and bench.json, which `plot` draws the speed figure from
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - command_start).count();
-    write_bench_csv(
-        inv, std::filesystem::path(*inv.out_dir) / "bench.csv",
-        metadata_comment_lines(make_metadata("bench", inv.scene, config, nlohmann::json::object(), seconds)), settings,
-        rows, reference);
+    const OutputMetadata metadata = make_metadata("bench", inv.scene, config, j, seconds);
+    const std::filesystem::path dir(*inv.out_dir);
+    write_bench_csv(inv, dir / "bench.csv", metadata_comment_lines(metadata), settings, rows, reference);
+    nlohmann::json file = j;
+    file["metadata"] = metadata_json(metadata);
+    write_output(inv, dir / "bench.json", file.dump(2) + "\n");
   }
-  if (inv.json) inv.out << bench_json(settings, rows, reference).dump(2) << "\n";
+  if (inv.json) inv.out << j.dump(2) << "\n";
   else print_bench(inv.out, settings, rows, reference);
   return 0;
 }
