@@ -92,14 +92,6 @@ class PeriodicBranch final : public BranchProblem {
                               weight_, CorrectorForcing{o_.forcing_max}, why, seconds, work_);
   }
 
-  // F(x, p), F_x and F_p (parameter_derivative: central differences, one-sided at a bound of the
-  // key's range).
-  void linearise(const Eigen::VectorXd& x, double p, Eigen::VectorXd& F, Eigen::SparseMatrix<double>& Fx,
-                 Eigen::VectorXd& Fp) const {
-    F = PeriodicOrbitProblem<Map>(map_at(p)).residual(x, &Fx);
-    Fp = F_p(x, p, F);
-  }
-
   // Multipliers and measures of the orbit x at p.
   ContinuationPoint evaluate(const State& s, double& krylov_seconds) const override {
     ContinuationPoint point;
@@ -132,6 +124,7 @@ class PeriodicBranch final : public BranchProblem {
   using States = Eigen::Map<const Eigen::Matrix<double, D, Eigen::Dynamic>>;
 
   bool uses_krylov() const { return o_.solver != ContinuationSolver::lu; }
+  // F_p (parameter_derivative: central differences, one-sided at a bound of the key's range).
   Eigen::VectorXd F_p(const Eigen::VectorXd& x, double p, const Eigen::VectorXd& F) const {
     return parameter_derivative([&](double q) { return PeriodicOrbitProblem<Map>(map_at(q)).residual(x); }, p, F,
                                 range_);
@@ -139,9 +132,9 @@ class PeriodicBranch final : public BranchProblem {
   // The bordered system at (x, p) for the sparse LU: F, F_x, F_p assembled.
   std::unique_ptr<BorderedLinearisation> lu_linearisation_at(const Eigen::VectorXd& x, double p,
                                                              const Eigen::VectorXd& row_x, double row_p) const {
-    Eigen::VectorXd F, Fp;
     Eigen::SparseMatrix<double> Fx;
-    linearise(x, p, F, Fx, Fp);
+    Eigen::VectorXd F = PeriodicOrbitProblem<Map>(map_at(p)).residual(x, &Fx);
+    Eigen::VectorXd Fp = F_p(x, p, F);
     return lu_linearisation(std::move(F), std::move(Fx), std::move(Fp), row_x, row_p, p);
   }
   // The bordered system at (x, p) matrix-free: F, the step maps and F_p (condensed_bordered.hpp);
