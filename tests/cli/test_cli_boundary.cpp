@@ -13,7 +13,6 @@
 //   k) s + 1 - k s e^{-s tau}, so it grazes x = e exactly where a = e |D(i w)| / w^2;
 // - bad input (exit 2) and no bifurcation at the start (exit 3 with what was found).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <complex>
@@ -137,8 +136,7 @@ TEST(BoundaryCli, TheMathieuCurvesPassThroughThePointsContinueLocates) {
 // v = -0.8 (the first fold in v from -1.2), goes right to the turning point u = 1 and comes back
 // to u = 0.6 on the upper half.
 TEST(BoundaryCli, ACurveIsFollowedThroughItsTurningPoint) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("delayspec_test_boundary_" + std::to_string(::getpid()));
+  const std::filesystem::path dir = delayspec::testing::scratch_path("boundary");
   std::filesystem::create_directories(dir);
   const std::string scene = (dir / "circle.toml").string();
   std::ofstream(scene) << "model = \"equations\"\n[equations]\nstate = [\"x\"]\nparameters = { u = 0.6, v = 0 }\n"
