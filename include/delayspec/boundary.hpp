@@ -30,6 +30,13 @@
 // pair reaches the real axis (angle 0: 1:1 resonance, angle pi: 1:2 resonance, meeting a fold or
 // period-doubling curve), found as the end of the curve's definition with the last angle within
 // 0.05 rad of 0 or pi; after max_points; or at a failure (step below step_min), named.
+//
+// Where a grazing curve meets a stability curve (a codim-2 point the curve passes, not an end):
+// found on either curve by the sign change, between two accepted points, of the other kind's test
+// function (BoundarySample::other: max H on a stability curve, |mu_1| - 1 of the leading
+// multiplier on a grazing curve), then located on the curve by regula falsi (Illinois) in the
+// position along the chord between them, each trial point corrected onto the curve across the
+// chord, to the curve's tolerance.
 #include <complex>
 #include <functional>
 #include <string>
@@ -46,11 +53,21 @@ struct BoundarySample {
   double value = NAN;    // g
   double angle = NAN;    // arg of the critical multiplier, in [0, pi] (grazing: NaN)
   std::string reason;    // why not defined
+  // The other kind's test function, whose zero on the curve is where it meets a curve of the
+  // other kind: on a stability curve max H (the orbit starts to touch the switching surface: NaN
+  // for a model without one), on a grazing curve |mu_1| - 1 (the grazing orbit's leading
+  // multiplier mu_1 on the unit circle: NaN when no multipliers were computed); other_type is the
+  // stability curve's type: the curve's own, or the type mu_1 crosses as (continuation.hpp's
+  // crossing_type), and other_angle |arg| of that multiplier.
+  double other = NAN;
+  BifurcationType other_type = BifurcationType::grazing;
+  double other_angle = NAN;
 };
 using BoundaryFunction = std::function<BoundarySample(double x, double y)>;
 
 // The test function of `type` from the leading multipliers (and max H for grazing): what
-// continuation locates (continuation_detail::multiplier_test).
+// continuation locates (continuation_detail::multiplier_test); with the other kind's test function
+// (max H, or |mu_1| - 1 when multipliers are given for a grazing curve).
 BoundarySample boundary_sample(BifurcationType type, const std::vector<std::complex<double>>& multipliers,
                                double max_H);
 
@@ -75,8 +92,10 @@ std::string to_string(BoundaryEnd end);
 
 // Where a curve changes character.
 struct Codim2Point {
-  std::string kind;  // "1:1 resonance" (angle 0), "1:2 resonance" (angle pi)
-  double x = 0, y = 0, angle = 0;
+  // "1:1 resonance" (angle 0), "1:2 resonance" (angle pi), "grazing meets TYPE" (TYPE the
+  // stability curve's: fold, period-doubling, neimark-sacker)
+  std::string kind;
+  double x = 0, y = 0, angle = 0;  // angle: the critical multiplier's |arg| there
 };
 
 struct BoundaryCurve {

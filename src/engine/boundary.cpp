@@ -30,6 +30,13 @@ BoundarySample boundary_sample(BifurcationType type, const std::vector<std::comp
     s.value = max_H;
     s.defined = std::isfinite(max_H);
     if (!s.defined) s.reason = "no max H (the model does not switch in the state)";
+    if (!multipliers.empty()) {
+      const std::complex<double> mu1 = *std::max_element(
+          multipliers.begin(), multipliers.end(), [](auto a, auto b) { return std::abs(a) < std::abs(b); });
+      s.other = std::abs(mu1) - 1;
+      s.other_type = crossing_type(mu1);
+      s.other_angle = std::abs(std::arg(mu1));
+    }
     return s;
   }
   std::complex<double> critical;
@@ -38,6 +45,9 @@ BoundarySample boundary_sample(BifurcationType type, const std::vector<std::comp
   if (s.defined) s.angle = std::abs(std::arg(critical));
   else s.reason = "no " + to_string(type) + " candidate among the " + std::to_string(multipliers.size()) +
                   " leading multipliers";
+  s.other = std::isfinite(max_H) ? max_H : NAN;
+  s.other_type = type;
+  s.other_angle = s.angle;
   return s;
 }
 
@@ -276,6 +286,49 @@ void end_where_it_stops(BoundaryCurve& curve, const ScaledCurve& scaled, const C
   }
 }
 
+// Where the other kind's test function changes sign between the accepted points a and b (a
+// grazing curve meeting a stability curve): regula falsi (Illinois) on the position w in [0, 1]
+// along the chord from a to b, each trial point a + w (b - a) corrected onto the curve across the
+// chord (the row of the chord's direction), until the bracket is shorter than the tolerance.
+// Nothing when the signs do not differ; the point where the bracket last stood when a correction
+// fails (it lies between two points of the curve, to the chord's bend).
+std::optional<Codim2Point> met_other_curve(const ScaledCurve& scaled, const CurveState& a, const CurveState& b,
+                                           double tolerance) {
+  double fa = a.sample.other, fb = b.sample.other;
+  if (!std::isfinite(fa) || !std::isfinite(fb) || (fa > 0) == (fb > 0)) return std::nullopt;
+  const Vec2 chord{b.X[0] - a.X[0], b.X[1] - a.X[1]};
+  const double length = norm(chord);
+  const Vec2 row{chord[0] / length, chord[1] / length};
+  double wa = 0, wb = 1;
+  CurveState at = std::abs(fa) < std::abs(fb) ? a : b;
+  int moved = 0;  // the end moved last (-1: a, 1: b); Illinois: an end kept twice has its value halved
+  for (int it = 0; it < 40 && (wb - wa) * length > tolerance; ++it) {
+    const double w = std::clamp((wa * fb - wb * fa) / (fb - fa), wa, wb);
+    const Vec2 P{a.X[0] + w * chord[0], a.X[1] + w * chord[1]};
+    std::string reason;
+    const std::optional<CurveState> on = correct(scaled, P, a.grad, row, dot(row, P), tolerance, reason);
+    if (!on || !std::isfinite(on->sample.other)) break;
+    at = *on;
+    const double f = on->sample.other;
+    if (f == 0) break;
+    if ((f > 0) == (fa > 0)) {
+      wa = w, fa = f;
+      if (moved == -1) fb /= 2;
+      moved = -1;
+    } else {
+      wb = w, fb = f;
+      if (moved == 1) fa /= 2;
+      moved = 1;
+    }
+  }
+  Codim2Point q;
+  q.kind = "grazing meets " + to_string(at.sample.other_type);
+  q.x = scaled.x(at.X);
+  q.y = scaled.y(at.X);
+  q.angle = at.sample.other_angle;
+  return q;
+}
+
 // The last three points (scaled), their arclengths and angles, for the resonances passed.
 struct ResonanceWatch {
   std::array<Vec2, 3> X{};
@@ -328,6 +381,7 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
       end_where_it_stops(curve, scaled, current, reason);
       return curve;
     }
+    if (std::optional<Codim2Point> q = met_other_curve(scaled, current, *next, o.tolerance)) curve.codim2.push_back(*q);
     current = *next;
     add_point(current);
     if (std::optional<Codim2Point> q = resonances.add(current.X, current.sample.angle, scaled)) curve.codim2.push_back(*q);

@@ -13,7 +13,6 @@
 //   k) s + 1 - k s e^{-s tau}, so it grazes x = e exactly where a = e |D(i w)| / w^2;
 // - bad input (exit 2) and no bifurcation at the start (exit 3 with what was found).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <complex>
@@ -43,6 +42,13 @@ double hopf_frequency(double a) {
     (mid / std::tan(mid) > a ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
+}
+
+// The forcing amplitude a at which the impact model's free-flight orbit touches x = e, at tau = T / 2
+// (e^{-i w tau} = -1: the feedback k (v(t - tau) - v(t)) is -2 k v on the forced response):
+// a = e |1 - w^2 + i w (2 zeta + 2 k)| / w^2.
+double impact_grazing_amplitude(double e, double w, double zeta, double k) {
+  return e * std::abs(std::complex<double>(1 - w * w, w * (2 * zeta + 2 * k))) / (w * w);
 }
 
 nlohmann::json boundary_json(std::vector<std::string> sets) {
@@ -137,8 +143,7 @@ TEST(BoundaryCli, TheMathieuCurvesPassThroughThePointsContinueLocates) {
 // v = -0.8 (the first fold in v from -1.2), goes right to the turning point u = 1 and comes back
 // to u = 0.6 on the upper half.
 TEST(BoundaryCli, ACurveIsFollowedThroughItsTurningPoint) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("delayspec_test_boundary_" + std::to_string(::getpid()));
+  const std::filesystem::path dir = delayspec::testing::scratch_path("boundary");
   std::filesystem::create_directories(dir);
   const std::string scene = (dir / "circle.toml").string();
   std::ofstream(scene) << "model = \"equations\"\n[equations]\nstate = [\"x\"]\nparameters = { u = 0.6, v = 0 }\n"
@@ -234,10 +239,7 @@ TEST(BoundaryCli, AScanFollowsEveryLobeOnceThroughThePointsContinueLocates) {
 // orbit grazes at a = 0.833 for k = 0; it also doubles its period 8e-4 above, which the curve
 // (followed on the orbit of the free-flight field, step_options.hpp's fixed_region) never meets.
 TEST(BoundaryCli, TheImpactGrazingCurveIsTheExactLinearResponseCurve) {
-  const double e = 1.5, w = 0.802, zeta = 0.01;
-  const auto exact_a = [&](double k) {  // tau = T / 2: e^{-i w tau} = -1
-    return e * std::abs(std::complex<double>(1 - w * w, w * (2 * zeta + 2 * k))) / (w * w);
-  };
+  const auto exact_a = [](double k) { return impact_grazing_amplitude(1.5, 0.802, 0.01, k); };
   const auto j = boundary_json({"model=impact", "tau_over_T=0.5", "e=1.5", "boundary_x=k", "boundary_y=a",
                                 "boundary_x_from=0", "boundary_x_to=0.2", "boundary_y_from=0.5", "boundary_y_to=1.5",
                                 "boundary_type=grazing", "boundary_Ns=50,100,200,400"});
@@ -275,6 +277,44 @@ TEST(BoundaryCli, TheImpactGrazingCurveIsTheExactLinearResponseCurve) {
     EXPECT_LT(p["error_estimate"].get<double>(), 1e-7) << k;
   }
   EXPECT_GE(extrapolated, points.size() * 9 / 10);
+}
+
+// Where the grazing curve above meets a stability curve: the curve follows the orbit of the
+// free-flight field, x'' + (2 zeta + k) x' + x = k x'(t - tau) + forcing, whose multipliers do not
+// depend on a or e; its characteristic equation lambda^2 + (2 zeta + k) lambda + 1 = k lambda
+// e^{-lambda tau} has roots i w0 (a Neimark-Sacker crossing) where 2 zeta + k (1 - cos w0 tau) = 0
+// and 1 - w0^2 = k w0 sin w0 tau, that is 1 - w0^2 + 2 zeta w0 cot(w0 tau / 2) = 0 and
+// k* = -2 zeta / (1 - cos w0 tau) (w0 = 0.99601, k* = -0.0115953 at tau = T / 2). The grazing
+// orbit is stable for k > k*: the codim-2 point lies at k*, up to the discretisation's O(h^2).
+TEST(BoundaryCli, TheGrazingCurveMeetsTheFreeFlightStabilityCurveAtTheExactGain) {
+  const double zeta = 0.01, w = 0.802, tau = std::numbers::pi / w;
+  const auto f = [&](double w0) { return 1 - w0 * w0 + 2 * zeta * w0 / std::tan(w0 * tau / 2); };
+  double lo = 0.9, hi = 1.05;  // f(0.9) > 0 > f(1.05), one root between
+  ASSERT_GT(f(lo), 0);
+  ASSERT_LT(f(hi), 0);
+  for (int i = 0; i < 200 && hi - lo > 1e-15; ++i) (f((lo + hi) / 2) > 0 ? lo : hi) = (lo + hi) / 2;
+  const double w0 = (lo + hi) / 2, k_star = -2 * zeta / (1 - std::cos(w0 * tau));
+  const double angle = std::abs(std::arg(std::polar(1.0, w0 * 2 * std::numbers::pi / w)));
+  const auto meeting = [&](int N) {
+    const auto j = boundary_json({"model=impact", "tau_over_T=0.5", "e=1.5", "boundary_x=k", "boundary_y=a",
+                                  "boundary_x_from=0.02", "boundary_x_to=-0.03", "boundary_y_from=0.5",
+                                  "boundary_y_to=1.5", "boundary_type=grazing", "N=" + std::to_string(N),
+                                  "boundary_Ns=" + std::to_string(N)});
+    EXPECT_FALSE(j.is_null());
+    const auto& curve = j["curves"][0];
+    EXPECT_EQ(curve["end"], "to");  // the meeting is passed
+    EXPECT_EQ(curve["codim2"].size(), 1u) << curve["codim2"];
+    return curve["codim2"].at(0);
+  };
+  const auto coarse = meeting(100), fine = meeting(200);
+  EXPECT_EQ(fine["kind"], "grazing meets neimark-sacker");
+  const double miss_coarse = std::abs(coarse["x"].get<double>() - k_star);
+  const double miss_fine = std::abs(fine["x"].get<double>() - k_star);
+  EXPECT_LT(miss_fine, 1e-3 * std::abs(k_star)) << fine;
+  EXPECT_NEAR(std::log2(miss_coarse / miss_fine), 2.0, 0.2) << coarse << " " << fine;  // O(h^2)
+  EXPECT_NEAR(fine["angle"].get<double>(), angle, 1e-3) << fine;
+  // On the grazing curve: a(k) = e |1 - w^2 + i w (2 zeta + 2 k)| / w^2 (the test above), to O(h^2)
+  EXPECT_NEAR(fine["y"].get<double>(), impact_grazing_amplitude(1.5, w, zeta, fine["x"].get<double>()), 1e-4);
 }
 
 TEST(BoundaryCli, BadInputAndNoBifurcationAtTheStart) {

@@ -2,7 +2,6 @@
 // linear DDE, and every bad-input and failure path of the issue (exit 2 naming the key and value,
 // exit 3 naming the residual or the point reached, with the branch so far written).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -46,10 +45,7 @@ std::vector<std::string> linear_args(std::vector<std::string> extra) {
 }
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("delayspec_test_continue_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
+  return delayspec::testing::scratch_path("continue_" + name);
 }
 
 std::vector<std::string> data_lines(const fs::path& file) {

@@ -201,8 +201,7 @@ TEST(OutputDirectory, RunJsonAbsentAfterAFailedRun) {
 TEST(OutputDirectory, KilledRunIsIncompleteAndResumesToTheSameTables) {
   const fs::path dir = fresh_dir("outdir_killed");
   const fs::path reference = fresh_dir("outdir_killed_reference");
-  const fs::path scene =
-      fs::temp_directory_path() / ("delayspec_test_outdir_killed_" + std::to_string(::getpid()) + ".toml");
+  const fs::path scene = fresh_dir("outdir_killed.toml");
   // ~200 points of several milliseconds each: the sweep runs long enough to be caught mid-way.
   std::ofstream(scene) << "analyses = [\"floquet\", \"sweep\"]\nmodel = \"linear\"\nb = -0.5\nN = 10\nsolver = "
                           "\"dense\"\nnev = 2\nperiods = 4000\ntransient = 0\nsweep_key = \"a\"\nsweep_from = -2\n"

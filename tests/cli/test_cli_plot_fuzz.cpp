@@ -113,7 +113,7 @@ struct Mutator {
 }  // namespace
 
 TEST(PlotFuzz, EveryMutatedInputEndsInExit0_2Or3) {
-  const fs::path dir = fs::temp_directory_path() / "delayspec_test_plot_fuzz";
+  const fs::path dir = delayspec::testing::scratch_path("plot_fuzz");
   // DELAYSPEC_PLOT_FUZZ_SEED / _CASES: a longer or different run by hand (the suite: 13, 300).
   const char* seed_text = std::getenv("DELAYSPEC_PLOT_FUZZ_SEED");
   const char* cases_text = std::getenv("DELAYSPEC_PLOT_FUZZ_CASES");

@@ -21,7 +21,7 @@ using delayspec::testing::fresh_dir;
 using delayspec::testing::run;
 
 std::string scene(const std::string& name, const std::string& text) {
-  const fs::path path = fs::temp_directory_path() / ("delayspec_test_run_" + name + ".toml");
+  const fs::path path = fresh_dir("run_" + name + ".toml");
   std::ofstream(path) << text;
   return path.string();
 }

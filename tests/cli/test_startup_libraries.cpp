@@ -28,6 +28,7 @@
 #include "scene/equations/equations_module_loader.hpp"
 #include "scene/loading/module_loader.hpp"
 #include "scene/loading/running_library.hpp"
+#include "scratch_dir.hpp"
 
 namespace {
 
@@ -120,8 +121,7 @@ TEST(StartupLibraries, EachSolverLoadsItsLibraryOnFirstUse) {
 // found first through LD_LIBRARY_PATH): exit 2 naming it, not a crash, for the run that needs it
 // (Newton's sparse LU); runs that do not need it are not affected.
 TEST(StartupLibraries, AnUnloadableLinearAlgebraLibraryExits2NamingIt) {
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_bad_umfpack_" + std::to_string(getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = delayspec::testing::scratch_path("bad_umfpack");
   fs::create_directories(dir);
   {
     std::FILE* f = std::fopen((dir / DELAYSPEC_UMFPACK_SONAME).c_str(), "w");
@@ -155,8 +155,7 @@ std::string file_text(const fs::path& path) {
 // default no earlier run has used (this process's id), overridden on the command line, so its
 // first run here is a first run (the model itself, the same code, is compiled once per cache).
 TEST(StartupLibraries, AnEquationsSceneLoadsGiNaCUntilItsModelIsCached) {
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_cached_table_" + std::to_string(getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = delayspec::testing::scratch_path("cached_table");
   fs::create_directories(dir);
   std::string text = file_text(std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/equations_impact.toml");
   const std::string zeta = "zeta = 0.01,";
@@ -185,8 +184,7 @@ TEST(StartupLibraries, AnEquationsSceneLoadsGiNaCUntilItsModelIsCached) {
 // before the build tree's RUNPATH, so this libdelayspec is the one that runs): exit 2, naming
 // the file it looked for, before any computation.
 TEST(StartupLibraries, MissingModuleExits2NamingTheFile) {
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_no_module_" + std::to_string(getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = delayspec::testing::scratch_path("no_module");
   fs::create_directories(dir);
   // libdelayspec under each of its names (the soname the program asks for among them).
   const fs::path library = delayspec::cli::running_library();

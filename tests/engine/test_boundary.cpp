@@ -4,6 +4,8 @@
 // - g = u^2 + v^2 - 1: every point on the circle to the tolerance, through the turning point
 //   u = 1 and back to u_from, in fewer steps and evaluations than the chord corrector needs
 //   (the Broyden update's gain).
+// - where the curve meets a curve of the other kind (the sign change of BoundarySample::other
+//   between two points): located on the curve to the tolerance, passed, named by the type.
 // - on_boundary_curve: a point of the true curve between two samples is on it although the
 //   chord misses it by more than the tolerance (its sagitta); a point off by more is not.
 #include <gtest/gtest.h>
@@ -49,6 +51,32 @@ TEST(Boundary, ACircleIsFollowedThroughItsTurningPointToTheTolerance) {
   // linearly at a rate set by the step). The bounds lie between: losing the update fails them.
   EXPECT_LE(c.points.size(), 80u);
   EXPECT_LE(c.evaluations, 600);
+  EXPECT_TRUE(c.codim2.empty());  // (no other kind's test function: never a meeting)
+}
+
+TEST(Boundary, WhereTheCurveMeetsACurveOfTheOtherKindIsLocatedAndPassed) {
+  // The circle as above, now a period-doubling curve whose orbit grazes where v = 0.6 (the other
+  // kind's test function, max H, = v - 0.6): on the upper half at u = 0.8.
+  const auto g = [](double u, double v) {
+    BoundarySample s = circle(u, v);
+    s.angle = std::numbers::pi;
+    s.other = v - 0.6;
+    s.other_type = BifurcationType::period_doubling;
+    s.other_angle = s.angle;
+    return s;
+  };
+  BoundaryOptions o;
+  o.x_from = 0.6, o.x_to = 1.5, o.y_from = -1.2, o.y_to = 1.2;
+  const BoundaryCurve c = trace_boundary(g, -0.8, o);
+  EXPECT_EQ(c.end, BoundaryEnd::from) << c.note;  // passed, not an end
+  ASSERT_EQ(c.codim2.size(), 1u);
+  const Codim2Point& q = c.codim2[0];
+  EXPECT_EQ(q.kind, "grazing meets period-doubling");
+  // The bracket along the chord is closed to the tolerance, 1e-10 of the ranges (<= 2.4e-10),
+  // on points each on the circle to |g| <= ~1e-9 (above): v to 1e-9, u = sqrt(1 - v^2) to 2e-9.
+  EXPECT_NEAR(q.y, 0.6, 1e-9);
+  EXPECT_NEAR(q.x, 0.8, 2e-9);
+  EXPECT_EQ(q.angle, std::numbers::pi);
 }
 
 TEST(Boundary, AStartBetweenTwoSamplesOfACurvedCurveIsOnIt) {

@@ -79,8 +79,7 @@ TEST(Simulation, BadWindowIsBadInput) {
 }
 
 TEST(CliSimulate, JsonAndCsvFiles) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "delayspec_test_simulate";
-  std::filesystem::remove_all(dir);
+  const std::filesystem::path dir = delayspec::testing::scratch_path("simulate");
   const CliResult r = run({"simulate", kScene, "--set", "N=50", "--set", "t_end=100", "--set", "t_start=50", "--set",
                            "sample_every=5", "--json", "--out", dir.string()});
   ASSERT_EQ(r.status, 0) << r.err;

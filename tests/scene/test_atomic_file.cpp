@@ -8,6 +8,7 @@
 
 #include "scene/output/atomic_file.hpp"
 #include "delayspec/errors.hpp"
+#include "scratch_dir.hpp"
 #include "text_support.hpp"
 
 namespace fs = std::filesystem;
@@ -18,9 +19,7 @@ using delayspec::testing::read_text;
 namespace {
 
 fs::path atomic_scratch_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("delayspec_test_atomic_" + name);
-  fs::remove_all(dir);
-  return dir;
+  return delayspec::testing::scratch_path("atomic_" + name);
 }
 
 size_t entries(const fs::path& dir) {

@@ -10,6 +10,7 @@
 #include "scene/keys/config.hpp"
 #include "scene/commands/key_registry.hpp"
 #include "delayspec/errors.hpp"
+#include "scratch_dir.hpp"
 #include "text_support.hpp"
 
 using delayspec::BadInput;
@@ -33,7 +34,7 @@ std::string bad_input_message(F&& f) {
 using delayspec::testing::contains;
 
 std::string write_scene(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("delayspec_test_config_" + name + ".toml");
+  const auto path = delayspec::testing::scratch_path("config_" + name + ".toml");
   std::ofstream(path) << text;
   return path.string();
 }
@@ -258,8 +259,7 @@ TEST(ConfigErrors, RangedIntegerChecksBeforeNarrowing) {
 
 TEST(ConfigErrors, SceneMustBeARegularFileAndAFifoDoesNotBlock) {
   // Regression (issue 13): a FIFO as scene blocked forever in open(); now refused at once.
-  const auto fifo = std::filesystem::temp_directory_path() / "delayspec_test_config_fifo.toml";
-  std::filesystem::remove(fifo);
+  const auto fifo = delayspec::testing::scratch_path("config_fifo.toml");
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   const std::string m = bad_input_message([&] { Config::from_scene_file(fifo.string()); });
   EXPECT_TRUE(contains(m, "not a regular file")) << m;

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "cli/run_cli.hpp"
+#include "scratch_dir.hpp"
 #include "text_support.hpp"
 
 namespace delayspec::testing {
@@ -20,14 +21,8 @@ struct CliResult {
   std::string out, err;
 };
 
-// A scratch path for one test, removed first and not created: the temporary directory's
-// delayspec_test_NAME_PID (per process: ctest -j runs the cases of a parameterised test at once).
-inline std::filesystem::path fresh_dir(const std::string& name) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("delayspec_test_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  return dir;
-}
+// A scratch folder for one test, removed first and not created (scratch_dir.hpp).
+inline std::filesystem::path fresh_dir(const std::string& name) { return scratch_path(name); }
 
 // `args` without the program name, e.g. {"floquet", scene, "--json", "--set", "N=40"}.
 inline CliResult run(std::vector<std::string> args) {

@@ -114,10 +114,13 @@ BoundaryRun read_boundary_run(Config& config) {
 
 // The test function of `type` at (x, y) at one N: the scene with both keys set, its orbit and
 // leading multipliers. A nonlinear model's orbit is found by Newton from the last one found.
+// `traced`: the function of the curve followed (the finest N), whose samples also carry where it
+// meets a curve of the other kind (boundary.hpp): on a grazing curve this needs the multipliers
+// too; the coarser levels only place their curves.
 class TestFunctionAt {
  public:
-  TestFunctionAt(const Config& base, const BoundaryRun& run, BifurcationType type, int N)
-      : base_(base), run_(run), type_(type), orbit_settings_(run.orbit_settings) {
+  TestFunctionAt(const Config& base, const BoundaryRun& run, BifurcationType type, int N, bool traced = false)
+      : base_(base), run_(run), type_(type), traced_(traced), orbit_settings_(run.orbit_settings) {
     base_.set("N", std::to_string(N), "boundary_Ns");
     // From the last point's orbit: one Newton step even when it meets the tolerance (orbit_newton.hpp)
     orbit_settings_.newton.min_iterations = 1;
@@ -155,8 +158,17 @@ class TestFunctionAt {
     const bool grazing = type_ == BifurcationType::grazing;
     if (grazing) map.step.fixed_region = 2;
     const LinearisedOrbit at = p.analyses->linearised_orbit(map, orbit_settings_, request);
-    // (grazing: max H alone; no multipliers)
-    const FloquetResult r = grazing ? FloquetResult{} : floquet_multipliers(*at.monodromy, run_.floquet);
+    // Grazing: max H, and on the traced curve the multipliers, where the eigensolver converges (a
+    // failure there only hides where the curve meets a stability curve).
+    FloquetResult r;
+    if (!grazing) {
+      r = floquet_multipliers(*at.monodromy, run_.floquet);
+    } else if (traced_) {
+      try {
+        r = floquet_multipliers(*at.monodromy, run_.floquet);
+      } catch (const NumericalFailure&) {
+      }
+    }
     if (at.sequence.size() > 0) last_orbit_ = at.sequence;
     return boundary_sample(type_, r.multipliers, at.contacts.max_H);
   }
@@ -168,6 +180,7 @@ class TestFunctionAt {
   Config base_;
   const BoundaryRun& run_;
   BifurcationType type_;
+  bool traced_;
   OrbitSettings orbit_settings_;
   mutable Eigen::VectorXd last_orbit_;
 };
@@ -286,7 +299,7 @@ struct Outcome {
 Outcome compute_boundary(const Config& config, const BoundaryRun& run, const Invocation& inv) {
   Outcome out;
   out.stable_below = follow_starts(config, run, out.curves, out.types, [&](const Start& start) {
-    const TestFunctionAt finest(config, run, start.type, run.Ns.back());
+    const TestFunctionAt finest(config, run, start.type, run.Ns.back(), true);
     return trace_boundary_both_ways(std::cref(finest), run.options, start.x, start.y);
   });
   long points = 0;
