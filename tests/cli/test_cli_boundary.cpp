@@ -308,12 +308,16 @@ TEST(BoundaryCli, TheGrazingCurveMeetsTheFreeFlightStabilityCurveAtTheExactGain)
   };
   const auto coarse = meeting(100), fine = meeting(200);
   EXPECT_EQ(fine["kind"], "grazing meets neimark-sacker");
-  const double miss_coarse = std::abs(coarse["x"].get<double>() - k_star);
-  const double miss_fine = std::abs(fine["x"].get<double>() - k_star);
-  EXPECT_LT(miss_fine, 1e-3 * std::abs(k_star)) << fine;
-  EXPECT_NEAR(std::log2(miss_coarse / miss_fine), 2.0, 0.2) << coarse << " " << fine;  // O(h^2)
-  EXPECT_NEAR(fine["angle"].get<double>(), angle, 1e-3) << fine;
-  // On the grazing curve: a(k) = e |1 - w^2 + i w (2 zeta + 2 k)| / w^2 (the test above), to O(h^2)
+  // O(h^2) in the gain and in the angle (measured: k off by 2.2e-6 and 5.6e-7, the angle by 9.7e-4
+  // and 2.4e-4, at N = 100 and 200; located to 5e-12 in k, far below).
+  const auto order = [&](const char* field, double exact) {
+    return std::log2(std::abs(coarse[field].get<double>() - exact) / std::abs(fine[field].get<double>() - exact));
+  };
+  EXPECT_NEAR(order("x", k_star), 2.0, 0.2) << coarse << " " << fine;
+  EXPECT_NEAR(order("angle", angle), 2.0, 0.2) << coarse << " " << fine;
+  EXPECT_LT(std::abs(fine["x"].get<double>() - k_star), 1e-4 * std::abs(k_star)) << fine;
+  // On the grazing curve: a(k) = e |1 - w^2 + i w (2 zeta + 2 k)| / w^2, to the curve's O(h^2)
+  // (1.5e-5 at N = 400 in the test above, so about 6e-5 at N = 200)
   EXPECT_NEAR(fine["y"].get<double>(), impact_grazing_amplitude(1.5, w, zeta, fine["x"].get<double>()), 1e-4);
 }
 
