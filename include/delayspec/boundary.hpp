@@ -29,7 +29,9 @@
 // (the point on the range's edge); at a codim-2 point where a Neimark-Sacker curve's critical
 // pair reaches the real axis (angle 0: 1:1 resonance, angle pi: 1:2 resonance, meeting a fold or
 // period-doubling curve), found as the end of the curve's definition with the last angle within
-// 0.05 rad of 0 or pi; after max_points; or at a failure (step below step_min), named.
+// 0.05 rad of 0 or pi, and on a fold or period-doubling curve at a 1:1 or 1:2 resonance, found as
+// its end with a second multiplier within 0.05 of +1 or -1 (second_gap); after max_points; or at a
+// failure (step below step_min), named.
 //
 // Where a grazing curve meets a stability curve (a codim-2 point the curve passes, not an end):
 // found on either curve by the sign change, between two accepted points, of the other kind's test
@@ -62,6 +64,10 @@ struct BoundarySample {
   double other = NAN;
   BifurcationType other_type = BifurcationType::grazing;
   double other_angle = NAN;
+  // On a fold or period-doubling curve: the distance from the next multiplier to the critical
+  // point (+1 or -1). Small where a second real multiplier meets the critical one there, the 1:1
+  // or 1:2 resonance such a curve can end at (its angle is 0 or pi everywhere, so says nothing).
+  double second_gap = NAN;
 };
 using BoundaryFunction = std::function<BoundarySample(double x, double y)>;
 

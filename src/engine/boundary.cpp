@@ -45,6 +45,18 @@ BoundarySample boundary_sample(BifurcationType type, const std::vector<std::comp
   if (s.defined) s.angle = std::abs(std::arg(critical));
   else s.reason = "no " + to_string(type) + " candidate among the " + std::to_string(multipliers.size()) +
                   " leading multipliers";
+  if (s.defined && type != BifurcationType::neimark_sacker) {
+    const double target = type == BifurcationType::fold ? 1.0 : -1.0;
+    bool skipped = false;  // the critical multiplier itself, once
+    for (const std::complex<double>& mu : multipliers) {
+      if (!skipped && mu == critical) {
+        skipped = true;
+        continue;
+      }
+      const double gap = std::abs(mu - target);
+      if (!(gap >= s.second_gap)) s.second_gap = gap;  // (NaN at first)
+    }
+  }
   s.other = std::isfinite(max_H) ? max_H : NAN;
   s.other_type = type;
   s.other_angle = s.angle;
@@ -270,11 +282,15 @@ std::optional<CurveState> next_point(const ScaledCurve& scaled, const CurveState
 }
 
 // The end of a curve that cannot go on from `last` (step below step_min): a codim-2 point where a
-// critical pair met the real axis (the last angle within 0.05 of 0 or pi), else a failure.
+// critical pair met the real axis (the last angle within 0.05 of 0 or pi), else a failure. On a
+// fold or period-doubling curve the angle is 0 or pi throughout: there the resonance also needs a
+// second multiplier within 0.05 of the critical point (two real multipliers meeting at +1 or -1).
 void end_where_it_stops(BoundaryCurve& curve, const ScaledCurve& scaled, const CurveState& last,
                         const std::string& reason) {
   const double angle = last.sample.angle, x = scaled.x(last.X), y = scaled.y(last.X);
-  if (std::isfinite(angle) && (angle < 0.05 || angle > std::numbers::pi - 0.05)) {
+  const bool pair = last.sample.other_type == BifurcationType::neimark_sacker;
+  if (std::isfinite(angle) && (angle < 0.05 || angle > std::numbers::pi - 0.05) &&
+      (pair || last.sample.second_gap < 0.05)) {
     const bool one_to_one = angle < 0.05;
     curve.codim2.push_back({one_to_one ? "1:1 resonance" : "1:2 resonance", x, y, angle});
     curve.end = BoundaryEnd::codim2;

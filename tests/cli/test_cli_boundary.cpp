@@ -14,6 +14,7 @@
 // - bad input (exit 2) and no bifurcation at the start (exit 3 with what was found).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <filesystem>
@@ -319,6 +320,43 @@ TEST(BoundaryCli, TheGrazingCurveMeetsTheFreeFlightStabilityCurveAtTheExactGain)
   // On the grazing curve: a(k) = e |1 - w^2 + i w (2 zeta + 2 k)| / w^2, to the curve's O(h^2)
   // (1.5e-5 at N = 400 in the test above, so about 6e-5 at N = 200)
   EXPECT_NEAR(fine["y"].get<double>(), impact_grazing_amplitude(1.5, w, zeta, fine["x"].get<double>()), 1e-4);
+}
+
+// A period-doubling curve whose follower stops is a failure unless it stops at a 1:2 resonance,
+// where a second multiplier meets the critical one at -1. (Its angle is pi all along, which alone
+// made every stop a "1:2 resonance", exit 0.) The impact orbit's period-doubling curve near its
+// grazing, at N = 100, stops at k = 0.0037; floquet there, run apart, has its second multiplier
+// far from -1 (-0.82). The milling lobes' flip curves, which do end at 1:2 points (two real
+// multipliers meeting at -1), keep their resonances: the scan test above and docs/milling.md.
+TEST(BoundaryCli, APeriodDoublingCurveThatStopsAwayFromA12ResonanceIsAFailure) {
+  const std::vector<std::string> impact = {"--set", "model=impact", "--set", "tau_over_T=0.5", "--set", "e=1.5",
+                                           "--set", "N=100"};
+  std::vector<std::string> args = {"boundary", "--json"};
+  args.insert(args.end(), impact.begin(), impact.end());
+  const CliResult r = run(with_sets(args, {"boundary_x=k", "boundary_y=a", "boundary_x_from=0", "boundary_x_to=0.2",
+                                           "boundary_y_from=0.5", "boundary_y_to=1.5",
+                                           "boundary_type=period-doubling", "boundary_Ns=100"}));
+  ASSERT_EQ(r.status, 3) << r.out << r.err;
+  EXPECT_FALSE(contains(r.err, "resonance")) << r.err;
+  // "... at x = K, y = A: no period-doubling candidate ...": the point as printed (every digit: the
+  // multipliers there change fast, two real ones turning complex within 1e-6 in a)
+  const size_t x_at = r.err.find("at x = "), y_at = r.err.find(", y = ", x_at);
+  ASSERT_TRUE(x_at != std::string::npos && y_at != std::string::npos) << r.err;
+  const std::string k = r.err.substr(x_at + 7, y_at - x_at - 7);
+  const std::string a = r.err.substr(y_at + 6, r.err.find(':', y_at) - y_at - 6);
+  EXPECT_TRUE(contains(r.err, "no period-doubling candidate")) << r.err;
+  args = {"floquet", "--json"};
+  args.insert(args.end(), impact.begin(), impact.end());
+  const CliResult f = run(with_sets(args, {"k=" + k, "a=" + a, "nev=4"}));
+  ASSERT_EQ(f.status, 0) << f.err;
+  const auto mu = nlohmann::json::parse(f.out)["multipliers"];
+  // the two nearest -1 (one of them the critical one, within 0.05 of it: the curve's last point)
+  std::vector<double> gaps;
+  for (const auto& m : mu) gaps.push_back(std::abs(std::complex<double>(m["re"], m["im"]) + 1.0));
+  std::sort(gaps.begin(), gaps.end());
+  ASSERT_GE(gaps.size(), 2u);
+  EXPECT_LT(gaps[0], 0.05);
+  EXPECT_GT(gaps[1], 0.1);
 }
 
 TEST(BoundaryCli, BadInputAndNoBifurcationAtTheStart) {
