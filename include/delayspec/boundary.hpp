@@ -116,7 +116,11 @@ struct BoundaryCurve {
 // located it). BadInput: an empty range, a step <= 0, step_min > step_max, max_points < 2;
 // NumericalFailure: g undefined at the start, or the start not on the curve (|correction| above
 // 1e-6 of the range).
-BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options);
+// `at_points`, when given: the test function at the curve's own points (each accepted point, and
+// each located on it), in place of g there: g with what only those points need (a grazing curve's
+// multipliers, for BoundarySample::other), never evaluated for gradients or corrector iterations.
+BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options,
+                             const BoundaryFunction* at_points = nullptr);
 
 // The curve through (x_start, y_start), a point on it with x_start in [x_from, x_to] of `whole`:
 // traced from there to x_to and, when it starts inside the range, also back to x_from, the two
@@ -124,7 +128,7 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
 // or a resonance before a range's edge). Steps and tolerance are those of the whole range's scaled
 // plane. A curve that comes back to its start (closed) is traced once.
 BoundaryCurve trace_boundary_both_ways(const BoundaryFunction& g, const BoundaryOptions& whole, double x_start,
-                                       double y_start);
+                                       double y_start, const BoundaryFunction* at_points = nullptr);
 
 // Whether (x, y) lies on one of the curves: within `y_tolerance` of a segment's y at that x.
 bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, double y, double y_tolerance);

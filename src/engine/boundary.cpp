@@ -73,20 +73,14 @@ double norm(const Vec2& a) { return std::sqrt(dot(a, a)); }
 // The curve in the scaled plane: g at a scaled point, counted.
 class ScaledCurve {
  public:
-  ScaledCurve(const BoundaryFunction& g, const BoundaryOptions& o, long& evaluations)
-      : g_(g), o_(o), evaluations_(evaluations) {}
+  ScaledCurve(const BoundaryFunction& g, const BoundaryFunction* at_points, const BoundaryOptions& o,
+              long& evaluations)
+      : g_(g), at_points_(at_points ? *at_points : g), o_(o), evaluations_(evaluations) {}
   double x(const Vec2& X) const { return o_.x_from + X[0] * (o_.x_to - o_.x_from); }
   double y(const Vec2& X) const { return o_.y_from + X[1] * (o_.y_to - o_.y_from); }
-  BoundarySample at(const Vec2& X) const {
-    ++evaluations_;
-    try {
-      return g_(x(X), y(X));
-    } catch (const NumericalFailure& e) {
-      BoundarySample s;
-      s.reason = e.what();
-      return s;
-    }
-  }
+  BoundarySample at(const Vec2& X) const { return evaluate(g_, X); }
+  // At a point of the curve (trace_boundary's at_points).
+  BoundarySample at_point(const Vec2& X) const { return evaluate(at_points_, X); }
   // grad g at X (g(X) = g0 known) by forward differences; nullopt where g is undefined.
   std::optional<Vec2> gradient(const Vec2& X, double g0, std::string& reason) const {
     constexpr double kDelta = 1e-7;
@@ -109,7 +103,18 @@ class ScaledCurve {
   }
 
  private:
+  BoundarySample evaluate(const BoundaryFunction& f, const Vec2& X) const {
+    ++evaluations_;
+    try {
+      return f(x(X), y(X));
+    } catch (const NumericalFailure& e) {
+      BoundarySample s;
+      s.reason = e.what();
+      return s;
+    }
+  }
   const BoundaryFunction& g_;
+  const BoundaryFunction& at_points_;
   const BoundaryOptions& o_;
   long& evaluations_;
 };
@@ -169,7 +174,7 @@ std::optional<CurveState> correct(const ScaledCurve& curve, Vec2 X, const Vec2& 
     if (norm(dX) <= tolerance) {
       CurveState state;
       state.X = X;
-      state.sample = curve.at(X);
+      state.sample = curve.at_point(X);
       if (!state.sample.defined) {
         reason = state.sample.reason;
         return std::nullopt;
@@ -366,7 +371,8 @@ struct ResonanceWatch {
 
 }  // namespace
 
-BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options) {
+BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const BoundaryOptions& options,
+                             const BoundaryFunction* at_points) {
   const BoundaryOptions& o = options;
   if (!std::isfinite(o.x_from) || !std::isfinite(o.x_to) || o.x_from == o.x_to)
     throw BadInput("boundary: the x range is empty or not finite");
@@ -377,7 +383,7 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
   if (o.max_points < 2) throw BadInput("boundary: max_points must be >= 2");
 
   BoundaryCurve curve;
-  const ScaledCurve scaled(g, o, curve.evaluations);
+  const ScaledCurve scaled(g, at_points, o, curve.evaluations);
   const auto add_point = [&](const CurveState& s) {
     curve.points.push_back({scaled.x(s.X), scaled.y(s.X), s.sample.angle, s.iterations});
   };
@@ -417,14 +423,14 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
 }
 
 BoundaryCurve trace_boundary_both_ways(const BoundaryFunction& g, const BoundaryOptions& whole, double x_start,
-                                       double y_start) {
+                                       double y_start, const BoundaryFunction* at_points) {
   const auto half = [&](double x_end) {
     BoundaryOptions o = whole;
     o.x_from = x_start;
     o.x_to = x_end;
     const double factor = std::abs(whole.x_to - whole.x_from) / std::abs(x_end - x_start);
     o.step *= factor, o.step_min *= factor, o.step_max *= factor, o.tolerance *= factor;
-    return trace_boundary(g, y_start, o);
+    return trace_boundary(g, y_start, o, at_points);
   };
   const double edge = 1e-12 * std::abs(whole.x_to - whole.x_from);
   const bool forward = std::abs(whole.x_to - x_start) > edge, backward = std::abs(x_start - whole.x_from) > edge;

@@ -114,18 +114,21 @@ BoundaryRun read_boundary_run(Config& config) {
 
 // The test function of `type` at (x, y) at one N: the scene with both keys set, its orbit and
 // leading multipliers. A nonlinear model's orbit is found by Newton from the last one found.
-// `traced`: the function of the curve followed (the finest N), whose samples also carry where it
-// meets a curve of the other kind (boundary.hpp): on a grazing curve this needs the multipliers
-// too; the coarser levels only place their curves.
+// at_point: at a point of the traced curve, whose sample also carries where it meets a curve of
+// the other kind (boundary.hpp's at_points): on a grazing curve this needs the multipliers too.
 class TestFunctionAt {
  public:
-  TestFunctionAt(const Config& base, const BoundaryRun& run, BifurcationType type, int N, bool traced = false)
-      : base_(base), run_(run), type_(type), traced_(traced), orbit_settings_(run.orbit_settings) {
+  TestFunctionAt(const Config& base, const BoundaryRun& run, BifurcationType type, int N)
+      : base_(base), run_(run), type_(type), orbit_settings_(run.orbit_settings) {
     base_.set("N", std::to_string(N), "boundary_Ns");
     // From the last point's orbit: one Newton step even when it meets the tolerance (orbit_newton.hpp)
     orbit_settings_.newton.min_iterations = 1;
   }
-  BoundarySample operator()(double x, double y) const {
+  BoundarySample operator()(double x, double y) const { return evaluate(x, y, false); }
+  BoundarySample at_point(double x, double y) const { return evaluate(x, y, true); }
+
+ private:
+  BoundarySample evaluate(double x, double y, bool on_curve) const {
     Config c = base_;
     c.set(run_.x_key, format_number(x), "boundary");
     c.set(run_.y_key, format_number(y), "boundary");
@@ -133,11 +136,11 @@ class TestFunctionAt {
       const Problem p = read_problem(c, 100);
       if (last_orbit_.size() > 0) {
         try {
-          return sample(p, &last_orbit_);
+          return sample(p, &last_orbit_, on_curve);
         } catch (const NumericalFailure&) {  // Newton from the last orbit: the search from scratch below
         }
       }
-      return sample(p, nullptr);
+      return sample(p, nullptr, on_curve);
     } catch (const BadInput& e) {  // a value the model rejects
       return undefined(e.what());
     } catch (const NumericalFailure& e) {  // an orbit or an eigensolver that fails
@@ -145,10 +148,9 @@ class TestFunctionAt {
     }
   }
 
- private:
   // The test function on the orbit found by Newton from `guess` (the last orbit found), or
   // (nullptr) by the orbit search of the scene's settings.
-  BoundarySample sample(const Problem& p, const Eigen::VectorXd* guess) const {
+  BoundarySample sample(const Problem& p, const Eigen::VectorXd* guess, bool on_curve) const {
     OrbitRequest request;
     request.sequence = !p.analyses->is_linear();
     request.newton_guess = guess;
@@ -158,12 +160,12 @@ class TestFunctionAt {
     const bool grazing = type_ == BifurcationType::grazing;
     if (grazing) map.step.fixed_region = 2;
     const LinearisedOrbit at = p.analyses->linearised_orbit(map, orbit_settings_, request);
-    // Grazing: max H, and on the traced curve the multipliers, where the eigensolver converges (a
-    // failure there only hides where the curve meets a stability curve).
+    // Grazing: max H, and at a point of the curve the multipliers, where the eigensolver converges
+    // (a failure there only hides where the curve meets a stability curve).
     FloquetResult r;
     if (!grazing) {
       r = floquet_multipliers(*at.monodromy, run_.floquet);
-    } else if (traced_) {
+    } else if (on_curve) {
       try {
         r = floquet_multipliers(*at.monodromy, run_.floquet);
       } catch (const NumericalFailure&) {
@@ -180,7 +182,6 @@ class TestFunctionAt {
   Config base_;
   const BoundaryRun& run_;
   BifurcationType type_;
-  bool traced_;
   OrbitSettings orbit_settings_;
   mutable Eigen::VectorXd last_orbit_;
 };
@@ -299,8 +300,9 @@ struct Outcome {
 Outcome compute_boundary(const Config& config, const BoundaryRun& run, const Invocation& inv) {
   Outcome out;
   out.stable_below = follow_starts(config, run, out.curves, out.types, [&](const Start& start) {
-    const TestFunctionAt finest(config, run, start.type, run.Ns.back(), true);
-    return trace_boundary_both_ways(std::cref(finest), run.options, start.x, start.y);
+    const TestFunctionAt finest(config, run, start.type, run.Ns.back());
+    const BoundaryFunction at_points = [&finest](double x, double y) { return finest.at_point(x, y); };
+    return trace_boundary_both_ways(std::cref(finest), run.options, start.x, start.y, &at_points);
   });
   long points = 0;
   for (const BoundaryCurve& c : out.curves) points += static_cast<long>(c.points.size());
