@@ -106,7 +106,7 @@ static void BM_Compile(benchmark::State& state) {
   const std::filesystem::path dir = cache_dir() + "-compile";
   std::filesystem::remove_all(dir);
   const cli::EquationModelSource source = cli::generate_equation_model(toml::parse(table), cli::engine_keys(cli::key_index()));
-  for (auto _ : state) cli::load_equation_plugin(source.code, dir, {table, ""});
+  for (auto _ : state) cli::load_equation_plugin(source.code, source.shape, dir, {table, ""});
   std::filesystem::remove_all(dir);
 }
 BENCHMARK(BM_Compile)->Iterations(1)->Unit(benchmark::kSecond);

@@ -244,7 +244,7 @@ history = { x = "1" }
   EXPECT_EQ(source.state, std::vector<std::string>{"x"});
   EXPECT_EQ(source.parameters, std::vector<std::string>{"a"});
   EXPECT_EQ(source.parameter_defaults, std::vector<double>{-1});
-  EXPECT_TRUE(mentions(source.code, "struct EquationModel"));
+  EXPECT_TRUE(mentions(source.code, "kFunctions"));
 }
 
 }  // namespace

@@ -77,13 +77,17 @@ TEST(EquationModelSource, ImpactSceneIsAStateSwitchWithContinuousFields) {
   EXPECT_EQ(s.parameter_defaults, (std::vector<double>{0.7, 28, 1.26, 0.55, 0.802, 0.01}));
   EXPECT_TRUE(s.switches_in_state);
   EXPECT_FALSE(s.switches_in_time);
+  EXPECT_EQ(s.shape, (delayspec::ModelShape{2, 1, delayspec::ModelSwitching::state, false, true, false}));
   for (const char* line :
-       {"static constexpr int d = 2;", "static constexpr int parameter_count = 6;",
-        "static constexpr bool has_switching = true;", "static constexpr bool has_time_switches = false;",
-        "static constexpr bool affine_in_state = true;", "static constexpr bool is_linear = false;", "double H(",
-        "Vector grad_H(", "Vector f_t(", "Vector f_tt(", "Matrix A(", "Matrix B("})
+       {"constexpr int d = 2;", "constexpr int parameter_count = 6;",
+        "constexpr delayspec::ModelShape kShape{d, 1, delayspec::ModelSwitching::state, false, true, false};",
+        "static double H(", "static void grad_H(", "static void f_t(", "static void f_tt(", "static void A(",
+        "static void B(", "kFunctions = {f, A, B, f_t, f_tt, H, grad_H, nullptr};"})
     EXPECT_TRUE(contains(s.code, line)) << line << "\n" << s.code;
-  EXPECT_FALSE(contains(s.code, "time_segment"));
+  EXPECT_FALSE(contains(s.code, "switch_value"));
+  // A column by column: row 1 of the contact field is -1 - beta in column 0 (index 1 + 2 * 0)
+  // and -2 zeta - k in column 1 (index 3); A(0, 1) = 1 is index 2.
+  EXPECT_TRUE(contains(s.code, "    r[2] = 1.0;")) << s.code;
 }
 
 TEST(EquationModelSource, TwoOscillatorSceneIsSmoothOfDimensionFour) {
@@ -91,8 +95,10 @@ TEST(EquationModelSource, TwoOscillatorSceneIsSmoothOfDimensionFour) {
   EXPECT_EQ(s.state.size(), 4u);
   EXPECT_FALSE(s.switches_in_state);
   EXPECT_FALSE(s.switches_in_time);
-  EXPECT_TRUE(contains(s.code, "static constexpr int d = 4;"));
+  EXPECT_EQ(s.shape, (delayspec::ModelShape{4, 1, delayspec::ModelSwitching::none, false, false, false}));
+  EXPECT_TRUE(contains(s.code, "constexpr int d = 4;"));
   EXPECT_FALSE(contains(s.code, "double H("));
+  EXPECT_TRUE(contains(s.code, "kFunctions = {f, A, B, nullptr, nullptr, nullptr, nullptr, nullptr};")) << s.code;
 }
 
 TEST(EquationModelSource, FlagsFollowTheSecondDerivatives) {
@@ -149,9 +155,8 @@ TEST(EquationModelSource, AStateSwitchIsNeverLinearAndATimeSwitchMayBe) {
   const EquationModelSource s = generate_equation_model(window, kEngineKeys);
   EXPECT_TRUE(s.switches_in_time);
   EXPECT_FALSE(s.switches_in_state);
-  for (const char* line : {"static constexpr bool has_switching = false;",
-                           "static constexpr bool has_time_switches = true;", "static constexpr bool is_linear = true;",
-                           "int time_segment(double t) const", "double next_time_switch(double t0, double t1) const"})
+  EXPECT_EQ(s.shape, (delayspec::ModelShape{1, 1, delayspec::ModelSwitching::time, false, true, true}));
+  for (const char* line : {"static double switch_value(", "nullptr, nullptr, nullptr, nullptr, switch_value};"})
     EXPECT_TRUE(contains(s.code, line)) << line << "\n" << s.code;
   EXPECT_FALSE(contains(s.code, "grad_H"));
 }
@@ -160,8 +165,7 @@ TEST(EquationModelSource, NoParametersGiveAnEmptyArray) {
   toml::table table{{"state", toml::array{"x"}}, {"period", "2*pi"}, {"rhs", toml::array{"-x + x_tau/2"}}};
   const EquationModelSource s = generate_equation_model(table, kEngineKeys);
   EXPECT_TRUE(s.parameters.empty());
-  EXPECT_TRUE(contains(s.code, "static constexpr int parameter_count = 0;"));
-  EXPECT_TRUE(contains(s.code, "std::array<double, parameter_count> p{};"));
+  EXPECT_TRUE(contains(s.code, "constexpr int parameter_count = 0;"));
   // delay defaults to the period
   const SymbolicEquationModel m = analyse_equations(table, kEngineKeys);
   ASSERT_EQ(m.delays.size(), 1u);

@@ -1,4 +1,4 @@
-// The run-time compilation of a model (equation_plugin.hpp), on a struct written here by hand in
+// The run-time compilation of a model (equation_plugin.hpp), on functions written here by hand in
 // the form the equation printer emits: x' = a x + b x(t - tau), the built-in linear model. What
 // is checked: the loaded analyses give the built-in model's multipliers; a second load is a
 // cache hit (counted compilations, not a clock), and so is a later run of the same table found by
@@ -16,38 +16,29 @@
 #include "delayspec/builtin_analyses.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
+#include "delayspec/prebuilt_shapes.hpp"
 #include "scene/equations/equation_plugin.hpp"
 
 namespace delayspec::cli {
 namespace {
 
 // What equation_model_source prints for state x, parameters (a, b), period 1, delay 1, rhs
-// a*x + b*x_tau, history x = 1.
-const char* kLinearCode = R"(struct EquationModel {
-  static constexpr int d = 1;
-  static constexpr int parameter_count = 2;
-  static constexpr bool has_switching = false;
-  static constexpr bool has_time_switches = false;
-  static constexpr bool affine_in_state = true;
-  static constexpr bool is_linear = true;
-  using Vector = delayspec::Vec<d>;
-  using Matrix = delayspec::Mat<d>;
-  std::array<double, parameter_count> p{};
-  double tau_ = 0, period_ = 0;
-  Vector history_ = Vector::Zero();
-  static double period_of(const double*) { return 1.0; }
-  static void delays_of(const double*, double* taus) { taus[0] = 1.0; }
-  void set_delays(const double* taus) { tau_ = taus[0]; }
-  static Vector history_of(const double*) { return Vector(1.0); }
-  double tau() const { return tau_; }
-  double period() const { return period_; }
-  Vector initial_state() const { return history_; }
-  Vector f(int, double, const Vector& y, const Vector& z) const { return Vector(p[0] * y[0] + p[1] * z[0]); }
-  Matrix A(int, double, const Vector&, const Vector&) const { return Matrix::Constant(p[0]); }
-  Matrix B(int, double, const Vector&, const Vector&) const { return Matrix::Constant(p[1]); }
-  Vector f_t(int, double, const Vector&, const Vector&) const { return Vector::Zero(); }
-  Vector f_tt(int, double, const Vector&, const Vector&) const { return Vector::Zero(); }
-};)";
+// a*x + b*x_tau, history x = 1 (model_functions.hpp), with the shape `shape`.
+std::string linear_code(const char* shape) {
+  return std::string("constexpr int d = 1;\nconstexpr int parameter_count = 2;\n") +
+         "constexpr delayspec::ModelShape kShape" + shape + ";\n" + R"(
+static double period_of(const double*) { return 1.0; }
+static void delays_of(const double*, double* taus) { taus[0] = 1.0; }
+static void history_of(const double*, double* r) { r[0] = 1.0; }
+static void f(int, double, const double* y, const double* z, const double* p, double* r) { r[0] = p[0] * y[0] + p[1] * z[0]; }
+static void A(int, double, const double*, const double*, const double* p, double* r) { r[0] = p[0]; }
+static void B(int, double, const double*, const double*, const double* p, double* r) { r[0] = p[1]; }
+const delayspec::ModelFunctions kFunctions = {f, A, B, nullptr, nullptr, nullptr, nullptr, nullptr};
+)";
+}
+// Linear and autonomous: a shape of prebuilt_shapes.hpp (the unit is the functions alone).
+const ModelShape kPrebuilt{1, 1, ModelSwitching::none, true, true, true};
+const std::string kLinearCode = linear_code("{1, 1, delayspec::ModelSwitching::none, true, true, true}");
 
 // The table the code came from and what the scene layer keeps of it (here only its form matters).
 const TableRecord kRecord{"state = [ 'x' ]\nrhs = [ 'a*x + b*x_tau' ]", "state x\n"};
@@ -76,8 +67,15 @@ std::vector<std::complex<double>> leading(const ModelAnalyses& analyses, int N) 
 TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInASecondLoadIsACacheHitAndItsTableFindsIt) {
   EXPECT_FALSE(found_equation_plugin(kRecord.table_text, cache_));  // (an empty cache)
   const long before = equation_plugin_compilations();
-  const EquationPlugin plugin = load_equation_plugin(kLinearCode, cache_, kRecord);
+  const EquationPlugin plugin = load_equation_plugin(kLinearCode, kPrebuilt, cache_, kRecord);
   EXPECT_EQ(equation_plugin_compilations(), before + 1);
+  {  // a prebuilt shape: the unit is the functions, and the analyses come from libdelayspec_prebuilt
+    std::filesystem::path unit = plugin.object;
+    std::ifstream in(unit.replace_extension(".cpp"));
+    const std::string source(std::istreambuf_iterator<char>(in), {});
+    EXPECT_NE(source.find("delayspec::prebuilt_model_analyses(kShape"), std::string::npos) << source;
+    EXPECT_EQ(source.find("model_analyses.hpp"), std::string::npos) << source;
+  }
   const double p[2] = {-1.0, 0.5};
   EXPECT_EQ(plugin.period(p), 1.0);
   double tau = 0;
@@ -100,7 +98,7 @@ TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInASecondLoadIsACacheHitAndI
   // the compiled expressions, a few ulp per entry).
   for (size_t k = 0; k < a.size(); ++k) EXPECT_LE(std::abs(a[k] - b[k]), 1e-14 * std::abs(b[0])) << k;
 
-  const EquationPlugin again = load_equation_plugin(kLinearCode, cache_, kRecord);
+  const EquationPlugin again = load_equation_plugin(kLinearCode, kPrebuilt, cache_, kRecord);
   EXPECT_EQ(equation_plugin_compilations(), before + 1);  // the cached object, not a compilation
   EXPECT_EQ(again.object, plugin.object);
 
@@ -132,13 +130,38 @@ TEST_F(EquationPluginTest, LoadedModelEqualsTheBuiltInASecondLoadIsACacheHitAndI
   EXPECT_FALSE(found_equation_plugin(kRecord.table_text, cache_));
 }
 
+TEST_F(EquationPluginTest, AShapeThatIsNotPrebuiltCompilesWholeAndGivesTheSameMultipliers) {
+  // The same model declared forced (autonomous = false): no prebuilt shape, so its unit
+  // instantiates the analyses of FunctionModel itself. The multipliers are those of the prebuilt
+  // shape's analyses to the last bit (the same template over the same functions) and the
+  // built-in model's to rounding (see above).
+  const ModelShape forced{1, 1, ModelSwitching::none, false, true, true};
+  ASSERT_FALSE(is_prebuilt_shape(forced));
+  const EquationPlugin whole =
+      load_equation_plugin(linear_code("{1, 1, delayspec::ModelSwitching::none, false, true, true}"), forced, cache_, kRecord);
+  const EquationPlugin prebuilt = load_equation_plugin(kLinearCode, kPrebuilt, cache_, kRecord);
+  const double p[2] = {-1.0, 0.5}, y0 = 1, tau = 1;
+  const std::unique_ptr<ModelAnalyses> a(whole.analyses(p, &tau, 1, &y0)), b(prebuilt.analyses(p, &tau, 1, &y0));
+  EXPECT_FALSE(a->is_autonomous());
+  EXPECT_TRUE(b->is_autonomous());
+  const auto from_whole = leading(*a, 64), from_prebuilt = leading(*b, 64);
+  ASSERT_EQ(from_whole.size(), from_prebuilt.size());
+  for (size_t k = 0; k < from_whole.size(); ++k) EXPECT_EQ(from_whole[k], from_prebuilt[k]) << k;
+  LinearParameters lp;
+  lp.a = -1;
+  lp.b = 0.5;
+  const auto builtin = leading(*builtin_analyses(LinearModel(lp)), 64);
+  for (size_t k = 0; k < builtin.size(); ++k)
+    EXPECT_LE(std::abs(from_whole[k] - builtin[k]), 1e-14 * std::abs(builtin[0])) << k;
+}
+
 TEST_F(EquationPluginTest, ConcurrentFirstLoadsCompileOnce) {
   // Another source (a comment differs) than the other tests: a new cache entry.
   const std::string code = std::string("// concurrent\n") + kLinearCode;
   const long before = equation_plugin_compilations();
   EquationPlugin first, second;
-  std::thread t1([&] { first = load_equation_plugin(code, cache_, kRecord); });
-  std::thread t2([&] { second = load_equation_plugin(code, cache_, kRecord); });
+  std::thread t1([&] { first = load_equation_plugin(code, kPrebuilt, cache_, kRecord); });
+  std::thread t2([&] { second = load_equation_plugin(code, kPrebuilt, cache_, kRecord); });
   t1.join();
   t2.join();
   EXPECT_EQ(equation_plugin_compilations(), before + 1);
@@ -153,9 +176,10 @@ TEST_F(EquationPluginTest, TwoModelsInOneProcessAreTwoObjects) {
   // and get the first model's code (it did, with the descriptor closed after loading).
   std::string other = kLinearCode;
   const std::string period = "static double period_of(const double*) { return 1.0; }";
+  ASSERT_NE(other.find(period), std::string::npos);
   other.replace(other.find(period), period.size(), "static double period_of(const double*) { return 2.0; }");
-  const EquationPlugin first = load_equation_plugin(kLinearCode, cache_, kRecord);
-  const EquationPlugin second = load_equation_plugin(other, cache_, kRecord);
+  const EquationPlugin first = load_equation_plugin(kLinearCode, kPrebuilt, cache_, kRecord);
+  const EquationPlugin second = load_equation_plugin(other, kPrebuilt, cache_, kRecord);
   const double p[2] = {-1.0, 0.5};
   EXPECT_EQ(first.period(p), 1.0);
   EXPECT_EQ(second.period(p), 2.0);
@@ -164,7 +188,7 @@ TEST_F(EquationPluginTest, TwoModelsInOneProcessAreTwoObjects) {
 
 TEST_F(EquationPluginTest, ACompileErrorIsBadInputWithTheCompilersFirstLines) {
   try {
-    load_equation_plugin("struct EquationModel { this is not C++ };", cache_, kRecord);
+    load_equation_plugin("constexpr int d = 1; this is not C++;", kPrebuilt, cache_, kRecord);
     FAIL() << "no BadInput";
   } catch (const BadInput& e) {
     const std::string what = e.what();
@@ -178,7 +202,7 @@ TEST_F(EquationPluginTest, NoCompilerIsBadInputNamingThePackage) {
   const std::string saved = old ? old : "";
   ::setenv("DELAYSPEC_CXX", "/nonexistent/g++", 1);
   try {
-    load_equation_plugin(kLinearCode, cache_, kRecord);
+    load_equation_plugin(kLinearCode, kPrebuilt, cache_, kRecord);
     ADD_FAILURE() << "no BadInput";
   } catch (const BadInput& e) {
     const std::string what = e.what();
@@ -193,7 +217,7 @@ TEST_F(EquationPluginTest, AnUnusableCacheDirectoryIsBadInput) {
   std::filesystem::create_directories(cache_);
   const std::filesystem::path file = cache_ / "a-file";
   { std::ofstream(file) << "x"; }
-  EXPECT_THROW(load_equation_plugin(kLinearCode, file / "cache", kRecord), BadInput);
+  EXPECT_THROW(load_equation_plugin(kLinearCode, kPrebuilt, file / "cache", kRecord), BadInput);
 }
 
 }  // namespace

@@ -18,18 +18,24 @@ namespace delayspec::cli {
 
 namespace {
 
-// A time switch's roots are looked for in this many equal sub-intervals of (t0, t1) (one step of
-// the engine), each sign change then bisected to adjacent doubles: two roots within one
-// sub-interval are missed (docs/models.md).
-constexpr int kTimeSwitchSamples = 16;
-
-// The largest model compiled: the printed struct's size. Measured (2 cores, load 2): 500 terms
+// The largest model compiled: the printed functions' size. Measured (2 cores, load 2): 500 terms
 // c x^a v_tau^b sin(k t) in a d = 2 model print 165 kB and compile in 14.8 s, and the time grows
 // with the text; 1 MB is about 3000 such terms, a minute and a half. The impact scene prints 6 kB.
 constexpr size_t kMaxModelCode = 1'000'000;
 
 std::string bool_text(bool b) { return b ? "true" : "false"; }
 
+const char* switching_text(SwitchKind kind) {
+  switch (kind) {
+    case SwitchKind::state: return "delayspec::ModelSwitching::state";
+    case SwitchKind::time: return "delayspec::ModelSwitching::time";
+    case SwitchKind::none: break;
+  }
+  return "delayspec::ModelSwitching::none";
+}
+
+// The model as the functions of model_functions.hpp (static, in the caller's namespace), its
+// shape kShape and the table kFunctions of them.
 class ModelPrinter {
  public:
   explicit ModelPrinter(const SymbolicEquationModel& m) : m_(m) {
@@ -42,51 +48,44 @@ class ModelPrinter {
   std::string print() {
     const bool state_switch = m_.switch_kind == SwitchKind::state;
     const bool time_switch = m_.switch_kind == SwitchKind::time;
-    out_ << "struct EquationModel {\n"
-         << "  static constexpr int d = " << m_.d() << ";\n"
-         << "  static constexpr int parameter_count = " << m_.p.size() << ";\n"
-         << "  static constexpr bool has_switching = " << bool_text(state_switch) << ";\n"
-         << "  static constexpr bool has_time_switches = " << bool_text(time_switch) << ";\n"
-         << "  static constexpr bool affine_in_state = " << bool_text(m_.affine_in_state) << ";\n"
-         << "  static constexpr bool is_linear = " << bool_text(m_.is_linear) << ";\n"
-         << "  static constexpr bool autonomous = " << bool_text(m_.autonomous) << ";\n"
-         << "  using Vector = delayspec::Vec<d>;\n"
-         << "  using Matrix = delayspec::Mat<d>;\n"
-         << "  std::array<double, parameter_count> p{};\n"
-         << "  double tau_ = 0, period_ = 0;\n"
-         << "  Vector history_ = Vector::Zero();\n"
-         << "  double tau() const { return tau_; }\n"
-         << "  double period() const { return period_; }\n"
-         << "  Vector initial_state() const { return history_; }\n";
-    print_delays();
-    out_ << "  // The functions of the expressions, as <cmath>'s (the printed expressions call them unqualified).\n";
+    out_ << "constexpr int d = " << m_.d() << ";\n"
+         << "constexpr int parameter_count = " << m_.p.size() << ";\n"
+         << "constexpr delayspec::ModelShape kShape{d, " << m_.delay_count() << ", " << switching_text(m_.switch_kind)
+         << ", " << bool_text(m_.autonomous) << ", " << bool_text(m_.affine_in_state) << ", "
+         << bool_text(m_.is_linear) << "};\n";
+    out_ << "// The functions of the expressions, as <cmath>'s (the printed expressions call them unqualified).\n";
     // sin and cos through the per-thread memo of the built-in models (detail/remembered_trig.hpp,
     // the same values bit for bit): a forcing term sin(w t) is evaluated at one t by f, f_t,
     // f_tt, the event test and the next step's left node. Measured on the impact equations,
     // lyapunov N = 1000, 1e4 periods (bench_equations): 1.43 s with std::sin, 1.24 s with the
     // memo, against 1.07 s for the built-in model.
     for (const auto& f : equation_functions())
-      out_ << "  static double " << f << "(double x) { return "
+      out_ << "[[maybe_unused]] static double " << f << "(double x) { return "
            << (f == "sin" || f == "cos" ? "delayspec::detail::remembered_" : "std::") << f << "(x); }\n";
-    out_ << "  static double pow(double x, double y) { return std::pow(x, y); }\n"
-         << "  static constexpr double " << pi_.get_name() << " = "
+    out_ << "[[maybe_unused]] static double pow(double x, double y) { return std::pow(x, y); }\n"
+         << "[[maybe_unused]] constexpr double " << pi_.get_name() << " = "
          << "3.141592653589793238462643383279502884;\n";
-    out_ << "  static double period_of([[maybe_unused]] const double* p) { return " << cxx(m_.period) << "; }\n"
-         << "  static void delays_of([[maybe_unused]] const double* p, double* taus) {\n";
-    for (int k = 0; k < m_.delay_count(); ++k) out_ << "    taus[" << k << "] = " << cxx(m_.delays[k]) << ";\n";
-    out_ << "  }\n"
-         << "  static Vector history_of([[maybe_unused]] const double* p) {\n"
-         << "    Vector r;\n";
-    for (int i = 0; i < m_.d(); ++i) out_ << "    r[" << i << "] = " << cxx(m_.history[i]) << ";\n";
-    out_ << "    return r;\n  }\n";
+    out_ << "static double period_of([[maybe_unused]] const double* p) { return " << cxx(m_.period) << "; }\n"
+         << "static void delays_of([[maybe_unused]] const double* p, double* taus) {\n";
+    for (int k = 0; k < m_.delay_count(); ++k) out_ << "  taus[" << k << "] = " << cxx(m_.delays[k]) << ";\n";
+    out_ << "}\n"
+         << "static void history_of([[maybe_unused]] const double* p, double* r) {\n";
+    for (int i = 0; i < m_.d(); ++i) out_ << "  r[" << i << "] = " << cxx(m_.history[i]) << ";\n";
+    out_ << "}\n";
     print_field_vector("f", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f; });
-    print_field_matrix("Matrix", "A", [](const SymbolicField& f) -> const auto& { return f.A; });
-    print_field_matrix("DelayedMatrix", "B", [](const SymbolicField& f) -> const auto& { return f.B; });
-    print_field_vector("f_t", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f_t; });
-    print_field_vector("f_tt", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f_tt; });
-    if (state_switch) print_state_switch();
-    if (time_switch) print_time_switch();
-    out_ << "};\n";
+    print_field_matrix("A", [](const SymbolicField& f) -> const auto& { return f.A; });
+    print_field_matrix("B", [](const SymbolicField& f) -> const auto& { return f.B; });
+    if (state_switch) {
+      print_field_vector("f_t", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f_t; });
+      print_field_vector("f_tt", [](const SymbolicField& f) -> const std::vector<GiNaC::ex>& { return f.f_tt; });
+      print_state_switch();
+    }
+    if (time_switch)
+      out_ << "static double switch_value([[maybe_unused]] double t, [[maybe_unused]] const double* p) { return "
+           << cxx(m_.switch_function) << "; }\n";
+    out_ << "const delayspec::ModelFunctions kFunctions = {f, A, B, "
+         << (state_switch ? "f_t, f_tt, H, grad_H, nullptr" : "nullptr, nullptr, nullptr, nullptr, ")
+         << (state_switch ? "" : time_switch ? "switch_value" : "nullptr") << "};\n";
     return out_.str();
   }
 
@@ -115,99 +114,51 @@ class ModelPrinter {
   }
 
   static std::string arguments() {
-    return "([[maybe_unused]] int j, [[maybe_unused]] double t, [[maybe_unused]] const Vector& y, "
-           "[[maybe_unused]] const Delayed& z) const {\n";
+    return "([[maybe_unused]] int j, [[maybe_unused]] double t, [[maybe_unused]] const double* y, "
+           "[[maybe_unused]] const double* z, [[maybe_unused]] const double* p, double* r) {\n";
   }
 
   // The body for each field: one field, or `if (j == 1) f_1 else f_2`.
   void per_field(const std::function<void(const SymbolicField&, const std::string&)>& body) {
     if (m_.fields.size() == 1) {
-      body(m_.fields[0], "    ");
+      body(m_.fields[0], "  ");
       return;
     }
-    out_ << "    if (j == 1) {\n";
-    body(m_.fields[0], "      ");
-    out_ << "    } else {\n";
-    body(m_.fields[1], "      ");
-    out_ << "    }\n";
+    out_ << "  if (j == 1) {\n";
+    body(m_.fields[0], "    ");
+    out_ << "  } else {\n";
+    body(m_.fields[1], "    ");
+    out_ << "  }\n";
   }
 
   void print_field_vector(const std::string& name, const Components& components) {
-    out_ << "  Vector " << name << arguments() << "    Vector r;\n";
+    out_ << "static void " << name << arguments();
     per_field([&](const SymbolicField& field, const std::string& indent) {
       const auto& c = components(field);
       for (size_t i = 0; i < c.size(); ++i) out_ << indent << "r[" << i << "] = " << cxx(c[i]) << ";\n";
     });
-    out_ << "    return r;\n  }\n";
+    out_ << "}\n";
   }
 
-  void print_field_matrix(const std::string& type, const std::string& name, const Matrix& matrix) {
-    out_ << "  " << type << " " << name << arguments() << "    " << type << " r = " << type << "::Zero();\n";
+  // Column by column (model_functions.hpp): entry (i, a) is r[i + d a]; r arrives zeroed.
+  void print_field_matrix(const std::string& name, const Matrix& matrix) {
+    out_ << "static void " << name << arguments();
     per_field([&](const SymbolicField& field, const std::string& indent) {
       const auto& entries = matrix(field);
       for (size_t i = 0; i < entries.size(); ++i)
         for (size_t a = 0; a < entries[i].size(); ++a)
           if (!entries[i][a].is_zero())
-            out_ << indent << "r(" << i << ", " << a << ") = " << cxx(entries[i][a]) << ";\n";
+            out_ << indent << "r[" << i + entries.size() * a << "] = " << cxx(entries[i][a]) << ";\n";
     });
-    out_ << "    return r;\n  }\n";
-  }
-
-  // The delays: one (tau_, set by the loader; Delayed is Vector), or n >= 2 (model.hpp's
-  // delay_count and delays(); tau_ the longest). set_delays takes the values in the order of
-  // the names (sorted).
-  void print_delays() {
-    const int n = m_.delay_count();
-    if (n == 1) {
-      out_ << "  using Delayed = Vector;\n"
-           << "  using DelayedMatrix = Matrix;\n"
-           << "  void set_delays(const double* taus) { tau_ = taus[0]; }\n";
-      return;
-    }
-    out_ << "  static constexpr int delay_count = " << n << ";\n"
-         << "  using Delayed = delayspec::Vec<d * delay_count>;\n"
-         << "  using DelayedMatrix = delayspec::RectMat<d, d * delay_count>;\n"
-         << "  std::array<double, delay_count> delays_{};\n"
-         << "  std::array<double, delay_count> delays() const { return delays_; }\n"
-         << "  void set_delays(const double* taus) {\n"
-         << "    tau_ = 0;\n"
-         << "    for (int k = 0; k < delay_count; ++k) delays_[k] = taus[k], tau_ = taus[k] > tau_ ? taus[k] : tau_;\n"
-         << "  }\n";
+    out_ << "}\n";
   }
 
   void print_state_switch() {
-    out_ << "  double H([[maybe_unused]] const Vector& y) const { return " << cxx(m_.switch_function) << "; }\n"
-         << "  Vector grad_H([[maybe_unused]] const Vector& y) const {\n"
-         << "    Vector r;\n";
-    for (size_t a = 0; a < m_.grad_H.size(); ++a) out_ << "    r[" << a << "] = " << cxx(m_.grad_H[a]) << ";\n";
-    out_ << "    return r;\n  }\n";
-  }
-
-  // time_segment: 1 where H(t) > 0, else 2. next_time_switch: the sub-intervals of (t0, t1) are
-  // searched in order for a change of segment, which is then bisected to adjacent doubles; the
-  // first double of the new segment is returned (> t0, as time_switch_step.hpp requires).
-  void print_time_switch() {
-    out_ << "  double switch_value_([[maybe_unused]] double t) const { return " << cxx(m_.switch_function) << "; }\n"
-         << "  int time_segment(double t) const { return switch_value_(t) > 0 ? 1 : 2; }\n"
-         << "  double next_time_switch(double t0, double t1) const {\n"
-         << "    constexpr int samples = " << kTimeSwitchSamples << ";\n"
-         << "    if (!(t1 > t0)) return t1;\n"
-         << "    const int first = time_segment(t0);\n"
-         << "    double a = t0;\n"
-         << "    for (int i = 1; i <= samples; ++i) {\n"
-         << "      const double b = i == samples ? t1 : t0 + (t1 - t0) * i / samples;\n"
-         << "      if (time_segment(b) != first) {\n"
-         << "        double lo = a, hi = b;\n"
-         << "        for (;;) {\n"
-         << "          const double mid = lo + (hi - lo) / 2;\n"
-         << "          if (!(mid > lo && mid < hi)) return hi;\n"
-         << "          (time_segment(mid) == first ? lo : hi) = mid;\n"
-         << "        }\n"
-         << "      }\n"
-         << "      a = b;\n"
-         << "    }\n"
-         << "    return t1;\n"
-         << "  }\n";
+    out_ << "static double H([[maybe_unused]] const double* y, [[maybe_unused]] const double* p) { return "
+         << cxx(m_.switch_function) << "; }\n"
+         << "static void grad_H([[maybe_unused]] const double* y, [[maybe_unused]] const double* p, double* r) {\n";
+    for (size_t a = 0; a < m_.grad_H.size(); ++a) out_ << "  r[" << a << "] = " << cxx(m_.grad_H[a]) << ";\n";
+    out_ << "}\n";
   }
 
   const SymbolicEquationModel& m_;
@@ -230,6 +181,11 @@ EquationModelSource generate_equation_model(const toml::table& equations,
   source.delays = model.delay_names;
   source.written_with_delays = equations.contains("delays");
   for (size_t a = 0; a < model.z.size(); ++a) source.delayed.push_back(model.delayed_name(a));
+  source.shape = {model.d(), model.delay_count(),
+                  model.switch_kind == SwitchKind::state  ? ModelSwitching::state
+                  : model.switch_kind == SwitchKind::time ? ModelSwitching::time
+                                                          : ModelSwitching::none,
+                  model.autonomous, model.affine_in_state, model.is_linear};
   source.code = ModelPrinter(model).print();
   if (source.code.size() > kMaxModelCode)
     throw BadInput("`equations`: the model's derivatives print as " + std::to_string(source.code.size() / 1000) +

@@ -1,6 +1,7 @@
 #pragma once
 // The [equations] table of a scene (docs/models.md), checked, differentiated (GiNaC) and printed
-// as the C++ source of a model struct, which the plugin loader compiles and loads.
+// as the C++ source of the model's functions (model_functions.hpp), which the plugin loader
+// compiles and loads.
 //
 // Nothing of the scene reaches the code as text: user names become generated names (y[i],
 // z[i], p[k], t), numbers their exact values, and every expression is printed by GiNaC from its
@@ -10,6 +11,8 @@
 #include <vector>
 
 #include <toml++/toml.h>
+
+#include "delayspec/model_functions.hpp"
 
 namespace delayspec::cli {
 
@@ -23,7 +26,8 @@ struct EquationModelSource {
   bool written_with_delays = false;        // the `delays` table (else `delay` or none): for messages
   bool switches_in_state = false;          // `switch` given and depends on the state
   bool switches_in_time = false;           // `switch` given and depends on t only
-  std::string code;                        // C++ text of `struct EquationModel {...};`
+  ModelShape shape;                        // what the engine's templates need to know (model_functions.hpp)
+  std::string code;                        // C++ text of the functions and their table (below)
   // The constant expressions at parameter values (in the order of `parameters`): period, the
   // delays (in the order of `delays`), then the d history values, each GiNaC's evaluation of the exact expression (NaN where that is
   // not a finite real number, e.g. 1/0). So that they are checked before the model is compiled
@@ -40,13 +44,13 @@ struct EquationModelSource {
 // is not about the compiler. reserved_keys: every key the engine reads (N, nev, seed, ...): a
 // parameter may not take one of these names. NOT thread-safe (GiNaC is not): call under a mutex.
 //
-// The code (after <array>, <cmath> and "delayspec/types.hpp") defines struct EquationModel with
-// d, parameter_count, the model flags, `std::array<double, parameter_count> p` (values in the
-// order of `parameters`), tau_, period_, history_ (set by the loader; set_delays(taus) sets the
-// delays), the types Delayed and DelayedMatrix of the delayed argument and of B, the static
-// period_of(p), delays_of(p, taus), history_of(p), and f, A, B, f_t, f_tt for j = 1 (rhs_switched, switch > 0) and
-// j = 2 (rhs), H and grad_H with a state switch, time_segment and next_time_switch with a time
-// switch: a delayspec::DelayModel (model.hpp).
+// The code (after <cmath>, "delayspec/detail/remembered_trig.hpp" and
+// "delayspec/model_functions.hpp", inside a namespace of the caller's) defines the constants d,
+// parameter_count and kShape (= shape), the static functions period_of(p), delays_of(p, taus),
+// history_of(p, y) of the constant expressions, and the model's functions (model_functions.hpp:
+// f, A, B for j = 1 (rhs_switched, switch > 0) and j = 2 (rhs); f_t, f_tt, H and grad_H with a
+// state switch; switch_value with a time switch) with their table `kFunctions`, in which p holds
+// the parameters in the order of `parameters`.
 EquationModelSource generate_equation_model(const toml::table& equations,
                                             const std::vector<std::string>& reserved_keys);
 

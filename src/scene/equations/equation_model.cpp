@@ -140,7 +140,7 @@ const EquationPlugin& compiled(const EquationModelSource& source, const std::str
   const std::lock_guard<std::mutex> lock(equations_mutex());
   const std::string key = cache_dir.string() + '\n' + source.code;
   if (auto it = plugins.find(key); it != plugins.end()) return it->second;
-  return plugins[key] = load_equation_plugin(source.code, cache_dir, {table_text, names_text(names_of(source))});
+  return plugins[key] = load_equation_plugin(source.code, source.shape, cache_dir, {table_text, names_text(names_of(source))});
 }
 
 // The plugin's analyses (compiled from the equations), with a failure at a step that is not

@@ -1,10 +1,12 @@
 #pragma once
-// A model compiled at run time. The C++ struct printed from a scene's equations
-// (equation_model_source.hpp: only code GiNaC printed from parsed expressions) is wrapped in a
-// translation unit that instantiates the analyses for it (ModelAnalysesFor<EquationModel>,
-// model_analyses.hpp), compiled with the compiler that built delayspec against its headers into
-// a shared object that links this same libdelayspec, and loaded with dlopen. Nothing is
-// interpreted per step: the model's steps are compiled code with the model's d fixed.
+// A model compiled at run time. The functions printed from a scene's equations
+// (equation_model_source.hpp: only code GiNaC printed from parsed expressions) are wrapped in a
+// translation unit, compiled with the compiler that built delayspec against its headers into a
+// shared object that links this same libdelayspec, and loaded with dlopen. The analyses are those
+// of FunctionModel<shape> (function_model.hpp): taken from libdelayspec_prebuilt when the shape
+// is one of prebuilt_shapes.hpp and that library is built (the unit is then the functions alone,
+// under a second), else instantiated in the unit (about 20 s). Nothing is interpreted per step:
+// the model's functions are compiled code, called once per evaluation, with d fixed.
 //
 // Cache (model_cache.hpp: a directory private to the user, entries never opened through a link):
 // DIR/eq-HASH.so beside its source DIR/eq-HASH.cpp, its checksum DIR/eq-HASH.sum and the
@@ -24,6 +26,7 @@
 #include <vector>
 
 #include "delayspec/model_analyses.hpp"
+#include "delayspec/model_functions.hpp"
 
 namespace delayspec::cli {
 
@@ -39,7 +42,7 @@ struct EquationPlugin {
   std::filesystem::path object;                                        // the loaded shared object
 };
 
-// Loads the model whose printed struct is `model_code`, compiling it into `cache_dir` first
+// Loads the model whose printed functions are `model_code`, of the shape `shape`, compiling it into `cache_dir` first
 // unless a cached object exists. The compiler is the one that built delayspec, or the program
 // the environment variable DELAYSPEC_CXX names. BadInput (exit 2) when there is no compiler
 // (naming the Debian package), when the code does not compile (with the compiler's first lines)
@@ -51,8 +54,8 @@ struct TableRecord {
   std::string table_text;  // the [equations] table as the scene gave it
   std::string names;       // what the caller needs of the model besides its code, as text
 };
-EquationPlugin load_equation_plugin(const std::string& model_code, const std::filesystem::path& cache_dir,
-                                    const TableRecord& record);
+EquationPlugin load_equation_plugin(const std::string& model_code, const ModelShape& shape,
+                                    const std::filesystem::path& cache_dir, const TableRecord& record);
 
 // The model this program compiled from the table `table_text` into `cache_dir` (same program,
 // compiler, library and headers: the entry's hash), with the names recorded then: found from the
