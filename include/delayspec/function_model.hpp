@@ -37,6 +37,11 @@ class FunctionModel {
       : fn_(&functions), p_(values.parameters, values.parameters + values.parameter_count), period_(values.period) {
     for (int k = 0; k < delay_count; ++k) delays_[k] = values.delays[k], tau_ = std::max(tau_, values.delays[k]);
     for (int i = 0; i < d; ++i) history_[i] = values.history[i];
+    if constexpr (has_switching) {  // H affine in y (model.hpp; the equations' reader refuses others)
+      const Vector zero = Vector::Zero();
+      fn_->grad_H(zero.data(), p_.data(), grad_H_.data());
+      H_at_zero_ = fn_->H(zero.data(), p_.data());
+    }
   }
 
   double tau() const { return tau_; }
@@ -58,12 +63,13 @@ class FunctionModel {
     return r;
   }
 
-  double H(const Vector& y) const { return fn_->H(y.data(), p_.data()); }
-  Vector grad_H(const Vector& y) const {
-    Vector r;
-    fn_->grad_H(y.data(), p_.data(), r.data());
-    return r;
-  }
+  // H(y) = H(0) + grad_H . y, as H is affine: no call per evaluation (the event step evaluates H
+  // many times per step in its root search). Measured on the impact equations' Lyapunov run
+  // (bench_equations): 91.5 ns per step with H and grad_H called, against 75 ns for the model
+  // compiled whole before. Equal to the printed H to rounding (the same terms summed in another
+  // order; bit for bit when grad_H has one nonzero entry 1, as for `x - e`).
+  double H(const Vector& y) const { return grad_H_.dot(y) + H_at_zero_; }
+  Vector grad_H(const Vector&) const { return grad_H_; }
 
   // 1 where the switch is > 0, else 2.
   int time_segment(double t) const { return fn_->switch_value(t, p_.data()) > 0 ? 1 : 2; }
@@ -101,6 +107,8 @@ class FunctionModel {
   std::array<double, delay_count> delays_{};
   double tau_ = 0, period_ = 0;
   Vector history_ = Vector::Zero();
+  Vector grad_H_ = Vector::Zero();  // a state switch's constant gradient, and H(0)
+  double H_at_zero_ = 0;
 };
 
 }  // namespace delayspec

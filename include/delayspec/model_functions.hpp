@@ -54,7 +54,11 @@ struct ModelValues {
 // The analyses (model_analyses.hpp) of FunctionModel<shape> over `functions`, compiled in the
 // library; null when the library was not built for `shape`. `functions` must outlive them (a
 // model's object is never unloaded). The caller owns the result.
+// Defined in libdelayspec_prebuilt, as is:
 ModelAnalyses* prebuilt_model_analyses(const ModelShape& shape, const ModelFunctions& functions,
                                        const ModelValues& values);
+// "VERSION REVISION" of the build that made libdelayspec_prebuilt (delayspec/version.hpp): a
+// model's loader checks it against its own.
+const char* prebuilt_library_build();
 
 }  // namespace delayspec

@@ -20,7 +20,7 @@ inline constexpr ModelShape kPrebuiltShapes[] = {
     ModelShape{1, 1, ModelSwitching::time, false, true, true},    // a scalar time switch
     ModelShape{4, 1, ModelSwitching::none, false, false, false},  // equations_two_oscillators.toml
     ModelShape{2, 2, ModelSwitching::none, false, false, false},  // equations_two_delays.toml
-    ModelShape{4, 3, ModelSwitching::none, true, false, false},   // equilibrium_neuron_ring.toml
+    ModelShape{4, 3, ModelSwitching::none, true, true, false},    // equilibrium_neuron_ring.toml
 };
 
 // Is `shape` one of them? (A model's unit checks this of its shape at compile time.)

@@ -1,9 +1,11 @@
-// prebuilt_model_analyses (model_functions.hpp): the shape looked up in kPrebuiltShapes.
+// prebuilt_model_analyses (model_functions.hpp): the shape looked up in kPrebuiltShapes; and the
+// library's build, which a model's loader checks.
 #include <iterator>
 #include <utility>
 
 #include "delayspec/model_functions.hpp"
 #include "delayspec/prebuilt_shapes.hpp"
+#include "delayspec/version.hpp"
 #include "modules/prebuilt/prebuilt_analyses.hpp"
 
 namespace delayspec {
@@ -27,5 +29,7 @@ ModelAnalyses* prebuilt_model_analyses(const ModelShape& shape, const ModelFunct
   return analyses_of_shape(shape, functions, values,
                            std::make_integer_sequence<int, static_cast<int>(std::size(kPrebuiltShapes))>());
 }
+
+const char* prebuilt_library_build() { return DELAYSPEC_VERSION " " DELAYSPEC_REVISION; }
 
 }  // namespace delayspec

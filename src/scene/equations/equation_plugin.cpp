@@ -59,7 +59,10 @@ std::string plugin_source(const std::string& model_code, bool prebuilt) {
          "using namespace delayspec_equations;\n"
          "#define DELAYSPEC_EXPORT extern \"C\" __attribute__((visibility(\"default\")))\n\n"
          "DELAYSPEC_EXPORT const char* delayspec_equation_version() {\n"
-         "  return DELAYSPEC_VERSION \" \" DELAYSPEC_REVISION;\n}\n"
+         "  return DELAYSPEC_VERSION \" \" DELAYSPEC_REVISION;\n}\n" +
+         (prebuilt ? "DELAYSPEC_EXPORT const char* delayspec_equation_prebuilt_build() {\n"
+                     "  return delayspec::prebuilt_library_build();\n}\n"
+                   : "") +
          "DELAYSPEC_EXPORT double delayspec_equation_period(const double* p) { return period_of(p); }\n"
          "DELAYSPEC_EXPORT void delayspec_equation_delays(const double* p, double* taus) { delays_of(p, taus); }\n"
          "DELAYSPEC_EXPORT void delayspec_equation_history(const double* p, double* y) { history_of(p, y); }\n"
@@ -280,6 +283,12 @@ EquationPlugin plugin_of(const detail::SharedObject& model, const std::filesyste
   if (version != expected)
     throw BadInput("equations: the compiled model " + object.string() + " is of delayspec " + version + ", this is " +
                    expected + ": delete it");
+  // A model of a prebuilt shape runs the analyses of libdelayspec_prebuilt, which must be of this
+  // build too (a partial build, e.g. of the program alone, leaves an older one beside it).
+  using Build = const char*();
+  if (Build* prebuilt = model.function<Build>("delayspec_equation_prebuilt_build"); prebuilt && prebuilt() != expected)
+    throw BadInput("equations: " + std::string(kPrebuiltLibrary) + " beside the library is of delayspec " +
+                   prebuilt() + ", this is " + expected + ": rebuild it (cmake --build BUILD_DIR --target delayspec_prebuilt)");
   EquationPlugin plugin;
   plugin.analyses = symbol<std::remove_pointer_t<decltype(plugin.analyses)>>(model, "delayspec_equation_analyses", object);
   plugin.period = symbol<std::remove_pointer_t<decltype(plugin.period)>>(model, "delayspec_equation_period", object);
