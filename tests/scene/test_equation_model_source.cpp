@@ -3,6 +3,7 @@
 // tested end to end with the plugin loader; here: every bad input names its item, the model
 // flags, the continuity check of a state switch, nothing of the scene reaches the code as text,
 // and GiNaC's derivatives against finite differences of f.
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include "delayspec/errors.hpp"
+#include "delayspec/prebuilt_shapes.hpp"
 #include "text_support.hpp"
 #include "delayspec_test_paths.hpp"
 #include "modules/equations/equation_model_source.hpp"
@@ -99,6 +101,25 @@ TEST(EquationModelSource, TwoOscillatorSceneIsSmoothOfDimensionFour) {
   EXPECT_TRUE(contains(s.code, "constexpr int d = 4;"));
   EXPECT_FALSE(contains(s.code, "double H("));
   EXPECT_TRUE(contains(s.code, "kFunctions = {f, A, B, nullptr, nullptr, nullptr, nullptr, nullptr};")) << s.code;
+}
+
+TEST(EquationModelSource, EveryShippedEquationSceneHasAPrebuiltShape) {
+  // docs/models.md: the shapes of the shipped scenes are prebuilt, so each of them compiles only
+  // its functions (under a second). A new scene of another shape fails here: add its shape to
+  // prebuilt_shapes.hpp (or say in the docs why not).
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes")) {
+    if (entry.path().extension() != ".toml") continue;
+    const toml::table scene = toml::parse_file(entry.path().string());
+    if (scene["model"].value_or(std::string()) != "equations") continue;
+    ++scenes;
+    const EquationModelSource s = generate_equation_model(*scene["equations"].as_table(), kEngineKeys);
+    EXPECT_TRUE(delayspec::is_prebuilt_shape(s.shape))
+        << entry.path().filename() << ": d " << s.shape.d << ", " << s.shape.delay_count << " delay(s), switch "
+        << static_cast<int>(s.shape.switching) << ", autonomous " << s.shape.autonomous << ", affine "
+        << s.shape.affine_in_state << ", linear " << s.shape.is_linear;
+  }
+  EXPECT_EQ(scenes, 5);  // equations_impact, _two_delays, _two_oscillators, equilibrium_neuron_ring, pyragas_oscillator
 }
 
 TEST(EquationModelSource, FlagsFollowTheSecondDerivatives) {

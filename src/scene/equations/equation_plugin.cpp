@@ -116,7 +116,6 @@ struct Toolchain {
   std::filesystem::path prebuilt;
 };
 
-
 std::string file_stamp(const std::filesystem::path& p) {
   struct stat st {};
   if (stat(p.c_str(), &st) != 0) return p.string() + ":missing";
