@@ -11,7 +11,9 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <memory>
 #include <thread>
+#include <vector>
 
 #include "delayspec/builtin_analyses.hpp"
 #include "delayspec/errors.hpp"
@@ -153,6 +155,43 @@ TEST_F(EquationPluginTest, AShapeThatIsNotPrebuiltCompilesWholeAndGivesTheSameMu
   const auto builtin = leading(*builtin_analyses(LinearModel(lp)), 64);
   for (size_t k = 0; k < builtin.size(); ++k)
     EXPECT_LE(std::abs(from_whole[k] - builtin[k]), 1e-14 * std::abs(builtin[0])) << k;
+}
+
+// The library's lookup (model_functions.hpp): the analyses for each listed shape, null for any
+// other (the loader then says to rebuild the library, equation_model.cpp).
+void linear_f(int, double, const double* y, const double* z, const double* p, double* r) { r[0] = p[0] * y[0] + p[1] * z[0]; }
+void linear_A(int, double, const double*, const double*, const double* p, double* r) { r[0] = p[0]; }
+void linear_B(int, double, const double*, const double*, const double* p, double* r) { r[0] = p[1]; }
+// A switch x - 1 (a model of a state-switch shape reads its gradient and H(0) when made).
+double switch_H(const double* y, const double*) { return y[0] - 1; }
+void switch_grad_H(const double*, const double*, double* r) { r[0] = 1; }
+
+TEST(PrebuiltModels, EveryListedShapeAndNoOtherHasAnalyses) {
+  ModelFunctions functions{linear_f, linear_A, linear_B};
+  functions.H = switch_H;
+  functions.grad_H = switch_grad_H;
+  const double p[2] = {-1.0, 0.5}, tau = 1, y0 = 1;
+  const ModelValues values{p, 2, &tau, 1.0, &y0};
+  const std::unique_ptr<ModelAnalyses> linear(prebuilt_model_analyses(kPrebuilt, functions, values));
+  ASSERT_TRUE(linear);
+  EXPECT_EQ(linear->state_dimension(), 1);
+  EXPECT_TRUE(linear->is_linear());
+  EXPECT_TRUE(linear->is_autonomous());
+  EXPECT_EQ(linear->tau(), 1.0);
+  for (const ModelShape& shape : kPrebuiltShapes) {  // each shape's own analyses (not evaluated)
+    std::vector<double> taus(static_cast<size_t>(shape.delay_count), 1.0), history(static_cast<size_t>(shape.d), 0.0);
+    const std::unique_ptr<ModelAnalyses> a(prebuilt_model_analyses(shape, functions, {p, 2, taus.data(), 1.0, history.data()}));
+    ASSERT_TRUE(a) << shape.d;
+    EXPECT_EQ(a->state_dimension(), shape.d);
+    EXPECT_EQ(a->delays().size(), static_cast<size_t>(shape.delay_count));
+    EXPECT_EQ(a->switches_in_state(), shape.switching == ModelSwitching::state);
+    EXPECT_EQ(a->switches_in_time(), shape.switching == ModelSwitching::time);
+    EXPECT_EQ(a->is_autonomous(), shape.autonomous);
+    EXPECT_EQ(a->is_linear(), shape.is_linear);
+  }
+  const ModelShape forced{1, 1, ModelSwitching::none, false, true, true};
+  EXPECT_EQ(prebuilt_model_analyses(forced, functions, values), nullptr);
+  EXPECT_EQ(prebuilt_model_analyses({7, 1, ModelSwitching::none, false, false, false}, functions, values), nullptr);
 }
 
 TEST_F(EquationPluginTest, ConcurrentFirstLoadsCompileOnce) {

@@ -350,9 +350,14 @@ EquationModel read_equation_model(Config& config,
   EquationModel model;
   model.state = names.state;
   model.parameters = names.parameters;
-  model.analyses = std::make_shared<const ExplainedAnalyses>(
-      std::unique_ptr<const ModelAnalyses>(plugin.analyses(p.data(), taus.data(), period, history.data())), text,
-      names, p);
+  std::unique_ptr<const ModelAnalyses> analyses(plugin.analyses(p.data(), taus.data(), period, history.data()));
+  // Null only from a model of a prebuilt shape whose libdelayspec_prebuilt lacks that shape: a
+  // library left from a build with another list (prebuilt_shapes.hpp) under the same revision.
+  if (!analyses)
+    throw BadInput("equations: libdelayspec_prebuilt beside the library does not hold the shape of the model " +
+                   plugin.object.string() + " (left from another build?): rebuild it (cmake --build BUILD_DIR "
+                   "--target delayspec_prebuilt)");
+  model.analyses = std::make_shared<const ExplainedAnalyses>(std::move(analyses), text, names, p);
   return model;
 }
 
