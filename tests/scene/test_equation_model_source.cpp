@@ -77,8 +77,8 @@ TEST(EquationModelSource, ImpactSceneIsAStateSwitchWithContinuousFields) {
   // sorted by name (toml++ keeps tables sorted): the order of p[k] in the code
   EXPECT_EQ(s.parameters, (std::vector<std::string>{"a", "beta", "e", "k", "omega", "zeta"}));
   EXPECT_EQ(s.parameter_defaults, (std::vector<double>{0.7, 28, 1.26, 0.55, 0.802, 0.01}));
-  EXPECT_TRUE(s.switches_in_state);
-  EXPECT_FALSE(s.switches_in_time);
+  EXPECT_TRUE(s.shape.switching == delayspec::ModelSwitching::state);
+  EXPECT_FALSE(s.shape.switching == delayspec::ModelSwitching::time);
   EXPECT_EQ(s.shape, (delayspec::ModelShape{2, 1, delayspec::ModelSwitching::state, false, true, false}));
   for (const char* line :
        {"constexpr int d = 2;", "constexpr int parameter_count = 6;",
@@ -95,8 +95,8 @@ TEST(EquationModelSource, ImpactSceneIsAStateSwitchWithContinuousFields) {
 TEST(EquationModelSource, TwoOscillatorSceneIsSmoothOfDimensionFour) {
   const EquationModelSource s = generate_equation_model(scene_equations("equations_two_oscillators.toml"), kEngineKeys);
   EXPECT_EQ(s.state.size(), 4u);
-  EXPECT_FALSE(s.switches_in_state);
-  EXPECT_FALSE(s.switches_in_time);
+  EXPECT_FALSE(s.shape.switching == delayspec::ModelSwitching::state);
+  EXPECT_FALSE(s.shape.switching == delayspec::ModelSwitching::time);
   EXPECT_EQ(s.shape, (delayspec::ModelShape{4, 1, delayspec::ModelSwitching::none, false, false, false}));
   EXPECT_TRUE(contains(s.code, "constexpr int d = 4;"));
   EXPECT_FALSE(contains(s.code, "double H("));
@@ -174,8 +174,8 @@ TEST(EquationModelSource, AStateSwitchIsNeverLinearAndATimeSwitchMayBe) {
   window.insert_or_assign("switch", "sin(pi*t)");               // on for half the period
   window.insert_or_assign("rhs_switched", toml::array{"a*x"});  // discontinuous in t: allowed
   const EquationModelSource s = generate_equation_model(window, kEngineKeys);
-  EXPECT_TRUE(s.switches_in_time);
-  EXPECT_FALSE(s.switches_in_state);
+  EXPECT_TRUE(s.shape.switching == delayspec::ModelSwitching::time);
+  EXPECT_FALSE(s.shape.switching == delayspec::ModelSwitching::state);
   EXPECT_EQ(s.shape, (delayspec::ModelShape{1, 1, delayspec::ModelSwitching::time, false, true, true}));
   for (const char* line : {"static double switch_value(", "nullptr, nullptr, nullptr, nullptr, switch_value};"})
     EXPECT_TRUE(contains(s.code, line)) << line << "\n" << s.code;

@@ -25,13 +25,18 @@ constexpr size_t kMaxModelCode = 1'000'000;
 
 std::string bool_text(bool b) { return b ? "true" : "false"; }
 
-const char* switching_text(SwitchKind kind) {
+const char* switching_text(ModelSwitching kind) {
   switch (kind) {
-    case SwitchKind::state: return "delayspec::ModelSwitching::state";
-    case SwitchKind::time: return "delayspec::ModelSwitching::time";
-    case SwitchKind::none: break;
+    case ModelSwitching::state: return "delayspec::ModelSwitching::state";
+    case ModelSwitching::time: return "delayspec::ModelSwitching::time";
+    case ModelSwitching::none: break;
   }
   return "delayspec::ModelSwitching::none";
+}
+
+// What the engine's templates must know of the model (model_functions.hpp).
+ModelShape shape_of(const SymbolicEquationModel& m) {
+  return {m.d(), m.delay_count(), m.switch_kind, m.autonomous, m.affine_in_state, m.is_linear};
 }
 
 // The model as the functions of model_functions.hpp (static, in the caller's namespace), its
@@ -48,11 +53,12 @@ class ModelPrinter {
   std::string print() {
     const bool state_switch = m_.switch_kind == SwitchKind::state;
     const bool time_switch = m_.switch_kind == SwitchKind::time;
-    out_ << "constexpr int d = " << m_.d() << ";\n"
+    const ModelShape shape = shape_of(m_);
+    out_ << "constexpr int d = " << shape.d << ";\n"
          << "constexpr int parameter_count = " << m_.p.size() << ";\n"
-         << "constexpr delayspec::ModelShape kShape{d, " << m_.delay_count() << ", " << switching_text(m_.switch_kind)
-         << ", " << bool_text(m_.autonomous) << ", " << bool_text(m_.affine_in_state) << ", "
-         << bool_text(m_.is_linear) << "};\n";
+         << "constexpr delayspec::ModelShape kShape{d, " << shape.delay_count << ", " << switching_text(shape.switching)
+         << ", " << bool_text(shape.autonomous) << ", " << bool_text(shape.affine_in_state) << ", "
+         << bool_text(shape.is_linear) << "};\n";
     out_ << "// The functions of the expressions, as <cmath>'s (the printed expressions call them unqualified).\n";
     // sin and cos through the per-thread memo of the built-in models (detail/remembered_trig.hpp,
     // the same values bit for bit): a forcing term sin(w t) is evaluated at one t by f, f_t,
@@ -176,16 +182,10 @@ EquationModelSource generate_equation_model(const toml::table& equations,
   source.state = model.state;
   source.parameters = model.parameters;
   source.parameter_defaults = model.parameter_defaults;
-  source.switches_in_state = model.switch_kind == SwitchKind::state;
-  source.switches_in_time = model.switch_kind == SwitchKind::time;
   source.delays = model.delay_names;
   source.written_with_delays = equations.contains("delays");
   for (size_t a = 0; a < model.z.size(); ++a) source.delayed.push_back(model.delayed_name(a));
-  source.shape = {model.d(), model.delay_count(),
-                  model.switch_kind == SwitchKind::state  ? ModelSwitching::state
-                  : model.switch_kind == SwitchKind::time ? ModelSwitching::time
-                                                          : ModelSwitching::none,
-                  model.autonomous, model.affine_in_state, model.is_linear};
+  source.shape = shape_of(model);
   source.code = ModelPrinter(model).print();
   if (source.code.size() > kMaxModelCode)
     throw BadInput("`equations`: the model's derivatives print as " + std::to_string(source.code.size() / 1000) +

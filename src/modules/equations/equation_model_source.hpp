@@ -24,9 +24,9 @@ struct EquationModelSource {
   std::vector<std::string> delays;         // the delays' names (sorted; {"tau"} for one delay)
   std::vector<std::string> delayed;        // the delayed states' names NAME_X, d per delay, delay by delay
   bool written_with_delays = false;        // the `delays` table (else `delay` or none): for messages
-  bool switches_in_state = false;          // `switch` given and depends on the state
-  bool switches_in_time = false;           // `switch` given and depends on t only
-  ModelShape shape;                        // what the engine's templates need to know (model_functions.hpp)
+  // What the engine's templates need to know (model_functions.hpp); shape.switching is `state`
+  // when `switch` is given and depends on the state, `time` when it depends on t only.
+  ModelShape shape;
   std::string code;                        // C++ text of the functions and their table (below)
   // The constant expressions at parameter values (in the order of `parameters`): period, the
   // delays (in the order of `delays`), then the d history values, each GiNaC's evaluation of the exact expression (NaN where that is

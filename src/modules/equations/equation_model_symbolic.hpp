@@ -12,9 +12,12 @@
 #include <ginac/ginac.h>
 #include <toml++/toml.h>
 
+#include "delayspec/model_functions.hpp"
+
 namespace delayspec::cli {
 
-enum class SwitchKind { none, time, state };
+// The kind of switch: the engine's ModelSwitching (model_functions.hpp), part of the model's shape.
+using SwitchKind = ModelSwitching;
 
 // One vector field f_j and what the engine needs of it, by GiNaC's diff.
 struct SymbolicField {
