@@ -22,6 +22,7 @@ LEVELS = [
     ("src/scene/loading", 1),     # opening a shared object by name, with its version check
     ("src/modules/equations", 2),  # plug-in: the symbolic front end (GiNaC)
     ("src/modules/mpi", 2),       # plug-in: the MPI calls
+    ("src/modules/models", 2),    # library: the analyses of the built-in models but the impact model
     ("src/modules/prebuilt", 2),  # library: the analyses of the prebuilt equation-model shapes
     ("src/scene/output", 3),      # JSON, CSV, metadata, the atomic writer, progress
     ("src/scene/equations", 4),   # model = equations: the key side, the compiled model's cache

@@ -18,8 +18,10 @@ cmake -S "$here/examples/user_model" -B "$prefix/example" -G Ninja -DCMAKE_BUILD
 cmake --build "$prefix/example" >/dev/null
 "$prefix/example/user_model"
 "$prefix/install/bin/delayspec" --version
-# The modules loaded on first use are found beside the installed library: an equations scene
-# (libdelayspec_equations) and, with MPI, a run under mpirun (libdelayspec_mpi).
+# The modules loaded on first use are found beside the installed library: a built-in model other
+# than impact (libdelayspec_models), an equations scene (libdelayspec_equations) and, with MPI, a
+# run under mpirun (libdelayspec_mpi).
+"$prefix/install/bin/delayspec" floquet --set model=linear --set N=20 --set nev=2 --quiet >/dev/null
 "$prefix/install/bin/delayspec" floquet "$here/data/scenes/equations_impact.toml" --set N=20 --set nev=2 \
   --set model_cache="$prefix/cache" --quiet >/dev/null
 if grep -q '^DELAYSPEC_MPI:BOOL=ON' "$here/build/CMakeCache.txt"; then

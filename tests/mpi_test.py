@@ -220,12 +220,14 @@ def main():
             check(r.stderr.count("bad input") == 1, f"{what}: the message is not printed once:\n{r.stderr}")
 
         # 4. The MPI module (libdelayspec_mpi.so beside libdelayspec) is loaded only under a
-        # launcher: the program and its library copied without it run alone, and under mpirun
-        # every rank exits 2 with one message naming the file.
+        # launcher: the program and its library (with the built-in models' module, which the
+        # Mathieu chart needs) copied without it run alone, and under mpirun every rank exits 2
+        # with one message naming the file.
         copy = scratch / "without_mpi_module"
         copy.mkdir()
         libraries = list(Path(program).parent.glob("libdelayspec.so*"))
         check(len(libraries) >= 1, f"no libdelayspec.so* beside {program}")
+        libraries += list(Path(program).parent.glob("libdelayspec_models.so*"))
         for library in libraries:
             shutil.copyfile(library.resolve(), copy / library.name)
         shutil.copy(program, copy / "delayspec")

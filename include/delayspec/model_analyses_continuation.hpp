@@ -1,7 +1,8 @@
 #pragma once
 // ModelAnalysesFor's continuation (model_analyses.hpp), defined apart from the other analyses:
-// included where it is instantiated, src/engine/analyses_continuation.cpp for the built-in models
-// and the object compiled from a scene's equations (equation_plugin.cpp), never into the unit of
+// included where it is instantiated (DELAYSPEC_INSTANTIATE_CONTINUATION below: for the built-in
+// models src/engine/analyses_continuation.cpp and src/modules/models/models_continuation.cpp) and
+// into the object compiled from a scene's equations (equation_plugin.cpp), never into the unit of
 // the stepper's analyses, whose inlining it would share.
 #include <functional>
 #include <memory>
@@ -55,3 +56,13 @@ ContinuationResult ModelAnalysesFor<Model>::continue_from_hopf(const AnalysesAt&
 }
 
 }  // namespace delayspec
+
+// The explicit instantiation of Model's continuation, beside `template class ModelAnalysesFor<Model>`
+// in a unit of its own.
+#define DELAYSPEC_INSTANTIATE_CONTINUATION(Model)                                                          \
+  template ContinuationResult ModelAnalysesFor<Model>::continue_orbit(const AnalysesAt&, const OrbitSettings&, \
+                                                                      const ContinuationOptions&) const;   \
+  template ContinuationResult ModelAnalysesFor<Model>::continue_period_doubled(                           \
+      const AnalysesAt&, const Bifurcation&, const ContinuationOptions&) const;                           \
+  template ContinuationResult ModelAnalysesFor<Model>::continue_from_hopf(                                \
+      const AnalysesAt&, const EquilibriumBifurcation&, const ContinuationOptions&) const;

@@ -28,6 +28,7 @@
 #include "scene/equations/equations_module_loader.hpp"
 #include "scene/loading/module_loader.hpp"
 #include "scene/loading/running_library.hpp"
+#include "scene/problem/models_module_loader.hpp"
 #include "scratch_dir.hpp"
 
 namespace {
@@ -75,6 +76,17 @@ TEST(StartupLibraries, BuiltInModelLoadsNeitherGiNaCNorMPI) {
   const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, "floquet --set model=impact --set N=20 --json");
   EXPECT_EQ(p.status, 0) << p.trace;
   expect_no_module_libraries(p);
+  // The impact model's analyses are in the library: the other models' module stays unloaded.
+  EXPECT_FALSE(mentions(p.trace, "libdelayspec_models")) << p.trace.substr(0, 4000);
+}
+
+// Another built-in model loads its analyses' module (src/modules/models/models_module.hpp), and
+// only that one.
+TEST(StartupLibraries, AnotherBuiltInModelLoadsTheModelsModuleOnly) {
+  const Process p = run_traced("LD_DEBUG=files", DELAYSPEC_CLI_PATH, "floquet --set model=mathieu --set N=20 --json");
+  EXPECT_EQ(p.status, 0) << p.trace;
+  expect_no_module_libraries(p);
+  EXPECT_TRUE(mentions(p.trace, "libdelayspec_models.so")) << p.trace.substr(0, 4000);
 }
 
 // The linear-algebra libraries, by the names the library asks for.
@@ -199,10 +211,18 @@ TEST(StartupLibraries, MissingModuleExits2NamingTheFile) {
   EXPECT_TRUE(mentions(p.trace, (dir / "libdelayspec_equations.so").string() + " (delayspec's symbolic front end)"))
       << p.trace;
   EXPECT_TRUE(mentions(p.trace, "it is missing")) << p.trace;
-  // The same copy runs a built-in model: only model = equations needs the module.
+  // The same copy runs the impact model, whose analyses are in the library; the other built-in
+  // models' are in libdelayspec_models, loaded on first use as the equations module: exit 2
+  // naming the model and the file.
   const Process builtin = run_traced("LD_LIBRARY_PATH='" + dir.string() + "'", (dir / "delayspec").string(),
-                                     "floquet --set model=linear --set N=20");
+                                     "floquet --set model=impact --set N=20");
   EXPECT_EQ(builtin.status, 0) << builtin.trace;
+  const Process linear = run_traced("LD_LIBRARY_PATH='" + dir.string() + "'", (dir / "delayspec").string(),
+                                    "floquet --set model=linear --set N=20");
+  EXPECT_EQ(linear.status, 2) << linear.trace;
+  EXPECT_TRUE(mentions(linear.trace, "model = linear needs the module " + (dir / "libdelayspec_models.so").string()))
+      << linear.trace;
+  EXPECT_TRUE(mentions(linear.trace, "it is missing")) << linear.trace;
   fs::remove_all(dir);
 }
 
@@ -228,6 +248,19 @@ TEST(EquationsModuleLoader, RefusesAMissingFileAndAnObjectWithoutTheEntryPoint) 
     EXPECT_TRUE(mentions(e.what(), library.string())) << e.what();
     EXPECT_TRUE(mentions(e.what(), "lacks `delayspec_equations_module`")) << e.what();
   }
+}
+
+TEST(ModelsModuleLoader, TheModuleBesideTheLibraryIsThisBuildsWithEveryEntry) {
+  const delayspec::cli::ModelsModule& module = delayspec::cli::models_module("mathieu");
+  EXPECT_EQ(std::string(module.version), std::string(DELAYSPEC_VERSION) + " " + DELAYSPEC_REVISION);
+  EXPECT_NE(module.linear, nullptr);
+  EXPECT_NE(module.mathieu, nullptr);
+  EXPECT_NE(module.mackey_glass, nullptr);
+  EXPECT_NE(module.milling, nullptr);
+  EXPECT_NE(module.milling_variable_pitch, nullptr);
+  // Through the table, the analyses of the model given (its dimension: linear 1, mathieu 2).
+  EXPECT_EQ(module.linear(delayspec::LinearModel(delayspec::LinearParameters{}))->state_dimension(), 1);
+  EXPECT_EQ(module.mathieu(delayspec::MathieuModel(delayspec::MathieuParameters{}))->state_dimension(), 2);
 }
 
 TEST(EquationsModuleLoader, TheModuleBesideTheLibraryIsThisBuildsAndReadsATable) {

@@ -2,10 +2,10 @@
 
 #include <climits>
 
-#include "delayspec/builtin_analyses.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/grid.hpp"
 #include "scene/equations/equation_model.hpp"
+#include "scene/problem/models_module_loader.hpp"
 
 namespace delayspec::cli {
 
@@ -165,7 +165,7 @@ Problem read_problem(Config& config, int default_N) {
     if (model.name == problem.model_name) builtin = &model;
   if (builtin) {
     problem.model = builtin->read(config);
-    problem.analyses = std::visit([](const auto& model) { return builtin_analyses(model); }, *problem.model);
+    problem.analyses = builtin_model_analyses(*problem.model);
     problem.state_names = builtin->state_names;
     problem.forced = builtin->forced;
   } else {

@@ -1,4 +1,5 @@
-// The analyses of the built-in model MackeyGlassModel, compiled once here (builtin_analyses.hpp).
+// The analyses of the built-in model MackeyGlassModel, compiled once here in libdelayspec_models
+// (src/modules/models/models_module.hpp).
 #include "delayspec/builtin_analyses.hpp"
 
 namespace delayspec {
