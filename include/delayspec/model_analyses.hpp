@@ -5,7 +5,7 @@
 // (lyapunov, sweep), the stroboscopic sequence (basin) and a simulation (simulate).
 //
 // ModelAnalysesFor<Model> implements it from the templates of the engine, compiled for Model's
-// d. It is instantiated once per built-in model in the library (builtin_analyses.hpp) and, for a
+// d. It is instantiated once per built-in model (builtin_analyses.hpp) and, for a
 // model written as equations in a scene, inside the object compiled from those equations at run
 // time (docs/models.md): the per-step work is always compiled for the model, never interpreted,
 // and one virtual call per analysis is all the front ends add.
@@ -258,7 +258,7 @@ class ModelAnalysesFor final : public ModelAnalyses {
   }
 
   // Defined in model_analyses_continuation.hpp and instantiated apart (analyses_continuation.cpp
-  // for the built-in models): compiled into the same unit as the other analyses, continuation's
+  // and models_continuation.cpp for the built-in models): compiled into the same unit as the other analyses, continuation's
   // templates took GCC's inlining budget from the stepper's (lyapunov of the impact model 1.13x
   // slower, measured).
   ContinuationResult continue_orbit(const AnalysesAt& at, const OrbitSettings& settings,
