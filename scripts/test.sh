@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds and runs the whole test suite:
 #  1. Release build, all tests (ctest);
-#  2. install into a temporary prefix; build and run examples/user_model against the installed
-#     package (find_package(delayspec)); import the installed Python package;
+#  2. install into a temporary prefix; build and run examples/user_model (a model of the user's
+#     own, a built-in one) against the installed package (find_package(delayspec)); import the
+#     installed Python package;
 #  3. AddressSanitizer + UndefinedBehaviorSanitizer build, all tests
 #     (skip with DELAYSPEC_NO_SANITIZE=1 for a quick local run).
 set -euo pipefail
@@ -17,6 +18,7 @@ cmake -S "$here/examples/user_model" -B "$prefix/example" -G Ninja -DCMAKE_BUILD
   -DCMAKE_PREFIX_PATH="$prefix/install" >/dev/null
 cmake --build "$prefix/example" >/dev/null
 "$prefix/example/user_model"
+"$prefix/example/builtin_model"
 "$prefix/install/bin/delayspec" --version
 # The modules loaded on first use are found beside the installed library: a built-in model other
 # than impact (libdelayspec_models), an equations scene (libdelayspec_equations) and, with MPI, a

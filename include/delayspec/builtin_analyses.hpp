@@ -2,7 +2,8 @@
 // The analyses of the built-in models (model_analyses.hpp), compiled once: builtin_analyses(model)
 // wraps a model in them. The impact model's (the default scene's) are in the library
 // (src/engine/analyses_impact.cpp); the other five models' in libdelayspec_models
-// (src/modules/models/models_module.hpp), which a program or test that names them links, and
+// (src/modules/models/models_module.hpp; the CMake package's delayspec::models), which a program
+// or test that names them links, and
 // which the scene layer loads on first use, so that the program prints its first number without
 // waiting for their compilation (issue 37; docs/benchmarks.md, "Build time").
 #include <memory>
