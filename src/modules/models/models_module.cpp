@@ -1,6 +1,6 @@
 // The entry point of libdelayspec_models (models_module.hpp): the only symbol the program looks
-// up. The explicit instantiations of the other units stay visible for the tests and benches, which
-// link the module directly.
+// up. The explicit instantiations of the other units stay visible for the tests and the package's
+// users (delayspec::models), which link the module directly.
 #include "modules/models/models_module.hpp"
 
 #include <type_traits>

@@ -9,7 +9,8 @@
 //
 // The module exports one C symbol, models_module_symbol, a function that returns this table.
 // Its members have C++ types: the module and the program must come from one build, which the
-// loader checks with `version`. Tests and benches that name these models link the module directly.
+// loader checks with `version`. The tests and programs against the installed package
+// (delayspec::models) that name these models link the module directly.
 #include <memory>
 
 #include "delayspec/model_analyses.hpp"
