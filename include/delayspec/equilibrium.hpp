@@ -87,7 +87,8 @@ struct ConstantHistory {
   // sigma_min(Delta(lambda)) / (|lambda| + |A| + sum_i |B_i|), 2-norms.
   double residual(std::complex<double> lambda) const;
   // The unit vector c with |Delta(lambda) c| least: the right singular vector of the smallest
-  // singular value (at a root, Delta(lambda) c = 0: the critical eigenvector of a Hopf point).
+  // singular value (at a root, Delta(lambda) c = 0: the critical eigenvector of a Hopf point),
+  // its phase fixed by its entry of largest modulus being real and positive.
   Eigen::VectorXcd null_vector(std::complex<double> lambda) const;
 };
 

@@ -2,11 +2,15 @@
 // characteristic function c(lambda) = det Delta(lambda) for each root.
 #include "delayspec/equilibrium.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "delayspec/errors.hpp"
+#include "engine/linalg/linear_algebra.hpp"
 
 namespace delayspec {
 
@@ -39,15 +43,45 @@ std::complex<double> ConstantHistory::newton_step(std::complex<double> l) const 
 
 namespace {
 
+// The singular values of a (descending) and, when last_right is given, a right singular vector of
+// the smallest: LAPACK's zgesvd through the loaded table (linear_algebra.hpp). Not Eigen's
+// JacobiSVD: its real and complex instantiations took 24 s of this unit's 32 s of compile, on the
+// program's path to its first number (docs/benchmarks.md, "Build time"); these matrices are d x d.
+Eigen::VectorXd singular_values(Eigen::MatrixXcd a, Eigen::VectorXcd* last_right = nullptr) {
+  const int m = static_cast<int>(a.rows()), n = static_cast<int>(a.cols()), ldvt = last_right ? n : 1;
+  Eigen::VectorXd s(std::min(m, n));
+  Eigen::MatrixXcd vt(ldvt, last_right ? n : 1);
+  std::vector<double> rwork(5 * static_cast<size_t>(std::min(m, n)));
+  std::complex<double> query, u;
+  const int one = 1;
+  int lwork = -1, info = 0;
+  const char* jobvt = last_right ? "A" : "N";
+  const auto zgesvd = detail::lapack().zgesvd;
+  zgesvd("N", jobvt, &m, &n, a.data(), &m, s.data(), &u, &one, vt.data(), &ldvt, &query, &lwork, rwork.data(), &info);
+  lwork = std::max(1, static_cast<int>(query.real()));
+  std::vector<std::complex<double>> work(static_cast<size_t>(lwork));
+  zgesvd("N", jobvt, &m, &n, a.data(), &m, s.data(), &u, &one, vt.data(), &ldvt, work.data(), &lwork, rwork.data(),
+         &info);
+  if (info != 0)
+    throw NumericalFailure("equilibrium: the SVD of a " + std::to_string(m) + " x " + std::to_string(n) +
+                           " matrix (LAPACK zgesvd) failed, info = " + std::to_string(info));
+  if (last_right) *last_right = vt.row(n - 1).adjoint();  // A = U S V^H: V's last column
+  return s;
+}
+
 double largest_singular_value(const Eigen::MatrixXd& m) {
-  return m.size() == 1 ? std::abs(m(0, 0)) : Eigen::JacobiSVD<Eigen::MatrixXd>(m).singularValues()(0);
+  return m.size() == 1 ? std::abs(m(0, 0)) : singular_values(m.cast<std::complex<double>>())(0);
 }
 
 }  // namespace
 
 Eigen::VectorXcd ConstantHistory::null_vector(std::complex<double> l) const {
-  const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(delta(l), Eigen::ComputeFullV);
-  return svd.matrixV().col(A.rows() - 1);
+  Eigen::VectorXcd v;
+  singular_values(delta(l), &v);
+  // A convention of our own rather than the SVD's: the entry of largest modulus real and positive
+  Eigen::Index largest = 0;
+  v.cwiseAbs().maxCoeff(&largest);
+  return v * (std::abs(v[largest]) / v[largest]);
 }
 
 double ConstantHistory::residual(std::complex<double> l) const {
@@ -56,8 +90,7 @@ double ConstantHistory::residual(std::complex<double> l) const {
   for (size_t i = 0; i < taus.size(); ++i)
     scale += largest_singular_value(B.middleCols(static_cast<long>(i) * d, d));
   const Eigen::MatrixXcd value = delta(l);
-  const double smallest =
-      d == 1 ? std::abs(value(0, 0)) : Eigen::JacobiSVD<Eigen::MatrixXcd>(value).singularValues()(d - 1);
+  const double smallest = d == 1 ? std::abs(value(0, 0)) : singular_values(value)(d - 1);
   return smallest / scale;
 }
 

@@ -133,6 +133,39 @@ struct NoEquilibrium {
   Vec<1> initial_state() const { return Vec<1>(0); }
 };
 
+// ConstantHistory's SVD-based parts (LAPACK zgesvd in the library) against a system whose root
+// and eigenvector are known by hand, and against Eigen's JacobiSVD (an independent SVD):
+// A = [[a, -2 b], [b / 2, a]] has the eigenvalues a +- i b with the eigenvector (1, -i / 2) for
+// a + i b; with B = beta I and one delay, Delta(i w) = i w I - A - beta e^{-i w tau} I is singular
+// when a + i b = i w - beta e^{-i w tau}. The null vector is then (2, -i) / sqrt 5 (its largest
+// entry real and positive, the documented phase). 1e-13: the smallest singular value is simple,
+// the next ~|b| = O(1) away, so the SVD's vector is good to a few eps |Delta| / gap.
+TEST(Equilibrium, NullVectorAndResidualOfAKnownSingularDelta) {
+  const double w = 1.3, beta = 0.4, tau = 0.7;
+  const cd z = cd(0, w) - beta * std::exp(cd(0, -w * tau));
+  ConstantHistory h;
+  h.A.resize(2, 2);
+  h.A << z.real(), -2 * z.imag(), z.imag() / 2, z.real();
+  h.B = beta * Eigen::MatrixXd::Identity(2, 2);
+  h.taus = {tau};
+  h.f = Eigen::VectorXd::Zero(2);
+  const Eigen::VectorXcd c = h.null_vector(cd(0, w));
+  ASSERT_EQ(c.size(), 2);
+  EXPECT_NEAR(std::abs(c[0] - 2 / std::sqrt(5.0)), 0, 1e-13) << c.transpose();
+  EXPECT_NEAR(std::abs(c[1] - cd(0, -1 / std::sqrt(5.0))), 0, 1e-13) << c.transpose();
+  EXPECT_LT(h.residual(cd(0, w)), 1e-15);
+  // Away from the root: sigma_min(Delta) / (|lambda| + |A|_2 + |B|_2), by Eigen's JacobiSVD
+  for (const cd l : {cd(0.1, w), cd(-0.5, 2.0), cd(0.3, 0)}) {
+    const double smallest = Eigen::JacobiSVD<Eigen::MatrixXcd>(h.delta(l)).singularValues()(1);
+    const double scale = std::abs(l) + Eigen::JacobiSVD<Eigen::MatrixXd>(h.A).singularValues()(0) + beta;
+    EXPECT_NEAR(h.residual(l), smallest / scale, 1e-14 * smallest / scale + 1e-16) << l;
+    // the vector of the smallest singular value: |Delta c| = sigma_min, |c| = 1
+    const Eigen::VectorXcd v = h.null_vector(l);
+    EXPECT_NEAR(v.norm(), 1, 1e-14);
+    EXPECT_NEAR((h.delta(l) * v).norm(), smallest, 1e-13) << l;
+  }
+}
+
 TEST(Equilibrium, BadInputAndAModelWithoutEquilibrium) {
   EquilibriumOptions o;
   o.nroots = 0;

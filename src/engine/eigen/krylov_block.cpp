@@ -56,6 +56,43 @@ namespace {
 thread_local double select_threshold = 0;
 int select_large(const double* re, const double* im) { return std::hypot(*re, *im) >= select_threshold ? 1 : 0; }
 
+// The Rayleigh quotient's eigenvalues and unit right eigenvectors, by LAPACK dgeev through the
+// loaded table. Not Eigen's EigenSolver: its instantiation took 11 s of this unit's 21 s of
+// compile, on the program's path to its first number (docs/benchmarks.md, "Build time").
+struct Eigenpairs {
+  Eigen::VectorXcd values;
+  Eigen::MatrixXcd vectors;  // unit columns
+};
+
+Eigenpairs rayleigh_quotient_eigenpairs(Eigen::MatrixXd h) {
+  const int n = static_cast<int>(h.rows()), one = 1;
+  Eigen::VectorXd wr(n), wi(n);
+  Eigen::MatrixXd vr(n, n);
+  double query = 0, unused = 0;
+  int lwork = -1, info = 0;
+  const auto dgeev = detail::lapack().dgeev;
+  dgeev("N", "V", &n, h.data(), &n, wr.data(), wi.data(), &unused, &one, vr.data(), &n, &query, &lwork, &info);
+  lwork = std::max(1, static_cast<int>(query));
+  std::vector<double> work(static_cast<size_t>(lwork));
+  dgeev("N", "V", &n, h.data(), &n, wr.data(), wi.data(), &unused, &one, vr.data(), &n, work.data(), &lwork, &info);
+  if (info != 0)
+    throw NumericalFailure("Krylov (block): the eigenvalues of the " + std::to_string(n) + " x " + std::to_string(n) +
+                           " Rayleigh quotient did not converge (LAPACK dgeev info = " + std::to_string(info) + ")");
+  Eigenpairs e{Eigen::VectorXcd(n), Eigen::MatrixXcd::Zero(n, n)};
+  for (int j = 0; j < n; ++j) {
+    e.values[j] = {wr[j], wi[j]};
+    if (wi[j] == 0) {
+      e.vectors.col(j) = vr.col(j).cast<std::complex<double>>();
+    } else if (wi[j] > 0 && j + 1 < n) {  // a conjugate pair: columns j and j + 1 hold Re and Im
+      e.vectors.col(j).real() = vr.col(j), e.vectors.col(j).imag() = vr.col(j + 1);
+      e.vectors.col(j + 1) = e.vectors.col(j).conjugate();
+      e.values[j + 1] = {wr[j + 1], wi[j + 1]};
+      ++j;
+    }
+  }
+  return e;
+}
+
 class BlockKrylovSchur {
  public:
   BlockKrylovSchur(long n, int b, int m) : n_(n), b_(b), m_(m), V_(n, m + b), H_(Eigen::MatrixXd::Zero(m + b, m)) {}
@@ -267,12 +304,9 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
     const long p = j - b;  // Rayleigh quotient size
     const Eigen::MatrixXd Hp = H.topLeftCorner(p, p);
     const Eigen::MatrixXd coupling = H.block(p, 0, b, p);
-    Eigen::EigenSolver<Eigen::MatrixXd> es(Hp);
-    if (es.info() != Eigen::Success)
-      throw NumericalFailure("Krylov (block): the eigenvalues of the " + std::to_string(p) + " x " + std::to_string(p) +
-                             " Rayleigh quotient did not converge");
-    const Eigen::VectorXcd theta = es.eigenvalues();
-    const Eigen::MatrixXcd Yc = es.eigenvectors();  // unit columns
+    const Eigenpairs es = rayleigh_quotient_eigenpairs(Hp);
+    const Eigen::VectorXcd& theta = es.values;
+    const Eigen::MatrixXcd& Yc = es.vectors;  // unit columns
     std::vector<long> order(p);
     for (long i = 0; i < p; ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(),

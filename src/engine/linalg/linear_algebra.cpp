@@ -63,6 +63,7 @@ const detail::Lapack& detail::lapack() {
     const auto lapack = open_library(DELAYSPEC_LAPACK_SONAME, "LAPACK", error);
     find_function(lapack, DELAYSPEC_LAPACK_SONAME, "dgeev_", f.dgeev, error);
     find_function(lapack, DELAYSPEC_LAPACK_SONAME, "dgees_", f.dgees, error);
+    find_function(lapack, DELAYSPEC_LAPACK_SONAME, "zgesvd_", f.zgesvd, error);
   });
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 // The entry points of the linear-algebra libraries the library calls: BLAS dgemm and LAPACK
-// dgeev / dgees (OpenBLAS), ARPACK-ng's dnaupd / dneupd, SuiteSparse UMFPACK's umfpack_di_*. Internal: not
+// dgeev / dgees / zgesvd (OpenBLAS), ARPACK-ng's dnaupd / dneupd, SuiteSparse UMFPACK's umfpack_di_*. Internal: not
 // installed (include/delayspec/linear_algebra_libraries.hpp is the public side).
 //
 // Why through a table: the libraries are not linked but loaded with dlopen on first use
@@ -8,6 +8,8 @@
 // it solves anything (the dynamic loader binds OpenBLAS's ~14000 kernel-table relocations before
 // main: docs/benchmarks.md, "Eighth sitting"); loaded on first use, `--version`, `lyapunov` and
 // the others that need none of them do not pay it.
+#include <complex>
+
 #include <arpack/arpackdef.h>
 #include <umfpack.h>
 
@@ -24,9 +26,14 @@ struct Lapack {
   using Dgees = void(const char* jobvs, const char* sort, int (*select)(const double*, const double*), const int* n,
                      double* a, const int* lda, int* sdim, double* wr, double* wi, double* vs, const int* ldvs,
                      double* work, const int* lwork, int* bwork, int* info);
+  // COMPLEX*16 is laid out as std::complex<double> (two doubles, real first)
+  using Zgesvd = void(const char* jobu, const char* jobvt, const int* m, const int* n, std::complex<double>* a,
+                      const int* lda, double* s, std::complex<double>* u, const int* ldu, std::complex<double>* vt,
+                      const int* ldvt, std::complex<double>* work, const int* lwork, double* rwork, int* info);
   Dgemm* dgemm = nullptr;
   Dgeev* dgeev = nullptr;
   Dgees* dgees = nullptr;
+  Zgesvd* zgesvd = nullptr;
 };
 
 // ARPACK-ng's ISO_C_BINDING entry points (arpack/arpack.h declares them with C99 `_Complex`
