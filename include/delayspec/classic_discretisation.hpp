@@ -39,20 +39,13 @@
 #include <Eigen/Core>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "delayspec/classic_result.hpp"
 #include "delayspec/dense_spectrum.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/model.hpp"
 #include "delayspec/multipliers.hpp"
 
 namespace delayspec {
-
-enum class ClassicMethod { sdm0, fdm1 };
-
-struct ClassicResult {
-  Multipliers multipliers;  // the nev largest in modulus
-  long dimension = 0;       // n = d + m r
-  double seconds = 0;       // coefficients, product and eigenvalues
-};
 
 namespace detail {
 

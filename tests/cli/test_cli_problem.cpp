@@ -1,11 +1,16 @@
 // Problem, the one hand-off from the configuration to the computation: its grid and dimensions
-// are functions of (model, N, orbit_period) and agree with the map with_map() builds; events and
+// are functions of (model, N, orbit_period) and agree with the engine's map of the model; events and
 // jacobian are enums whose text appears only at the edge, with no silent fallback.
 #include <gtest/gtest.h>
 
 #include <string>
+#include <tuple>
+#include <type_traits>
+#include <variant>
 
 #include "delayspec/errors.hpp"
+#include "delayspec/stepper.hpp"
+#include "delayspec/stroboscopic_map.hpp"
 #include "scene/problem/problem.hpp"
 
 using delayspec::BadInput;
@@ -26,7 +31,7 @@ Problem problem_of(const std::string& model, int N, int orbit_period = 1) {
 
 }  // namespace
 
-TEST(Problem, DimensionsAgreeWithTheMapWithMapBuilds) {
+TEST(Problem, DimensionsAgreeWithTheEnginesMap) {
   // d (M + 1) by hand: linear and mackey-glass d = 1, tau = T, M = N; impact and mathieu d = 2.
   EXPECT_EQ(problem_of("linear", 20).dimension(), 21);
   EXPECT_EQ(problem_of("mackey-glass", 30).dimension(), 31);
@@ -34,13 +39,15 @@ TEST(Problem, DimensionsAgreeWithTheMapWithMapBuilds) {
   for (const std::string model : {"impact", "linear", "mathieu", "mackey-glass"}) {
     for (int N : {16, 50}) {
       const Problem p = problem_of(model, N, model == "impact" || model == "mathieu" ? 2 : 1);
-      const auto [n, K, d] = delayspec::cli::with_map(
-          p,
-          [](const auto& model_, const auto& map) {
-            (void)model_;
-            return std::tuple<long, int, int>(map.dimension(), map.grid().K, std::decay_t<decltype(model_)>::d);
+      // The engine's own map of the model, built here as the analyses build theirs.
+      const auto [n, K, d] = std::visit(
+          [&](const auto& model_) {
+            using Model = std::decay_t<decltype(model_)>;
+            const delayspec::StroboscopicMap<Model> map(
+                delayspec::TrapezoidStepper<Model>(model_, delayspec::cli::step_options(p)), p.grid());
+            return std::tuple<long, int, int>(map.dimension(), map.grid().K, Model::d);
           },
-          "test");
+          *p.model);
       EXPECT_EQ(p.dimension(), n) << model << " N = " << N;
       EXPECT_EQ(p.grid().K, K) << model << " N = " << N;
       EXPECT_EQ(p.state_dimension(), d) << model;

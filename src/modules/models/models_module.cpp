@@ -17,7 +17,8 @@ const cli::ModelsModule module_table{DELAYSPEC_VERSION " " DELAYSPEC_REVISION,
                                      &builtin_analyses<MathieuModel>,
                                      &builtin_analyses<MackeyGlassModel>,
                                      &builtin_analyses<MillingModel>,
-                                     &builtin_analyses<VariablePitchMillingModel>};
+                                     &builtin_analyses<VariablePitchMillingModel>,
+                                     &cli::classic_multipliers_of};
 
 }  // namespace
 

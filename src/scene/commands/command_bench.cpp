@@ -30,13 +30,14 @@
 
 #include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
-#include "delayspec/classic_discretisation.hpp"
+#include "delayspec/classic_result.hpp"
 #include "delayspec/convergence.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/linear_algebra_libraries.hpp"
 #include "scene/problem/floquet_settings.hpp"
 #include "scene/problem/level_runner.hpp"
+#include "scene/problem/models_module_loader.hpp"
 #include "scene/output/memory_probe.hpp"
 #include "scene/output/metadata.hpp"
 #include "scene/output/output.hpp"
@@ -133,9 +134,7 @@ BenchSettings read_bench_settings(Config& config) {
     // Checked now, before any work: the classic paths need a linear model with tau = T.
     const std::string key = "`solvers = " + s.classic_names.front() + "`: ";
     try {
-      with_map(
-          s.problem, [&](const auto& model, const auto&) { classic_monodromy(model, 2, s.classics.front()); },
-          "the classic discretisations");
+      builtin_classic_multipliers(s.problem, 2, s.classics.front(), 1);
     } catch (const BadInput& e) {
       throw BadInput(key + e.what());
     }
@@ -195,19 +194,15 @@ std::vector<BenchRow> run_bench(const BenchSettings& s, const Invocation& inv) {
       row.N = N;
       row.solver = s.classic_names[c];
       try {
-        with_map(
-            s.problem,
-            [&](const auto& model, const auto&) {
-              const MemoryProbe probe;
-              const ClassicResult r = classic_multipliers(model, N, s.classics[c], base.nev);
-              row.peak_bytes = probe.peak_bytes();
-              row.n = r.dimension;
-              row.multipliers = r.multipliers;
-              row.seconds = r.seconds;
-              keep_fastest_of_repeats(row, repeats,
-                                      [&] { return classic_multipliers(model, N, s.classics[c], base.nev).seconds; });
-            },
-            "the classic discretisations");
+        const MemoryProbe probe;
+        const ClassicResult r = builtin_classic_multipliers(s.problem, N, s.classics[c], base.nev);
+        row.peak_bytes = probe.peak_bytes();
+        row.n = r.dimension;
+        row.multipliers = r.multipliers;
+        row.seconds = r.seconds;
+        keep_fastest_of_repeats(row, repeats, [&] {
+          return builtin_classic_multipliers(s.problem, N, s.classics[c], base.nev).seconds;
+        });
       } catch (const NumericalFailure& e) {
         record_failure(row, e, inv);
       }

@@ -69,7 +69,7 @@ int command_simulate(Config& config, const Invocation& inv) {
   const double control_on_at = config.get_double("control_on_at", 0);
   require_finite("control_on_at", control_on_at);
   if (control_on_at < 0) throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: must be >= 0");
-  // The control switch changes the impact model's feedback gain k (with_map below).
+  // The control switch changes the impact model's feedback gain k (before_model below).
   if (control_on_at > 0 && !(problem.model && std::holds_alternative<ImpactModel>(*problem.model)))
     throw BadInput("`control_on_at = " + format_number(control_on_at) + "`: only for model = impact (it switches k)");
   Problem before_problem = problem;

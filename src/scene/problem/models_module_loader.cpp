@@ -36,4 +36,9 @@ std::shared_ptr<const ModelAnalyses> builtin_model_analyses(const AnyModel& mode
       model);
 }
 
+ClassicResult builtin_classic_multipliers(const Problem& problem, int m, ClassicMethod method, int nev) {
+  if (!problem.model) throw BadInput("the classic discretisations take the built-in models only, not model = equations");
+  return models_module(problem.model_name).classic(*problem.model, m, method, nev);
+}
+
 }  // namespace delayspec::cli

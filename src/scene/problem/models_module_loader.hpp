@@ -16,6 +16,11 @@ namespace delayspec::cli {
 // needs the module and it is missing, cannot be loaded or is of another build (load_module).
 std::shared_ptr<const ModelAnalyses> builtin_model_analyses(const AnyModel& model);
 
+// The classic dense discretisations (sdm0, fdm1) of the problem's model (the module's
+// classic_multipliers_of), for `bench`. BadInput for model = equations, for a model they do not
+// take, and as builtin_model_analyses when the module cannot be loaded.
+ClassicResult builtin_classic_multipliers(const Problem& problem, int m, ClassicMethod method, int nev);
+
 // The module beside libdelayspec, loaded on the first call (thread-safe); `model_name` is the
 // model that needs it, for the message of a failed load.
 const ModelsModule& models_module(const std::string& model_name);

@@ -5,30 +5,19 @@
 //
 // The model's analyses (delayspec/model_analyses.hpp) are the one hand-off from a problem to the
 // engine, for the built-in models and for a model written as equations in the scene alike.
-// with_map() is kept for what only the built-in models offer (the classic
-// discretisations, simulate's control switch).
+// What only the built-in models offer (the classic discretisations of `bench`) takes the
+// AnyModel itself (models_module_loader.hpp).
 #include <memory>
 #include <optional>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "scene/keys/config.hpp"
+#include "modules/models/any_model.hpp"
 #include "delayspec/grid.hpp"
-#include "delayspec/model_impact.hpp"
-#include "delayspec/model_linear.hpp"
-#include "delayspec/model_mackey_glass.hpp"
-#include "delayspec/model_mathieu.hpp"
 #include "delayspec/model_analyses.hpp"
-#include "delayspec/model_milling.hpp"
-#include "delayspec/model_milling_variable_pitch.hpp"
-#include "delayspec/stepper.hpp"
-#include "delayspec/stroboscopic_map.hpp"
 
 namespace delayspec::cli {
-
-using AnyModel =
-    std::variant<ImpactModel, LinearModel, MathieuModel, MackeyGlassModel, MillingModel, VariablePitchMillingModel>;
 
 struct Problem {
   std::string model_name;
@@ -58,21 +47,6 @@ struct Problem {
 
 // The stepper options (events, jacobian, contact sub-steps) the problem asks for.
 StepOptions step_options(const Problem& problem);
-
-// The problem as a map, in one place: builds the problem's stepper and stroboscopic map and
-// returns fn(model, map) (fn is generic in the model; every alternative must return one type).
-// Built-in models only: BadInput for model = equations, naming `what` needs a built-in model.
-template <class Fn>
-decltype(auto) with_map(const Problem& problem, Fn&& fn, const std::string& what) {
-  if (!problem.model) throw BadInput(what + " takes the built-in models only, not model = equations");
-  return std::visit(
-      [&](const auto& model) -> decltype(auto) {
-        using Model = std::decay_t<decltype(model)>;
-        const StroboscopicMap<Model> map(TrapezoidStepper<Model>(model, step_options(problem)), problem.grid());
-        return fn(model, map);
-      },
-      *problem.model);
-}
 
 // The one table of the built-in models, the default first: the name (the key `model`), how the
 // keys make the model, and the traits the scene layer needs beside its analyses.
