@@ -145,15 +145,21 @@ struct BoundaryPointStudy {
   double x_extrapolated = NAN, y_extrapolated = NAN;
   double x_error_estimate = NAN, y_error_estimate = NAN;
 };
+// `previous`: the study of the point before (k - 1), whose points of the coarser curves, projected
+// on this point's normal, start each search there (a curve's neighbouring points have their
+// coarser curves at nearly the same offsets).
 BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, const std::vector<BoundaryFunction>& coarser,
                                         const std::vector<int>& Ns, const BoundaryOptions& scale,
-                                        const RichardsonOptions& richardson);
+                                        const RichardsonOptions& richardson,
+                                        const BoundaryPointStudy* previous = nullptr);
 
-// The s nearest 0 with g((x, y) + s (dx, dy)) = 0, by the secant method from s = 0 and s = step,
-// to |ds| <= tolerance; NaN when it does not converge in 30 evaluations or g is undefined. Along
-// the curve's normal (another N's curve near a point of this one) the secant is well conditioned
-// wherever the curve goes, steep or flat.
+// The s with g((x, y) + s (dx, dy)) = 0 nearest `guess` (NaN: 0), by the secant method from s =
+// guess and guess + step, to |ds| <= tolerance. Where g is undefined at the guess, from s = 0;
+// where it is undefined there too, from the nearest s within 4e-3 where it is defined; a step into
+// where it is undefined is halved back. NaN when it does not converge in 30 evaluations or g stays
+// undefined. Along the curve's normal (another N's curve near a point of this one) the secant is
+// well conditioned wherever the curve goes, steep or flat.
 double boundary_offset_along(const BoundaryFunction& g, double x, double y, double dx, double dy, double step,
-                             double tolerance);
+                             double tolerance, double guess = NAN);
 
 }  // namespace delayspec

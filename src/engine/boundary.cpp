@@ -488,7 +488,7 @@ bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, doubl
 
 BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, const std::vector<BoundaryFunction>& coarser,
                                         const std::vector<int>& Ns, const BoundaryOptions& scale,
-                                        const RichardsonOptions& richardson) {
+                                        const RichardsonOptions& richardson, const BoundaryPointStudy* previous) {
   BoundaryPointStudy s;
   const size_t n = curve.points.size();
   const BoundaryPoint& pt = curve.points.at(k);
@@ -502,8 +502,13 @@ BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, co
   std::vector<std::complex<double>> offsets;
   for (size_t i = 0; i < Ns.size(); ++i) {
     double offset = 0;  // (the finest N: the point itself)
-    if (i < coarser.size())
-      offset = boundary_offset_along(coarser[i], pt.x, pt.y, nu * dx, nv * dy, 1e-6, scale.tolerance);
+    if (i < coarser.size()) {
+      // The previous point's point of this level's curve, projected on this point's normal
+      const double guess = previous && i < previous->x_by_N.size()
+                               ? (previous->x_by_N[i] - pt.x) / dx * nu + (previous->y_by_N[i] - pt.y) / dy * nv
+                               : NAN;
+      offset = boundary_offset_along(coarser[i], pt.x, pt.y, nu * dx, nv * dy, 1e-6, scale.tolerance, guess);
+    }
     s.x_by_N.push_back(pt.x + offset * nu * dx);
     s.y_by_N.push_back(pt.y + offset * nv * dy);
     if (std::isfinite(offset)) {
@@ -530,13 +535,39 @@ BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, co
 }
 
 double boundary_offset_along(const BoundaryFunction& g, double x, double y, double dx, double dy, double step,
-                             double tolerance) {
+                             double tolerance, double guess) {
   const auto at = [&](double s) { return g(x + s * dx, y + s * dy); };
   double s0 = 0, s1 = step;
-  BoundarySample g0 = at(s0);
+  BoundarySample g0;
+  if (std::isfinite(guess) && (g0 = at(guess)).defined) {
+    s0 = guess;
+    s1 = guess + step;
+  } else {
+    g0 = at(s0);
+  }
+  // Undefined at the point itself: the secant starts instead from the nearest point of the line
+  // where g is defined, searched on both sides at 10 step 4^k up to kReach. The case: a coarser
+  // level's flip lobe is narrower, so at points of the finest curve the coarser level's critical
+  // pair has not yet split on the real axis, and the period-doubling test needs a real multiplier.
+  // On the lobe diagram of milling_lobes_curves.toml this left a quarter of the offsets to the
+  // coarser curves undefined, and most flip-lobe points without an error estimate. kReach (a fifth
+  // of a percent of the scaled plane) is some ten times the offsets between the levels there, far
+  // below the distance to another lobe; a wrong root would fail the extrapolation's order check.
+  constexpr double kReach = 4e-3;
+  for (double d = 10 * step; !g0.defined && d <= kReach; d *= 4)
+    for (double side : {1.0, -1.0}) {
+      if ((g0 = at(side * d)).defined) {
+        s0 = side * d;
+        s1 = s0 + side * step;
+        break;
+      }
+    }
   if (!g0.defined) return NAN;
   for (int it = 0; it < 30; ++it) {
-    const BoundarySample g1 = at(s1);
+    BoundarySample g1 = at(s1);
+    // A secant step into where g is undefined (the same pair, not yet split): halved back toward
+    // the last defined point, down to a millionth of it.
+    for (int half = 0; !g1.defined && half < 20; ++half) g1 = at(s1 = s0 + (s1 - s0) / 2);
     if (!g1.defined || g1.value == g0.value) return NAN;
     const double s2 = s1 - g1.value * (s1 - s0) / (g1.value - g0.value);
     if (!std::isfinite(s2)) return NAN;

@@ -95,3 +95,52 @@ TEST(Boundary, AStartBetweenTwoSamplesOfACurvedCurveIsOnIt) {
   EXPECT_FALSE(on_boundary_curve({c}, x, y - 0.05, 1e-4));
   EXPECT_FALSE(on_boundary_curve({c}, 1.5, 0.0, 1e-4));  // outside the curve's x range
 }
+
+// boundary_offset_along on a line whose test function is undefined near the start, as a coarser
+// level's period-doubling test is at points of a flip lobe's finest curve (its critical pair not
+// yet split on the real axis there): g = s - 3e-4, defined only for s >= 2e-4. The root is found
+// from the nearest defined point, to the tolerance (the secant is exact on a line: 1e-15 here is
+// rounding of s ~ 3e-4); without that search the offset was NaN.
+TEST(Boundary, AnOffsetIsFoundFromTheNearestPointWhereTheTestFunctionIsDefined) {
+  const auto g = [](double /*x*/, double y) {
+    BoundarySample s;
+    s.defined = y >= 2e-4;
+    s.value = y - 3e-4;
+    return s;
+  };
+  EXPECT_NEAR(boundary_offset_along(g, 0, 0, 0, 1, 1e-6, 1e-12), 3e-4, 1e-15);
+  // On the other side too (the line's direction reversed), and from a guess where g is undefined.
+  EXPECT_NEAR(boundary_offset_along(g, 0, 0, 0, -1, 1e-6, 1e-12), -3e-4, 1e-15);
+  EXPECT_NEAR(boundary_offset_along(g, 0, 0, 0, 1, 1e-6, 1e-12, 1e-4), 3e-4, 1e-15);
+  // Undefined within the search's reach (4e-3) on both sides: NaN, not a root made up.
+  const auto far = [](double /*x*/, double y) {
+    BoundarySample s;
+    s.defined = std::abs(y) >= 1e-2;
+    s.value = y - 2e-2;
+    return s;
+  };
+  EXPECT_TRUE(std::isnan(boundary_offset_along(far, 0, 0, 0, 1, 1e-6, 1e-12)));
+}
+
+// With a guess, the root nearest the guess: g = (s - 1e-3)(s - 0.5) has roots 1e-3 and 0.5; from
+// 0 the secant finds 1e-3, from the guess 0.49 (the neighbour's offset) 0.5. A secant step into
+// where g is undefined (s > 0.6 here) is halved back toward the last defined point.
+TEST(Boundary, AnOffsetStartsFromTheGuessAndBacksOutOfWhereTheTestFunctionIsUndefined) {
+  const auto g = [](double /*x*/, double y) {
+    BoundarySample s;
+    s.defined = y <= 0.6;
+    s.value = (y - 1e-3) * (y - 0.5);
+    return s;
+  };
+  EXPECT_NEAR(boundary_offset_along(g, 0, 0, 0, 1, 1e-6, 1e-13), 1e-3, 1e-12);
+  EXPECT_NEAR(boundary_offset_along(g, 0, 0, 0, 1, 1e-6, 1e-13, 0.49), 0.5, 1e-12);
+  // From 0.59 the first secant step overshoots far past 0.6 (g is nearly flat in s there relative
+  // to its value): it is halved back and still ends on 0.5.
+  const auto steep = [](double /*x*/, double y) {
+    BoundarySample s;
+    s.defined = y <= 0.6;
+    s.value = std::exp(40 * (y - 0.5)) - 1;
+    return s;
+  };
+  EXPECT_NEAR(boundary_offset_along(steep, 0, 0, 0, 1, 1e-6, 1e-13, 0.3), 0.5, 1e-12);
+}

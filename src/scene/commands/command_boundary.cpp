@@ -281,7 +281,7 @@ std::vector<BoundaryPointStudy> study_points(const Config& config, const Boundar
   std::vector<BoundaryFunction> coarser(at_N.begin(), at_N.end());
   std::vector<BoundaryPointStudy> out;
   for (size_t k = 0; k < curve.points.size(); ++k) {
-    out.push_back(boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson));
+    out.push_back(boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson, k > 0 ? &out.back() : nullptr));
     progress.add();
   }
   return out;
