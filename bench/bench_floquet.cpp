@@ -4,9 +4,9 @@
 // System: the default scene's period-1 orbit of the impact oscillator (paper parameters,
 // tau = T, k = 0.2), found by simulation once per N (setup, not timed).
 //
-//   BM_KrylovTop20/<solver>/<N>     top-20 multipliers, solver 0 = spectra, 1 = arpack
-//   BM_DenseVsKrylov/<solver>/<N>   top-20 at N = 1000, 2000, solver 0..3 = spectra, arpack,
-//                                   dense-lapack, dense-eigen; counter max_diff = largest
+//   BM_KrylovTop20/<solver>/<N>     top-20 multipliers, solver 0 = spectra, 1 = arpack, 4 = block
+//   BM_DenseVsKrylov/<solver>/<N>   top-20 at N = 1000, 2000, solver 0..4 = spectra, arpack,
+//                                   dense-lapack, dense-eigen, block; counter max_diff = largest
 //                                   |mu_k - mu_k(dense-lapack)| / |mu_1| over the 20 (same run)
 //   BM_Apply/<k>/<N>                ns per step per vector: k = 0 single-vector perform_op,
 //                                   k >= 1 apply_block with k interleaved vectors
@@ -57,7 +57,7 @@ double peak_rss_mb() {
 }
 
 const FloquetSolver kSolvers[] = {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::dense_lapack,
-                                  FloquetSolver::dense_eigen};
+                                  FloquetSolver::dense_eigen, FloquetSolver::block};
 
 void report(benchmark::State& state, const FloquetResult& r, long n) {
   double worst = 0;
@@ -134,7 +134,7 @@ void BM_Apply(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_KrylovTop20)
-    ->ArgsProduct({{0, 1}, {10000, 100000, 1000000}})
+    ->ArgsProduct({{0, 1, 4}, {10000, 100000, 1000000}})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->MeasureProcessCPUTime();  // CPU time of all threads (OpenBLAS may use two inside ARPACK)
@@ -147,6 +147,8 @@ BENCHMARK(BM_DenseVsKrylov)
     ->Args({0, 2000})
     ->Args({1, 2000})
     ->Args({2, 2000})
+    ->Args({4, 1000})
+    ->Args({4, 2000})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->MeasureProcessCPUTime();

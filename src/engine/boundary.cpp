@@ -550,8 +550,8 @@ double boundary_offset_along(const BoundaryFunction& g, double x, double y, doub
   // level's flip lobe is narrower, so at points of the finest curve the coarser level's critical
   // pair has not yet split on the real axis, and the period-doubling test needs a real multiplier.
   // On the lobe diagram of milling_lobes_curves.toml this left a quarter of the offsets to the
-  // coarser curves undefined, and most flip-lobe points without an error estimate. kReach (a fifth
-  // of a percent of the scaled plane) is some ten times the offsets between the levels there, far
+  // coarser curves undefined, and most flip-lobe points without an error estimate. kReach (0.4 % of
+  // the scaled plane) is some ten times the offsets between the levels there, far
   // below the distance to another lobe; a wrong root would fail the extrapolation's order check.
   constexpr double kReach = 4e-3;
   for (double d = 10 * step; !g0.defined && d <= kReach; d *= 4)

@@ -30,8 +30,8 @@ struct ModelsModule {
   std::shared_ptr<const ModelAnalyses> (*milling)(const MillingModel&) = nullptr;
   std::shared_ptr<const ModelAnalyses> (*milling_variable_pitch)(const VariablePitchMillingModel&) = nullptr;
   // The classic dense discretisations of `bench` (sdm0, fdm1: classic_multipliers_of below), here
-  // rather than in the scene layer, whose build they lengthened by 8 s of CPU (their matrix
-  // exponentials and dense products, compiled for each linear model).
+  // rather than in the scene layer, whose first unity batch took 48 s to compile with them and 34
+  // without (their matrix exponentials and dense products, compiled for each linear model).
   ClassicResult (*classic)(const AnyModel& model, int m, ClassicMethod method, int nev) = nullptr;
 };
 
