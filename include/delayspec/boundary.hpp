@@ -15,9 +15,12 @@
 //
 //   g(X) = 0,   <t_i, X - X_pred> = 0,
 //
-// converged when the correction is <= tolerance. grad g by forward differences with delta = 1e-7
-// in the scaled plane: g is an eigenvalue modulus, accurate to ~1e-12, so the gradient is good
-// to ~1e-5, which only slows the chord's contraction (a point satisfies g = 0 whatever it is).
+// converged when the correction is <= tolerance, the chord's row updated by Broyden's rule. No
+// evaluation beyond the corrector's per point: the tangent at a new point from the quadratic
+// through the last three points (second-order in the step), the gradient the corrector's row
+// turned normal to it (a point satisfies g = 0 whatever the gradient; it only sets the
+// corrector's contraction). At the start, grad g by forward differences with delta = 1e-7 in
+// the scaled plane (g, an eigenvalue modulus accurate to ~1e-12, gives it to ~1e-5).
 // Bordered by the arclength condition the system stays regular where the curve turns in x, so
 // turning points are passed (x goes back). Step control as continue's: <= 3 iterations grow the
 // next step by 1.5, >= 6 shrink it by 0.7, a failure (not converged in 8 iterations, g
@@ -29,9 +32,11 @@
 // (the point on the range's edge); at a codim-2 point where a Neimark-Sacker curve's critical
 // pair reaches the real axis (angle 0: 1:1 resonance, angle pi: 1:2 resonance, meeting a fold or
 // period-doubling curve), found as the end of the curve's definition with the last angle within
-// 0.05 rad of 0 or pi, and on a fold or period-doubling curve at a 1:1 or 1:2 resonance, found as
-// its end with a second multiplier within 0.05 of +1 or -1 (second_gap); after max_points; or at a
-// failure (step below step_min), named.
+// 0.05 rad of 0 or pi; on a fold or period-doubling curve at a 1:1 or 1:2 resonance, where a
+// second multiplier near +1 or -1 (second_gap < 0.1) crosses the unit circle between two points
+// (second_side changes sign), located on the curve like a meeting below and made the last point,
+// or found as the curve's end with a second multiplier within 0.05 of +1 or -1; after max_points;
+// or at a failure (step below step_min), named.
 //
 // Where a grazing curve meets a stability curve (a codim-2 point the curve passes, not an end):
 // found on either curve by the sign change, between two accepted points, of the other kind's test
@@ -68,6 +73,7 @@ struct BoundarySample {
   // point (+1 or -1). Small where a second real multiplier meets the critical one there, the 1:1
   // or 1:2 resonance such a curve can end at (its angle is 0 or pi everywhere, so says nothing).
   double second_gap = NAN;
+  double second_side = NAN;  // |mu| - 1 of that next multiplier: its sign changes where it crosses
 };
 using BoundaryFunction = std::function<BoundarySample(double x, double y)>;
 
@@ -146,17 +152,17 @@ struct BoundaryPointStudy {
   double x_error_estimate = NAN, y_error_estimate = NAN;
 };
 // `previous`: the study of the point before (k - 1), whose points of the coarser curves, projected
-// on this point's normal, start each search there (a curve's neighbouring points have their
+// on this point's normal, are each search's guess (a curve's neighbouring points have their
 // coarser curves at nearly the same offsets).
 BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, const std::vector<BoundaryFunction>& coarser,
                                         const std::vector<int>& Ns, const BoundaryOptions& scale,
                                         const RichardsonOptions& richardson,
                                         const BoundaryPointStudy* previous = nullptr);
 
-// The s with g((x, y) + s (dx, dy)) = 0 nearest `guess` (NaN: 0), by the secant method from s =
-// guess and guess + step, to |ds| <= tolerance. Where g is undefined at the guess, from s = 0;
-// where it is undefined there too, from the nearest s within 4e-3 where it is defined; a step into
-// where it is undefined is halved back. NaN when it does not converge in 30 evaluations or g stays
+// The s with g((x, y) + s (dx, dy)) = 0 nearest 0, by the secant method from s = 0 and s = guess
+// (NaN: step), to |ds| <= tolerance. Where g is undefined at 0, from s = guess and guess + step;
+// where it is undefined there too (or no guess), from the nearest s within 4e-3 where it is
+// defined; a step into where it is undefined is halved back. NaN when it does not converge in 30 evaluations or g stays
 // undefined. Along the curve's normal (another N's curve near a point of this one) the secant is
 // well conditioned wherever the curve goes, steep or flat.
 double boundary_offset_along(const BoundaryFunction& g, double x, double y, double dx, double dy, double step,
