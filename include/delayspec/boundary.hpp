@@ -90,6 +90,7 @@ struct BoundaryOptions {
   double step_min = 1e-6, step_max = 0.1;
   int max_points = 1000;
   double tolerance = 1e-10;  // of a point, in the scaled plane
+  double chord_error = 1e-4;  // the curve's distance from the chord between two points (step control)
 };
 
 struct BoundaryPoint {
@@ -162,9 +163,9 @@ BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, co
 // The s with g((x, y) + s (dx, dy)) = 0 nearest 0, by the secant method from s = 0 and s = guess
 // (NaN: step), to |ds| <= tolerance. Where g is undefined at 0, from s = guess and guess + step;
 // where it is undefined there too (or no guess), from the nearest s within 4e-3 where it is
-// defined; a step into where it is undefined is halved back. NaN when it does not converge in 30 evaluations or g stays
-// undefined. Along the curve's normal (another N's curve near a point of this one) the secant is
-// well conditioned wherever the curve goes, steep or flat.
+// defined; a step into where it is undefined is halved back. NaN when it does not converge in 20
+// secant steps or g stays undefined. Along the curve's normal (another N's curve near a point of
+// this one) the secant is well conditioned wherever the curve goes, steep or flat.
 double boundary_offset_along(const BoundaryFunction& g, double x, double y, double dx, double dy, double step,
                              double tolerance, double guess = NAN);
 

@@ -174,8 +174,8 @@ TEST(BoundaryCli, ACurveIsFollowedThroughItsTurningPoint) {
 
 // With T = 2 the same curve's multiplier e^{i w T} passes -1 where w = pi / 2: a = 0, b = -pi / 2,
 // a 1:2 resonance, which the curve passes and reports. Its location is the vertex of |arg mu|
-// interpolated between curve points (within a step, 0.045 in a here; measured 1e-4), plus the
-// discretisation's O(h^2) (5e-5 at N = 400): 1e-3.
+// interpolated between curve points (steps moving the angle by <= 0.02 there; measured 4e-5),
+// plus the discretisation's O(h^2) (5e-5 at N = 400): 1e-3.
 TEST(BoundaryCli, ANeimarkSackerCurveReportsTheStrongResonanceItPasses) {
   const auto j = boundary_json({"model=linear", "tau=1", "period=2", "boundary_x=a", "boundary_y=b",
                                 "boundary_x_from=-1", "boundary_x_to=0.5", "boundary_y_from=-0.5", "boundary_y_to=-4",
@@ -194,38 +194,44 @@ TEST(BoundaryCli, ANeimarkSackerCurveReportsTheStrongResonanceItPasses) {
 // Neimark-Sacker lobe, a period-doubling lobe and another Neimark-Sacker lobe (the chart's
 // boundary, docs/milling.md); every curve passes through the depths `continue` locates at its
 // speeds (the same N), and the orbit is stable below them.
+// With boundary_Ns the starts are searched at the coarsest N and moved to the finest
+// (command_boundary.cpp's first_start_at): the same curves, through the same points.
 TEST(BoundaryCli, AScanFollowsEveryLobeOnceThroughThePointsContinueLocates) {
   const std::vector<std::string> milling = {"model=milling", "radial_immersion=0.05", "N=100"};
-  std::vector<std::string> sets = milling;
-  for (const char* s : {"boundary_x=spindle_rpm", "boundary_y=depth", "boundary_x_from=9000", "boundary_x_to=13000",
-                        "boundary_y_from=1e-5", "boundary_y_to=5e-3", "boundary_starts=scan", "boundary_scan_points=8"})
-    sets.push_back(s);
-  const auto j = boundary_json(sets);
-  ASSERT_FALSE(j.is_null());
-  EXPECT_EQ(j["stable_side"], "y_from");
-  std::vector<std::string> types;
-  for (const auto& curve : j["curves"]) types.push_back(curve["type"]);
-  EXPECT_EQ(types, (std::vector<std::string>{"neimark-sacker", "period-doubling", "neimark-sacker"}));
-  for (const auto& curve : j["curves"]) {
-    const auto& points = curve["points"];
-    for (size_t k : {size_t{0}, points.size() / 2, points.size() - 1}) {
-      const double rpm = points[k]["x"], depth = points[k]["y"];
-      if (depth >= 5e-3 * (1 - 1e-9)) continue;  // (where it left the range: no crossing below 5 mm there)
-      std::vector<std::string> c = milling;
-      for (const std::string& s : std::vector<std::string>{"continue_key=depth", "continue_from=1e-5",
-                                                           "continue_to=5e-3", "continue_tolerance=1e-16"})
-        c.push_back(s);
-      c.push_back("spindle_rpm=" + delayspec::format_number(rpm));
-      const CliResult r = run(with_sets({"continue", "--json"}, c));
-      ASSERT_EQ(r.status, 0) << r.err;
-      const nlohmann::json located = nlohmann::json::parse(r.out);
-      double nearest = INFINITY;
-      for (const auto& bif : located["bifurcations"]) {
-        const double at = bif["by_N"].back()["parameter"];
-        if (bif["type"] == curve["type"] && std::abs(at - depth) < std::abs(nearest - depth)) nearest = at;
+  for (const char* levels : {"boundary_Ns=100", "boundary_Ns=50,100"}) {
+    SCOPED_TRACE(levels);
+    std::vector<std::string> sets = milling;
+    for (const char* s :
+         {"boundary_x=spindle_rpm", "boundary_y=depth", "boundary_x_from=9000", "boundary_x_to=13000",
+          "boundary_y_from=1e-5", "boundary_y_to=5e-3", "boundary_starts=scan", "boundary_scan_points=8", levels})
+      sets.push_back(s);
+    const auto j = boundary_json(sets);
+    ASSERT_FALSE(j.is_null());
+    EXPECT_EQ(j["stable_side"], "y_from");
+    std::vector<std::string> types;
+    for (const auto& curve : j["curves"]) types.push_back(curve["type"]);
+    EXPECT_EQ(types, (std::vector<std::string>{"neimark-sacker", "period-doubling", "neimark-sacker"}));
+    for (const auto& curve : j["curves"]) {
+      const auto& points = curve["points"];
+      for (size_t k : {size_t{0}, points.size() / 2, points.size() - 1}) {
+        const double rpm = points[k]["x"], depth = points[k]["y"];
+        if (depth >= 5e-3 * (1 - 1e-9)) continue;  // (where it left the range: no crossing below 5 mm there)
+        std::vector<std::string> c = milling;
+        for (const std::string& s : std::vector<std::string>{"continue_key=depth", "continue_from=1e-5",
+                                                             "continue_to=5e-3", "continue_tolerance=1e-16"})
+          c.push_back(s);
+        c.push_back("spindle_rpm=" + delayspec::format_number(rpm));
+        const CliResult r = run(with_sets({"continue", "--json"}, c));
+        ASSERT_EQ(r.status, 0) << r.err;
+        const nlohmann::json located = nlohmann::json::parse(r.out);
+        double nearest = INFINITY;
+        for (const auto& bif : located["bifurcations"]) {
+          const double at = bif["by_N"].back()["parameter"];
+          if (bif["type"] == curve["type"] && std::abs(at - depth) < std::abs(nearest - depth)) nearest = at;
+        }
+        // Both to ~1e-10 of the 5 mm range: 1e-9 of it.
+        EXPECT_NEAR(nearest, depth, 5e-12) << curve["type"] << " at " << rpm << " rpm";
       }
-      // Both to ~1e-10 of the 5 mm range: 1e-9 of it.
-      EXPECT_NEAR(nearest, depth, 5e-12) << curve["type"] << " at " << rpm << " rpm";
     }
   }
   // The linear DDE's one Neimark-Sacker curve, scanned at ten values of a: found once.
@@ -376,6 +382,9 @@ TEST(BoundaryCli, BadInputAndNoBifurcationAtTheStart) {
   r = with({"boundary_x=a", "boundary_y=b", "boundary_y_to=-0.5"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "an empty range")) << r.err;
+  r = with({"boundary_x=a", "boundary_y=b", "boundary_chord_error=0"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "`boundary_chord_error = 0`: must be > 0")) << r.err;
   r = with({"boundary_x=a", "boundary_y=b", "boundary_type=grazing"});  // the linear model does not switch
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "`boundary_type = grazing`: model linear has no switching surface")) << r.err;

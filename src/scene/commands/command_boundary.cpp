@@ -90,6 +90,9 @@ BoundaryRun read_boundary_run(Config& config) {
     throw BadInput("`boundary_step_min = " + format_number(o.step_min) + "` exceeds `boundary_step_max = " +
                    format_number(o.step_max) + "`");
   o.max_points = static_cast<int>(config.get_int_in_range("boundary_max_points", 5000, 2, 10'000'000));
+  o.chord_error = config.get_double("boundary_chord_error", 1e-4);
+  if (!(o.chord_error > 0) || !std::isfinite(o.chord_error))
+    throw BadInput("`boundary_chord_error = " + format_number(o.chord_error) + "`: must be > 0");
   o.tolerance = config.get_double("boundary_tolerance", 1e-10);
   if (!(o.tolerance > 0) || !std::isfinite(o.tolerance))
     throw BadInput("`boundary_tolerance = " + format_number(o.tolerance) + "`: must be > 0");
@@ -200,9 +203,9 @@ struct Search {
   bool stable_at_y_from = false;
   std::string found, failure;
 };
-Search search_at(const Config& config, const BoundaryRun& run, double x) {
+Search search_at(const Config& config, const BoundaryRun& run, double x, int N) {
   Config at_x = config;
-  at_x.set("N", std::to_string(run.Ns.back()), "boundary_Ns");
+  at_x.set("N", std::to_string(N), "boundary_Ns");
   at_x.set(run.x_key, format_number(x), "boundary");
   at_x.set(run.y_key, format_number(run.options.y_from), "boundary_y_from");
   const Problem problem = read_problem(at_x, 100);
@@ -210,7 +213,7 @@ Search search_at(const Config& config, const BoundaryRun& run, double x) {
   search.from = run.options.y_from;
   search.to = run.options.y_to;
   search.tolerance = run.options.tolerance * std::abs(run.options.y_to - run.options.y_from);
-  search.N = run.Ns.back();
+  search.N = N;
   search.periods_per_map = problem.orbit_period;
   search.step_options = step_options(problem);
   search.floquet = run.floquet;
@@ -229,6 +232,39 @@ Search search_at(const Config& config, const BoundaryRun& run, double x) {
   return out;
 }
 
+// A start found at a coarser N moved to the finest: y at the same x where the finest N's test
+// function of the start's type vanishes, by the secant from the coarser y (boundary_offset_along
+// in y). Nothing when that finds no root within 10 % of the y range (on milling_lobes_curves.toml
+// N = 100 and 400 differ by up to 4.7 % at fixed speed: a lobe's side is steep, and the levels'
+// lobes lie apart in speed). Whatever root it finds is a point of a curve of that type at the
+// finest N: the curve's start checks it (trace_boundary), the scan skips it when it is on a
+// curve already followed.
+std::optional<Start> at_finest_N(const Config& config, const BoundaryRun& run, const Start& coarse) {
+  const TestFunctionAt g(config, run, coarse.type, run.Ns.back());
+  const double range = run.options.y_to - run.options.y_from;
+  const double s = boundary_offset_along(std::cref(g), coarse.x, coarse.y, 0, range, 1e-6, run.options.tolerance);
+  if (!(std::abs(s) <= 0.1)) return std::nullopt;
+  return Start{coarse.type, coarse.x, coarse.y + s * range};
+}
+
+// The first start in y at x: searched by `continue` at the coarsest N of boundary_Ns and moved to
+// the finest (at_finest_N), a quarter of the cost of the search at the finest N at N = 100 and
+// 400; searched at the finest N where the coarsest finds none or the move fails.
+Search first_start_at(const Config& config, const BoundaryRun& run, double x) {
+  if (run.Ns.size() > 1) {
+    try {
+      Search coarse = search_at(config, run, x, run.Ns.front());
+      if (!coarse.starts.empty())
+        if (const std::optional<Start> start = at_finest_N(config, run, coarse.starts.front())) {
+          coarse.starts = {*start};
+          return coarse;
+        }
+    } catch (const NumericalFailure&) {  // (the finest N's search below says what fails)
+    }
+  }
+  return search_at(config, run, x, run.Ns.back());
+}
+
 // The starts of the curves: the first bifurcation of the type at x_from (boundary_starts = first),
 // or (scan) the first one in y at each of scan_points values of x, less those on a curve already
 // followed (`follow` is called for each start in turn). stable_below: the orbit is stable at y_from
@@ -245,7 +281,7 @@ bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<Bou
     const double x = count == 1 ? o.x_from : o.x_from + (o.x_to - o.x_from) * i / (count - 1);
     Search search;
     try {
-      search = search_at(config, run, x);
+      search = first_start_at(config, run, x);
     } catch (const NumericalFailure& e) {  // (one x of a scan: the others may still start curves)
       if (count == 1) throw;
       found += (found.empty() ? "" : "; ") + run.x_key + " = " + format_number(x) + ": " + e.what();
@@ -272,13 +308,18 @@ bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<Bou
 
 // Each point's study (boundary_point_study) against the curves of the coarser N.
 std::vector<BoundaryPointStudy> study_points(const Config& config, const BoundaryRun& run, BifurcationType type,
-                                             const BoundaryCurve& curve, Progress& progress) {
+                                             const BoundaryCurve& curve, Progress& progress, long& evaluations) {
   RichardsonOptions richardson;
   if (run.problem.analyses->switches_in_state() && run.problem.events == EventMode::off)
     richardson.order = richardson.order_step = 1;  // design.md 1.5
   std::vector<TestFunctionAt> at_N;
   for (size_t i = 0; i + 1 < run.Ns.size(); ++i) at_N.emplace_back(config, run, type, run.Ns[i]);
-  std::vector<BoundaryFunction> coarser(at_N.begin(), at_N.end());
+  std::vector<BoundaryFunction> coarser;
+  for (const TestFunctionAt& g : at_N)
+    coarser.push_back([&g, &evaluations](double x, double y) {
+      ++evaluations;
+      return g(x, y);
+    });
   std::vector<BoundaryPointStudy> out;
   for (size_t k = 0; k < curve.points.size(); ++k) {
     out.push_back(boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson, k > 0 ? &out.back() : nullptr));
@@ -294,27 +335,42 @@ struct Outcome {
   std::vector<std::vector<BoundaryPointStudy>> studies;
   bool stable_below = false;  // stable at y_from wherever the starts were searched
   long evaluations = 0;
+  // Wall time of each phase: the starts' search (continue in y), the tracing, the error bars
+  double search_seconds = 0, trace_seconds = 0, study_seconds = 0;
+  long study_evaluations = 0;  // of the test function at the coarser N
   std::string failures;  // the curves that ended in a failure, named
 };
 
 Outcome compute_boundary(const Config& config, const BoundaryRun& run, const Invocation& inv) {
   Outcome out;
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  const Clock::time_point search_start = Clock::now();
   out.stable_below = follow_starts(config, run, out.curves, out.types, [&](const Start& start) {
+    const Clock::time_point trace_start = Clock::now();
     const TestFunctionAt finest(config, run, start.type, run.Ns.back());
+    // At the curve's points g itself, but for a grazing curve (the multipliers there too)
     const BoundaryFunction at_points = [&finest](double x, double y) { return finest.at_point(x, y); };
-    return trace_boundary_both_ways(std::cref(finest), run.options, start.x, start.y, &at_points);
+    const bool grazing = start.type == BifurcationType::grazing;
+    BoundaryCurve curve =
+        trace_boundary_both_ways(std::cref(finest), run.options, start.x, start.y, grazing ? &at_points : nullptr);
+    out.trace_seconds += since(trace_start);
+    return curve;
   });
+  out.search_seconds = since(search_start) - out.trace_seconds;
+  const Clock::time_point study_start = Clock::now();
   long points = 0;
   for (const BoundaryCurve& c : out.curves) points += static_cast<long>(c.points.size());
   Progress progress(inv.err, "boundary", points, inv.quiet);
   for (size_t i = 0; i < out.curves.size(); ++i) {
-    out.studies.push_back(study_points(config, run, out.types[i], out.curves[i], progress));
+    out.studies.push_back(study_points(config, run, out.types[i], out.curves[i], progress, out.study_evaluations));
     out.evaluations += out.curves[i].evaluations;
     if (out.curves[i].end == BoundaryEnd::failure)
       out.failures += (out.failures.empty() ? "" : "; ") + std::string("curve ") + std::to_string(i + 1) + " " +
                       out.curves[i].note;
   }
   progress.finish();
+  out.study_seconds = since(study_start);
   return out;
 }
 
@@ -362,7 +418,9 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
   j["stable_side"] = out.stable_below && stability_curves ? json("y_from") : json(nullptr);
   if (!out.failures.empty()) j["failure"] = out.failures;
   j["evaluations"] = out.evaluations;
+  j["study_evaluations"] = out.study_evaluations;
   j["seconds"] = seconds;
+  j["phase_seconds"] = {{"search", out.search_seconds}, {"trace", out.trace_seconds}, {"study", out.study_seconds}};
   return j;
 }
 
@@ -409,8 +467,10 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out
       os << "  codim 2: " << q.kind << " at " << run.x_key << " = " << format_number(q.x) << ", " << run.y_key
          << " = " << format_number(q.y) << "\n";
   }
-  os << "time: " << seconds << " s (" << out.evaluations << " evaluations of the test function at N = "
-     << run.Ns.back() << ")\n";
+  os << "time: " << seconds << " s: the starts' search " << format_number(out.search_seconds, 2) << " s, tracing "
+     << format_number(out.trace_seconds, 2) << " s (" << out.evaluations << " evaluations of the test function at N = "
+     << run.Ns.back() << "), error bars " << format_number(out.study_seconds, 2) << " s (" << out.study_evaluations
+     << " at the coarser N)\n";
 }
 
 }  // namespace

@@ -227,6 +227,8 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"boundary_step_min", "boundary: smallest step (the curve ends below it)"},
       {"boundary_step_max", "boundary: largest step"},
       {"boundary_max_points", "boundary: curve points at most, 2..1e7"},
+      {"boundary_chord_error", "boundary: how far the curve may stray from the chord between two points, in the "
+                               "scaled plane (sets the steps, > 0)"},
       {"boundary_tolerance", "boundary: a point's accuracy, in the scaled plane"},
       {"boundary_Ns", "boundary: N list (increasing) for error bars on each point's y (none: N only)"},
       // plot, run
