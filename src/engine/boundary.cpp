@@ -682,13 +682,17 @@ double boundary_offset_along(const BoundaryFunction& g, double x, double y, doub
   // The secant converges superlinearly: on the lobe diagram of milling_lobes_curves.toml 1250 of
   // 1380 searches ended in 3-6 evaluations, the slowest that converged in 18. One not converged
   // in 20 steps cycles or drifts (there 80 ran to the former limit, 30, each to NaN: a third of
-  // the error bars' evaluations).
-  for (int it = 0; it < 20; ++it) {
+  // the error bars' evaluations). Where g keeps its sign for 14 steps the line misses the curve
+  // (a coarser lobe's narrower tip: g has a maximum below 0 on the line, and the secant wanders
+  // around it): NaN then too.
+  bool crossed = false;  // g of both signs seen
+  for (int it = 0; it < 20 && (crossed || it < 14); ++it) {
     BoundarySample g1 = at(s1);
     // A secant step into where g is undefined (the same pair, not yet split): halved back toward
     // the last defined point, down to a millionth of it.
     for (int half = 0; !g1.defined && half < 20; ++half) g1 = at(s1 = s0 + (s1 - s0) / 2);
     if (!g1.defined || g1.value == g0.value) return NAN;
+    crossed = crossed || (g1.value > 0) != (g0.value > 0);
     const double s2 = s1 - g1.value * (s1 - s0) / (g1.value - g0.value);
     if (!std::isfinite(s2)) return NAN;
     if (std::abs(s2 - s1) <= tolerance) return s2;

@@ -196,3 +196,19 @@ TEST(Boundary, APeriodDoublingCurveEndsAtThe12ResonanceWhereASecondMultiplierRea
   };
   EXPECT_EQ(trace_boundary(apart, -0.8, o).end, BoundaryEnd::from);
 }
+
+// A line that misses the coarser curve (its lobe's tip narrower): g has a maximum below 0 on it,
+// and the secant wanders around that maximum. It stops after 14 steps without a sign change
+// (16 evaluations with the two starting ones), not after the 20 steps a crossed search may take.
+TEST(Boundary, AnOffsetSearchThatNeverSeesTheSignChangeStopsEarly) {
+  int evaluations = 0;
+  const auto g = [&evaluations](double /*x*/, double y) {
+    ++evaluations;
+    BoundarySample s;
+    s.defined = true;
+    s.value = -(y - 1e-3) * (y - 1e-3) - 1e-4;
+    return s;
+  };
+  EXPECT_TRUE(std::isnan(boundary_offset_along(g, 0, 0, 0, 1, 1e-6, 1e-13)));
+  EXPECT_LE(evaluations, 16);
+}
