@@ -314,6 +314,17 @@ std::optional<CurveState> next_point(const ScaledCurve& scaled, const CurveState
                                      double tolerance, std::string& reason) {
   std::optional<CurveState> next = correct(scaled, p.P, current.grad, p.row, p.rhs, tolerance, reason);
   if (!next) return std::nullopt;
+  // The corrector moves the predictor by about the curve's bend, kappa ds^2 / 2: a move longer
+  // than the step itself went to another part of the zero set (seen: from a lobe's start to a
+  // point 4 y ranges away, at 15 starts on milling_lobes_curves.toml). So does a point outside
+  // the scaled box, where the predictor's landing did not see the curve leave it.
+  const double moved = norm({next->X[0] - p.P[0], next->X[1] - p.P[1]});
+  const double margin = 1e-9;
+  if (moved > p.ds || next->X[0] < -margin || next->X[0] > 1 + margin || next->X[1] < -margin ||
+      next->X[1] > 1 + margin) {
+    reason = "the corrector left the step's neighbourhood or the ranges";
+    return std::nullopt;
+  }
   next->t = tangent_through(current.before, current.X, next->X, current.t);
   if (dot(next->t, current.t) < 0) next->t = {-next->t[0], -next->t[1]};
   if (dot(next->t, current.t) < 0.8) {

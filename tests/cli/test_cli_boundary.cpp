@@ -396,3 +396,24 @@ TEST(BoundaryCli, BadInputAndNoBifurcationAtTheStart) {
 }
 
 }  // namespace
+
+// The lobe diagram of milling_lobes_curves.toml with 15 starts instead of 40: the lobe started at
+// 6428.6 rpm, followed toward 5000 rpm, had its first corrector run to a point four y ranges away
+// (a point of another part of the zero set), accepted, and the curve ended in a failure there
+// (exit 3). A corrected point farther from its predictor than the step, or outside the ranges,
+// is now a failed step: every curve stays in the ranges and ends at an edge or a resonance.
+TEST(BoundaryCli, NoCurvePointLeavesTheRangesOrJumpsAway) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/milling_lobes_curves.toml";
+  const CliResult r = run({"boundary", scene, "--json", "--set", "boundary_scan_points=15"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  for (const auto& curve : j["curves"]) {
+    EXPECT_NE(curve["end"], "failure") << curve["note"];
+    for (const auto& p : curve["points"]) {
+      EXPECT_GE(p["x"].get<double>(), 5000.0);
+      EXPECT_LE(p["x"].get<double>(), 25000.0);
+      EXPECT_GE(p["y"].get<double>(), 1e-5);
+      EXPECT_LE(p["y"].get<double>(), 5e-3);
+    }
+  }
+}
