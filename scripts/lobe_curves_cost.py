@@ -1,14 +1,17 @@
 #!/usr/bin/python3
 """The a/D = 0.05 milling lobe diagram (5000-25000 rpm) as a grid chart and as curves, side by side
-(issue 36, item 2): `chart data/scenes/milling_lobes.toml` (200 x 100 points, N = 200, one thread, error_bars = off: |mu_1| at N alone, as the curves' levels give their own bars)
-and `boundary data/scenes/milling_lobes_curves.toml` (a start at 40 speeds, every lobe followed,
-each point extrapolated from N = 100, 200, 400), run in turn so that a drift of the machine's speed
-falls on both. Printed with the date, the load and the machine: each one's wall time (median) and
-its boundary accuracy: the chart's half a depth row (the boundary's place within the grid; its N's
-own error comes on top), the curves' largest error estimates in depth and in speed, and the share
-of curve points that have one.
+(issue 36, item 2): `chart data/scenes/milling_lobes.toml` (200 x 100 points, N = 200, one thread,
+error_bars = off: |mu_1| at N alone, as the curves' levels give their own bars) and `boundary
+data/scenes/milling_lobes_curves.toml` (a start at 40 speeds, every lobe followed, each point
+extrapolated from the levels of boundary_Ns: the scene's N = 100, 200, 400, and any other sets
+given with --levels), run in turn so that a drift of the machine's speed falls on all. Printed
+with the date, the load and the machine: each one's wall time (median) and its ratio to the
+chart's, and its boundary accuracy: the chart's half a depth row (the boundary's place within the
+grid; its N's own error comes on top), the curves' largest and median error estimates in depth
+and in speed, the share of curve points that have one, and where the curves' time goes (the
+starts' search, the tracing, the error bars: the command's own phase times, last run).
 
-    scripts/lobe_curves_cost.py [--delayspec build/delayspec] [--runs 3]"""
+    scripts/lobe_curves_cost.py [--delayspec build/delayspec] [--runs 3] [--levels 50,100,200 200,400,800]"""
 import argparse
 import json
 import os
@@ -21,6 +24,7 @@ from machine_stamp import machine_stamp
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENES = os.path.join(HERE, "..", "data", "scenes")
+SCENE_LEVELS = "100,200,400"  # milling_lobes_curves.toml's boundary_Ns
 
 
 def timed(cmd):
@@ -33,30 +37,43 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--delayspec", default="build/delayspec")
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--levels", nargs="*", default=[], help="more boundary_Ns sets, e.g. 200,400,800")
     args = ap.parse_args()
+    level_sets = [SCENE_LEVELS] + [levels for levels in args.levels if levels != SCENE_LEVELS]
     print(machine_stamp(f"{args.runs} runs each, in turn"))
-    chart_times, curve_times = [], []
+    chart_times, curve_times, results = [], {levels: [] for levels in level_sets}, {}
     with tempfile.TemporaryDirectory() as scratch:
         for i in range(args.runs):
-            chart_out, curve_out = os.path.join(scratch, f"chart{i}"), os.path.join(scratch, f"curves{i}")
+            chart_out = os.path.join(scratch, f"chart{i}")
             chart_times.append(timed([args.delayspec, "chart", os.path.join(SCENES, "milling_lobes.toml"), "--quiet",
                                       "--set", "threads=1", "--set", "error_bars=off", "--out", chart_out]))
-            curve_times.append(timed([args.delayspec, "boundary", os.path.join(SCENES, "milling_lobes_curves.toml"),
-                                      "--quiet", "--out", curve_out]))
-        with open(os.path.join(curve_out, "boundary.json")) as f:
-            curves = json.load(f)
-    points = [p for c in curves["curves"] for p in c["points"]]
-    with_bar = [p for p in points if p["error_estimate"] is not None]
-    y_range = curves["y_range"]
-    print(f"# {'method':44s} {'seconds':>8s}  boundary accuracy")
-    print(f"  {'chart, 200 x 100 points, N = 200, 1 thread':44s} {statistics.median(chart_times):8.2f}  "
+            for levels in level_sets:
+                out = os.path.join(scratch, f"curves{i}_{levels}")
+                finest = levels.split(",")[-1]
+                curve_times[levels].append(timed([args.delayspec, "boundary",
+                                                  os.path.join(SCENES, "milling_lobes_curves.toml"), "--quiet",
+                                                  "--set", f"boundary_Ns={levels}", "--set", f"N={finest}",
+                                                  "--out", out]))
+                with open(os.path.join(out, "boundary.json")) as f:
+                    results[levels] = json.load(f)
+    chart = statistics.median(chart_times)
+    y_range = results[SCENE_LEVELS]["y_range"]
+    print(f"# {'method':44s} {'seconds':>8s} {'/chart':>7s}  boundary accuracy")
+    print(f"  {'chart, 200 x 100 points, N = 200, 1 thread':44s} {chart:8.2f} {1:7.2f}  "
           f"half a depth row: {abs(y_range[1] - y_range[0]) / 99 / 2:.1e} m (plus the error at N = 200)")
-    print(f"  {'boundary, 40 starts, N = 100, 200, 400':44s} {statistics.median(curve_times):8.2f}  "
-          f"{len(curves['curves'])} curves, {len(points)} points, {len(with_bar)} with an estimate: largest "
-          f"{max(p['error_estimate'] for p in with_bar):.1e} m in depth, "
-          f"{max(p['x_error_estimate'] for p in with_bar):.1e} rpm in speed; median "
-          f"{statistics.median(p['error_estimate'] for p in with_bar):.1e} m, "
-          f"{statistics.median(p['x_error_estimate'] for p in with_bar):.1e} rpm")
+    for levels in level_sets:
+        curves = results[levels]
+        points = [p for c in curves["curves"] for p in c["points"]]
+        with_bar = [p for p in points if p["error_estimate"] is not None]
+        seconds = statistics.median(curve_times[levels])
+        phases = curves["phase_seconds"]
+        print(f"  {'boundary, 40 starts, N = ' + levels.replace(',', ', '):44s} {seconds:8.2f} {seconds / chart:7.2f}  "
+              f"{len(curves['curves'])} curves, {len(points)} points, {len(with_bar)} with an estimate: largest "
+              f"{max(p['error_estimate'] for p in with_bar):.1e} m in depth, "
+              f"{max(p['x_error_estimate'] for p in with_bar):.1e} rpm in speed; median "
+              f"{statistics.median(p['error_estimate'] for p in with_bar):.1e} m, "
+              f"{statistics.median(p['x_error_estimate'] for p in with_bar):.1e} rpm; "
+              f"search {phases['search']:.2f} s, tracing {phases['trace']:.2f} s, error bars {phases['study']:.2f} s")
     print(f"# load at the end {os.getloadavg()[0]:.2f}")
 
 
