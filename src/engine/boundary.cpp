@@ -613,7 +613,8 @@ bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, doubl
 
 BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, const std::vector<BoundaryFunction>& coarser,
                                         const std::vector<int>& Ns, const BoundaryOptions& scale,
-                                        const RichardsonOptions& richardson, const BoundaryPointStudy* previous) {
+                                        const RichardsonOptions& richardson, const BoundaryPointStudy* previous,
+                                        const BoundaryFunction* finer, int finer_N) {
   BoundaryPointStudy s;
   const size_t n = curve.points.size();
   const BoundaryPoint& pt = curve.points.at(k);
@@ -623,8 +624,13 @@ BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, co
   const BoundaryPoint& b = curve.points[k + 1 < n ? k + 1 : k];
   const double tu = (b.x - a.x) / dx, tv = (b.y - a.y) / dy, length = std::hypot(tu, tv);
   const double nu = length > 0 ? -tv / length : 0, nv = length > 0 ? tu / length : 1;
-  std::vector<double> h;
-  std::vector<std::complex<double>> offsets;
+  std::vector<double> offset_by_N;  // per level of s.levels, NaN where not found
+  const auto add_level = [&](int N, double offset) {
+    s.levels.push_back(N);
+    s.x_by_N.push_back(pt.x + offset * nu * dx);
+    s.y_by_N.push_back(pt.y + offset * nv * dy);
+    offset_by_N.push_back(offset);
+  };
   for (size_t i = 0; i < Ns.size(); ++i) {
     double offset = 0;  // (the finest N: the point itself)
     if (i < coarser.size()) {
@@ -634,16 +640,39 @@ BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, co
                                : NAN;
       offset = boundary_offset_along(coarser[i], pt.x, pt.y, nu * dx, nv * dy, 1e-6, scale.tolerance, guess);
     }
-    s.x_by_N.push_back(pt.x + offset * nu * dx);
-    s.y_by_N.push_back(pt.y + offset * nv * dy);
-    if (std::isfinite(offset)) {
-      h.push_back(1.0 / Ns[i]);
-      offsets.push_back(offset);
-    }
+    add_level(Ns[i], offset);
   }
-  if (offsets.size() < 2) return s;
-  const Extrapolation e = richardson_extrapolate(h, offsets, richardson);
-  if (!std::isfinite(e.error_estimate)) return s;
+  // The levels from `first` on, extrapolated (Richardson in h = 1 / N); nothing without two
+  // levels or an estimate.
+  const auto extrapolate = [&](size_t first) -> std::optional<std::pair<Extrapolation, std::vector<int>>> {
+    std::vector<double> h;
+    std::vector<std::complex<double>> offsets;
+    std::vector<int> used;
+    for (size_t l = first; l < s.levels.size(); ++l)
+      if (std::isfinite(offset_by_N[l])) {
+        h.push_back(1.0 / s.levels[l]);
+        offsets.push_back(offset_by_N[l]);
+        used.push_back(s.levels[l]);
+      }
+    if (offsets.size() < 2) return std::nullopt;
+    Extrapolation e = richardson_extrapolate(h, offsets, richardson);
+    if (!std::isfinite(e.error_estimate)) return std::nullopt;
+    return std::pair{std::move(e), std::move(used)};
+  };
+  auto result = extrapolate(0);
+  // Pre-asymptotic levels: no estimate, or one above the next coarser level's offset (the
+  // extrapolation less sure than the curve's own N, which the offset bounds), as at a lobe's cusp,
+  // narrower at the coarsest N than the offsets between the levels. There the level `finer` is
+  // added and the coarsest dropped, kept if it shows the order with a smaller estimate.
+  const double own = Ns.size() >= 2 ? std::abs(offset_by_N[Ns.size() - 2]) : 0;
+  if (finer && Ns.size() >= 3 && (!result || !(result->first.error_estimate <= own))) {
+    add_level(finer_N, boundary_offset_along(*finer, pt.x, pt.y, nu * dx, nv * dy, 1e-6, scale.tolerance));
+    auto refined = extrapolate(1);
+    if (refined && (!result || refined->first.error_estimate < result->first.error_estimate)) result = std::move(refined);
+  }
+  if (!result) return s;
+  const Extrapolation& e = result->first;
+  s.extrapolated_from = result->second;
   // Each offset is known to the location tolerance (the secant's last step; the finest N's 0 to
   // the corrector's), and the extrapolation adds them with weights of sum ~1.5 (h^2 .. h^6
   // eliminated, step ratio 2): the estimate never goes below 2 tolerances. Without this floor a

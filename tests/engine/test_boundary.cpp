@@ -212,3 +212,39 @@ TEST(Boundary, AnOffsetSearchThatNeverSeesTheSignChangeStopsEarly) {
   EXPECT_TRUE(std::isnan(boundary_offset_along(g, 0, 0, 0, 1, 1e-6, 1e-13)));
   EXPECT_LE(evaluations, 16);
 }
+
+// boundary_point_study on levels whose curves are v = C / N^2 (order 2 exactly, the limit v = 0),
+// the coarsest (N = 100) nowhere defined, as a narrower coarser lobe's tip: from N = 200 and the
+// curve's own 400 alone there is no estimate; with the refinement's level N = 800 the
+// extrapolation from 200, 400, 800 lands on v = 0 (exact in h^2: to the secant's 1e-13 of the
+// offsets, amplified by the tableau's weights, 1e-12).
+TEST(Boundary, APointWhoseCoarsestLevelIsMissingIsExtrapolatedWithTheFinerLevel) {
+  constexpr double C = 40.0;
+  const auto level = [](int N) {
+    return [N](double /*u*/, double v) {
+      BoundarySample s;
+      s.defined = N > 100;
+      s.value = v - C / (double(N) * N);
+      return s;
+    };
+  };
+  BoundaryCurve curve;  // the curve at N = 400
+  for (int k = 0; k < 3; ++k) curve.points.push_back({0.1 * k, C / 160000.0, NAN, 0});
+  BoundaryOptions scale;
+  scale.tolerance = 1e-13;
+  const std::vector<BoundaryFunction> coarser = {level(100), level(200)};
+  const std::vector<int> Ns = {100, 200, 400};
+  const BoundaryPointStudy without = boundary_point_study(curve, 1, coarser, Ns, scale, RichardsonOptions{});
+  EXPECT_TRUE(std::isnan(without.y_error_estimate));
+  EXPECT_TRUE(without.extrapolated_from.empty());
+  const BoundaryFunction finer = level(800);
+  const BoundaryPointStudy with =
+      boundary_point_study(curve, 1, coarser, Ns, scale, RichardsonOptions{}, nullptr, &finer, 800);
+  EXPECT_EQ(with.extrapolated_from, (std::vector<int>{200, 400, 800}));
+  EXPECT_EQ(with.levels, (std::vector<int>{100, 200, 400, 800}));
+  EXPECT_NEAR(with.y_extrapolated, 0.0, 1e-12);
+  // Three levels: the bar is the correction the h^2 column made at the finest level (the h^4
+  // column, which would show this one exact, cannot be checked): (C / 400^2 - C / 800^2) / 3.
+  EXPECT_NEAR(with.y_error_estimate, (C / 160000.0 - C / 640000.0) / 3, 1e-12);
+  EXPECT_NEAR(with.y_by_N[3], C / 640000.0, 1e-13);
+}

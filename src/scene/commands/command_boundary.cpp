@@ -17,6 +17,7 @@
 // Files with --out DIR: boundary.csv (metadata header; one row per point: curve, x, y, angle,
 // the extrapolations and their estimates, x and y at each N; nan where there is none) and
 // boundary.json (the --json result).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -48,6 +49,7 @@ struct BoundaryRun {
   BoundaryOptions options;
   std::optional<BifurcationType> type;  // none: any (the first found at x_from)
   std::vector<int> Ns;                  // boundary_Ns, or the one level N
+  int finer_N = 0;                      // boundary_refine: 2 Ns.back(), studied where Ns are pre-asymptotic; 0 off
   int scan_points = 0;                  // boundary_starts = scan: the x values searched; 0: the first start only
   OrbitSettings orbit_settings;
   FloquetOptions floquet;
@@ -102,6 +104,7 @@ BoundaryRun read_boundary_run(Config& config) {
       throw BadInput("`boundary_Ns`: must be increasing (" + std::to_string(run.Ns.back()) + ", " + std::to_string(N) + ")");
     run.Ns.push_back(static_cast<int>(N));
   }
+  const bool refine = config.get_choice("boundary_refine", "on", {"on", "off"}) == "on";
   run.orbit_settings = read_orbit_settings(config);
   run.floquet = read_floquet_options(config);
   config.set(run.x_key, format_number(o.x_from), "boundary_x_from");
@@ -112,6 +115,7 @@ BoundaryRun read_boundary_run(Config& config) {
                    " has no switching surface H(y) = 0 for its orbit to graze");
   config.check_all_used();
   if (run.Ns.empty()) run.Ns = {run.problem.N};
+  if (refine && run.Ns.size() >= 3) run.finer_N = 2 * run.Ns.back();  // (with two, the refined levels are two)
   return run;
 }
 
@@ -314,15 +318,19 @@ std::vector<BoundaryPointStudy> study_points(const Config& config, const Boundar
     richardson.order = richardson.order_step = 1;  // design.md 1.5
   std::vector<TestFunctionAt> at_N;
   for (size_t i = 0; i + 1 < run.Ns.size(); ++i) at_N.emplace_back(config, run, type, run.Ns[i]);
-  std::vector<BoundaryFunction> coarser;
+  if (run.finer_N > 0) at_N.emplace_back(config, run, type, run.finer_N);  // (the last)
+  std::vector<BoundaryFunction> counted;
   for (const TestFunctionAt& g : at_N)
-    coarser.push_back([&g, &evaluations](double x, double y) {
+    counted.push_back([&g, &evaluations](double x, double y) {
       ++evaluations;
       return g(x, y);
     });
+  const BoundaryFunction* finer = run.finer_N > 0 ? &counted.back() : nullptr;
+  const std::vector<BoundaryFunction> coarser(counted.begin(), counted.begin() + (run.Ns.size() - 1));
   std::vector<BoundaryPointStudy> out;
   for (size_t k = 0; k < curve.points.size(); ++k) {
-    out.push_back(boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson, k > 0 ? &out.back() : nullptr));
+    out.push_back(boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson, k > 0 ? &out.back() : nullptr,
+                                       finer, run.finer_N));
     progress.add();
   }
   return out;
@@ -397,11 +405,12 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
       const BoundaryPointStudy& st = studies[k];
       json by_N = json::array();
       for (size_t l = 0; l < st.y_by_N.size(); ++l)
-        by_N.push_back({{"N", run.Ns[l]}, {"x", number_or_null(st.x_by_N[l])}, {"y", number_or_null(st.y_by_N[l])}});
+        by_N.push_back({{"N", st.levels[l]}, {"x", number_or_null(st.x_by_N[l])}, {"y", number_or_null(st.y_by_N[l])}});
       c["points"].push_back({{"x", p.x},
                              {"y", p.y},
                              {"angle", number_or_null(p.angle)},
                              {"by_N", by_N},
+                             {"extrapolated_from", st.extrapolated_from.empty() ? json(nullptr) : json(st.extrapolated_from)},
                              {"x_extrapolated", number_or_null(st.x_extrapolated)},
                              {"y_extrapolated", number_or_null(st.y_extrapolated)},
                              {"x_error_estimate", number_or_null(st.x_error_estimate)},
@@ -427,7 +436,9 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
 // One row per point: its curve's index (from 1), then the point.
 std::string boundary_csv(const std::string& header, const BoundaryRun& run, const Outcome& out) {
   std::string text = header + "curve,x,y,angle,y_extrapolated,error_estimate,x_extrapolated,x_error_estimate";
-  for (int N : run.Ns) text += ",x_N" + std::to_string(N) + ",y_N" + std::to_string(N);
+  std::vector<int> columns = run.Ns;  // the levels' columns: Ns, then the refinement's (nan where not studied)
+  if (run.finer_N > 0) columns.push_back(run.finer_N);
+  for (int N : columns) text += ",x_N" + std::to_string(N) + ",y_N" + std::to_string(N);
   text += "\n";
   const auto cell = csv_number;  // (the shortest exact spelling, nan where there is none)
   for (size_t i = 0; i < out.curves.size(); ++i)
@@ -437,8 +448,13 @@ std::string boundary_csv(const std::string& header, const BoundaryRun& run, cons
       text += std::to_string(i + 1) + "," + cell(p.x) + "," + cell(p.y) + "," + cell(p.angle) + "," +
               cell(study.y_extrapolated) + "," + cell(study.y_error_estimate) + "," + cell(study.x_extrapolated) +
               "," + cell(study.x_error_estimate);
-      for (size_t l = 0; l < study.y_by_N.size(); ++l)  // (append: GCC 12's false -Wrestrict)
-        text.append(",").append(cell(study.x_by_N[l])).append(",").append(cell(study.y_by_N[l]));
+      for (int N : columns) {
+        const auto at = std::find(study.levels.begin(), study.levels.end(), N);
+        const size_t l = static_cast<size_t>(at - study.levels.begin());
+        const bool has = at != study.levels.end();
+        // (append: GCC 12's false -Wrestrict)
+        text.append(",").append(cell(has ? study.x_by_N[l] : NAN)).append(",").append(cell(has ? study.y_by_N[l] : NAN));
+      }
       text += "\n";
     }
   return text;
@@ -470,7 +486,7 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out
   os << "time: " << seconds << " s: the starts' search " << format_number(out.search_seconds, 2) << " s, tracing "
      << format_number(out.trace_seconds, 2) << " s (" << out.evaluations << " evaluations of the test function at N = "
      << run.Ns.back() << "), error bars " << format_number(out.study_seconds, 2) << " s (" << out.study_evaluations
-     << " at the coarser N)\n";
+     << " at the other N)\n";
 }
 
 }  // namespace
