@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """The a/D = 0.05 milling lobe diagram (5000-25000 rpm) as a grid chart and as curves, side by side
 (issue 36, item 2): `chart data/scenes/milling_lobes.toml` (200 x 100 points, N = 200, one thread,
-error_bars = off: |mu_1| at N alone, as the curves' levels give their own bars) and `boundary
+error_bars = off: |mu_1| at N alone, as the curves' levels give their own bars; no --out, whose
+per-point files for --resume would add their own seconds) and `boundary
 data/scenes/milling_lobes_curves.toml` (a start at 40 speeds, every lobe followed, each point
 extrapolated from the levels of boundary_Ns: the scene's N = 100, 200, 400, and any other sets
 given with --levels), run in turn so that a drift of the machine's speed falls on all. Printed
@@ -17,7 +18,6 @@ import json
 import os
 import statistics
 import subprocess
-import tempfile
 import time
 
 from machine_stamp import machine_stamp
@@ -28,9 +28,10 @@ SCENE_LEVELS = "100,200,400"  # milling_lobes_curves.toml's boundary_Ns
 
 
 def timed(cmd):
+    """Wall seconds of cmd, and what it printed."""
     t0 = time.perf_counter()
-    subprocess.run(cmd, check=True, capture_output=True, text=True)
-    return time.perf_counter() - t0
+    done = subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return time.perf_counter() - t0, done.stdout
 
 
 def main():
@@ -42,20 +43,18 @@ def main():
     level_sets = [SCENE_LEVELS] + [levels for levels in args.levels if levels != SCENE_LEVELS]
     print(machine_stamp(f"{args.runs} runs each, in turn"))
     chart_times, curve_times, results = [], {levels: [] for levels in level_sets}, {}
-    with tempfile.TemporaryDirectory() as scratch:
-        for i in range(args.runs):
-            chart_out = os.path.join(scratch, f"chart{i}")
-            chart_times.append(timed([args.delayspec, "chart", os.path.join(SCENES, "milling_lobes.toml"), "--quiet",
-                                      "--set", "threads=1", "--set", "error_bars=off", "--out", chart_out]))
-            for levels in level_sets:
-                out = os.path.join(scratch, f"curves{i}_{levels}")
-                finest = levels.split(",")[-1]
-                curve_times[levels].append(timed([args.delayspec, "boundary",
-                                                  os.path.join(SCENES, "milling_lobes_curves.toml"), "--quiet",
-                                                  "--set", f"boundary_Ns={levels}", "--set", f"N={finest}",
-                                                  "--out", out]))
-                with open(os.path.join(out, "boundary.json")) as f:
-                    results[levels] = json.load(f)
+    # Neither writes files (no --out): with --out the chart also writes a file per point for
+    # --resume (20000 here), seconds of system time of their own on this machine.
+    for i in range(args.runs):
+        seconds, _ = timed([args.delayspec, "chart", os.path.join(SCENES, "milling_lobes.toml"), "--quiet",
+                            "--set", "threads=1", "--set", "error_bars=off"])
+        chart_times.append(seconds)
+        for levels in level_sets:
+            finest = levels.split(",")[-1]
+            seconds, printed = timed([args.delayspec, "boundary", os.path.join(SCENES, "milling_lobes_curves.toml"),
+                                      "--quiet", "--json", "--set", f"boundary_Ns={levels}", "--set", f"N={finest}"])
+            curve_times[levels].append(seconds)
+            results[levels] = json.loads(printed)
     chart = statistics.median(chart_times)
     y_range = results[SCENE_LEVELS]["y_range"]
     print(f"# {'method':44s} {'seconds':>8s} {'/chart':>7s}  boundary accuracy")
