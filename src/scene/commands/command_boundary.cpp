@@ -310,6 +310,22 @@ bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<Bou
   return stable_below;
 }
 
+// The levels every point reports, in the JSON's by_N and the CSV's columns: boundary_Ns, then the
+// refinement's 2 N (null / nan where a point did not need it), so that every point has them all.
+std::vector<int> reported_levels(const BoundaryRun& run) {
+  std::vector<int> levels = run.Ns;
+  if (run.finer_N > 0) levels.push_back(run.finer_N);
+  return levels;
+}
+
+// The point of level N's curve in a study: (x, y), NaN where it was not studied or not found.
+std::pair<double, double> study_at_level(const BoundaryPointStudy& study, int N) {
+  const auto at = std::find(study.levels.begin(), study.levels.end(), N);
+  if (at == study.levels.end()) return {NAN, NAN};
+  const size_t l = static_cast<size_t>(at - study.levels.begin());
+  return {study.x_by_N[l], study.y_by_N[l]};
+}
+
 // Each point's study (boundary_point_study) against the curves of the coarser N.
 std::vector<BoundaryPointStudy> study_points(const Config& config, const BoundaryRun& run, BifurcationType type,
                                              const BoundaryCurve& curve, Progress& progress, long& evaluations) {
@@ -404,8 +420,10 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
       const BoundaryPoint& p = curve.points[k];
       const BoundaryPointStudy& st = studies[k];
       json by_N = json::array();
-      for (size_t l = 0; l < st.y_by_N.size(); ++l)
-        by_N.push_back({{"N", st.levels[l]}, {"x", number_or_null(st.x_by_N[l])}, {"y", number_or_null(st.y_by_N[l])}});
+      for (int N : reported_levels(run)) {
+        const auto [x, y] = study_at_level(st, N);
+        by_N.push_back({{"N", N}, {"x", number_or_null(x)}, {"y", number_or_null(y)}});
+      }
       c["points"].push_back({{"x", p.x},
                              {"y", p.y},
                              {"angle", number_or_null(p.angle)},
@@ -436,8 +454,7 @@ json boundary_json(const BoundaryRun& run, const Outcome& out, double seconds) {
 // One row per point: its curve's index (from 1), then the point.
 std::string boundary_csv(const std::string& header, const BoundaryRun& run, const Outcome& out) {
   std::string text = header + "curve,x,y,angle,y_extrapolated,error_estimate,x_extrapolated,x_error_estimate";
-  std::vector<int> columns = run.Ns;  // the levels' columns: Ns, then the refinement's (nan where not studied)
-  if (run.finer_N > 0) columns.push_back(run.finer_N);
+  const std::vector<int> columns = reported_levels(run);
   for (int N : columns) text += ",x_N" + std::to_string(N) + ",y_N" + std::to_string(N);
   text += "\n";
   const auto cell = csv_number;  // (the shortest exact spelling, nan where there is none)
@@ -449,11 +466,8 @@ std::string boundary_csv(const std::string& header, const BoundaryRun& run, cons
               cell(study.y_extrapolated) + "," + cell(study.y_error_estimate) + "," + cell(study.x_extrapolated) +
               "," + cell(study.x_error_estimate);
       for (int N : columns) {
-        const auto at = std::find(study.levels.begin(), study.levels.end(), N);
-        const size_t l = static_cast<size_t>(at - study.levels.begin());
-        const bool has = at != study.levels.end();
-        // (append: GCC 12's false -Wrestrict)
-        text.append(",").append(cell(has ? study.x_by_N[l] : NAN)).append(",").append(cell(has ? study.y_by_N[l] : NAN));
+        const auto [x, y] = study_at_level(study, N);
+        text.append(",").append(cell(x)).append(",").append(cell(y));  // (append: GCC 12's false -Wrestrict)
       }
       text += "\n";
     }
