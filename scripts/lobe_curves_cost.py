@@ -3,7 +3,7 @@
 (issue 36, item 2): `chart data/scenes/milling_lobes.toml` (200 x 100 points, N = 200, one thread,
 error_bars = off: |mu_1| at N alone, as the curves' levels give their own bars; no --out, whose
 per-point files for --resume would add their own seconds) and `boundary
-data/scenes/milling_lobes_curves.toml` (a start at 40 speeds, every lobe followed, each point
+data/scenes/milling_lobes_curves.toml` (one thread; a start at 40 speeds, every lobe followed, each point
 extrapolated from the levels of boundary_Ns: the scene's N = 100, 200, 400, and any other sets
 given with --levels), run in turn so that a drift of the machine's speed falls on all. Printed
 with the date, the load and the machine: each one's wall time (median) and its ratio to the
@@ -52,7 +52,8 @@ def main():
         for levels in level_sets:
             finest = levels.split(",")[-1]
             seconds, printed = timed([args.delayspec, "boundary", os.path.join(SCENES, "milling_lobes_curves.toml"),
-                                      "--quiet", "--json", "--set", f"boundary_Ns={levels}", "--set", f"N={finest}"])
+                                      "--quiet", "--json", "--set", "threads=1", "--set", f"boundary_Ns={levels}",
+                                      "--set", f"N={finest}"])
             curve_times[levels].append(seconds)
             results[levels] = json.loads(printed)
     chart = statistics.median(chart_times)

@@ -195,7 +195,8 @@ TEST(BoundaryCli, ANeimarkSackerCurveReportsTheStrongResonanceItPasses) {
 // boundary, docs/milling.md); every curve passes through the depths `continue` locates at its
 // speeds (the same N), and the orbit is stable below them.
 // With boundary_Ns the starts are searched at the coarsest N and moved to the finest
-// (command_boundary.cpp's first_start_at): the same curves, through the same points.
+// (command_boundary.cpp's first_start_at): the same curves, through the same points. On one
+// thread, two, or all cores (the default): the same result.
 TEST(BoundaryCli, AScanFollowsEveryLobeOnceThroughThePointsContinueLocates) {
   const std::vector<std::string> milling = {"model=milling", "radial_immersion=0.05", "N=100"};
   for (const char* levels : {"boundary_Ns=100", "boundary_Ns=50,100"}) {
@@ -207,6 +208,13 @@ TEST(BoundaryCli, AScanFollowsEveryLobeOnceThroughThePointsContinueLocates) {
       sets.push_back(s);
     const auto j = boundary_json(sets);
     ASSERT_FALSE(j.is_null());
+    // The error bars on one thread and on two: the same curves to the bit (each block of points
+    // searched alike whatever the thread count)
+    for (const char* threads : {"threads=1", "threads=2"}) {
+      sets.push_back(threads);
+      EXPECT_EQ(boundary_json(sets)["curves"], j["curves"]) << threads;
+      sets.pop_back();
+    }
     EXPECT_EQ(j["stable_side"], "y_from");
     std::vector<std::string> types;
     for (const auto& curve : j["curves"]) types.push_back(curve["type"]);

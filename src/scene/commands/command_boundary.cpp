@@ -18,6 +18,7 @@
 // the extrapolations and their estimates, x and y at each N; nan where there is none) and
 // boundary.json (the --json result).
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -33,9 +34,11 @@
 #include "scene/output/output.hpp"
 #include "scene/output/output_directory.hpp"
 #include "scene/output/progress.hpp"
+#include "scene/points/parallel_points.hpp"
 #include "scene/problem/continue_settings.hpp"
 #include "scene/problem/floquet_settings.hpp"
 #include "scene/problem/orbit_settings.hpp"
+#include "scene/problem/parameter_grid.hpp"
 #include "scene/problem/problem.hpp"
 
 namespace delayspec::cli {
@@ -51,6 +54,7 @@ struct BoundaryRun {
   std::vector<int> Ns;                  // boundary_Ns, or the one level N
   int finer_N = 0;                      // boundary_refine: 2 Ns.back(), studied where Ns are pre-asymptotic; 0 off
   int scan_points = 0;                  // boundary_starts = scan: the x values searched; 0: the first start only
+  int threads = 1;                      // for the error bars (study_points)
   OrbitSettings orbit_settings;
   FloquetOptions floquet;
   Problem problem;  // at (x_from, y_from)
@@ -105,6 +109,7 @@ BoundaryRun read_boundary_run(Config& config) {
     run.Ns.push_back(static_cast<int>(N));
   }
   const bool refine = config.get_choice("boundary_refine", "on", {"on", "off"}) == "on";
+  run.threads = read_threads(config);
   run.orbit_settings = read_orbit_settings(config);
   run.floquet = read_floquet_options(config);
   config.set(run.x_key, format_number(o.x_from), "boundary_x_from");
@@ -333,23 +338,36 @@ std::vector<BoundaryPointStudy> study_points(const Config& config, const Boundar
   RichardsonOptions richardson;
   if (run.problem.analyses->switches_in_state() && run.problem.events == EventMode::off)
     richardson.order = richardson.order_step = 1;  // design.md 1.5
-  std::vector<TestFunctionAt> at_N;
-  for (size_t i = 0; i + 1 < run.Ns.size(); ++i) at_N.emplace_back(config, run, type, run.Ns[i]);
-  if (run.finer_N > 0) at_N.emplace_back(config, run, type, run.finer_N);  // (the last)
-  std::vector<BoundaryFunction> counted;
-  for (const TestFunctionAt& g : at_N)
-    counted.push_back([&g, &evaluations](double x, double y) {
-      ++evaluations;
-      return g(x, y);
-    });
-  const BoundaryFunction* finer = run.finer_N > 0 ? &counted.back() : nullptr;
-  const std::vector<BoundaryFunction> coarser(counted.begin(), counted.begin() + (run.Ns.size() - 1));
-  std::vector<BoundaryPointStudy> out;
-  for (size_t k = 0; k < curve.points.size(); ++k) {
-    out.push_back(boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson, k > 0 ? &out.back() : nullptr,
-                                       finer, run.finer_N));
-    progress.add();
-  }
+  // Blocks of kBlock consecutive points on `threads` threads. Within a block each search starts
+  // from the point before's offset; a block's first point from none, whatever the thread count,
+  // so the results do not depend on it. Each block has test functions of its own (they keep the
+  // last orbit found).
+  constexpr size_t kBlock = 16;
+  const size_t n = curve.points.size();
+  std::vector<BoundaryPointStudy> out(n);
+  std::atomic<long> counted_evaluations{0};
+  parallel_points(static_cast<long>((n + kBlock - 1) / kBlock), run.threads, [&](long block) {
+    std::vector<TestFunctionAt> at_N;
+    for (size_t i = 0; i + 1 < run.Ns.size(); ++i) at_N.emplace_back(config, run, type, run.Ns[i]);
+    if (run.finer_N > 0) at_N.emplace_back(config, run, type, run.finer_N);  // (the last)
+    long block_evaluations = 0;
+    std::vector<BoundaryFunction> counted;
+    for (const TestFunctionAt& g : at_N)
+      counted.push_back([&g, &block_evaluations](double x, double y) {
+        ++block_evaluations;
+        return g(x, y);
+      });
+    const BoundaryFunction* finer = run.finer_N > 0 ? &counted.back() : nullptr;
+    const std::vector<BoundaryFunction> coarser(counted.begin(), counted.begin() + (run.Ns.size() - 1));
+    const size_t first = static_cast<size_t>(block) * kBlock, end = std::min(n, first + kBlock);
+    for (size_t k = first; k < end; ++k) {
+      out[k] = boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson, k > first ? &out[k - 1] : nullptr,
+                                    finer, run.finer_N);
+      progress.add();
+    }
+    counted_evaluations += block_evaluations;
+  });
+  evaluations += counted_evaluations;
   return out;
 }
 
