@@ -45,13 +45,13 @@ TEST(Boundary, ACircleIsFollowedThroughItsTurningPointToTheTolerance) {
   EXPECT_GT(u_max, 0.999);
   EXPECT_EQ(c.points.back().x, 0.6);
   EXPECT_NEAR(c.points.back().y, 0.8, 1e-9);
-  // The cost: a step grows (x 1.5) after a correction of <= 3 iterations and shrinks after 6 or
-  // more, so a slower corrector takes shorter steps. Measured: 60 points and 240 evaluations of g
-  // (4 per point, the corrector's iterations alone: the tangent from the last points, the
-  // gradient the corrector's Broyden row); 418 when each point also took g again at the
-  // converged point and a gradient by differences (2 more), 99 points and 766 evaluations with
-  // the chord corrector (no Broyden update, linear convergence at a rate set by the step). The
-  // bounds lie between: either loss fails them.
+  // The cost: the steps keep the chord within chord_error (1e-4) of the circle and shrink after a
+  // correction of 6 iterations or more. Measured: 59 points and 235 evaluations of g (4 per point,
+  // the corrector's iterations alone: the tangent from the last points, the gradient the
+  // corrector's Broyden row); g again at the converged point and a gradient by differences
+  // would add 3 a point (412); the chord corrector without the Broyden update converges so slowly
+  // that the steps shrink to 1000 points (max_points) in 5763 evaluations. The bounds lie
+  // between: either loss fails them.
   EXPECT_LE(c.points.size(), 80u);
   EXPECT_LE(c.evaluations, 300);
   EXPECT_TRUE(c.codim2.empty());  // (no other kind's test function: never a meeting)
