@@ -22,10 +22,14 @@
 // corrector's contraction). At the start, grad g by forward differences with delta = 1e-7 in
 // the scaled plane (g, an eigenvalue modulus accurate to ~1e-12, gives it to ~1e-5).
 // Bordered by the arclength condition the system stays regular where the curve turns in x, so
-// turning points are passed (x goes back). Step control as continue's: <= 3 iterations grow the
-// next step by 1.5, >= 6 shrink it by 0.7, a failure (not converged in 8 iterations, g
-// undefined: no multiplier of the type, the orbit or eigensolver failing; a tangent turning by
-// more than ~37 degrees) halves it; below step_min the curve ends.
+// turning points are passed (x goes back). Step control by the chord: the next step is this one
+// times sqrt(chord_error / sagitta) (within 0.5 .. 2), the sagitta ds theta / 8 from the
+// tangent's turn theta over the step, so the polyline stays within chord_error of the curve; at
+// most 0.7 of it after >= 6 iterations; within 0.1 of 0 or pi a Neimark-Sacker curve's angle moves
+// by at most 0.02 a step (a strong resonance between close points). A failure (not converged in
+// 8 iterations, g undefined: no multiplier of the type, the orbit or eigensolver failing; a
+// tangent turning by more than ~37 degrees; a corrected point farther from its predictor than the
+// step, or outside the ranges) halves the step; below step_min the curve ends.
 //
 // Ends: at x_to exactly (the predictor shortened to land there, the last point corrected with x
 // fixed); back at x_from after a turn (likewise); where it leaves the y range [y_from, y_to]
