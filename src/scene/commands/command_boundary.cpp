@@ -285,16 +285,26 @@ bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<Bou
                    std::vector<BifurcationType>& types, Follow follow) {
   const BoundaryOptions& o = run.options;
   const int count = run.scan_points > 0 ? run.scan_points : 1;
+  const auto x_of = [&](long i) { return count == 1 ? o.x_from : o.x_from + (o.x_to - o.x_from) * i / (count - 1); };
+  // The searches first, on `threads` threads (none depends on the curves), then the curves
+  // followed in the order of x: the same curves for any thread count.
+  std::vector<Search> searches(static_cast<size_t>(count));
+  std::vector<std::string> failed(static_cast<size_t>(count));  // a search's NumericalFailure
+  parallel_points(count, run.threads, [&](long i) {
+    try {
+      searches[static_cast<size_t>(i)] = first_start_at(config, run, x_of(i));
+    } catch (const NumericalFailure& e) {  // (one x of a scan: the others may still start curves)
+      if (count == 1) throw;
+      failed[static_cast<size_t>(i)] = e.what();
+    }
+  });
   bool stable_below = true;
   std::string found;
   for (int i = 0; i < count; ++i) {
-    const double x = count == 1 ? o.x_from : o.x_from + (o.x_to - o.x_from) * i / (count - 1);
-    Search search;
-    try {
-      search = first_start_at(config, run, x);
-    } catch (const NumericalFailure& e) {  // (one x of a scan: the others may still start curves)
-      if (count == 1) throw;
-      found += (found.empty() ? "" : "; ") + run.x_key + " = " + format_number(x) + ": " + e.what();
+    const double x = x_of(i);
+    const Search& search = searches[static_cast<size_t>(i)];
+    if (!failed[static_cast<size_t>(i)].empty()) {
+      found += (found.empty() ? "" : "; ") + run.x_key + " = " + format_number(x) + ": " + failed[static_cast<size_t>(i)];
       stable_below = false;
       continue;
     }
