@@ -433,8 +433,7 @@ std::optional<Codim2Point> met_other_curve(const ScaledCurve& scaled, const Curv
 std::optional<CurveState> reached_real_resonance(const ScaledCurve& scaled, const CurveState& a, const CurveState& b,
                                                  double tolerance, bool& closed) {
   closed = true;
-  if (a.sample.other_type == BifurcationType::neimark_sacker || a.sample.other_type == BifurcationType::grazing)
-    return std::nullopt;
+  // (second_gap is set on fold and period-doubling curves only: NaN elsewhere)
   if (!(a.sample.second_gap < 0.1 && b.sample.second_gap < 0.1)) return std::nullopt;
   return sign_change_between(scaled, a, b, tolerance, &BoundarySample::second_side, closed);
 }
