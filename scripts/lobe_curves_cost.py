@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """The a/D = 0.05 milling lobe diagram (5000-25000 rpm) as a grid chart and as curves, side by side
 (issue 36, item 2): `chart data/scenes/milling_lobes.toml` (200 x 100 points, N = 200, one thread,
-error_bars = off: |mu_1| at N alone, as the curves' levels give their own bars; no --out, whose
-per-point files for --resume would add their own seconds) and `boundary
+error_bars = off: |mu_1| at N alone, as the curves' levels give their own bars; no --out, so that
+neither's time includes writing files) and `boundary
 data/scenes/milling_lobes_curves.toml` (one thread; a start at 40 speeds, every lobe followed, each point
 extrapolated from the levels of boundary_Ns: the scene's N = 100, 200, 400, and any other sets
 given with --levels), run in turn so that a drift of the machine's speed falls on all. Printed

@@ -10,7 +10,8 @@ run without mpirun does not need.
 runs as root.) The reference is always a plain run of the same binary without mpirun: the
 distributed runs are checked against the code path that has no MPI in it.
 
-Compared: every file of the output directory. Timings are the only thing left out: the JSON keys
+Compared: every file of the output directory, and the point logs (POINTS/rank_R.jsonl, one per
+rank: which rank logged which point differs from run to run) record by record. Timings are the only thing left out: the JSON keys
 "seconds", "*_seconds" and "finished_utc", the CSV comment lines of the same names, and the last
 column (`seconds`) of sweep's exponents.csv. Everything else, including every number
 printed with 17 significant digits, must be identical byte for byte. Without --out, the JSON
@@ -98,7 +99,26 @@ def normalised(path):
 
 
 def files_of(directory):
-    return sorted(p.relative_to(directory) for p in directory.rglob("*") if p.is_file() and not p.name.startswith("."))
+    """The files but the hidden ones and the point logs (point_records)."""
+    return sorted(p.relative_to(directory) for p in directory.rglob("*")
+                  if p.is_file() and not p.name.startswith(".") and p.suffix != ".jsonl")
+
+
+def point_records(directory):
+    """The logged points: (points directory, index) -> the record without timings. A line that does
+    not parse (cut by a kill) is left out, as --resume leaves it; a point logged twice must be
+    the same record."""
+    records = {}
+    for log in sorted(directory.rglob("*.jsonl")):
+        for line in log.read_text().splitlines():
+            try:
+                record = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            key = (log.parent.name, record["index"])
+            text = json.dumps(strip_timing(record), sort_keys=True)
+            check(records.setdefault(key, text) == text, f"{log}: point {key} logged twice, differently")
+    return records
 
 
 def same_files(reference, other, what, leave_out=()):
@@ -108,6 +128,7 @@ def same_files(reference, other, what, leave_out=()):
         return
     for name in names:
         check(normalised(reference / name) == normalised(other / name), f"{what}: {name} differs from the reference")
+    check(point_records(reference) == point_records(other), f"{what}: the logged points differ from the reference")
 
 
 def run(command, env=None, cwd=None):
@@ -179,14 +200,14 @@ def main():
             env = dict(os.environ, DELAYSPEC_TEST_KILL_RANK=f"{killed}:1")
             r = run(mpirun(3, program, *SWEEP, "--quiet", "--out", str(out)), env=env)
             check(r.returncode != 0, f"sweep with rank {killed} killed: exit 0 (the test hook did not fire)")
-            points = list((out / "points").glob("point_*.json"))
-            check(len(points) >= 1, f"sweep with rank {killed} killed: no point file")
+            points = point_records(out)
+            check(len(points) >= 1, f"sweep with rank {killed} killed: no point logged")
             # The killed rank's last point never reached the lead, so the tables were not written.
             # A killed worker: the other ranks go on until mpirun ends them (about 0.3 s here),
             # possibly computing every point. A killed lead: the workers stop at their next
             # request, so points are missing and --resume computes them.
             if killed == 0:
-                check(len(points) < 12, f"sweep with the lead killed: all {len(points)} point files written")
+                check(len(points) < 12, f"sweep with the lead killed: all {len(points)} points logged")
             for name in ("complete.json", "exponents.csv", "sweep.json"):
                 check(not (out / name).exists(), f"sweep with rank {killed} killed: {name} exists")
             resume = [program, *SWEEP, "--quiet", "--resume", "--out", str(out)]
@@ -196,7 +217,7 @@ def main():
                 same_files(reference, out, f"sweep resumed after rank {killed} was killed",
                            leave_out=("complete.json", "sweep.json"))
 
-        # The grids keep point files too: the lead killed after its first point, the workers stop
+        # The grids keep point logs too: the lead killed after its first point, the workers stop
         # at their next request; --resume without MPI computes the rest.
         for name in ("chart", "basin"):
             out = scratch / f"{name}_killed"

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli_test_support.hpp"
+#include "point_logs.hpp"
 #include "delayspec_test_paths.hpp"
 
 namespace {
@@ -22,6 +23,7 @@ using delayspec::testing::CliResult;
 using delayspec::testing::fresh_dir;
 using delayspec::testing::read_text;
 using delayspec::testing::run;
+using delayspec::testing::forget_points;
 using delayspec::testing::without_metadata;
 
 struct LyapunovBadValue {
@@ -192,9 +194,8 @@ TEST(SweepCli, ResumeCompletesAnInterruptedSweep) {
   ASSERT_EQ(run(args).status, 0);
   const std::string complete_csv = read_text(dir / "exponents.csv");
   // simulate the interruption after points 0 and 3
-  for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "points/point_00001.json",
-                        "points/point_00002.json", "points/point_00004.json"})
-    fs::remove(dir / f);
+  for (const char* f : {"exponents.csv", "section.csv", "sweep.json"}) fs::remove(dir / f);
+  forget_points(dir / "points", {1, 2, 4});
   std::vector<std::string> changed = args;
   changed.insert(changed.end(), {"--set", "seed=9", "--resume"});
   CliResult refused = run(changed);

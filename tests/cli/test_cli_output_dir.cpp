@@ -24,6 +24,7 @@
 
 #include "scene/output/atomic_file.hpp"
 #include "cli_test_support.hpp"
+#include "point_logs.hpp"
 #include "scene/keys/config.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec_test_paths.hpp"
@@ -39,6 +40,11 @@ using delayspec::testing::fresh_dir;
 using delayspec::testing::read_text;
 using delayspec::testing::run;
 using delayspec::testing::without_metadata;
+using delayspec::testing::forget_points;
+using delayspec::testing::logged_line;
+using delayspec::testing::logged_points;
+using delayspec::testing::logged_records;
+using delayspec::testing::point_logs;
 
 std::vector<std::string> with(std::vector<std::string> head, const std::vector<std::string>& tail) {
   head.insert(head.end(), tail.begin(), tail.end());
@@ -222,13 +228,8 @@ TEST(OutputDirectory, KilledRunIsIncompleteAndResumesToTheSameTables) {
   pid_t child = 0;
   ASSERT_EQ(posix_spawn(&child, DELAYSPEC_CLI_PATH, &actions, nullptr, argv.data(), environ), 0);
   posix_spawn_file_actions_destroy(&actions);
-  auto points_done = [&] {
-    std::error_code ec;
-    long n = 0;
-    for (fs::directory_iterator it(dir / "points", ec), end; !ec && it != end; it.increment(ec))
-      n += it->path().filename().string().rfind("point_", 0) == 0;  // not the hidden temporaries
-    return n;
-  };
+  // (a line being written does not parse yet, so it is not counted)
+  auto points_done = [&] { return logged_records(dir / "points"); };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (points_done() < 3 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -268,29 +269,39 @@ TEST(OutputDirectory, KilledRunIsIncompleteAndResumesToTheSameTables) {
   fs::remove(scene);
 }
 
-// A point file of another sweep (other settings) in the directory: --resume refuses it, naming
-// the file, instead of merging it into the tables.
-TEST(OutputDirectory, ResumeRefusesAPointFileOfOtherSettings) {
+// A point of another sweep (other settings) in the directory's log: --resume refuses it, naming
+// the log and the line, instead of merging it into the tables.
+TEST(OutputDirectory, ResumeRefusesAPointOfOtherSettings) {
   const fs::path dir = fresh_dir("outdir_foreign");
   const fs::path other = fresh_dir("outdir_foreign_other");
   ASSERT_EQ(run(with({"sweep", "--out", dir.string()}, kSweep)).status, 0);
   ASSERT_EQ(run(with({"sweep", "--out", other.string(), "--set", "seed=9"}, kSweep)).status, 0);
-  for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "complete.json", "points/point_00001.json"})
-    fs::remove(dir / f);
-  fs::copy_file(other / "points/point_00002.json", dir / "points/point_00002.json",
-                fs::copy_options::overwrite_existing);
+  for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "complete.json"}) fs::remove(dir / f);
+  forget_points(dir / "points", {1, 2});
+  const std::string foreign = logged_line(other / "points", 2);
+  ASSERT_FALSE(foreign.empty());
+  const std::vector<fs::path> logs = point_logs(dir / "points");
+  ASSERT_EQ(logs.size(), 1u);
+  long lines = 0;
+  {
+    std::ifstream in(logs[0]);
+    for (std::string line; std::getline(in, line);) ++lines;
+  }
+  std::ofstream(logs[0], std::ios::app) << foreign << "\n";
   CliResult r = run(with({"sweep", "--out", dir.string(), "--resume"}, kSweep));
   EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_TRUE(contains(r.err, (dir / "points/point_00002.json").string() + "` belongs to a sweep with other settings"))
+  EXPECT_TRUE(contains(r.err, logs[0].string() + "` line " + std::to_string(lines + 1) +
+                                  " belongs to a sweep with other settings"))
       << r.err;
   EXPECT_FALSE(fs::exists(dir / "exponents.csv"));
   fs::remove_all(dir);
   fs::remove_all(other);
 }
 
-// chart and basin keep their points as sweep does (point_files.hpp): with some point files and
-// the table gone, --resume computes only the missing points, and the table is the one of the
-// uninterrupted run. A second run without --resume is refused instead of mixing two runs.
+// chart and basin keep their points as sweep does (point_files.hpp): with some points gone from
+// the log and the table gone, --resume computes only the missing points, and the table is the
+// one of the uninterrupted run. A second run without --resume is refused instead of mixing two
+// runs.
 TEST(OutputDirectory, ChartAndBasinResumeToTheSameTable) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> grids = {
       {"chart",
@@ -304,8 +315,7 @@ TEST(OutputDirectory, ChartAndBasinResumeToTheSameTable) {
     ASSERT_EQ(run(with(args, {"--out", dir.string()})).status, 0) << name;
     const std::string complete = without_metadata(read_text(dir / (name + ".csv")));
     EXPECT_TRUE(fs::exists(dir / (name + "_settings.json"))) << name;
-    for (int i = 0; i < 6; ++i)
-      EXPECT_TRUE(fs::exists(dir / (name + "_points/point_0000" + std::to_string(i) + ".json")));
+    EXPECT_EQ(logged_points(dir / (name + "_points")), (std::set<long>{0, 1, 2, 3, 4, 5})) << name;
     CliResult again = run(with(args, {"--out", dir.string()}));
     EXPECT_EQ(again.status, 2) << name;
     // finished: nothing to resume, so no --resume advice (a new run with other keys would fail it)
@@ -317,14 +327,46 @@ TEST(OutputDirectory, ChartAndBasinResumeToTheSameTable) {
     EXPECT_TRUE(contains(again.err, "already holds a " + name + ": add --resume")) << again.err;
 
     fs::remove(dir / (name + ".csv"));
-    fs::remove(dir / (name + "_points/point_00001.json"));
-    fs::remove(dir / (name + "_points/point_00004.json"));
+    forget_points(dir / (name + "_points"), {1, 4});
     CliResult resumed = run(with(args, {"--out", dir.string(), "--resume", "--json"}));
     ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(logged_records(dir / (name + "_points")), 6) << name;  // the 4 kept and the 2 computed again
     EXPECT_EQ(without_metadata(read_text(dir / (name + ".csv"))), complete) << name;
-    EXPECT_TRUE(fs::exists(dir / (name + "_points/point_00004.json"))) << name;
+    EXPECT_EQ(logged_points(dir / (name + "_points")), (std::set<long>{0, 1, 2, 3, 4, 5})) << name;
     fs::remove_all(dir);
   }
+}
+
+// A run killed while it wrote a point's line leaves that line cut short: --resume skips it
+// (computing the point again) and starts its own records on a new line, so the cut line takes
+// no finished point with it.
+TEST(OutputDirectory, ResumeSkipsALineCutShortByAKill) {
+  const std::vector<std::string> args = {"chart", "--quiet", "--set", "model=mathieu", "--set", "N=10", "--set",
+                                         "solver=dense", "--set", "chart_x_points=3", "--set", "chart_y_points=2"};
+  const fs::path dir = fresh_dir("outdir_cut_line");
+  ASSERT_EQ(run(with(args, {"--out", dir.string()})).status, 0);
+  const std::string complete = without_metadata(read_text(dir / "chart.csv"));
+  const fs::path points = dir / "chart_points";
+  const std::string line3 = logged_line(points, 3);
+  ASSERT_GT(line3.size(), 20u);
+  fs::remove(dir / "complete.json");
+  fs::remove(dir / "chart.csv");
+  forget_points(points, {3, 5});
+  const std::vector<fs::path> logs = point_logs(points);
+  ASSERT_EQ(logs.size(), 1u);
+  std::ofstream(logs[0], std::ios::app) << line3.substr(0, 20);  // no newline: the write was cut
+  CliResult resumed = run(with(args, {"--out", dir.string(), "--resume"}));
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_EQ(without_metadata(read_text(dir / "chart.csv")), complete);
+  EXPECT_EQ(logged_points(points), (std::set<long>{0, 1, 2, 3, 4, 5}));
+  // The 4 kept, the cut line on its own, then the 2 computed again.
+  std::ifstream in(logs[0]);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 7u);
+  EXPECT_EQ(lines[4], line3.substr(0, 20));
+  EXPECT_EQ(logged_records(points), 6);
+  fs::remove_all(dir);
 }
 
 // The settings --resume compares are the effective ones: a scene or --set stating keys at their
@@ -334,7 +376,8 @@ TEST(OutputDirectory, ResumeAcceptsExplicitDefaults) {
   CliResult full = run(with({"sweep", "--out", dir.string()}, kSweep));
   ASSERT_EQ(full.status, 0) << full.err;
   const std::string complete_csv = read_text(dir / "exponents.csv");
-  for (const char* f : {"exponents.csv", "section.csv", "sweep.json", "points/point_00001.json"}) fs::remove(dir / f);
+  for (const char* f : {"exponents.csv", "section.csv", "sweep.json"}) fs::remove(dir / f);
+  forget_points(dir / "points", {1});
   const fs::path scene = dir.string() + ".toml";
   std::ofstream(scene) << "seed = 1\nevents = \"on\"\nqr_every = 1\n";  // the defaults (lyapunov_settings.cpp)
   CliResult r = run(with(with({"sweep", scene.string(), "--out", dir.string(), "--resume", "--json"}, kSweep),
@@ -343,7 +386,7 @@ TEST(OutputDirectory, ResumeAcceptsExplicitDefaults) {
   EXPECT_EQ(nlohmann::json::parse(r.out)["points_computed_now"], 1);
   EXPECT_EQ(without_seconds(read_text(dir / "exponents.csv")), without_seconds(complete_csv));
   // A value that differs is still refused, naming the key and both values.
-  fs::remove(dir / "points/point_00001.json");
+  forget_points(dir / "points", {1});
   r = run(with({"sweep", "--out", dir.string(), "--resume", "--set", "b=0.6"}, kSweep));
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "`b` (now \"0.6\", the sweep's \"0.5\")")) << r.err;

@@ -78,7 +78,7 @@ struct BasinPoints {
   std::vector<std::string> failure;
 };
 
-// A point's record: its row of the result, its file in --out DIR (point_files.hpp), and its
+// A point's record: its row of the result, its line in --out DIR's log (point_files.hpp), and its
 // message to the lead under mpirun (distributed_points.hpp).
 nlohmann::json basin_record(const BasinSettings& s, const BasinPoints& pts, long i) {
   nlohmann::json row = {{"index", i}, {"x", s.x.value(i % s.x.points)}, {"y", s.y.value(i / s.x.points)}};

@@ -87,7 +87,7 @@ struct ChartPoints {
   std::vector<std::string> verdict;
 };
 
-// A point's record: its row of the result, its file in --out DIR (point_files.hpp), and its
+// A point's record: its row of the result, its line in --out DIR's log (point_files.hpp), and its
 // message to the lead under mpirun (distributed_points.hpp).
 nlohmann::json chart_record(const ChartSettings& s, const ChartPoints& pts, long i) {
   nlohmann::json row = {{"index", i}, {"x", s.x.value(i % s.x.points)}, {"y", s.y.value(i / s.x.points)}};
@@ -106,12 +106,12 @@ bool take_chart_record(const ChartSettings& s, ChartPoints& pts, long i, const n
   if (row.contains("failure")) {
     pts.failure[i] = row.at("failure").get<std::string>();
   } else {
-    if (!row.contains("angle")) return false;  // a point file of an older version: recompute
+    if (!row.contains("angle")) return false;  // a record of an older version: recompute
     pts.radius[i] = row.at("spectral_radius").is_number() ? row["spectral_radius"].get<double>() : NAN;
     pts.angle[i] = row["angle"].is_number() ? row["angle"].get<double>() : NAN;
   }
   if (s.with_error_bars && !row.contains("failure")) {
-    if (!row.contains("verdict")) return false;  // a point file of a run without error bars: recompute
+    if (!row.contains("verdict")) return false;  // a record of a run without error bars: recompute
     pts.verdict[i] = row.at("verdict").get<std::string>();
     pts.bar[i] = row.at("error_estimate").is_number() ? row["error_estimate"].get<double>() : INFINITY;
   }

@@ -102,7 +102,7 @@ Invocation analysis_invocation(const std::string& name, const Invocation& inv, s
 }
 
 // Under mpirun, a worker rank (ranks.hpp): it takes part in the point loops of the analyses that
-// have them (distributed_points.hpp), in the lead's order, and writes nothing but point files.
+// have them (distributed_points.hpp), in the lead's order, and writes nothing but point logs.
 int run_worker_analyses(const Config& config, const Invocation& inv, const RunPlan& plan) {
   for (const auto& name : plan.analyses) {
     if (!command_spec(name).distributes) continue;

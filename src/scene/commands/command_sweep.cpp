@@ -6,7 +6,7 @@
 // DIR the results are kept point by point, so an interrupted sweep loses only the points in
 // flight and `--resume` completes it:
 //   DIR/sweep_settings.json     the effective settings of the sweep (resume refuses other settings)
-//   DIR/points/point_NNNNN.json one file per finished point, written atomically, with the
+//   DIR/points/rank_RRRRR.jsonl a line per finished point, appended by rank R, with the
 //                               settings_hash of its sweep (resume refuses a point of another sweep)
 //   DIR/exponents.csv           parameter,lambda1..k,se1..k,lambda1_per_time..,seconds
 //   DIR/section.csv             parameter,x (one row per Poincare point)
@@ -47,7 +47,7 @@ struct SweepPoint {
   long index = 0;
   double parameter = 0;
   Problem problem;
-  json result;  // the point's record (also its file)
+  json result;  // the point's record (also its line in the log)
 };
 
 
@@ -160,9 +160,9 @@ int command_sweep(Config& config, const Invocation& inv) {
   SweepSettings s = read_sweep_settings(config);
   const LyapunovOptions& options = s.options;
   const int d = s.first.state_dimension();
-  const std::string hash = settings_hash(resume_settings(config, {s.key}));  // the point files' label
+  const std::string hash = settings_hash(resume_settings(config, {s.key}));  // the point records' label
   // Compute the points not done yet, in parallel (threads, and ranks under mpirun); with
-  // --out DIR a point's file is written as it finishes, by the rank that computed it.
+  // --out DIR a point's record is logged as it finishes, by the rank that computed it.
   PointLoop loop{.command = "sweep", .count = s.count, .threads = s.threads, .per_point_keys = {s.key}};
   loop.compute = [&](long index) {
     SweepPoint& p = s.points[static_cast<size_t>(index)];

@@ -15,7 +15,7 @@ const std::vector<CommandSpec>& command_table() {
        .run = command_basin,
        .summary = "delayspec basin [SCENE]: basins of attraction, the attractor (its period) reached from each constant initial "
                 "history of a grid.",
-       .out = OutDirUse::written,  // point files: --resume computes only the missing points
+       .out = OutDirUse::written,  // point logs: --resume computes only the missing points
        .resume = true,
        .distributes = true,
        .analysis = true,
@@ -46,7 +46,7 @@ const std::vector<CommandSpec>& command_table() {
       {.name = "chart",
        .run = command_chart,
        .summary = "delayspec chart [SCENE]: a stability chart, the spectral radius |mu_1| over a grid of two parameters.",
-       .out = OutDirUse::written,  // point files, as sweep
+       .out = OutDirUse::written,  // point logs, as sweep
        .resume = true,
        .distributes = true,
        .analysis = true,
@@ -126,7 +126,7 @@ const std::vector<CommandSpec>& command_table() {
        .run = command_sweep,
        .summary = "delayspec sweep [SCENE]: one parameter over a range; at each point the leading Lyapunov exponents and the "
                 "Poincare section (bifurcation-diagram data).",
-       .out = OutDirUse::written,  // point files: --resume computes only the missing points
+       .out = OutDirUse::written,  // point logs: --resume computes only the missing points
        .resume = true,
        .distributes = true,
        .analysis = true,

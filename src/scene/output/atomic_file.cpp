@@ -29,23 +29,27 @@ std::string temporary_name(const std::string& name) {
 
 }  // namespace
 
+int write_whole(int fd, const std::string& text) {
+  size_t written = 0;
+  while (written < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return errno;
+    written += static_cast<size_t>(n);
+  }
+  return 0;
+}
+
 void write_atomically_at(int dir_fd, const std::string& name, const std::string& contents, unsigned mode,
                          Flush flush) {
   const std::string temp = temporary_name(name);
   const int fd = ::openat(dir_fd, temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC,
                           static_cast<mode_t>(mode));
   if (fd < 0) throw AtomicWriteFailed{"cannot create `" + temp + "`", errno};
-  size_t written = 0;
-  while (written < contents.size()) {
-    const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      const int error = errno;
-      ::close(fd);
-      ::unlinkat(dir_fd, temp.c_str(), 0);
-      throw AtomicWriteFailed{"write failed", error};
-    }
-    written += static_cast<size_t>(n);
+  if (const int error = write_whole(fd, contents); error != 0) {
+    ::close(fd);
+    ::unlinkat(dir_fd, temp.c_str(), 0);
+    throw AtomicWriteFailed{"write failed", error};
   }
   // fsync before rename: after a crash the new name never points at unwritten blocks (Flush).
   int error = flush == Flush::skip || ::fsync(fd) == 0 ? 0 : errno;
@@ -61,7 +65,7 @@ void write_atomically_at(int dir_fd, const std::string& name, const std::string&
   }
 }
 
-void write_file_atomically(const std::filesystem::path& target, const std::string& contents, Flush flush) {
+void write_file_atomically(const std::filesystem::path& target, const std::string& contents) {
   if (target.filename().empty()) throw BadInput("cannot write `" + target.string() + "`: not a file name");
   const std::filesystem::path parent = target.parent_path().empty() ? "." : target.parent_path();
   std::error_code ec;
@@ -70,7 +74,7 @@ void write_file_atomically(const std::filesystem::path& target, const std::strin
   const int dir_fd = ::open(parent.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir_fd < 0) fail(target, "cannot open directory `" + parent.string() + "`", errno);
   try {
-    write_atomically_at(dir_fd, target.filename().string(), contents, 0644, flush);
+    write_atomically_at(dir_fd, target.filename().string(), contents, 0644, Flush::to_disk);
   } catch (const AtomicWriteFailed& e) {
     ::close(dir_fd);
     fail(target, e.step, e.error);

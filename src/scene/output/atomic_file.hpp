@@ -21,9 +21,8 @@
 namespace delayspec::cli {
 
 // Whether the temporary is flushed to disk (fsync) before the rename. `skip` is for files whose
-// reader survives their loss after a machine crash: the point files of a sweep, chart or basin
-// (point_files.hpp), where --resume recomputes a point whose file is empty or unreadable; an
-// fsync per point doubles the cost of a chart point (0.3 ms) and loads a cluster file system.
+// reader survives their loss after a machine crash: the model cache's entries (model_cache.hpp),
+// compiled again when one is missing or fails its checksum.
 enum class Flush { to_disk, skip };
 
 // The write itself, in the directory open as `dir_fd`: `name` gets `contents` through a temporary
@@ -37,10 +36,13 @@ struct AtomicWriteFailed {
 void write_atomically_at(int dir_fd, const std::string& name, const std::string& contents, unsigned mode,
                          Flush flush);
 
+// Writes all of `text` to the descriptor (write(2) may take less than asked; EINTR is retried):
+// 0, or the errno of the write that failed.
+int write_whole(int fd, const std::string& text);
+
 // Writes `contents` to `target` atomically (see above), mode 0644. Creates the parent directory if
 // needed. BadInput "cannot write `target`: STEP: REASON".
-void write_file_atomically(const std::filesystem::path& target, const std::string& contents,
-                           Flush flush = Flush::to_disk);
+void write_file_atomically(const std::filesystem::path& target, const std::string& contents);
 
 // A file built in memory and written atomically by commit(). Output files of delayspec are
 // small (tables, JSON), so buffering them whole is cheap and keeps the write a single step.

@@ -128,14 +128,14 @@ void OutputDirectory::abandon() noexcept {
     if (is_new) fs::remove_all(dir_ / name, ec);
 }
 
-void OutputDirectory::write(const fs::path& target, const std::string& contents, Flush flush) {
+void OutputDirectory::write(const fs::path& target, const std::string& contents) {
   note_write(target);
-  write_file_atomically(target, contents, flush);
+  write_file_atomically(target, contents);
 }
 
-void write_output(const Invocation& inv, const fs::path& target, const std::string& contents, Flush flush) {
-  if (inv.output) inv.output->write(target, contents, flush);
-  else write_file_atomically(target, contents, flush);
+void write_output(const Invocation& inv, const fs::path& target, const std::string& contents) {
+  if (inv.output) inv.output->write(target, contents);
+  else write_file_atomically(target, contents);
 }
 
 void OutputFile::commit() {

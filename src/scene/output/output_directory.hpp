@@ -52,8 +52,12 @@ class OutputDirectory {
 
   // Writes `target` atomically (write_file_atomically) after telling the directory: when target
   // lies in DIR, takes the lock if not yet held, removes complete.json on the first write and
-  // records the file. Thread-safe (sweep's worker threads write point files).
-  void write(const std::filesystem::path& target, const std::string& contents, Flush flush = Flush::to_disk);
+  // records the file. Thread-safe.
+  void write(const std::filesystem::path& target, const std::string& contents);
+
+  // What write() tells the directory before it writes, for a file the caller writes itself (a
+  // point log, point_files.hpp): call it before the file's first byte. Thread-safe.
+  void note_write(const std::filesystem::path& target);
 
   // After bad input: removes what this run created (see above). Never throws (it runs while a
   // BadInput propagates); what cannot be removed stays, and DIR still has no complete.json.
@@ -64,7 +68,6 @@ class OutputDirectory {
 
  private:
   void acquire();  // creates DIR if needed and takes the lock (BadInput if held); idempotent
-  void note_write(const std::filesystem::path& target);
 
   std::filesystem::path dir_;
   bool existed_ = false;  // DIR existed when the run started (else the run must create it)
@@ -80,9 +83,8 @@ class OutputDirectory {
 };
 
 // A command's result file: through the run's OutputDirectory when it has one (inv.output), else
-// (a worker rank's point files, a command called without run_command) written atomically alone.
-void write_output(const Invocation& inv, const std::filesystem::path& target, const std::string& contents,
-                  Flush flush = Flush::to_disk);
+// (a command called without run_command) written atomically alone.
+void write_output(const Invocation& inv, const std::filesystem::path& target, const std::string& contents);
 
 // A result file built in memory and written by commit() through write_output. Output files of
 // delayspec are small (tables, JSON): buffering them whole keeps the write a single step.

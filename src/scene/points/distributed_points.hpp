@@ -15,7 +15,7 @@
 //
 // Test hook (for the tests of resuming a killed run, tests/mpi_test.py; not a user setting):
 // DELAYSPEC_TEST_KILL_RANK=R:K makes rank R (0 without MPI) kill itself with SIGKILL right
-// after it has computed its K-th point of a loop (its point file, if any, written).
+// after it has computed its K-th point of a loop (its line in the point log, if any, written).
 #include <vector>
 
 #include "modules/mpi/mpi_module.hpp"  // PointTasks

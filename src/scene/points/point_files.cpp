@@ -1,10 +1,12 @@
 #include "scene/points/point_files.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 
 #include "scene/output/output_directory.hpp"
+#include "scene/points/ranks.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec::cli {
@@ -63,20 +65,33 @@ PointFiles::PointFiles(const Invocation& inv, std::string command, json settings
 
 fs::path PointFiles::settings_path() const { return dir_ / (command_ + "_settings.json"); }
 
-fs::path PointFiles::point_path(long index) const {
+fs::path PointFiles::points_path() const { return dir_ / points_directory(command_); }
+
+fs::path PointFiles::log_path(int rank) const {
   char name[32];
-  std::snprintf(name, sizeof name, "point_%05ld.json", index);
-  return dir_ / points_directory(command_) / name;
+  std::snprintf(name, sizeof name, "rank_%05d.jsonl", rank);
+  return points_path() / name;
 }
 
-void PointFiles::write(long index, json record) const {
+void PointFiles::write(long index, json record) {
+  (void)index;  // (the record carries it: point_loop.hpp)
   record["settings_hash"] = hash_;
-  write_output(inv_, point_path(index), record.dump() + "\n", Flush::skip);  // see Flush
+  {
+    std::lock_guard<std::mutex> guard(open_mutex_);
+    if (!log_) {
+      const fs::path path = log_path(this_rank());
+      // The lead tells its output directory (lock, complete.json, what abandon() removes); a
+      // worker rank has none (output_directory.hpp).
+      if (inv_.output) inv_.output->note_write(path);
+      log_ = std::make_unique<AppendLog>(path);
+    }
+  }
+  log_->append(record.dump());
 }
 
 std::map<long, json> PointFiles::start(bool resume, long count) const {
   if (!resume) {
-    if (fs::exists(settings_path()) || fs::exists(dir_ / points_directory(command_))) {
+    if (fs::exists(settings_path()) || fs::exists(points_path())) {
       // A finished run (its complete.json, output_directory.hpp) has nothing to resume: a new
       // run, with other keys say, needs a directory of its own.
       if (fs::exists(dir_ / OutputDirectory::marker_name))
@@ -100,26 +115,34 @@ std::map<long, json> PointFiles::start(bool resume, long count) const {
   if (stored != settings_) settings_differ(settings_, stored, command_);
 
   std::map<long, json> finished;
-  for (long index = 0; index < count; ++index) {
-    const fs::path path = point_path(index);
-    std::ifstream pin(path);
-    if (!pin) continue;
-    json record;
-    try {
-      record = json::parse(pin);
-    } catch (const std::exception&) {
-      continue;  // unreadable point file: recompute the point
+  std::error_code ec;
+  std::vector<fs::path> logs;  // every rank's, of this run and of the runs it resumes
+  for (const auto& entry : fs::directory_iterator(points_path(), ec))
+    if (entry.path().extension() == ".jsonl") logs.push_back(entry.path());
+  std::sort(logs.begin(), logs.end());
+  for (const fs::path& path : logs) {
+    std::ifstream in_log(path);
+    std::string line;
+    for (long number = 1; std::getline(in_log, line); ++number) {
+      json record;
+      try {
+        record = json::parse(line);
+      } catch (const std::exception&) {
+        continue;  // a line cut short by a killed run: its point is computed again
+      }
+      // A point of another run (other settings) is never merged into this one.
+      const json stored_hash = record.is_object() ? record.value("settings_hash", json()) : json();
+      if (stored_hash != hash_)
+        throw BadInput("`--resume`: `" + path.string() + "` line " + std::to_string(number) + " belongs to a " +
+                       command_ + " with other settings (settings_hash " +
+                       (stored_hash.is_string() ? stored_hash.get<std::string>() : std::string("missing")) +
+                       ", this " + command_ + " " + hash_ + ", settings in " + settings_path().string() +
+                       "): remove the log, or resume with the settings it was computed with");
+      const json stored_index = record.value("index", json());
+      if (!stored_index.is_number_integer()) continue;
+      const long index = stored_index.get<long>();
+      if (index >= 0 && index < count) finished.emplace(index, std::move(record));
     }
-    // A point of another run (other settings) is never merged into this one.
-    const json stored_hash = record.is_object() ? record.value("settings_hash", json()) : json();
-    if (stored_hash != hash_)
-      throw BadInput("`--resume`: `" + path.string() + "` belongs to a " + command_ +
-                     " with other settings (settings_hash " +
-                     (stored_hash.is_string() ? stored_hash.get<std::string>() : std::string("missing")) + ", this " +
-                     command_ + " " + hash_ + ", settings in " + settings_path().string() +
-                     "): remove the file, or resume with the settings it was computed with");
-    const json stored_index = record.value("index", json());
-    if (stored_index.is_number_integer() && stored_index.get<long>() == index) finished[index] = record;
   }
   return finished;
 }

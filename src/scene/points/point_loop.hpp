@@ -1,9 +1,9 @@
 #pragma once
 // The point loop of a command over many independent points (sweep, chart, basin): with
-// `--out DIR` the point files and `--resume` (point_files.hpp), the progress report, and the
+// `--out DIR` the point logs and `--resume` (point_files.hpp), the progress report, and the
 // distribution over threads and MPI ranks (distributed_points.hpp). The command says how to
 // compute a point and how a point's result reads and writes as its JSON record; the record is
-// the point's file and, under mpirun, the message that brings a worker's point to rank 0, so a
+// the point's line in the log and, under mpirun, the message that brings a worker's point to rank 0, so a
 // point read back (resumed, or from another rank) is the point computed here, double for double.
 //
 // Example (command_chart.cpp):
@@ -22,7 +22,7 @@
 namespace delayspec::cli {
 
 struct PointLoop {
-  std::string command;  // names the point files (point_files.hpp) and the progress report
+  std::string command;  // names the point logs (point_files.hpp) and the progress report
   long count = 0;       // points 0..count-1
   int threads = 1;
   std::vector<std::string> per_point_keys;                // keys whose value differs per point (resume_settings)

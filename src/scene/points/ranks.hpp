@@ -3,9 +3,9 @@
 // (`mpirun -n R delayspec ...`, `srun delayspec ...`) in a build with DELAYSPEC_MPI.
 //
 // Rank 0 (the lead) is the program as it runs alone: it reads and checks the input, owns the
-// --out directory, prints, and writes every file except the point files. The other ranks
+// --out directory, prints, and writes every file except the other ranks' point logs. The other ranks
 // (workers) read the same input, then only compute points inside distributed_points
-// (distributed_points.hpp) and write those points' files; their stdout and stderr are kept
+// (distributed_points.hpp) and append those points to their logs; their stdout and stderr are kept
 // in memory (main.cpp), so a message is printed once.
 //
 // Synchronisation is one collective of one integer, broadcast by the lead, at two places:
