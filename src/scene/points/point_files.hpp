@@ -9,9 +9,9 @@
 // where POINTS is `points` for sweep and NAME_points otherwise, so that the analyses of one `run`
 // keep their points apart. A resumed run appends to the logs there; a point recorded twice (a
 // rank killed after its line was written but before the lead heard of it) is the same record.
-// One log per rank, not one file per point: on this machine's ext4 a file per point (create,
-// write, rename) cost 45 us a point, an appended line 1 us; the 20000 files of the lobe chart
-// (milling_lobes.toml) took 1.5 of its 3.5 s.
+// One log per rank, not one file per point (as until 2026-11-28): creating, writing and renaming
+// a file per point made the lobe chart (milling_lobes.toml, 20000 points of 0.1 ms) 1.7x slower
+// than its log does, and loads a cluster file system's metadata server (docs/milling.md).
 //
 // Example (command_sweep.cpp):
 //     PointFiles files(dir, "sweep", resume_settings(config, {key}));
