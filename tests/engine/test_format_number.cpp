@@ -1,7 +1,8 @@
 // format_number(x): the shortest of the %.{1..17}g spellings of x that strtod reads back as x.
 // Checked against that definition computed here with the C library's own snprintf and strtod, on
 // doubles of every kind: random bit patterns (all exponents, subnormals), short decimals as a
-// person types them, integers and powers of ten around the %g switch to exponent notation.
+// person types them, integers and powers of ten around the %g switch to exponent notation, powers
+// of two and of ten with their neighbours (format_number's fast path: errors.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -65,7 +66,15 @@ TEST(FormatNumber, IsTheShortestPrintfSpellingThatReadsBack) {
                                      .c_str(),
                                  nullptr));
   for (int e = -20; e <= 20; ++e)
-    for (double m : {1.0, 2.0, 9.0, 12.0, 99.0, 1234.0}) values.push_back(m * std::pow(10.0, e));
+    for (double m : {1.0, 2.0, 9.0, 12.0, 99.0, 1234.0, 1.5, 150.0, 999999.0}) values.push_back(m * std::pow(10.0, e));
+  // Powers of two (the gap below is half the gap above: the shortest form may round the other
+  // way there) and powers of ten (where %g's rounding carries into the next exponent), with their
+  // neighbours.
+  std::vector<double> edges;
+  for (int e = -1074; e <= 1023; ++e) edges.push_back(std::ldexp(1.0, e));
+  for (int e = -30; e <= 30; ++e) edges.push_back(std::pow(10.0, e));
+  for (double x : edges)
+    for (double y : {x, std::nextafter(x, 0.0), std::nextafter(x, INFINITY), -x}) values.push_back(y);
   for (double x : values) ASSERT_EQ(delayspec::format_number(x), shortest_printf_spelling(x)) << x;
 }
 
