@@ -4,6 +4,8 @@
 // step, extrapolated from their own refinements.
 #include <cmath>
 #include <cstdio>
+#include <numbers>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -130,6 +132,61 @@ TEST(Milling, ClassicPathsExactForConstantCoefficients) {
     EXPECT_NEAR(std::abs(r.multipliers[0]), std::abs(exact), 1e-13);
     EXPECT_NEAR(std::abs(std::arg(r.multipliers[0])), std::abs(std::arg(exact)), 1e-12);
   }
+}
+
+}  // namespace
+}  // namespace delayspec
+
+namespace delayspec {
+namespace {
+
+// next_time_switch passes over the boundaries a tooth cannot reach within the step without their
+// exact crossing times (model_milling.hpp). Checked against the crossings computed here from the
+// definition, in long double: t = (boundary - 2 pi j / N_t + 2 pi n) / spindle, the first after
+// t0, for every tooth and boundary: over steps of every size from a sixth of a tooth period down
+// to 1e-7 of one, at times up to 1e4 revolutions, in down- and up-milling and at full immersion,
+// the switch returned is the first crossing in the step (to the rounding of t, 1e-12 relative),
+// and t1 where there is none. A boundary passed over wrongly returns t1 or a later crossing.
+TEST(Milling, TheNextTimeSwitchIsTheFirstCrossingInTheStep) {
+  std::mt19937_64 rng(20261128);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const MillingDirection direction : {MillingDirection::down, MillingDirection::up})
+    for (const double immersion : {0.05, 0.5, 1.0})
+      for (const int teeth : {1, 2, 4}) {
+        MillingParameters q;
+        q.direction = direction;
+        q.radial_immersion = immersion;
+        q.teeth = teeth;
+        q.spindle_rpm = 12345.6;
+        const MillingModel model(q);
+        const long double spindle = 2 * std::numbers::pi_v<long double> * q.spindle_rpm / 60;
+        const long double two_pi = 2 * std::numbers::pi_v<long double>;
+        const long double ratio = 2 * static_cast<long double>(immersion) - 1;
+        const long double entry = direction == MillingDirection::down ? std::acos(ratio) : 0;
+        const long double exit = direction == MillingDirection::down ? std::numbers::pi_v<long double> : std::acos(-ratio);
+        const double tooth_period = 60 / (teeth * q.spindle_rpm);
+        int crossings = 0;
+        for (int i = 0; i < 20000; ++i) {
+          const double t0 = unit(rng) * std::pow(10.0, 4 * unit(rng)) * 60 / q.spindle_rpm;
+          const double h = tooth_period * std::pow(10.0, -7 * unit(rng)) / 6;
+          const double t1 = t0 + h;
+          long double first = t1;
+          for (int j = 0; j < teeth; ++j)
+            for (const long double boundary : {entry, exit}) {
+              const long double base = boundary - two_pi * j / teeth;
+              long double n = std::floor((spindle * t0 - base) / two_pi);
+              while ((base + two_pi * n) / spindle <= t0) n += 1;
+              first = std::min(first, (base + two_pi * n) / spindle);
+            }
+          const double expected = static_cast<double>(first);
+          const double got = model.next_time_switch(t0, t1);
+          const double tolerance = 1e-12 * (t0 + tooth_period);
+          if (expected < t1 - tolerance) ++crossings;
+          ASSERT_NEAR(got, expected, tolerance) << "t0 = " << t0 << ", h = " << h << ", teeth = " << teeth
+                                                << ", a/D = " << immersion;
+        }
+        EXPECT_GT(crossings, 100) << "too few steps met a switch to test the exact path";
+      }
 }
 
 }  // namespace
