@@ -43,7 +43,7 @@ namespace {
 using nlohmann::json;
 
 // One level N with the continued key at p: the scene the family of models reads (analyses_with_key
-// keeps a reference to `config`), its problem, and the options' discretisation taken from it.
+// copies it), its problem, and the options' discretisation taken from it.
 struct Level {
   Config config;
   Problem problem;

@@ -78,10 +78,12 @@ ContinueSettings read_continue_settings(Config& config) {
 }
 
 AnalysesAt analyses_with_key(const Config& base, const std::string& key) {
-  return [&base, &key](double p) {
-    Config c = base;
-    c.set(key, format_number(p), "continue");
-    return read_problem(c, 100).analyses;
+  // One scene, the key replaced in place at each call, not a copy of the scene's keys per
+  // parameter value (the continuation calls this at every corrector step): a family serves one
+  // thread (the library's continuation runs on one).
+  return [at = base, &key](double p) mutable {
+    at.set(key, format_number(p), "continue");
+    return read_problem(at, 100).analyses;
   };
 }
 

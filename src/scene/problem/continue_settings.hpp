@@ -30,7 +30,7 @@ ContinueSettings read_continue_settings(Config& config);
 
 // The model's analyses with `key` set to p: the scene `base` read again with that value (the
 // same validation as any scene value; an equation model keeps its compiled code, new constants).
-// Keeps references to `base` and `key`.
+// Keeps a copy of `base` (the scene as it is now) and a reference to `key`; one thread at a time.
 AnalysesAt analyses_with_key(const Config& base, const std::string& key);
 
 }  // namespace delayspec::cli
