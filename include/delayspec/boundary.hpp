@@ -152,7 +152,7 @@ bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, doubl
 // the normal, projected), never below twice `scale.tolerance` (a point and each level's offset
 // are located to it). NaN where the levels do not show their order or a level finds no curve.
 struct BoundaryPointStudy {
-  std::vector<int> levels;             // the N of each entry below: Ns, then `finer` where it was studied
+  std::vector<int> levels;             // the N of each entry below: Ns, then those of `finer` studied
   std::vector<double> x_by_N, y_by_N;  // the point of each level's curve on the normal (Ns.back(): the point)
   std::vector<int> extrapolated_from;  // the levels the extrapolation used (empty: none)
   double x_extrapolated = NAN, y_extrapolated = NAN;
@@ -161,15 +161,18 @@ struct BoundaryPointStudy {
 // `previous`: the study of the point before (k - 1), whose points of the coarser curves, projected
 // on this point's normal, are each search's guess (a curve's neighbouring points have their
 // coarser curves at nearly the same offsets).
-// `finer`: the test function at finer_N > Ns.back(), studied (with three levels Ns or more) only
-// where the levels Ns are pre-asymptotic (no estimate, or one above a quarter of the next coarser level's offset, what
-// the curve's own N should be off by at order 2): the extrapolation from Ns[1..] and finer_N is
-// kept where it has an estimate smaller than theirs.
+// `finer`: the test functions at the levels finer_Ns, increasing from above Ns.back(), studied
+// (with three levels Ns or more) one after the other only while the levels so far are
+// pre-asymptotic: no estimate, or one above the next coarser level's offset (the extrapolation
+// less sure than the curve's own N, which that offset bounds). Each adds its level and drops the
+// coarsest (Ns[1..] and finer_Ns[0], then Ns[2..] and finer_Ns[0..1], ...); an extrapolation is
+// kept where it has an estimate smaller than the one before.
 BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, const std::vector<BoundaryFunction>& coarser,
                                         const std::vector<int>& Ns, const BoundaryOptions& scale,
                                         const RichardsonOptions& richardson,
                                         const BoundaryPointStudy* previous = nullptr,
-                                        const BoundaryFunction* finer = nullptr, int finer_N = 0);
+                                        const std::vector<BoundaryFunction>& finer = {},
+                                        const std::vector<int>& finer_Ns = {});
 
 // The s with g((x, y) + s (dx, dy)) = 0 nearest 0, by the secant method from s = 0 and s = guess
 // (NaN: step), to |ds| <= tolerance. Where g is undefined at 0, from s = guess and guess + step;

@@ -225,14 +225,15 @@ def test_boundary_equals_cli_json():
 
 def test_boundary_refined_points_keep_the_levels_shape():
     # a flip lobe's tip (milling, a/D = 0.05): where N = 100, 200, 400 do not show their order the
-    # level 800 is added (boundary_refine); every point reports all four levels, null where not needed
+    # level 800 is added (boundary_refine), then 1600; every point reports all five levels, null
+    # where not needed
     r = delayspec.boundary(model="milling", radial_immersion=0.05, nev=4, boundary_x="spindle_rpm",
                            boundary_y="depth", boundary_x_from=9744, boundary_x_to=13000, boundary_y_from=1e-5,
                            boundary_y_to=5e-3, N=400, boundary_Ns=[100, 200, 400], boundary_type="period-doubling")
-    assert r.by_N.shape == (len(r.x), 4)
+    assert r.by_N.shape == (len(r.x), 5)
     points = r["curves"][0]["points"]
     assert any(p["extrapolated_from"] == [200, 400, 800] for p in points)
-    assert all(p["by_N"][3]["N"] == 800 for p in points)
+    assert all(p["by_N"][3]["N"] == 800 and p["by_N"][4]["N"] == 1600 for p in points)
 
 
 # ---- numpy views -----------------------------------------------------------------------------

@@ -614,7 +614,7 @@ bool on_boundary_curve(const std::vector<BoundaryCurve>& curves, double x, doubl
 BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, const std::vector<BoundaryFunction>& coarser,
                                         const std::vector<int>& Ns, const BoundaryOptions& scale,
                                         const RichardsonOptions& richardson, const BoundaryPointStudy* previous,
-                                        const BoundaryFunction* finer, int finer_N) {
+                                        const std::vector<BoundaryFunction>& finer, const std::vector<int>& finer_Ns) {
   BoundaryPointStudy s;
   const size_t n = curve.points.size();
   const BoundaryPoint& pt = curve.points.at(k);
@@ -662,13 +662,18 @@ BoundaryPointStudy boundary_point_study(const BoundaryCurve& curve, size_t k, co
   auto result = extrapolate(0);
   // Pre-asymptotic levels: no estimate, or one above the next coarser level's offset (the
   // extrapolation less sure than the curve's own N, which the offset bounds), as at a lobe's cusp,
-  // narrower at the coarsest N than the offsets between the levels. There the level `finer` is
-  // added and the coarsest dropped, kept if it shows the order with a smaller estimate.
-  const double own = Ns.size() >= 2 ? std::abs(offset_by_N[Ns.size() - 2]) : 0;
-  if (finer && Ns.size() >= 3 && (!result || !(result->first.error_estimate <= own))) {
-    add_level(finer_N, boundary_offset_along(*finer, pt.x, pt.y, nu * dx, nv * dy, 1e-6, scale.tolerance));
-    auto refined = extrapolate(1);
-    if (refined && (!result || refined->first.error_estimate < result->first.error_estimate)) result = std::move(refined);
+  // narrower at the coarsest N than the offsets between the levels. There the levels `finer` are
+  // added one by one, each dropping the coarsest, and kept if it shows the order with a smaller
+  // estimate. (At a flip lobe's tip even N = 200 may have no flip lobe on the normal of the N = 400
+  // curve: 2N and 4N, both wider there, give the point its estimate.)
+  if (Ns.size() >= 3) {
+    const double own = std::abs(offset_by_N[Ns.size() - 2]);
+    for (size_t f = 0; f < finer.size() && (!result || !(result->first.error_estimate <= own)); ++f) {
+      add_level(finer_Ns.at(f), boundary_offset_along(finer[f], pt.x, pt.y, nu * dx, nv * dy, 1e-6, scale.tolerance));
+      auto refined = extrapolate(f + 1);
+      if (refined && (!result || refined->first.error_estimate < result->first.error_estimate))
+        result = std::move(refined);
+    }
   }
   if (!result) return s;
   const Extrapolation& e = result->first;

@@ -237,9 +237,9 @@ TEST(Boundary, APointWhoseCoarsestLevelIsMissingIsExtrapolatedWithTheFinerLevel)
   const BoundaryPointStudy without = boundary_point_study(curve, 1, coarser, Ns, scale, RichardsonOptions{});
   EXPECT_TRUE(std::isnan(without.y_error_estimate));
   EXPECT_TRUE(without.extrapolated_from.empty());
-  const BoundaryFunction finer = level(800);
+  const std::vector<BoundaryFunction> finer = {level(800), level(1600)};
   const BoundaryPointStudy with =
-      boundary_point_study(curve, 1, coarser, Ns, scale, RichardsonOptions{}, nullptr, &finer, 800);
+      boundary_point_study(curve, 1, coarser, Ns, scale, RichardsonOptions{}, nullptr, finer, {800, 1600});
   EXPECT_EQ(with.extrapolated_from, (std::vector<int>{200, 400, 800}));
   EXPECT_EQ(with.levels, (std::vector<int>{100, 200, 400, 800}));
   EXPECT_NEAR(with.y_extrapolated, 0.0, 1e-12);
@@ -247,4 +247,34 @@ TEST(Boundary, APointWhoseCoarsestLevelIsMissingIsExtrapolatedWithTheFinerLevel)
   // column, which would show this one exact, cannot be checked): (C / 400^2 - C / 800^2) / 3.
   EXPECT_NEAR(with.y_error_estimate, (C / 160000.0 - C / 640000.0) / 3, 1e-12);
   EXPECT_NEAR(with.y_by_N[3], C / 640000.0, 1e-13);
+}
+
+// As above, with N = 200 missing too (a flip lobe's tip where even N = 200 has no flip lobe on the
+// normal): 800 with 400 alone is two levels, whose estimate cannot be compared with the missing
+// N = 200's offset, so the second refinement's 1600 is added, and 400, 800, 1600 land on v = 0
+// with the bar of their h^2 column's correction, (C / 800^2 - C / 1600^2) / 3.
+TEST(Boundary, APointWhoseTwoCoarsestLevelsAreMissingIsExtrapolatedWithTwoFinerLevels) {
+  constexpr double C = 40.0;
+  const auto level = [](int N) {
+    return [N](double /*u*/, double v) {
+      BoundarySample s;
+      s.defined = N > 200;
+      s.value = v - C / (double(N) * N);
+      return s;
+    };
+  };
+  BoundaryCurve curve;  // the curve at N = 400
+  for (int k = 0; k < 3; ++k) curve.points.push_back({0.1 * k, C / 160000.0, NAN, 0});
+  BoundaryOptions scale;
+  scale.tolerance = 1e-13;
+  const std::vector<BoundaryFunction> coarser = {level(100), level(200)}, finer = {level(800), level(1600)};
+  const BoundaryPointStudy once =
+      boundary_point_study(curve, 1, coarser, {100, 200, 400}, scale, RichardsonOptions{}, nullptr, {finer[0]}, {800});
+  EXPECT_NE(once.extrapolated_from, (std::vector<int>{400, 800, 1600}));
+  const BoundaryPointStudy twice =
+      boundary_point_study(curve, 1, coarser, {100, 200, 400}, scale, RichardsonOptions{}, nullptr, finer, {800, 1600});
+  EXPECT_EQ(twice.extrapolated_from, (std::vector<int>{400, 800, 1600}));
+  EXPECT_EQ(twice.levels, (std::vector<int>{100, 200, 400, 800, 1600}));
+  EXPECT_NEAR(twice.y_extrapolated, 0.0, 1e-12);
+  EXPECT_NEAR(twice.y_error_estimate, (C / 640000.0 - C / 2560000.0) / 3, 1e-12);
 }

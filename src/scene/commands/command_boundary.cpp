@@ -52,7 +52,7 @@ struct BoundaryRun {
   BoundaryOptions options;
   std::optional<BifurcationType> type;  // none: any (the first found at x_from)
   std::vector<int> Ns;                  // boundary_Ns, or the one level N
-  int finer_N = 0;                      // boundary_refine: 2 Ns.back(), studied where Ns are pre-asymptotic; 0 off
+  std::vector<int> finer_Ns;            // boundary_refine: 2 and 4 Ns.back(), studied where Ns are pre-asymptotic
   int scan_points = 0;                  // boundary_starts = scan: the x values searched; 0: the first start only
   int threads = 1;                      // for the error bars (study_points)
   OrbitSettings orbit_settings;
@@ -120,7 +120,8 @@ BoundaryRun read_boundary_run(Config& config) {
                    " has no switching surface H(y) = 0 for its orbit to graze");
   config.check_all_used();
   if (run.Ns.empty()) run.Ns = {run.problem.N};
-  if (refine && run.Ns.size() >= 3) run.finer_N = 2 * run.Ns.back();  // (with two, the refined levels are two)
+  if (refine && run.Ns.size() >= 3)  // (with two, the refined levels are two)
+    run.finer_Ns = {2 * run.Ns.back(), 4 * run.Ns.back()};
   return run;
 }
 
@@ -329,10 +330,10 @@ bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<Bou
 }
 
 // The levels every point reports, in the JSON's by_N and the CSV's columns: boundary_Ns, then the
-// refinement's 2 N (null / nan where a point did not need it), so that every point has them all.
+// refinement's 2 N and 4 N (null / nan where a point did not need them), so that every point has them all.
 std::vector<int> reported_levels(const BoundaryRun& run) {
   std::vector<int> levels = run.Ns;
-  if (run.finer_N > 0) levels.push_back(run.finer_N);
+  levels.insert(levels.end(), run.finer_Ns.begin(), run.finer_Ns.end());
   return levels;
 }
 
@@ -361,7 +362,7 @@ std::vector<BoundaryPointStudy> study_points(const Config& config, const Boundar
   parallel_points(static_cast<long>((n + kBlock - 1) / kBlock), run.threads, [&](long block) {
     std::vector<TestFunctionAt> at_N;
     for (size_t i = 0; i + 1 < run.Ns.size(); ++i) at_N.emplace_back(config, run, type, run.Ns[i]);
-    if (run.finer_N > 0) at_N.emplace_back(config, run, type, run.finer_N);  // (the last)
+    for (int N : run.finer_Ns) at_N.emplace_back(config, run, type, N);  // (the last ones)
     long block_evaluations = 0;
     std::vector<BoundaryFunction> counted;
     for (const TestFunctionAt& g : at_N)
@@ -369,12 +370,12 @@ std::vector<BoundaryPointStudy> study_points(const Config& config, const Boundar
         ++block_evaluations;
         return g(x, y);
       });
-    const BoundaryFunction* finer = run.finer_N > 0 ? &counted.back() : nullptr;
     const std::vector<BoundaryFunction> coarser(counted.begin(), counted.begin() + (run.Ns.size() - 1));
+    const std::vector<BoundaryFunction> finer(counted.end() - static_cast<long>(run.finer_Ns.size()), counted.end());
     const size_t first = static_cast<size_t>(block) * kBlock, end = std::min(n, first + kBlock);
     for (size_t k = first; k < end; ++k) {
       out[k] = boundary_point_study(curve, k, coarser, run.Ns, run.options, richardson, k > first ? &out[k - 1] : nullptr,
-                                    finer, run.finer_N);
+                                    finer, run.finer_Ns);
       progress.add();
     }
     counted_evaluations += block_evaluations;

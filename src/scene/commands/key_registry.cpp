@@ -232,7 +232,8 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"boundary_tolerance", "boundary: a point's accuracy, in the scaled plane"},
       {"boundary_Ns", "boundary: N list (increasing) for error bars on each point's y (none: N only)"},
       {"boundary_refine", "boundary: on (with three levels or more: where the levels of boundary_Ns do not show their "
-                          "order at a point, the level 2 N is added there and the coarsest dropped) or off"},
+                          "order at a point, the level 2 N is added there and the coarsest dropped, then if need be "
+                          "4 N and the next) or off"},
       // plot, run
       {"plot_gnuplot", "plot: the gnuplot program"},
       {"plot_width", "plot: PNG width in pixels, 100..10000"},
