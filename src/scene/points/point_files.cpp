@@ -73,8 +73,7 @@ fs::path PointFiles::log_path(int rank) const {
   return points_path() / name;
 }
 
-void PointFiles::write(long index, json record) {
-  (void)index;  // (the record carries it: point_loop.hpp)
+void PointFiles::write(json record) {
   record["settings_hash"] = hash_;
   {
     std::lock_guard<std::mutex> guard(open_mutex_);

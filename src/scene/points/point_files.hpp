@@ -16,7 +16,7 @@
 // Example (command_sweep.cpp):
 //     PointFiles files(dir, "sweep", resume_settings(config, {key}));
 //     for (auto& [index, record] : files.start(inv.resume, count)) ...;   // the lead, before the points
-//     files.write(index, record);                                  // as each point finishes
+//     files.write(record);                                         // as each point finishes
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -56,9 +56,9 @@ class PointFiles {
   // its index, is left out: its point is computed again).
   std::map<long, nlohmann::json> start(bool resume, long count) const;
 
-  // Appends point `index`'s record, with this run's settings_hash added, to this rank's log
-  // (opened at the first point). Thread-safe.
-  void write(long index, nlohmann::json record);
+  // Appends a point's record (which carries its "index"), with this run's settings_hash added,
+  // to this rank's log (opened at the first point). Thread-safe.
+  void write(nlohmann::json record);
 
   const std::string& hash() const { return hash_; }  // settings_hash of the settings
   std::filesystem::path settings_path() const;

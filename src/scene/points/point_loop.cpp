@@ -49,7 +49,7 @@ long run_point_loop(const PointLoop& loop, const Config& config, const Invocatio
   PointTasks tasks;
   tasks.compute = [&](long index) {
     loop.compute(index);
-    if (files) files->write(index, loop.record(index));
+    if (files) files->write(loop.record(index));
     progress.add();
   };
   tasks.encode = [&](long index) { return loop.record(index).dump(); };
