@@ -426,6 +426,40 @@ TEST(BoundaryCli, NoCurvePointLeavesTheRangesOrJumpsAway) {
   }
 }
 
+namespace {
+
+// The bifurcation of `type` nearest y that `continue` in depth locates at the spindle speed x,
+// over (1 -+ spread) y, extrapolated from the levels Ns (the finest the last) with its error
+// estimate: an extrapolation along another line (fixed speed) from other levels than a boundary
+// curve's along its normal. Null where continue has none with an estimate.
+nlohmann::json continue_limit(const std::vector<std::string>& model, const nlohmann::json& type, double x, double y,
+                              double spread, const std::vector<int>& Ns) {
+  std::string levels;
+  for (int N : Ns) {
+    if (!levels.empty()) levels += ",";
+    levels += std::to_string(N);
+  }
+  std::vector<std::string> c = model;
+  for (const std::string& s : {std::string("continue_key=depth"), "continue_from=" + delayspec::format_number((1 - spread) * y),
+                               "continue_to=" + delayspec::format_number((1 + spread) * y), "N=" + std::to_string(Ns.back()),
+                               "continue_Ns=" + levels, std::string("continue_tolerance=1e-16"),
+                               "spindle_rpm=" + delayspec::format_number(x)})
+    c.push_back(s);
+  const CliResult r = run(with_sets({"continue", "--json"}, c));
+  EXPECT_EQ(r.status, 0) << r.err;
+  if (r.status != 0) return nullptr;
+  const nlohmann::json located = nlohmann::json::parse(r.out);
+  nlohmann::json nearest;
+  for (const auto& b : located["bifurcations"])
+    if (b["type"] == type && !b["error_estimate"].is_null() &&
+        (nearest.is_null() || std::abs(b["extrapolated"].get<double>() - y) <
+                                  std::abs(nearest["extrapolated"].get<double>() - y)))
+      nearest = b;
+  return nearest;
+}
+
+}  // namespace
+
 // The lobes between 9000 and 13000 rpm at a/D = 0.05 (a Neimark-Sacker lobe's side, a flip lobe
 // with its tip, another Neimark-Sacker lobe), each point extrapolated from N = 100, 200, 400, and
 // where those levels do not show their order (the flip lobe's tip, narrower at N = 100 than the
@@ -463,27 +497,13 @@ TEST(BoundaryCli, TheLobesExtrapolatedPointsAreWithinTheirBarsOfContinuesLimit) 
       const double x = p["x_extrapolated"], y = p["y_extrapolated"];
       const double slope = (points[k + 1]["y"].get<double>() - points[k - 1]["y"].get<double>()) /
                            (points[k + 1]["x"].get<double>() - points[k - 1]["x"].get<double>());
-      std::vector<std::string> c = milling;
-      for (const std::string& s : {std::string("continue_key=depth"), "continue_from=" + delayspec::format_number(0.99 * y),
-                                   "continue_to=" + delayspec::format_number(1.01 * y), std::string("N=1600"),
-                                   std::string("continue_Ns=200,400,800,1600"), std::string("continue_tolerance=1e-16"),
-                                   "spindle_rpm=" + delayspec::format_number(x)})
-        c.push_back(s);
-      const CliResult r = run(with_sets({"continue", "--json"}, c));
-      ASSERT_EQ(r.status, 0) << r.err;
-      const nlohmann::json located = nlohmann::json::parse(r.out);
-      const nlohmann::json* nearest = nullptr;
-      for (const auto& b : located["bifurcations"])
-        if (b["type"] == curve["type"] && !b["error_estimate"].is_null() &&
-            (!nearest || std::abs(b["extrapolated"].get<double>() - y) <
-                             std::abs((*nearest)["extrapolated"].get<double>() - y)))
-          nearest = &b;
-      if (!nearest) continue;  // (no estimate of continue's there: nothing to check against)
-      const double limit = (*nearest)["extrapolated"], bar = (*nearest)["error_estimate"];
+      const nlohmann::json nearest = continue_limit(milling, curve["type"], x, y, 0.01, {200, 400, 800, 1600});
+      if (nearest.is_null()) continue;  // (no estimate of continue's there: nothing to check against)
+      const double limit = nearest["extrapolated"], bar = nearest["error_estimate"];
       const double allowed = p["error_estimate"].get<double>() + std::abs(slope) * p["x_error_estimate"].get<double>() + bar;
       EXPECT_LE(std::abs(limit - y), allowed) << curve["type"] << " at " << x << " rpm";
       misses.push_back(std::abs(limit - y));
-      for (const auto& level : (*nearest)["by_N"])
+      for (const auto& level : nearest["by_N"])
         if (level["N"] == 400) finest_misses.push_back(std::abs(limit - level["parameter"].get<double>()));
     }
   }
@@ -524,23 +544,9 @@ TEST(BoundaryCli, AFlipLobesPointsFromTheSecondRefinementAreWithinTheirBarsOfCon
       const auto& a = points[k > 0 ? k - 1 : k];
       const auto& b = points[k + 1 < points.size() ? k + 1 : k];
       const double slope = (b["y"].get<double>() - a["y"].get<double>()) / (b["x"].get<double>() - a["x"].get<double>());
-      std::vector<std::string> c = milling;
-      for (const std::string& s : {std::string("continue_key=depth"), "continue_from=" + delayspec::format_number(0.97 * y),
-                                   "continue_to=" + delayspec::format_number(1.03 * y), std::string("N=3200"),
-                                   std::string("continue_Ns=400,800,1600,3200"), std::string("continue_tolerance=1e-16"),
-                                   "spindle_rpm=" + delayspec::format_number(x)})
-        c.push_back(s);
-      const CliResult r = run(with_sets({"continue", "--json"}, c));
-      ASSERT_EQ(r.status, 0) << r.err;
-      const nlohmann::json located = nlohmann::json::parse(r.out);
-      const nlohmann::json* nearest = nullptr;
-      for (const auto& f : located["bifurcations"])
-        if (f["type"] == curve["type"] && !f["error_estimate"].is_null() &&
-            (!nearest || std::abs(f["extrapolated"].get<double>() - y) <
-                             std::abs((*nearest)["extrapolated"].get<double>() - y)))
-          nearest = &f;
-      if (!nearest) continue;  // (no estimate of continue's there: nothing to check against)
-      const double limit = (*nearest)["extrapolated"], bar = (*nearest)["error_estimate"];
+      const nlohmann::json nearest = continue_limit(milling, curve["type"], x, y, 0.03, {400, 800, 1600, 3200});
+      if (nearest.is_null()) continue;  // (no estimate of continue's there: nothing to check against)
+      const double limit = nearest["extrapolated"], bar = nearest["error_estimate"];
       const double allowed = p["error_estimate"].get<double>() + std::abs(slope) * p["x_error_estimate"].get<double>() + bar;
       EXPECT_LE(std::abs(limit - y), allowed) << "at " << x << " rpm";
       ++checked;

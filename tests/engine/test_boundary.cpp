@@ -218,20 +218,36 @@ TEST(Boundary, AnOffsetSearchThatNeverSeesTheSignChangeStopsEarly) {
 // curve's own 400 alone there is no estimate; with the refinement's level N = 800 the
 // extrapolation from 200, 400, 800 lands on v = 0 (exact in h^2: to the secant's 1e-13 of the
 // offsets, amplified by the tableau's weights, 1e-12).
-TEST(Boundary, APointWhoseCoarsestLevelIsMissingIsExtrapolatedWithTheFinerLevel) {
-  constexpr double C = 40.0;
-  const auto level = [](int N) {
-    return [N](double /*u*/, double v) {
-      BoundarySample s;
-      s.defined = N > 100;
-      s.value = v - C / (double(N) * N);
-      return s;
-    };
+namespace {
+// The level N of the family v = C / N^2 below, undefined at N <= `missing` (a narrower lobe).
+constexpr double kC = 40.0;
+BoundaryFunction exact_h2_level(int N, int missing) {
+  return [N, missing](double /*u*/, double v) {
+    BoundarySample s;
+    s.defined = N > missing;
+    s.value = v - kC / (double(N) * N);
+    return s;
   };
-  BoundaryCurve curve;  // the curve at N = 400
-  for (int k = 0; k < 3; ++k) curve.points.push_back({0.1 * k, C / 160000.0, NAN, 0});
+}
+// The curve at N = 400 (three points on v = C / 400^2), and a location tolerance far below its
+// offsets to the other levels.
+BoundaryCurve exact_h2_curve() {
+  BoundaryCurve curve;
+  for (int k = 0; k < 3; ++k) curve.points.push_back({0.1 * k, kC / 160000.0, NAN, 0});
+  return curve;
+}
+BoundaryOptions fine_scale() {
   BoundaryOptions scale;
   scale.tolerance = 1e-13;
+  return scale;
+}
+}  // namespace
+
+TEST(Boundary, APointWhoseCoarsestLevelIsMissingIsExtrapolatedWithTheFinerLevel) {
+  constexpr double C = kC;
+  const auto level = [](int N) { return exact_h2_level(N, 100); };
+  const BoundaryCurve curve = exact_h2_curve();
+  const BoundaryOptions scale = fine_scale();
   const std::vector<BoundaryFunction> coarser = {level(100), level(200)};
   const std::vector<int> Ns = {100, 200, 400};
   const BoundaryPointStudy without = boundary_point_study(curve, 1, coarser, Ns, scale, RichardsonOptions{});
@@ -254,19 +270,10 @@ TEST(Boundary, APointWhoseCoarsestLevelIsMissingIsExtrapolatedWithTheFinerLevel)
 // N = 200's offset, so the second refinement's 1600 is added, and 400, 800, 1600 land on v = 0
 // with the bar of their h^2 column's correction, (C / 800^2 - C / 1600^2) / 3.
 TEST(Boundary, APointWhoseTwoCoarsestLevelsAreMissingIsExtrapolatedWithTwoFinerLevels) {
-  constexpr double C = 40.0;
-  const auto level = [](int N) {
-    return [N](double /*u*/, double v) {
-      BoundarySample s;
-      s.defined = N > 200;
-      s.value = v - C / (double(N) * N);
-      return s;
-    };
-  };
-  BoundaryCurve curve;  // the curve at N = 400
-  for (int k = 0; k < 3; ++k) curve.points.push_back({0.1 * k, C / 160000.0, NAN, 0});
-  BoundaryOptions scale;
-  scale.tolerance = 1e-13;
+  constexpr double C = kC;
+  const auto level = [](int N) { return exact_h2_level(N, 200); };
+  const BoundaryCurve curve = exact_h2_curve();
+  const BoundaryOptions scale = fine_scale();
   const std::vector<BoundaryFunction> coarser = {level(100), level(200)}, finer = {level(800), level(1600)};
   const BoundaryPointStudy once =
       boundary_point_study(curve, 1, coarser, {100, 200, 400}, scale, RichardsonOptions{}, nullptr, {finer[0]}, {800});
