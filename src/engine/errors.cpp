@@ -24,8 +24,8 @@ std::string format_number(double value) {
   // P = D and the first fixed one, P = X + 1 ("150000" is shorter than "1.5e+05"). Where the
   // correctly rounded D digits do not read back (the shortest form may be rounded the other way
   // next to a power of two, where the gap below is half the gap above), every P is tried, as
-  // before: the same text, in the boundary's evaluations a tenth of the time (two to_chars
-  // instead of 17, one from_chars instead of up to 17).
+  // before: the same text, its share of the lobe diagram's profile 1 % instead of 8 % (two
+  // to_chars instead of 17, one from_chars instead of up to 17).
   if (!std::isfinite(value)) return format_number(value, 1);
   char buffer[64];
   std::string best;

@@ -32,8 +32,6 @@ class AppendLog {
   // Appends `line` and a newline, in one write. Thread-safe.
   void append(const std::string& line);
 
-  const std::filesystem::path& path() const { return path_; }
-
  private:
   std::filesystem::path path_;
   int fd_ = -1;
