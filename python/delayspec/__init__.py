@@ -264,8 +264,10 @@ class ContinueResult(SweepResult):
 
 
 class BoundaryResult(Result):
-    """`boundary`: the curve's points stacked (`x`, `y`, `angle`, `y_extrapolated`,
-    `error_estimate`: nan where null; `by_N`: points x levels), and the CLI's fields (`curves`,
+    """`boundary`: the first curve's points stacked (`x`, `y`, `angle` at the finest N; the
+    extrapolated point `x_extrapolated`, `y_extrapolated` with `x_error_estimate`,
+    `error_estimate`, nan where null: it lies on the curve's normal, so pair `y_extrapolated` with
+    `x_extrapolated`, not with `x`; `by_N`: points x levels), and the CLI's fields (`curves`,
     `Ns`, ...; see docs/continuation.md)."""
 
     def __getattr__(self, name):

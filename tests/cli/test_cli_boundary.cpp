@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -97,6 +98,36 @@ TEST(BoundaryCli, TheLinearNeimarkSackerCurveIsTheExactHopfCurve) {
     };
     EXPECT_NEAR(std::log2(miss(2) / miss(3)), 2.0, 0.05) << a;
   }
+}
+
+// The printed table gives the extrapolated point's both coordinates, each with its bar: the point
+// moves along the curve's normal, so its b belongs to its own a, not to the finest N's. Each row
+// against the exact Hopf curve, as the JSON above: the vertical miss |b - b(a)| within the b bar
+// plus |b'| times the a bar, the bars printed to two digits (+1 %) and the values to 12 (1e-11).
+// Printed beside the finest N's a (the table before 2026-11-28), b misses by |b'| times the
+// normal's shift, 3e-7 here against bars of 7.5e-10.
+TEST(BoundaryCli, TheTableGivesTheExtrapolatedPointsBothCoordinates) {
+  const CliResult r = run(with_sets({"boundary"}, {"model=linear", "tau=1", "period=1", "boundary_x=a", "boundary_y=b",
+                                                   "boundary_x_from=-1", "boundary_x_to=0.5", "boundary_y_from=-0.5",
+                                                   "boundary_y_to=-4", "boundary_type=neimark-sacker", "N=400",
+                                                   "boundary_Ns=50,100,200,400"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "extrapolated (N -> infinity)")) << r.out;
+  const auto exact_b = [](double a) { return -hopf_frequency(a) / std::sin(hopf_frequency(a)); };
+  std::istringstream lines(r.out);
+  int rows = 0;
+  double largest_shift = 0;
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream row(line);
+    double a, b, xe, bar_x, ye, bar_y, angle;
+    if (!(row >> a >> b >> xe >> bar_x >> ye >> bar_y >> angle)) continue;
+    ++rows;
+    largest_shift = std::max(largest_shift, std::abs(xe - a));
+    const double slope = (exact_b(xe + 1e-6) - exact_b(xe - 1e-6)) / 2e-6;
+    EXPECT_LE(std::abs(ye - exact_b(xe)), 1.01 * (bar_y + std::abs(slope) * bar_x) + 1e-11) << line;
+  }
+  EXPECT_GE(rows, 10) << r.out;
+  EXPECT_GT(largest_shift, 1e-7) << "the normal's shift in a, which the test is to see: " << r.out;
 }
 
 // The Mathieu curves against `continue` in b at fixed delta (the same discrete problem, N = 200).

@@ -516,13 +516,21 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out
     const BoundaryCurve& curve = out.curves[i];
     os << "curve " << i + 1 << ": " << to_string(out.types[i]) << ", " << curve.points.size() << " points, ended at `"
        << to_string(curve.end) << "`" << (curve.note.empty() ? "" : ": " + curve.note) << "\n";
-    std::snprintf(line, sizeof line, "  %16s  %16s  %18s  %10s  %8s\n", run.x_key.c_str(), run.y_key.c_str(),
-                  "extrapolated", "+-", "angle/pi");
+    // The extrapolated point lies on the curve's normal through the point at the finest N, so
+    // both of its coordinates move: on a lobe's steep side mostly x (at N = 100, 200, 400, up to
+    // 4 rpm; a depth beside the finest N's speed would be off by 1e-4 m there, not by its +-).
+    std::snprintf(line, sizeof line, "  %-34s  %s\n", ("at N = " + std::to_string(run.Ns.back())).c_str(),
+                  "extrapolated (N -> infinity)");
+    os << line;
+    std::snprintf(line, sizeof line, "  %16s  %16s  %18s  %8s  %18s  %8s  %8s\n", run.x_key.c_str(),
+                  run.y_key.c_str(), run.x_key.c_str(), "+-", run.y_key.c_str(), "+-", "angle/pi");
     os << line;
     for (size_t k = 0; k < curve.points.size(); ++k) {
       const BoundaryPoint& p = curve.points[k];
-      std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %18.12g  %10.2g  %8.4f\n", p.x, p.y,
-                    out.studies[i][k].y_extrapolated, out.studies[i][k].y_error_estimate, p.angle / std::numbers::pi);
+      const BoundaryPointStudy& st = out.studies[i][k];
+      std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %18.12g  %8.2g  %18.12g  %8.2g  %8.4f\n", p.x, p.y,
+                    st.x_extrapolated, st.x_error_estimate, st.y_extrapolated, st.y_error_estimate,
+                    p.angle / std::numbers::pi);
       os << line;
     }
     for (const Codim2Point& q : curve.codim2)
