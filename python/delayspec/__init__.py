@@ -85,10 +85,13 @@ def _to_numpy(value):
 
 
 def _stack(rows, field):
-    """The field of each row as one array, rows first; a row without it (a failed point) is nan."""
+    """The field of each row as one array, rows first; a row without it (a failed point) or with
+    null is nan (every row null: all nan, e.g. boundary's estimates from two levels)."""
     values = [row.get(field) for row in rows]
     present = [np.asarray(_to_numpy(v)) for v in values if v is not None]
     if not present:
+        if any(field in row for row in rows):
+            return np.full(len(values), np.nan)
         raise AttributeError(f"no row has the field `{field}`")
     shape = present[0].shape
     dtype = np.result_type(*present) if len(present) == len(values) else np.result_type(np.float64, *present)
@@ -264,18 +267,27 @@ class ContinueResult(SweepResult):
 
 
 class BoundaryResult(Result):
-    """`boundary`: the first curve's points stacked (`x`, `y`, `angle` at the finest N; the
-    extrapolated point `x_extrapolated`, `y_extrapolated` with `x_error_estimate`,
-    `error_estimate`, nan where null: it lies on the curve's normal, so pair `y_extrapolated` with
-    `x_extrapolated`, not with `x`; `by_N`: points x levels), and the CLI's fields (`curves`,
-    `Ns`, ...; see docs/continuation.md)."""
+    """`boundary`: the points of every curve stacked, curve after curve in the order of `curves`
+    (as boundary.csv): `curve` (int64, each point's curve, from 1), `x`, `y`, `angle` at the
+    finest N; the extrapolated point `x_extrapolated`, `y_extrapolated` with `x_error_estimate`,
+    `error_estimate`, nan where null: it lies on the curve's normal, so pair `y_extrapolated`
+    with `x_extrapolated`, not with `x`; `by_N`: points x levels; and the CLI's fields
+    (`curves`, `Ns`, ...; see docs/continuation.md)."""
+
+    def _points(self):
+        return [p for c in self._data.get("curves", []) for p in c["points"]]
+
+    @property
+    def curve(self):
+        return np.array([i + 1 for i, c in enumerate(self._data.get("curves", [])) for _ in c["points"]],
+                        dtype=np.int64)
 
     def __getattr__(self, name):
         if name.startswith("_"):
             raise AttributeError(name)
         if name in self._data:
             return super().__getattr__(name)
-        rows = self._data.get("curves", [{}])[0].get("points", [])
+        rows = self._points()
         if any(name in row for row in rows):
             return _stack(rows, name)
         return super().__getattr__(name)

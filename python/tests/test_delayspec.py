@@ -223,6 +223,24 @@ def test_boundary_equals_cli_json():
     assert r.x[0] == -1 and r.x[-1] == 0.5 and r.by_N.shape == (len(r.x), 2)
 
 
+def test_boundary_stacks_the_points_of_every_curve():
+    # milling, a/D = 0.05, a start at 4 speeds: three lobes; every curve's points, in the order of
+    # `curves` (before 2026-11-28 the arrays held the first curve's points alone)
+    r = delayspec.boundary(SCENES / "milling_lobes_curves.toml", boundary_scan_points=4, boundary_Ns=[25, 50, 100],
+                           N=100)
+    curves = r["curves"]
+    assert len(curves) >= 2
+    assert r.curve.dtype == np.int64 and r.x.shape == r.curve.shape == (sum(len(c["points"]) for c in curves),)
+    for i, c in enumerate(curves):
+        assert list(r.x[r.curve == i + 1]) == [p["x"] for p in c["points"]]
+        ye = [np.nan if p["y_extrapolated"] is None else p["y_extrapolated"] for p in c["points"]]
+        assert np.array_equal(r.y_extrapolated[r.curve == i + 1], np.array(ye), equal_nan=True)
+    assert np.isfinite(r.y_extrapolated).any()
+    # two levels: no point has an estimate (the order cannot be checked), every one is nan
+    two = delayspec.boundary(SCENES / "milling_lobes_curves.toml", boundary_scan_points=4, boundary_Ns=[50, 100], N=100)
+    assert two.error_estimate.shape == two.x.shape and np.isnan(two.error_estimate).all()
+
+
 def test_boundary_refined_points_keep_the_levels_shape():
     # a flip lobe's tip (milling, a/D = 0.05): where N = 100, 200, 400 do not show their order the
     # level 800 is added (boundary_refine), then 1600; every point reports all five levels, null

@@ -533,9 +533,11 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out
                     p.angle / std::numbers::pi);
       os << line;
     }
+    // (located on the finest N's curve only: the coarser levels' curves are not followed, so
+    // nothing says how far it is from N -> infinity)
     for (const Codim2Point& q : curve.codim2)
       os << "  codim 2: " << q.kind << " at " << run.x_key << " = " << format_number(q.x) << ", " << run.y_key
-         << " = " << format_number(q.y) << "\n";
+         << " = " << format_number(q.y) << " (at N = " << run.Ns.back() << ", no error estimate)\n";
   }
   os << "time: " << seconds << " s: the starts' search " << format_number(out.search_seconds, 2) << " s, tracing "
      << format_number(out.trace_seconds, 2) << " s (" << out.evaluations << " evaluations of the test function at N = "
