@@ -517,8 +517,10 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out
     os << "curve " << i + 1 << ": " << to_string(out.types[i]) << ", " << curve.points.size() << " points, ended at `"
        << to_string(curve.end) << "`" << (curve.note.empty() ? "" : ": " + curve.note) << "\n";
     // The extrapolated point lies on the curve's normal through the point at the finest N, so
-    // both of its coordinates move: on a lobe's steep side mostly x (at N = 100, 200, 400, up to
-    // 4 rpm; a depth beside the finest N's speed would be off by 1e-4 m there, not by its +-).
+    // both of its coordinates move, on a lobe's steep side mostly x. On milling_lobes_curves.toml
+    // (N = 100, 200, 400) by up to 3.4 rpm: the extrapolated depth read beside the finest N's
+    // speed (the table before 2026-11-28) missed by 139 times its +- at the median point, and by
+    // 1.3e-3 m on a flip lobe's side.
     std::snprintf(line, sizeof line, "  %-34s  %s\n", ("at N = " + std::to_string(run.Ns.back())).c_str(),
                   "extrapolated (N -> infinity)");
     os << line;
