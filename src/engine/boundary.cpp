@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "delayspec/detail/bifurcation_locator.hpp"  // multiplier_test
+#include "delayspec/detail/illinois.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {
@@ -372,17 +373,17 @@ void end_where_it_stops(BoundaryCurve& curve, const ScaledCurve& scaled, const C
 // chord's bend), with `closed` false.
 std::optional<CurveState> sign_change_between(const ScaledCurve& scaled, const CurveState& a, const CurveState& b,
                                               double tolerance, double BoundarySample::*field, bool& closed) {
-  double fa = a.sample.*field, fb = b.sample.*field;
+  const double fa = a.sample.*field, fb = b.sample.*field;
   if (!std::isfinite(fa) || !std::isfinite(fb) || (fa > 0) == (fb > 0)) return std::nullopt;
   const Vec2 chord{b.X[0] - a.X[0], b.X[1] - a.X[1]};
   const double length = norm(chord);
   const Vec2 row{chord[0] / length, chord[1] / length};
   double wa = 0, wb = 1;
   CurveState at = std::abs(fa) < std::abs(fb) ? a : b;
-  int moved = 0;  // the end moved last (-1: a, 1: b); Illinois: an end kept twice has its value halved
+  detail::IllinoisValues illinois{fa, fb};
   closed = false;
   for (int it = 0; it < 40 && !(closed = (wb - wa) * length <= tolerance); ++it) {
-    const double w = std::clamp((wa * fb - wb * fa) / (fb - fa), wa, wb);
+    const double w = std::clamp(illinois.root(wa, wb), wa, wb);
     const Vec2 P{a.X[0] + w * chord[0], a.X[1] + w * chord[1]};
     std::string reason;
     const std::optional<CurveState> on = correct(scaled, P, a.grad, row, dot(row, P), tolerance, reason);
@@ -393,15 +394,7 @@ std::optional<CurveState> sign_change_between(const ScaledCurve& scaled, const C
       closed = true;
       break;
     }
-    if ((f > 0) == (fa > 0)) {
-      wa = w, fa = f;
-      if (moved == -1) fb /= 2;
-      moved = -1;
-    } else {
-      wb = w, fb = f;
-      if (moved == 1) fa /= 2;
-      moved = 1;
-    }
+    (illinois.replace(f) < 0 ? wa : wb) = w;
   }
   return at;
 }

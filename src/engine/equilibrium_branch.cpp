@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 
+#include "delayspec/detail/illinois.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {
@@ -132,13 +133,13 @@ EquilibriumBifurcation locate(const Tracer& tracer, const OnBranch& a, double h,
     std::complex<double> lambda;
   };
   End lo{0, a.p(), lambda_a}, hi{h, b.p(), lambda_b};
-  double g_lo = lo.lambda.real(), g_hi = hi.lambda.real();
-  int side = 0;
+  // (the end a is hi: a value of hi's sign replaces it, as before illinois.hpp)
+  detail::IllinoisValues illinois{hi.lambda.real(), lo.lambda.real()};
   EquilibriumBifurcation out;
   OnBranch at;
   CharacteristicRoot root;
   for (out.evaluations = 1; out.evaluations <= 100; ++out.evaluations) {
-    const double s = (lo.s * g_hi - hi.s * g_lo) / (g_hi - g_lo);
+    const double s = illinois.root(hi.s, lo.s);
     int its = 0;
     if (!tracer.correct(a, s, at, its))
       throw NumericalFailure("a point inside the segment could not be corrected while locating the crossing");
@@ -152,18 +153,10 @@ EquilibriumBifurcation locate(const Tracer& tracer, const OnBranch& a, double h,
     // last step: the root is far more accurate than that, and the bracket goes on shrinking.)
     const double rounding = 4 * std::numeric_limits<double>::epsilon() * (1 + std::abs(root.value));
     if (std::abs(g) <= rounding) {
-      out.parameter_bound = rounding * std::abs(hi.p - lo.p) / std::abs(g_hi - g_lo);
+      out.parameter_bound = rounding * std::abs(hi.p - lo.p) / std::abs(illinois.a - illinois.b);
       break;
     }
-    if ((g > 0) == (g_hi > 0)) {
-      hi = c, g_hi = g;
-      if (side == -1) g_lo /= 2;
-      side = -1;
-    } else {
-      lo = c, g_lo = g;
-      if (side == +1) g_hi /= 2;
-      side = +1;
-    }
+    (illinois.replace(g) < 0 ? hi : lo) = c;
     out.parameter_bound = std::abs(hi.p - lo.p);
     if (out.parameter_bound <= tolerance) break;
   }

@@ -26,6 +26,7 @@
 
 #include "delayspec/continuation.hpp"
 #include "delayspec/detail/branch_corrector.hpp"
+#include "delayspec/detail/illinois.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec::continuation_detail {
@@ -83,8 +84,7 @@ class BifurcationLocator {
     slope_ = std::max({std::abs(b.parameter - a.parameter) / s_b, std::abs(a.tangent_p), std::abs(b.tangent_p)});
     if (type_ != BifurcationType::grazing) bisect_on_counts();
     if (neg_.g > 0) std::swap(neg_, pos_);
-    g_neg_ = neg_.g;
-    g_pos_ = pos_.g;
+    illinois_ = {neg_.g, pos_.g};
     if (!(neg_.g < 0 && pos_.g > 0)) {
       bif_.note += std::string(bif_.note.empty() ? "" : "; ") +
                    "the test function does not change sign over the segment (" + format_number(neg_.g) + ", " +
@@ -160,9 +160,8 @@ class BifurcationLocator {
     return std::isfinite(s_root);
   }
 
-  // Stage 2, one Illinois step on g(neg) < 0 < g(pos): the regula falsi point s = (s_n g_p -
-  // s_p g_n) / (g_p - g_n), where the copy g_n or g_p of the side that did not move is halved
-  // when the same side moved twice (which keeps the convergence superlinear). After a failure on
+  // Stage 2, one Illinois step on g(neg) < 0 < g(pos) (illinois.hpp: the regula falsi point of
+  // the working values, the side that did not move halved when the same side moved twice). After a failure on
   // the positive side the point is the one-sided secant root (bisection when the last step came
   // from that side). Returns false when done: the bracket is within the tolerance, the secant
   // puts the root within the tolerance of neg (located_), or g = 0 was hit.
@@ -191,8 +190,8 @@ class BifurcationLocator {
       }
     }
     const double lo = std::min(neg_.s, pos_.s), hi = std::max(neg_.s, pos_.s), margin = 1e-3 * (hi - lo);
-    double s = (neg_.s * g_pos_ - pos_.s * g_neg_) / (g_pos_ - g_neg_);  // regula falsi
-    if (one_sided_) s = one_sided_secant(s_root) && side_ != 1 ? s_root : 0.5 * (lo + hi);
+    double s = illinois_.root(neg_.s, pos_.s);  // regula falsi
+    if (one_sided_) s = one_sided_secant(s_root) && illinois_.last != 1 ? s_root : 0.5 * (lo + hi);
     s = std::clamp(s, lo + margin, hi - margin);
     std::string reason;
     std::optional<Sample> sample = sample_at(s, reason);
@@ -205,7 +204,7 @@ class BifurcationLocator {
       one_sided_ = true;
       pos_.p = neg_.p + (s - neg_.s) * (pos_.p - neg_.p) / (pos_.s - neg_.s);
       pos_.s = s;
-      side_ = 1;
+      illinois_.last = 1;
       // (one note per location: the last failure's; a second contact region's prefix kept)
       bif_.note = std::string(by_ == LocatedBy::second_max_H ? "a second contact region; " : "") +
                   "located from one side: " + (sample ? std::string("no candidate multiplier") : reason) +
@@ -218,17 +217,11 @@ class BifurcationLocator {
       pos_ = neg_;
       return false;
     }
-    if (g < 0) {
+    if (illinois_.replace(g) < 0) {  // (the end a is the negative side)
       prev_neg_ = std::move(neg_);
       neg_ = std::move(*sample);
-      g_neg_ = g;
-      if (side_ == -1) g_pos_ *= 0.5;
-      side_ = -1;
     } else {
       pos_ = std::move(*sample);
-      g_pos_ = g;
-      if (side_ == 1) g_neg_ *= 0.5;
-      side_ = 1;
     }
     return true;
   }
@@ -273,8 +266,7 @@ class BifurcationLocator {
   int refine_left_ = kRefineEvaluations;
   Sample neg_, pos_;                // the samples on the negative and the positive side of g
   std::optional<Sample> prev_neg_;  // the negative sample before neg_ (the one-sided secant)
-  double g_neg_ = 0, g_pos_ = 0;    // Illinois: possibly halved copies of neg_.g, pos_.g
-  int side_ = 0;                    // which side moved last (Illinois)
+  detail::IllinoisValues illinois_; // a: neg_.g, b: pos_.g, possibly halved; the side moved last
   bool one_sided_ = false;          // a point failed on the positive side: the root from the negative side
   double located_ = NAN;            // the root from the one-sided secant
 };
