@@ -16,9 +16,23 @@
 // and a root refined on c there, so the location has no discretisation error and its bracket in
 // p shrinks to `tolerance`. A complex pair is a Hopf point (omega = Im lambda, the period of the
 // orbit born 2 pi / omega); a real root a fold when p turns back on the segment, else a branch
-// point (a transcritical or pitchfork crossing). Several roots crossing in one segment are each
-// located; a root that crosses twice within one segment (out and back) is not seen: steps are
-// limited by step_max.
+// point (a transcritical or pitchfork crossing). A root that crosses twice within one segment
+// (out and back) is not seen: steps are limited by step_max.
+//
+// Nothing is printed that was not checked (issue 61: Newton on c from a root far away converges to
+// another root, and a location bracketed between two different roots is not a bifurcation):
+//  * every point tracks `nroots` roots and at least kRootMargin more than it has with Re >= 0, so
+//    a root about to cross is among them;
+//  * following back must be one to one (no two roots of the later point onto one root of the
+//    earlier) and land on a root the earlier point lists, and the crossings found must account
+//    for the change in the count of roots with Re > 0 (a pair counts 2, a real root 1);
+//  * a segment with more than one crossing is halved (each is located on its own only once the
+//    step is down to step_min);
+//  * while locating, every refined root lies within half the bracket's spread of the root
+//    interpolated between its ends, and at the end the two ends' roots have closed in with the
+//    bracket: the same root on both sides, on the axis.
+// A segment failing a check is halved and redone; at step_min the branch ends in a failure that
+// names the check.
 #include <complex>
 #include <functional>
 #include <string>
@@ -32,15 +46,20 @@
 namespace delayspec {
 
 // The model at parameter p: its values on a constant history, and its equilibrium near a guess
-// with its rightmost roots (find_equilibrium).
+// with its `nroots` rightmost roots (find_equilibrium with EquilibriumOptions::nroots = nroots).
 struct EquilibriumFamily {
   std::function<ConstantHistory(const Eigen::VectorXd& y, double p)> at;
-  std::function<EquilibriumResult(const Eigen::VectorXd& guess, double p)> equilibrium;
+  std::function<EquilibriumResult(const Eigen::VectorXd& guess, double p, int nroots)> equilibrium;
 };
+
+// Roots tracked beyond those with Re >= 0: a complex pair and a real root about to cross, and one
+// more for the ordering of roots of nearly equal real part.
+inline constexpr int kRootMargin = 4;
 
 struct EquilibriumBranchOptions : BranchRange {  // the range and steps as continue_orbit's
   double newton_tolerance = 1e-12;  // corrector: |dx|_inf <= this (1 + |x|_inf)
   int newton_iterations = 10;       // corrector iterations per point
+  int nroots = 6;                   // roots tracked at least (more where more are unstable: above)
   std::function<void()> on_point;   // after every accepted point; may be empty
 };
 

@@ -6,6 +6,7 @@
 //  * NumericalFailure: the input was valid but a numerical method did not reach
 //    its goal (Newton, Krylov, orbit search). The message carries the numbers
 //    (iterations, residual). The CLI maps it to exit status 3.
+#include <complex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -58,6 +59,8 @@ std::string format_number(double value);
 // Formats a double with `significant_digits` digits (printf's %g): a tolerance in a message
 // (3), a coordinate in a plot script (10). The one home of number formatting with format_number.
 std::string format_number(double value, int significant_digits);
+// "a + bi" / "a - bi" with format_number's parts: a complex number in a message.
+std::string format_complex(std::complex<double> value);
 
 // Throws BadInput("`name = value`: must be finite") when value is NaN or infinite.
 void require_finite(const char* name, double value);

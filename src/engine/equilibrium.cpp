@@ -36,9 +36,13 @@ Eigen::MatrixXcd ConstantHistory::delta(std::complex<double> l, Eigen::MatrixXcd
 
 std::complex<double> ConstantHistory::newton_step(std::complex<double> l) const {
   Eigen::MatrixXcd derivative;
-  const Eigen::MatrixXcd value = delta(l, &derivative);
-  // infinite where Delta is singular: lambda is a root
-  return 1.0 / Eigen::PartialPivLU<Eigen::MatrixXcd>(value).solve(derivative).trace();
+  const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(delta(l, &derivative));
+  // Delta exactly singular (a zero pivot): lambda is a root to the last bit, and the step is 0.
+  // The solve would divide by that pivot and give inf - inf = NaN in the trace (issue 61: the
+  // Lang-Kobayashi carrier root -1/Tc, a decoupled linear decay, is hit exactly). A pivot that is
+  // merely tiny gives a huge trace and a tiny step, as it should.
+  if (lu.matrixLU().diagonal().cwiseAbs().minCoeff() == 0 && std::isfinite(std::abs(l))) return 0;
+  return 1.0 / lu.solve(derivative).trace();
 }
 
 namespace {
@@ -127,10 +131,8 @@ CharacteristicRoot refined_root(const ConstantHistory& h, std::complex<double> l
     l -= step;
     root.last_step = std::abs(step);
     if (!std::isfinite(l.real()) || !std::isfinite(l.imag()) || root.iterations >= o.max_iterations)
-      throw NumericalFailure("equilibrium: the characteristic root near " + format_number(root.discretised.real()) +
-                             (root.discretised.imag() < 0 ? " - " : " + ") +
-                             format_number(std::abs(root.discretised.imag())) +
-                             "i did not converge on det(lambda I - A - sum B e^(-lambda tau)) (last step " +
+      throw NumericalFailure("equilibrium: the characteristic root near " + format_complex(root.discretised) +
+                             " did not converge on det(lambda I - A - sum B e^(-lambda tau)) (last step " +
                              format_number(root.last_step) + ")");
     if (root.last_step <= o.tolerance * (1 + std::abs(l))) break;
   }

@@ -51,6 +51,10 @@ std::string format_number(double value) {
   return best;
 }
 
+std::string format_complex(std::complex<double> value) {
+  return format_number(value.real()) + (value.imag() < 0 ? " - " : " + ") + format_number(std::abs(value.imag())) + "i";
+}
+
 std::string format_number(double value, int significant_digits) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*g", significant_digits, value);

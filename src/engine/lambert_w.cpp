@@ -58,8 +58,7 @@ cd lambert_w(cd z, int k) {
   // Never a value that is not a root: |w e^w - z| within the rounding of e^w (the identity test's
   // bound, 1e-14 |z| (1 + |w|), with a margin of 100).
   if (!(std::abs(w * std::exp(w) - z) <= 1e-12 * std::abs(z) * (1 + std::abs(w))))
-    throw NumericalFailure("lambert_w: Halley's iteration did not converge for z = " + format_number(z.real()) +
-                           (z.imag() < 0 ? " - " : " + ") + format_number(std::abs(z.imag())) + "i on branch " +
+    throw NumericalFailure("lambert_w: Halley's iteration did not converge for z = " + format_complex(z) + " on branch " +
                            std::to_string(k));
   return w;
 }

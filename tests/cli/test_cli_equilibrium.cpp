@@ -5,16 +5,20 @@
 #include <cmath>
 #include <complex>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "cli_test_support.hpp"
+#include "delayspec_test_paths.hpp"
 #include "delayspec/lambert_w.hpp"
 
 namespace {
 
 using delayspec::testing::CliResult;
+using delayspec::testing::contains;
 using delayspec::testing::run;
 
 // x' = a x + b x(t - 1): the equilibrium 0 and its six rightmost roots, against
@@ -118,16 +122,22 @@ TEST(EquilibriumCli, ContinueLocatesTheMackeyGlassHopfPoint) {
 
 // x' = b x(t - 1) (a = 0): at lambda = i omega, i omega = b e^{-i omega}, so cos omega = 0 and
 // b = -omega / sin omega: Hopf points at b = -pi/2 (omega = pi/2) and b = -5 pi/2 (omega = 5 pi/2)
-// on the way to b = -9. One step covers the whole range: both pairs cross inside one segment and
-// each must be located on its own.
+// on the way to b = -9. The first step covers the whole range: both pairs cross inside it. The
+// step is halved (issue 61: one crossing per segment) and each is located on its own. Where
+// continue_step_min forbids halving, the roots of b = -9 followed back to b = -0.5 in one Newton
+// jump land two on one root (measured): that segment cannot be verified, and the run says so with
+// exit 3 instead of printing what it could not check (before issue 61 this passed, by luck).
 TEST(EquilibriumCli, TwoPairsCrossingInOneStepAreBothLocated) {
-  const CliResult r = run({"continue", "--json", "--set", "model=linear", "--set", "a=0", "--set",
-                           "continue_object=equilibrium", "--set", "continue_key=b", "--set", "continue_from=-0.5",
-                           "--set", "continue_to=-9", "--set", "continue_step=10", "--set", "continue_step_max=10",
-                           "--set", "continue_tolerance=1e-12"});
+  const auto continue_with_step_min = [](const char* step_min) {
+    return run({"continue", "--json", "--set", "model=linear", "--set", "a=0", "--set", "continue_object=equilibrium",
+                "--set", "continue_key=b", "--set", "continue_from=-0.5", "--set", "continue_to=-9", "--set",
+                "continue_step=10", "--set", "continue_step_max=10", "--set", step_min, "--set",
+                "continue_tolerance=1e-12"});
+  };
+  const CliResult r = continue_with_step_min("continue_step_min=0.01");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j["points"].size(), 2u);
+  EXPECT_GT(j["points"].size(), 2u);
   ASSERT_EQ(j["bifurcations"].size(), 2u);
   for (int k = 0; k < 2; ++k) {
     const double omega = (4 * k + 1) * M_PI / 2;
@@ -136,6 +146,31 @@ TEST(EquilibriumCli, TwoPairsCrossingInOneStepAreBothLocated) {
     EXPECT_NEAR(j["bifurcations"][k]["omega"].get<double>(), omega, 1e-10);
   }
   EXPECT_EQ(j["points"].back()["unstable"], 4);
+
+  const CliResult one_segment = continue_with_step_min("continue_step_min=10");
+  EXPECT_EQ(one_segment.status, 3) << one_segment.out;
+  EXPECT_TRUE(contains(one_segment.err, "down to continue_step_min = 10")) << one_segment.err;
+}
+
+// Issue 61's reproducer as a user types it: Mackey-Glass over tau in [3, 60] with the default
+// nroots = 6 and steps. Its four Hopf points (arccos(-1/4) + 2 pi k) / sqrt(0.15) are all printed,
+// with omega = sqrt(0.15), and nothing else (the engine's test checks the same through the
+// library; here the scene's nroots reaches the branch).
+TEST(EquilibriumCli, MackeyGlassOverALongRangeFindsEveryHopfPoint) {
+  const CliResult r = run({"continue", "--json", "--set", "model=mackey-glass", "--set", "continue_object=equilibrium",
+                           "--set", "continue_key=tau", "--set", "continue_from=3", "--set", "continue_to=60",
+                           "--set", "equilibrium_guess=1.1"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["bifurcations"].size(), 4u);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(j["bifurcations"][k]["type"], "hopf");
+    EXPECT_NEAR(j["bifurcations"][k]["parameter"].get<double>(),
+                (std::acos(-0.25) + 2 * M_PI * k) / std::sqrt(0.15), 5.7e-9);  // tolerance 1e-10 * 57
+    EXPECT_NEAR(j["bifurcations"][k]["omega"].get<double>(), std::sqrt(0.15), 1e-9);
+  }
+  EXPECT_EQ(j["points"].back()["unstable"], 8);
+  EXPECT_GE(j["points"].back()["roots"].size(), 12u);  // tracked: 8 unstable + kRootMargin
 }
 
 // continue_switch: the orbits born at the Mackey-Glass Hopf point (hopf_branch.hpp; the engine's
@@ -207,3 +242,44 @@ TEST(EquilibriumCli, ContinueEquilibriaBadInput) {
 }
 
 }  // namespace
+
+// The Lang-Kobayashi laser as a new user writes it (issue 61: the first report), its off state
+// E = 0 continued in the pump P. The carrier root -1/Tc = -0.05 is exact at every P (Delta exactly
+// singular there); kappa = 0.1 ended in exit 3 ("did not converge (last step -nan)"), kappa = 0.3
+// printed a branch point at P = -0.1279 with exit 0. The Hopf points of the closed form (P =
+// -kappa cos(w tau), w = -kappa (alpha cos(w tau) + sin(w tau)), solved in Python with scipy's
+// brentq to 1e-15): -0.0899456574624 and -0.2071272864337. 1.5e-10: the location's tolerance
+// 1e-10 |to - from|. The model compiles once (its shape is not prebuilt: ~30 s), cached for both.
+TEST(EquilibriumCli, LangKobayashiOffStateHopfPointIsTheClosedForm) {
+  const std::filesystem::path dir = delayspec::testing::fresh_dir("lang_kobayashi");
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "lang_kobayashi.toml").string();
+  std::ofstream(scene) << R"(model = "equations"
+continue_object = "equilibrium"
+continue_key = "P"
+[equations]
+state = ["Ex", "Ey", "Nc"]
+parameters = { alpha = 3, kappa = 0.1, P = -0.2, Tc = 20 }
+period = "2"
+delay = "2"
+rhs = ["Nc*Ex - alpha*Nc*Ey + kappa*Ex_tau",
+       "Nc*Ey + alpha*Nc*Ex + kappa*Ey_tau",
+       "(P - Nc - (1 + 2*Nc)*(Ex^2 + Ey^2))/Tc"]
+history = { Ex = 0, Ey = 0, Nc = -0.2 }
+)";
+  for (const auto& [kappa, from, to, hopf] : {std::tuple{"0.1", "-0.2", "0.1", -0.0899456574624},
+                                              std::tuple{"0.3", "-0.5", "1.0", -0.2071272864337}}) {
+    SCOPED_TRACE(std::string("kappa = ") + kappa);
+    const CliResult r = run({"continue", scene, "--json", "--set", std::string("kappa=") + kappa, "--set",
+                             std::string("continue_from=") + from, "--set", std::string("continue_to=") + to, "--set",
+                             std::string("equilibrium_guess=0,0,") + from, "--set",
+                             std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["end"], "to");
+    ASSERT_EQ(j["bifurcations"].size(), 1u) << j["bifurcations"].dump();
+    EXPECT_EQ(j["bifurcations"][0]["type"], "hopf");
+    EXPECT_NEAR(j["bifurcations"][0]["parameter"].get<double>(), hopf, 1.5e-10);
+  }
+  std::filesystem::remove_all(dir);
+}

@@ -8,9 +8,11 @@
 //    of starts (tests/support/characteristic_roots.hpp), mapped back from exp(lambda T).
 // After refinement on the exact characteristic function the roots carry no discretisation error:
 // 1e-12 (Newton's stopping test is 1e-12 relative; the Lambert-W values are good to ~1e-15).
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <iostream>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -190,7 +192,11 @@ namespace {
 template <class Model, class Make>
 EquilibriumFamily family_of(Make make) {
   return {[make](const Eigen::VectorXd& y, double p) { return constant_history(make(p), Vec<Model::d>(y)); },
-          [make](const Eigen::VectorXd& guess, double p) { return find_equilibrium(make(p), Vec<Model::d>(guess)); }};
+          [make](const Eigen::VectorXd& guess, double p, int nroots) {
+            EquilibriumOptions o;
+            o.nroots = nroots;
+            return find_equilibrium(make(p), Vec<Model::d>(guess), o);
+          }};
 }
 
 TEST(EquilibriumBranch, MackeyGlassHopfPointInTauIsTheClosedForm) {
@@ -254,6 +260,134 @@ TEST(EquilibriumBranch, FoldIsPassedAndLocated) {
   EXPECT_EQ(f.root.value.imag(), 0);
   EXPECT_EQ(branch.points.front().equilibrium.unstable, 0);
   EXPECT_EQ(branch.points.back().equilibrium.unstable, 1);
+}
+
+// The Lang-Kobayashi laser with delayed optical feedback in real form (issue 61's reproducer),
+// E = Ex + i Ey, C = 0:
+//
+//   E' = (1 + i alpha) Nc E + kappa E(t - tau),   Tc Nc' = P - Nc - (1 + 2 Nc) |E|^2.
+//
+// Its off state E = 0, Nc = P has the carrier root lambda = -1/Tc exactly (Nc decouples: a
+// linear decay) and the roots of lambda = (1 + i alpha) P + kappa e^{-lambda tau} with their
+// conjugates. A Hopf point: lambda = i w gives P = -kappa cos(w tau) and
+// w = alpha P - kappa sin(w tau) = -kappa (alpha cos(w tau) + sin(w tau)).
+struct LangKobayashi {
+  static constexpr int d = 3;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double alpha = 3, kappa = 0.1, P = -0.2, Tc = 20, delay = 2;
+  double tau() const { return delay; }
+  double period() const { return delay; }
+  Vec<3> f(int, double, const Vec<3>& y, const Vec<3>& w) const {
+    const double n = y[2], e2 = y[0] * y[0] + y[1] * y[1];
+    return Vec<3>(n * y[0] - alpha * n * y[1] + kappa * w[0], n * y[1] + alpha * n * y[0] + kappa * w[1],
+                  (P - n - (1 + 2 * n) * e2) / Tc);
+  }
+  Mat<3> A(int, double, const Vec<3>& y, const Vec<3>&) const {
+    const double n = y[2], e2 = y[0] * y[0] + y[1] * y[1];
+    Mat<3> a;
+    a << n, -alpha * n, y[0] - alpha * y[1],  //
+        alpha * n, n, y[1] + alpha * y[0],    //
+        -2 * (1 + 2 * n) * y[0] / Tc, -2 * (1 + 2 * n) * y[1] / Tc, (-1 - 2 * e2) / Tc;
+    return a;
+  }
+  Mat<3> B(int, double, const Vec<3>&, const Vec<3>&) const {
+    Mat<3> b = Mat<3>::Zero();
+    b(0, 0) = b(1, 1) = kappa;
+    return b;
+  }
+  Vec<3> initial_state() const { return Vec<3>(0, 0, P); }
+};
+
+// The Hopf points of the off state in P, from w + kappa (alpha cos(w tau) + sin(w tau)) = 0 by
+// bisection on a fine grid of w (a reference the engine does not produce).
+std::vector<double> lang_kobayashi_hopf_points(const LangKobayashi& m) {
+  const auto g = [&](double w) { return w + m.kappa * (m.alpha * std::cos(w * m.delay) + std::sin(w * m.delay)); };
+  std::vector<double> points;
+  for (double w0 = -5; w0 < 5; w0 += 1e-4) {
+    double lo = w0, hi = w0 + 1e-4;
+    if ((g(lo) > 0) == (g(hi) > 0)) continue;
+    for (int i = 0; i < 200 && hi - lo > 1e-16; ++i)
+      ((g(0.5 * (lo + hi)) > 0) == (g(lo) > 0) ? lo : hi) = 0.5 * (lo + hi);
+    points.push_back(-m.kappa * std::cos(0.5 * (lo + hi) * m.delay));
+  }
+  return points;
+}
+
+// Delta exactly singular: the carrier root -1/Tc of the off state makes Delta's third row and
+// column zero, a zero pivot. Newton's step there is 0 (the root is exact); before issue 61 the
+// solve divided by the pivot and the trace was inf - inf = NaN, and the root "did not converge".
+TEST(Equilibrium, AnExactlySingularDeltaIsAConvergedRoot) {
+  const LangKobayashi m;
+  const ConstantHistory h = constant_history(m, m.initial_state());
+  EXPECT_EQ(h.newton_step(-1 / m.Tc), 0.0);
+  EquilibriumOptions o;
+  const CharacteristicRoot root = refined_root(h, -1 / m.Tc, o);
+  EXPECT_EQ(root.value, cd(-1 / m.Tc));
+  // and the whole computation at that point: every root found, the carrier root among them
+  const EquilibriumResult r = find_equilibrium(m, Vec<3>(0, 0, -0.2), o);
+  EXPECT_TRUE(std::any_of(r.roots.begin(), r.roots.end(), [&](const CharacteristicRoot& c) {
+    return std::abs(c.value - cd(-1 / m.Tc)) < 1e-15;
+  }));
+}
+
+// Issue 61's reproducers: from the default steps (range / 50, growing to range / 10), each Hopf
+// point of the closed form is found once, as a Hopf point, and nothing else. Before: kappa = 0.1
+// ended in "did not converge (last step -nan)"; kappa = 0.3 printed a branch point at P = -0.1279
+// (the crossing root refined onto the carrier root, a bracket around no root on the axis).
+// 1e-10: the location's tolerance, 1e-10 |to - from| (<= 1.5e-10), on the exact characteristic
+// function.
+TEST(EquilibriumBranch, LangKobayashiHopfPointIsTheClosedFormAndNothingElse) {
+  for (const auto& [kappa, from, to] : {std::tuple{0.1, -0.2, 0.1}, std::tuple{0.3, -0.5, 1.0}}) {
+    SCOPED_TRACE("kappa = " + std::to_string(kappa));
+    LangKobayashi base;
+    base.kappa = kappa;
+    const std::vector<double> exact = lang_kobayashi_hopf_points(base);
+    ASSERT_EQ(exact.size(), 1u);  // one w solves it for these kappa (|kappa tau sqrt(1 + alpha^2)| < 1)
+    const EquilibriumFamily family = family_of<LangKobayashi>([base](double P) {
+      LangKobayashi m = base;
+      m.P = P;
+      return m;
+    });
+    EquilibriumBranchOptions o;
+    o.from = from, o.to = to;
+    const EquilibriumBranch branch = continue_equilibrium(family, Vec<3>(0, 0, from), o);
+    ASSERT_EQ(branch.end, BranchEnd::to) << branch.failure;
+    ASSERT_EQ(branch.bifurcations.size(), 1u);
+    const EquilibriumBifurcation& h = branch.bifurcations[0];
+    EXPECT_EQ(h.type, EquilibriumBifurcationType::hopf);
+    EXPECT_NEAR(h.parameter, exact[0], 1.5e-10);
+    EXPECT_LT(std::abs(h.root.value.real()), 1e-9);
+    EXPECT_EQ(branch.points.front().equilibrium.unstable, 0);
+    EXPECT_EQ(branch.points.back().equilibrium.unstable, 2);
+  }
+}
+
+// Mackey-Glass at x* = 1 over tau in [3, 60] (issue 61): its Hopf points are
+// tau_k = (arccos(-gamma / b) + 2 pi k) / omega, omega = sqrt(b^2 - gamma^2) = sqrt(0.15), b = -0.4:
+// four of them, each adding a pair, so that at tau = 53.4 six roots are already unstable. Before:
+// with nroots = 6 tracked, one printed at tau = 23.616 with omega = 0.105 (another root's) and the
+// fourth missed. The tracked roots grow with the count (kRootMargin), a step with two crossings
+// is halved, and the location's checks hold. 2e-9: the tolerance 1e-10 |to - from| = 5.7e-9 is
+// the bracket's width; measured within 1e-9.
+TEST(EquilibriumBranch, MackeyGlassFourHopfPointsOverALongRangeInTau) {
+  const double a = -0.1, b = -0.4, omega = std::sqrt(b * b - a * a);
+  const EquilibriumFamily family = family_of<MackeyGlassModel>([](double tau) {
+    MackeyGlassParameters p;
+    p.tau = p.period = tau;
+    return MackeyGlassModel(p);
+  });
+  EquilibriumBranchOptions o;
+  o.from = 3, o.to = 60;
+  const EquilibriumBranch branch = continue_equilibrium(family, Vec<1>(1.1), o);
+  ASSERT_EQ(branch.end, BranchEnd::to) << branch.failure;
+  ASSERT_EQ(branch.bifurcations.size(), 4u);
+  for (int k = 0; k < 4; ++k) {
+    const EquilibriumBifurcation& h = branch.bifurcations[static_cast<size_t>(k)];
+    EXPECT_EQ(h.type, EquilibriumBifurcationType::hopf);
+    EXPECT_NEAR(h.parameter, (std::acos(-a / b) + 2 * M_PI * k) / omega, 5.7e-9) << k;
+    EXPECT_NEAR(h.omega, omega, 1e-9) << k;
+  }
+  EXPECT_EQ(branch.points.back().equilibrium.unstable, 8);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "scene/commands/continue_equilibria.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <sstream>
@@ -67,17 +68,21 @@ json branch_json(const Problem& problem, const std::string& key, const Equilibri
   return j;
 }
 
-std::string points_csv(const std::string& header, const Problem& problem, const EquilibriumBranch& b, int nroots) {
+std::string points_csv(const std::string& header, const Problem& problem, const EquilibriumBranch& b) {
+  // a column pair per root of the point with the most (the branch tracks more roots where more are
+  // unstable: equilibrium_branch.hpp)
+  size_t nroots = 0;
+  for (const EquilibriumPoint& p : b.points) nroots = std::max(nroots, p.equilibrium.roots.size());
   std::ostringstream rows;
   rows << header << "parameter,stable,unstable";
   for (const std::string& name : problem.state_names) rows << "," << name;
-  for (int k = 1; k <= nroots; ++k) rows << ",lambda" << k << "_re,lambda" << k << "_im";
+  for (size_t k = 1; k <= nroots; ++k) rows << ",lambda" << k << "_re,lambda" << k << "_im";
   rows << "\n";
   for (const EquilibriumPoint& p : b.points) {
     rows << csv_number(p.parameter) << "," << (p.equilibrium.stable() ? 1 : 0) << "," << p.equilibrium.unstable;
     for (long i = 0; i < p.equilibrium.state.size(); ++i) rows << "," << csv_number(p.equilibrium.state[i]);
-    for (int k = 0; k < nroots; ++k) {
-      const bool has = static_cast<size_t>(k) < p.equilibrium.roots.size();
+    for (size_t k = 0; k < nroots; ++k) {
+      const bool has = k < p.equilibrium.roots.size();
       rows << "," << csv_number(has ? p.equilibrium.roots[k].value.real() : NAN) << ","
            << csv_number(has ? p.equilibrium.roots[k].value.imag() : NAN);
     }
@@ -261,7 +266,7 @@ void write_equilibria_files(const Invocation& inv, const Config& config, const E
   metadata.parameters.erase(run.settings.key);  // per row
   std::string header = metadata_comment_lines(metadata);
   if (!failures.empty()) header += "# INCOMPLETE: a branch ended in a failure: " + failures + "\n";
-  write_output(inv, dir / "equilibria.csv", points_csv(header, run.problem, branch, run.eq.options.nroots));
+  write_output(inv, dir / "equilibria.csv", points_csv(header, run.problem, branch));
   write_output(inv, dir / "equilibrium_bifurcations.csv", equilibrium_bifurcations_csv(header, branch));
   for (size_t i = 0; i < orbits.size(); ++i) {
     const std::string n = std::to_string(i + 1);
@@ -284,13 +289,18 @@ int continue_equilibria(Config& config, const Invocation& inv) {
   EquilibriumBranchOptions o;
   static_cast<BranchRange&>(o) = run.settings.options;
   o.newton_tolerance = run.eq.options.tolerance;
+  o.nroots = run.eq.options.nroots;
   Progress progress(inv.err, "continue", 0, inv.quiet);
   o.on_point = [&progress] { progress.add(); };
   const AnalysesAt at = analyses_with_key(config, key);
   const EquilibriumOptions& eq = run.eq.options;
   const EquilibriumFamily family{
       [&at](const Eigen::VectorXd& y, double p) { return at(p)->at_constant_history(y); },
-      [&at, &eq](const Eigen::VectorXd& guess, double p) { return at(p)->equilibrium(guess, eq); }};
+      [&at, &eq](const Eigen::VectorXd& guess, double p, int nroots) {
+        EquilibriumOptions with = eq;
+        with.nroots = nroots;
+        return at(p)->equilibrium(guess, with);
+      }};
   const EquilibriumBranch branch = continue_equilibrium(family, run.eq.guess, o);
   const std::vector<HopfBranch> orbits =
       run.from_hopf ? hopf_branches(branch, at, run.Ns, run.orbit_options, progress) : std::vector<HopfBranch>{};
