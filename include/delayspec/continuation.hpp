@@ -102,6 +102,7 @@
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/grid.hpp"
+#include "delayspec/model_grid.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/richardson.hpp"
 #include "delayspec/stepper.hpp"
@@ -315,10 +316,9 @@ ContinuationResult continue_period_doubled(const ModelAt& model_at, const Bifurc
     throw BadInput("continue_period_doubled: needs a located period doubling with its orbit");
   const Model model = model_at(at.parameter);
   const StepOptions& so = options.step_options;
-  const Map map1(TrapezoidStepper<Model>(model, so),
-                 make_grid(delays_of(model), model.period(), options.N, options.periods_per_map));
-  const Map map2(TrapezoidStepper<Model>(model, so),
-                 make_grid(delays_of(model), model.period(), options.N, 2 * options.periods_per_map));
+  const int N = options.N, periods = options.periods_per_map;
+  const Map map1(TrapezoidStepper<Model>(model, so), model_grid(model, N, periods, so.grid));
+  const Map map2(TrapezoidStepper<Model>(model, so), model_grid(model, N, 2 * periods, so.grid));
   const PeriodicOrbitProblem<Map> problem1(map1);
   if (at.orbit.size() != problem1.unknowns())
     throw BadInput("continue_period_doubled: the orbit has " + std::to_string(at.orbit.size()) + " entries, expected " +

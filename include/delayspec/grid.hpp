@@ -15,10 +15,27 @@
 // In both cases the delayed value at the start of a step is (1 - theta) u_m + theta u_{m+1}
 // and at its end (1 - theta) u_{m-1} + theta u_m (the terms with theta = 0 are absent):
 // HistoryGrid::delay_tap, the one statement of this rule.
+//
+//  * Aligned with breakpoints (design.md 1.4c; issue 58): where the field switches at known times
+//    (GridBreaks: milling's tooth entries and exits) and the one delay is aligned, tau / T = p / q,
+//    the nodes are put on every switch. The pattern P = T / q = tau / p repeats (so that t - tau
+//    of a node is a node); the breakpoints taken mod P cut it into pieces, each uniform with
+//    n_i steps, sum n_i = N / p (so N keeps its meaning, steps per delay, and M = N). A piece's
+//    steps are L_i / n_i long; h is the mean, T / K_1. The n_i are nested: n_i(2 n) = 2 n_i(n)
+//    whenever n / 2 >= kMinPatternSteps (the largest-remainder allocation is made once, at the
+//    odd part or at the first n of the halving chain below kMinPatternSteps), so that doubling N
+//    halves every step and the error keeps the even expansion h^2, h^4, ... that Richardson needs.
 #include <string>
 #include <vector>
 
 namespace delayspec {
+
+// The field's switch times the grid puts nodes on (HistoryGrid, "aligned with breakpoints").
+struct GridBreaks {
+  std::vector<double> times;     // switch times in [0, T), any order (time_switches_in_period)
+  std::vector<int> piece_steps;  // empty: allocated from N (nested); else each piece's steps, as given
+                                 // (a continuation keeps its start's allocation: the map smooth in p)
+};
 
 // What step l of a map reads from the history (HistoryGrid::delay_tap).
 template <class V>
@@ -40,7 +57,15 @@ struct HistoryGrid {
   double theta = 0;          // fractional part of tau / h; 0 when aligned
   int M = 0;                 // last history slot: the history has M + 1 blocks
 
+  // Aligned with breakpoints (header): the pieces' start times in [0, P), P = the pattern, and
+  // their steps; `nodes` the K_1 + 1 node times of one period, 0 .. T. All empty: uniform.
+  std::vector<double> breakpoints;
+  std::vector<int> piece_steps;
+  std::vector<double> nodes;
+  double pattern = 0;  // P (0: uniform)
+
   bool aligned() const { return theta == 0; }
+  bool has_breakpoints() const { return !nodes.empty(); }
 
   // The slot of the working history holding u_m for step l: b(delayed_slot(l)) = y(t - tau)
   // when aligned (numbering of delay_tap). The block kernels (block_kernel.hpp) take it as d0.
@@ -62,11 +87,23 @@ struct HistoryGrid {
     const double c0 = 1 - theta;
     return {V(c0 * b(j) + theta * b(j - 1)), V(c0 * b(j + 1) + theta * b(j)), t};
   }
-  // The start of step l within the forcing period, (l mod K_1) h. l mod K_1 without a division
-  // where l < K_1 (every step of a one-period map): a 64-bit idiv sat at the head of the step's
-  // dependency chain (t -> forcing -> S -> ...)
+  // The start of step l within the forcing period, (l mod K_1) h (or its node, with breakpoints).
+  // l mod K_1 without a division where l < K_1 (every step of a one-period map): a 64-bit idiv
+  // sat at the head of the step's dependency chain (t -> forcing -> S -> ...)
   double time_in_period(long l) const {
-    return static_cast<double>(l < steps_per_period ? l : l % steps_per_period) * h;
+    const long j = l < steps_per_period ? l : l % steps_per_period;
+    return nodes.empty() ? static_cast<double>(j) * h : nodes[static_cast<size_t>(j)];
+  }
+  // The length of step l: h, or its piece's step with breakpoints.
+  double step_size(long l) const {
+    if (nodes.empty()) return h;
+    const size_t j = static_cast<size_t>(l < steps_per_period ? l : l % steps_per_period);
+    return nodes[j + 1] - nodes[j];
+  }
+  // The start of step l from the start of the run (l >= 0): l h, or (l div K_1) T + its node.
+  double node_time(long l) const {
+    if (nodes.empty()) return static_cast<double>(l) * h;
+    return static_cast<double>(l / steps_per_period) * period + nodes[static_cast<size_t>(l % steps_per_period)];
   }
 
   // Several delays (model.hpp): `delays` holds each delay's position, tau_i = (m_i + theta_i) h,
@@ -113,17 +150,30 @@ struct HistoryGrid {
   std::string describe() const;
 };
 
+// Steps a pattern keeps at least before its allocation is halved (header): the allocation of the
+// halving chain's base, from which finer n double it.
+inline constexpr int kMinPatternSteps = 8;
+
 // Builds the grid; throws BadInput naming N, tau, period or orbit_period when they are invalid
 // (N < 1, non-positive or non-finite times, a rational ratio with incompatible N, a delay
-// shorter than one step).
-HistoryGrid make_grid(double tau, double period, int N, int periods_per_map = 1);
+// shorter than one step). With breaks (non-empty times) and an aligned delay the nodes are put on
+// them (header); BadInput naming N when N / p is below the number of pieces (each needs a step),
+// or a given allocation does not sum to N / p or has a piece without a step. A fractional delay
+// ignores the breaks (uniform).
+HistoryGrid make_grid(double tau, double period, int N, int periods_per_map = 1, const GridBreaks& breaks = {});
 
 // Several delays (taus in the model's order; one entry is make_grid above): N steps per the
 // longest, laid as make_grid lays it, each other delay at its (m_i, theta_i). Throws BadInput
 // naming the delay when it is not positive and finite or shorter than one step: by names[i] when
 // given (one per delay, e.g. "`equations.delays.tau1`"), else by its place ("delay 2 of 3").
+// Breaks are used with one delay only (another delay would fall between the nodes of the pieces).
 HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map = 1,
-                      const std::vector<std::string>& names = {});
+                      const std::vector<std::string>& names = {}, const GridBreaks& breaks = {});
+
+// The same problem's grid at another N (the same delays, period, map length and breakpoints; the
+// allocation made afresh for N, nested with g's where N / g.N is a power of two): the levels of a
+// resolution study or of nested shooting.
+HistoryGrid regrid(const HistoryGrid& g, int N);
 
 // A grid of exactly `steps_per_period` steps per period (h = period / steps_per_period), every
 // delay placed where it falls, (m_i, theta_i) = tau_i / h as above (aligned only where tau_i / h

@@ -23,6 +23,7 @@
 #include "delayspec/linear_operator.hpp"
 #include "delayspec/lyapunov.hpp"
 #include "delayspec/model.hpp"
+#include "delayspec/model_grid.hpp"
 #include "delayspec/monodromy.hpp"
 #include "delayspec/orbit_search.hpp"
 #include "delayspec/simulation.hpp"
@@ -82,7 +83,14 @@ class ModelAnalyses {
   // Every delay, in the model's order ({tau()} for one delay; model.hpp).
   virtual std::vector<double> delays() const = 0;
   virtual double period() const = 0;
-  HistoryGrid grid(const MapSettings& s) const { return make_grid(delays(), period(), s.N, s.orbit_period); }
+  // The model's time switches in [0, T) (model_grid.hpp; empty: none).
+  virtual std::vector<double> time_switches() const = 0;
+  // The grid of these settings (model_grid.hpp: the switches as breakpoints when aligned).
+  HistoryGrid grid(const MapSettings& s) const {
+    GridBreaks breaks;
+    if (s.step.grid == GridLayout::aligned) breaks.times = time_switches();
+    return make_grid(delays(), period(), s.N, s.orbit_period, {}, breaks);
+  }
 
   // The periodic orbit (orbit_search.hpp; the zero orbit of a linear model) and its monodromy.
   virtual LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
@@ -145,6 +153,7 @@ class ModelAnalysesFor final : public ModelAnalyses {
   double tau() const override { return model_.tau(); }
   std::vector<double> delays() const override { return delays_of(model_); }
   double period() const override { return model_.period(); }
+  std::vector<double> time_switches() const override { return time_switches_in_period(model_); }
 
   LinearisedOrbit linearised_orbit(const MapSettings& s, const OrbitSettings& settings,
                                    const OrbitRequest& request) const override {
@@ -153,7 +162,7 @@ class ModelAnalysesFor final : public ModelAnalyses {
     LinearisedOrbit out;
     OrbitLinearisation<D, DW> at_orbit;  // step maps and states of one map at the orbit
     if (request.newton_guess && !Model::is_linear) {
-      const Eigen::VectorXd guess = prolong_periodic_sequence(*request.newton_guess, D, K);
+      const Eigen::VectorXd guess = prolonged_guess(*request.newton_guess, map.grid());
       out.orbit = orbit_by_newton(map, guess, settings.newton);
       map.apply(out.orbit.history, &at_orbit.maps, &at_orbit.states);
     } else {
@@ -269,6 +278,16 @@ class ModelAnalysesFor final : public ModelAnalyses {
                                         const ContinuationOptions& options) const override;
 
  private:
+  // Another level's orbit (any K) on this map's grid: on a grid with breakpoints, from that
+  // level's grid (the same problem at N' = N K' / K; grid.hpp's regrid), else by index.
+  static Eigen::VectorXd prolonged_guess(const Eigen::VectorXd& sequence, const HistoryGrid& grid) {
+    const long K_from = sequence.size() / D;
+    if (grid.has_breakpoints() && sequence.size() == K_from * D && (K_from * grid.N) % grid.K == 0) {
+      const HistoryGrid from = regrid(grid, static_cast<int>(K_from * grid.N / grid.K));
+      if (from.K == K_from) return prolong_periodic_sequence(sequence, D, from, grid);
+    }
+    return prolong_periodic_sequence(sequence, D, grid.K);
+  }
   static bool all_finite(const OrbitLinearisation<D, DW>& at) {
     for (const StepMap<D, DW>& m : at.maps)
       if (!m.P.allFinite() || !m.Q.allFinite() || !m.R.allFinite()) return false;

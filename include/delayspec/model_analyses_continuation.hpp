@@ -31,7 +31,7 @@ template <class Model>
 ContinuationResult ModelAnalysesFor<Model>::continue_orbit(const AnalysesAt& at, const OrbitSettings& settings,
                                                            const ContinuationOptions& options) const {
   const StroboscopicMap<Model> map(TrapezoidStepper<Model>(model_, options.step_options),
-                                   make_grid(delays_of(model_), model_.period(), options.N, options.periods_per_map));
+                                   model_grid(model_, options.N, options.periods_per_map, options.step_options.grid));
   const PeriodicOrbit orbit = find_orbit(model_, map, settings);
   const Eigen::VectorXd guess = PeriodicOrbitProblem<StroboscopicMap<Model>>(map).sequence_from_history(orbit.history);
   return delayspec::continue_orbit<Model>(detail::model_at<Model>(at), guess, options);

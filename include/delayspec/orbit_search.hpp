@@ -120,8 +120,9 @@ ContactSummary orbit_contacts(const StroboscopicMap<Model, Stepper>& map, std::v
       const V a = u(l), b = u(l + 1);
       const double Ha = model.H(a), Hb = model.H(b);
       const V grad = model.grad_H(a);
+      const double h = g.step_size(l);
       const double top = detail::hermite_maximum(Ha, Hb, grad.dot(model.f(region(a), t, a, w0)),
-                                                 grad.dot(model.f(region(b), t + g.h, b, w1)), g.h);
+                                                 grad.dot(model.f(region(b), t + h, b, w1)), h);
       s.max_H = std::max(s.max_H, top);
       if (!(Ha > 0) && !(Hb > 0) && top > 0) {
         ++s.contacts;

@@ -202,7 +202,7 @@ PeriodicOrbit orbit_by_nested_shooting(const StroboscopicMap<Model, Stepper>& ma
   const HistoryGrid& fine = map.grid();
   const std::vector<int> Ns = shooting_levels(fine, opt.coarse_N, opt.refinement);
   auto level_map = [&](int N) {
-    return N == fine.N ? map : Map(map.stepper(), make_grid(fine.delay_values(), fine.period, N, fine.periods_per_map));
+    return N == fine.N ? map : Map(map.stepper(), regrid(fine, N));
   };
   auto clock = [] { return std::chrono::steady_clock::now(); };
   auto since = [](auto t0) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
@@ -249,7 +249,7 @@ PeriodicOrbit orbit_by_nested_shooting(const StroboscopicMap<Model, Stepper>& ma
     Eigen::VectorXd sequence(static_cast<long>(Model::d) * static_cast<long>(lin.states.size() - 1));
     for (size_t l = 0; l + 1 < lin.states.size(); ++l)
       sequence.segment<Model::d>(Model::d * static_cast<long>(l)) = lin.states[l];
-    const Eigen::VectorXd guess = prolong_periodic_sequence(sequence, Model::d, level.grid().K);
+    const Eigen::VectorXd guess = prolong_periodic_sequence(sequence, Model::d, regrid(fine, Ns[i - 1]), level.grid());
     orbit = orbit_by_shooting(level, PeriodicOrbitProblem<Map>(level).history(guess), opt.shooting, &lin);
     linear_iterations += orbit.linear_iterations;
     levels.push_back(

@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include "delayspec/grid.hpp"
+
 namespace delayspec {
 
 // How an orbit was found: by simulation (orbit_simulation.hpp), by sparse-LU Newton on the
@@ -53,5 +55,12 @@ struct PeriodicOrbit {
 // interpolation; from N = 12500 to 1e5 it is 9e-8.
 // BadInput: d < 1, K_to < 1, or x.size() not a positive multiple of d.
 Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, long K_to);
+// The same from the grid `from` (x has from.K states) to the grid `to`, for grids with
+// breakpoints (grid.hpp): each state of `to` interpolated linearly in time between the states of
+// `from` around it (the pieces share their ends, and the orbit's derivative jumps there, so no
+// stencil crosses one; linear costs nothing against the orbit's own O(h^2) change with N, above).
+// Grids without breakpoints: the uniform version above. BadInput as above, or x not from.K states.
+Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, const HistoryGrid& from,
+                                          const HistoryGrid& to);
 
 }  // namespace delayspec

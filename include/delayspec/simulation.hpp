@@ -11,6 +11,7 @@
 //
 // History storage: a ring buffer of M + 3 blocks (no growth with the time window), so memory
 // is O(N) plus what is recorded.
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -42,6 +43,16 @@ struct SimulationRecord {
   double max_H = -INFINITY;  // largest H at grid points in the window
 };
 
+// Steps from t = 0 to the first node at or after t_end (less 1e-9 h of rounding): ceil(t_end / h)
+// on a uniform grid (as a double: the caller bounds it before converting).
+inline double steps_to_reach(const HistoryGrid& grid, double t_end) {
+  if (!grid.has_breakpoints()) return std::ceil(t_end / grid.h - 1e-9);
+  const double periods = std::floor(t_end / grid.period);
+  const double rest = t_end - periods * grid.period;
+  const auto first = std::lower_bound(grid.nodes.begin(), grid.nodes.end(), rest - 1e-9 * grid.h);
+  return periods * grid.steps_per_period + static_cast<double>(first - grid.nodes.begin());
+}
+
 // Simulates from history U0 (oldest block first, as StroboscopicMap). `before` runs the steps
 // starting before options.switch_time, `after` the others. BadInput for a non-positive or
 // non-finite t_end, t_start outside [0, t_end], sample_every < 1, or a wrong history size.
@@ -60,7 +71,7 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
   if (U0.size() != grid.dimension(D))
     throw BadInput("simulate: history has " + std::to_string(U0.size()) + " entries, expected " +
                    std::to_string(grid.dimension(D)));
-  const double steps_real = std::ceil(options.t_end / grid.h - 1e-9);
+  const double steps_real = steps_to_reach(grid, options.t_end);
   if (steps_real > 1e10) throw BadInput("`t_end = " + format_number(options.t_end) + "`: more than 1e10 steps");
   const long steps = static_cast<long>(steps_real);
   // The trajectory is kept in memory (time and state per sample): bound it before allocating.
@@ -70,14 +81,13 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
                    "`, `sample_every = " + std::to_string(options.sample_every) +
                    "`: more than 1e8 trajectory samples; raise sample_every or shorten the window");
   const long M = grid.M, ring = M + 3;
-  const double h = grid.h;
   std::vector<V> b(static_cast<size_t>(ring));
   auto slot = [&](long i) -> V& { return b[static_cast<size_t>(i % ring)]; };  // linear index -> ring
   for (long j = 0; j <= M; ++j) slot(j) = U0.template segment<D>(j * D);       // u_M .. u_0 at t = 0
   SimulationRecord<D> rec;
   rec.steps = steps;
   auto record_point = [&](long l, const V& y) {
-    const double t = static_cast<double>(l) * h;
+    const double t = grid.node_time(l);
     if (t < options.t_start) return;
     if (l % options.sample_every == 0) {
       rec.t.push_back(t);
@@ -96,7 +106,7 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
     // Between periods a front end may stop the run (cancellation.hpp).
     if (l % grid.steps_per_period == 0) throw_if_cancelled();
     const DelayTap<DelayedVec<Model>> tap = grid.template delay_taps<D, DelayedVec<Model>>(l, slot);  // tap.t: the time in the period, as StroboscopicMap
-    const double t_abs = static_cast<double>(l) * h;
+    const double t_abs = grid.node_time(l), h = grid.step_size(l);
     const TrapezoidStepper<Model>& stepper = t_abs >= options.switch_time ? after : before;
     const V u = slot(M + l);
     const V next = stepper.step(tap.t, h, u, tap.w0, tap.w1, scratch, &events);

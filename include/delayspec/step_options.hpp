@@ -13,6 +13,13 @@ enum class EventMode { on, linear, off };
 // (event-time sensitivity included) or the paper's, with the split points frozen.
 enum class JacobianMode { consistent, frozen };
 
+// Where the grid's nodes go (grid.hpp): on every time switch of the model, each piece between
+// switches uniform (aligned: the error expansion even, h^2, h^4, ...; design.md 1.4c), or
+// uniform over the period, the switches falling inside steps (split there: time_switch_step.hpp).
+// A model without time switches, or with a fractional or several delays, has a uniform grid
+// either way.
+enum class GridLayout { aligned, uniform };
+
 struct StepOptions {
   EventMode events = EventMode::on;
   JacobianMode jacobian = JacobianMode::consistent;
@@ -30,6 +37,7 @@ struct StepOptions {
   // `boundary` follows as a grazing curve (a switched orbit that barely touches has a contact
   // whose length grows as a square root, and Newton stalls there).
   int fixed_region = 0;
+  GridLayout grid = GridLayout::aligned;  // where the grid's nodes go (above)
 };
 
 // What happened inside one step (filled by step() when asked; events off: always empty).

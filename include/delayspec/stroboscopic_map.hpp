@@ -3,8 +3,8 @@
 // stepper), optionally recording the step maps along the way, which gives the Monodromy at U.
 //
 // Same linear-buffer layout as Monodromy: b[0..M] = U, step l writes b[M + l + 1], the result
-// is b[K .. K + M]. Step l starts at time t = l h (the grid phase is fixed: the section is
-// t = 0 mod T).
+// is b[K .. K + M]. Step l starts at time t = l h, or at its node on a grid with breakpoints
+// (grid.hpp; the grid phase is fixed: the section is t = 0 mod T).
 #include <string>
 #include <vector>
 
@@ -61,7 +61,7 @@ class StroboscopicMap {
     auto slot = [&b](long i) -> const V& { return b[i]; };
     for (long l = 0; l < K; ++l) {
       const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
-      b[M + l + 1] = stepper_.step(tap.t, grid_.h, b[M + l], tap.w0, tap.w1, maps ? (*maps)[l] : scratch);
+      b[M + l + 1] = stepper_.step(tap.t, grid_.step_size(l), b[M + l], tap.w0, tap.w1, maps ? (*maps)[l] : scratch);
       if (trajectory) trajectory->push_back(b[M + l + 1]);
     }
     Eigen::VectorXd out(dimension());
@@ -85,19 +85,20 @@ class StroboscopicMap {
       for (long l = 0; l < K; ++l) {
         const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
         StepMap<D, DW> step_map;
+        const double h = grid_.step_size(l);
         try {
-          b[M + l + 1] = stepper_.step(tap.t, grid_.h, b[M + l], tap.w0, tap.w1, step_map);
+          b[M + l + 1] = stepper_.step(tap.t, h, b[M + l], tap.w0, tap.w1, step_map);
         } catch (const NonFiniteStep& e) {
           throw NonFiniteStep(what + " (" + which + std::to_string(l + 1) + "): " + e.what(), e.points());
         }
         if (!b[M + l + 1].allFinite() || !step_map.P.allFinite() || !step_map.Q.allFinite() ||
             !step_map.R.allFinite())
           throw NonFiniteStep(what + " (" + which + std::to_string(l + 1) + "): the step from t = " +
-                                  format_number(tap.t) + " to " + format_number(tap.t + grid_.h) + " has a " +
+                                  format_number(tap.t) + " to " + format_number(tap.t + h) + " has a " +
                                   (b[M + l + 1].allFinite() ? "derivative (step map)" : "new state") +
                                   " that is not finite",
                               {model_point<D, DW>(tap.t, b[M + l], tap.w0),
-                               model_point<D, DW>(tap.t + grid_.h, b[M + l + 1], tap.w1)});
+                               model_point<D, DW>(tap.t + h, b[M + l + 1], tap.w1)});
       }
       for (long j = 0; j <= M; ++j) U.segment<D>(j * D) = b[K + j];
     }

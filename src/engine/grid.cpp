@@ -38,11 +38,91 @@ HistoryGrid::DelayPosition position_on_grid(double tau, double h) {
   return {tau, static_cast<int>(std::min(m, static_cast<double>(kMaxSteps))), theta};
 }
 
+// Steps per piece of a pattern of n steps (header of grid.hpp): halved while n / 2 keeps at least
+// kMinPatternSteps and a step per piece, so that allocation(2 n) = 2 allocation(n); at the base,
+// the largest-remainder rule on the ideal counts n L_i / P with at least one step per piece.
+std::vector<int> allocate_steps(const std::vector<double>& lengths, double pattern, long n) {
+  const long pieces = static_cast<long>(lengths.size());
+  if (n % 2 == 0 && n / 2 >= std::max<long>(kMinPatternSteps, pieces)) {
+    std::vector<int> half = allocate_steps(lengths, pattern, n / 2);
+    for (int& c : half) c *= 2;
+    return half;
+  }
+  std::vector<int> count(lengths.size());
+  std::vector<std::pair<double, size_t>> remainder;  // (fractional part, piece)
+  long total = 0;
+  for (size_t i = 0; i < lengths.size(); ++i) {
+    const double ideal = static_cast<double>(n) * lengths[i] / pattern;
+    count[i] = std::max(1, static_cast<int>(std::floor(ideal)));
+    remainder.emplace_back(ideal - std::floor(ideal), i);
+    total += count[i];
+  }
+  // the steps left to the largest remainders (ties to the earlier piece); steps too many (a piece
+  // raised to its one step) taken from the pieces with the most, the longest first
+  std::stable_sort(remainder.begin(), remainder.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (size_t r = 0; total < n; ++r, ++total) ++count[remainder[r % remainder.size()].second];
+  while (total > n) {
+    const size_t most = static_cast<size_t>(std::max_element(count.begin(), count.end()) - count.begin());
+    --count[most];
+    --total;
+  }
+  return count;
+}
+
+// Lays the pieces of the aligned grid g (header of grid.hpp) with q patterns per period of n
+// steps each: g.breakpoints, g.piece_steps, g.pattern and the K_1 + 1 node times.
+void lay_breakpoints(HistoryGrid& g, const GridBreaks& breaks, long q, long n) {
+  const double P = g.period / static_cast<double>(q);
+  const double merge = 1e-12 * P;  // one time computed twice with rounding (time_switch_step.hpp: 64 eps)
+  std::vector<double> starts{0.0};
+  for (double t : breaks.times) {
+    if (!std::isfinite(t)) throw BadInput("a time switch of the model is " + format_number(t));
+    double b = std::fmod(t, P);
+    if (b < 0) b += P;
+    if (b > P - merge) b = 0;
+    starts.push_back(b);
+  }
+  std::sort(starts.begin(), starts.end());
+  std::vector<double> kept;
+  for (double b : starts)
+    if (kept.empty() || b - kept.back() > merge) kept.push_back(b);
+  std::vector<double> lengths;
+  for (size_t i = 0; i < kept.size(); ++i) lengths.push_back((i + 1 < kept.size() ? kept[i + 1] : P) - kept[i]);
+  const long pieces = static_cast<long>(kept.size());
+  std::vector<int> counts = breaks.piece_steps;
+  if (counts.empty()) {
+    if (n < pieces)
+      throw BadInput("`N = " + std::to_string(g.N) + "`: the grid aligned with the model's " +
+                     std::to_string(pieces) + " pieces between time switches needs a step in each (N >= " +
+                     std::to_string(pieces * (g.N / n)) + "), or `grid = uniform`");
+    counts = allocate_steps(lengths, P, n);
+  } else {
+    long sum = 0;
+    for (int c : counts) sum += c;
+    if (static_cast<long>(counts.size()) != pieces || sum != n ||
+        std::any_of(counts.begin(), counts.end(), [](int c) { return c < 1; }))
+      throw BadInput("the grid's allocation (" + std::to_string(counts.size()) + " pieces, " + std::to_string(sum) +
+                     " steps) does not fit " + std::to_string(pieces) + " pieces between time switches and " +
+                     std::to_string(n) + " steps per pattern at N = " + std::to_string(g.N));
+  }
+  g.breakpoints = kept;
+  g.piece_steps = counts;
+  g.pattern = P;
+  g.nodes.clear();
+  g.nodes.reserve(static_cast<size_t>(q * n + 1));
+  for (long k = 0; k < q; ++k)
+    for (size_t i = 0; i < kept.size(); ++i)
+      for (int j = 0; j < counts[i]; ++j)
+        g.nodes.push_back(static_cast<double>(k) * P + kept[i] + lengths[i] * j / counts[i]);
+  g.nodes.push_back(g.period);
+}
+
 }  // namespace
 
 std::string HistoryGrid::describe() const {
   std::string text = "N=" + std::to_string(N) + " h=" + format_number(h) + " K=" + std::to_string(K) +
                      " M=" + std::to_string(M);
+  if (has_breakpoints()) text.append(" aligned with ").append(std::to_string(breakpoints.size())).append(" pieces");
   if (delays.empty())
     return text + (aligned() ? " (aligned delay)" : " (fractional delay, theta=" + format_number(theta) + ")");
   text += " (" + std::to_string(delays.size()) + " delays at m + theta steps:";
@@ -61,7 +141,7 @@ std::vector<double> HistoryGrid::delay_values() const {
 }
 
 HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int periods_per_map,
-                      const std::vector<std::string>& names) {
+                      const std::vector<std::string>& names, const GridBreaks& breaks) {
   if (taus.empty()) throw BadInput("make_grid: no delay given");
   const auto name = [&](size_t i) {
     return names.size() == taus.size() ? names[i]
@@ -71,7 +151,7 @@ HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int
     if (!(std::isfinite(taus[i]) && taus[i] > 0))
       throw BadInput(name(i) + " is " + format_number(taus[i]) + ": a delay must be positive and finite");
   const size_t longest = static_cast<size_t>(std::max_element(taus.begin(), taus.end()) - taus.begin());
-  HistoryGrid g = make_grid(taus[longest], period, N, periods_per_map);
+  HistoryGrid g = make_grid(taus[longest], period, N, periods_per_map, taus.size() == 1 ? breaks : GridBreaks{});
   if (taus.size() == 1) return g;
   for (size_t i = 0; i < taus.size(); ++i) {
     HistoryGrid::DelayPosition p{taus[i], g.m, g.theta};
@@ -87,7 +167,7 @@ HistoryGrid make_grid(const std::vector<double>& taus, double period, int N, int
   return g;
 }
 
-HistoryGrid make_grid(double tau, double period, int N, int periods_per_map) {
+HistoryGrid make_grid(double tau, double period, int N, int periods_per_map, const GridBreaks& breaks) {
   require_positive("tau", tau);
   require_positive("period", period);
   if (N < 1) throw BadInput("`N = " + std::to_string(N) + "`: must be an integer >= 1");
@@ -114,6 +194,7 @@ HistoryGrid make_grid(double tau, double period, int N, int periods_per_map) {
     g.m = N;
     g.theta = 0;
     g.M = N;
+    if (!breaks.times.empty()) lay_breakpoints(g, breaks, r.q, N / r.p);  // p | N: N q / p whole, gcd(p, q) = 1
   } else {
     // Fractional: h = T / K_1, tau = (m + theta) h.
     double k1 = std::round(static_cast<double>(N) * period / tau);
@@ -179,6 +260,12 @@ HistoryGrid make_grid_with_steps(const std::vector<double>& taus, double period,
   g.M = g.theta > 0 ? g.m + 1 : g.m;
   g.N = g.m;  // steps per the longest delay, as laid
   return g;
+}
+
+HistoryGrid regrid(const HistoryGrid& g, int N) {
+  GridBreaks breaks;
+  breaks.times = g.breakpoints;
+  return make_grid(g.delay_values(), g.period, N, g.periods_per_map, {}, breaks);
 }
 
 }  // namespace delayspec

@@ -41,4 +41,24 @@ Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, long 
   return y;
 }
 
+Eigen::VectorXd prolong_periodic_sequence(const Eigen::VectorXd& x, int d, const HistoryGrid& from,
+                                          const HistoryGrid& to) {
+  if (!from.has_breakpoints() && !to.has_breakpoints()) return prolong_periodic_sequence(x, d, to.K);
+  if (d < 1 || x.size() != static_cast<long>(d) * from.K)
+    throw BadInput("prolong_periodic_sequence: " + std::to_string(x.size()) + " entries of dimension " +
+                   std::to_string(d) + " for a grid of " + std::to_string(from.K) + " states");
+  const long K_from = from.K;
+  const double span = static_cast<double>(from.periods_per_map) * from.period;  // the map's time
+  Eigen::VectorXd y(static_cast<long>(d) * to.K);
+  long i = 0;  // the state of `from` at or before t (t increases with l)
+  for (long l = 0; l < to.K; ++l) {
+    const double t = to.node_time(l);
+    while (i + 1 < K_from && from.node_time(i + 1) <= t) ++i;
+    const double t0 = from.node_time(i), t1 = i + 1 < K_from ? from.node_time(i + 1) : span;
+    const double w = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+    y.segment(d * l, d) = (1 - w) * x.segment(d * i, d) + w * x.segment(d * ((i + 1) % K_from), d);
+  }
+  return y;
+}
+
 }  // namespace delayspec

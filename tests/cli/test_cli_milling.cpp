@@ -27,7 +27,8 @@ TEST(MillingCli, DepthZeroIsTheFreeOscillatorsCayleyTransform) {
   const int teeth = 3, N = 60;
   CliResult r = run(
       with_sets({"floquet", "--json"}, {"model=milling", "depth=0", "spindle_rpm=7200", "teeth=3",
-                                        "omega_n=" + std::to_string(w), "zeta=0.02", "N=60", "nev=2", "solver=dense"}));
+                                        "omega_n=" + std::to_string(w), "zeta=0.02", "N=60", "nev=2", "solver=dense",
+                                        "grid=uniform"}));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["model"], "milling");

@@ -20,6 +20,7 @@
 #include "delayspec/errors.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/grid.hpp"
+#include "delayspec/model_grid.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/detail/branch_corrector.hpp"
 #include "delayspec/detail/condensed_bordered.hpp"
@@ -58,6 +59,7 @@ class PeriodicBranch final : public BranchProblem {
     const HistoryGrid g = grid_at(o.from);
     K_ = g.K;
     M_ = g.M;
+    piece_steps_ = g.piece_steps;
     weight_ = 1.0 / static_cast<double>(K_);
     range_ = std::abs(o.to - o.from);
   }
@@ -168,7 +170,6 @@ class PeriodicBranch final : public BranchProblem {
   void switching_measures(const Map& map, const States& states, OrbitMeasures& m) const {
     const HistoryGrid& g = map.grid();
     const Model& model = map.stepper().model();
-    const double h = g.h;
     const long M = g.M;
     auto u = [&](long l) { return V(states.col(((l % K_) + K_) % K_)); };
     auto slot = [&](long i) { return u(i - M); };
@@ -178,6 +179,7 @@ class PeriodicBranch final : public BranchProblem {
     StepMap<D, delayed_rows<Model>> scratch;
     for (long l = 0; l < K_; ++l) {
       const auto [w0, w1, t] = g.template delay_taps<D, DelayedVec<Model>>(l, slot);
+      const double h = g.step_size(l);
       const V a = u(l), b = u(l + 1);
       const int ja = region_of(model, a), jb = region_of(model, b);
       const V grad = model.grad_H(a);
@@ -203,7 +205,10 @@ class PeriodicBranch final : public BranchProblem {
 
   HistoryGrid grid_at(double p) const { return grid_at_model(model_at_(p), p); }
   HistoryGrid grid_at_model(const Model& model, double p) const {
-    const HistoryGrid g = make_grid(delays_of(model), model.period(), o_.N, o_.periods_per_map);
+    // Aligned with the model's time switches, the pieces keep the start's steps (piece_steps_),
+    // so that the discrete problem moves smoothly with p (grid.hpp)
+    const HistoryGrid g = make_grid(delays_of(model), model.period(), o_.N, o_.periods_per_map, {},
+                                    grid_breaks(model, o_.step_options.grid, piece_steps_));
     if (K_ != 0 && (g.K != K_ || g.M != M_))
       throw ProblemSizeChanged("continuation: at parameter " + format_number(p) +
                                " the grid has K = " + std::to_string(g.K) + ", M = " + std::to_string(g.M) +
@@ -215,6 +220,7 @@ class PeriodicBranch final : public BranchProblem {
   const ModelAt& model_at_;
   ContinuationOptions o_;
   long K_ = 0, M_ = 0;
+  std::vector<int> piece_steps_;  // the start's allocation on an aligned grid (grid_at_model)
   double range_ = 1;
 };
 

@@ -111,6 +111,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["h"] = problem.grid().h;
     json["steps_per_map"] = problem.grid().K;
     json["events"] = to_string(problem.events);
+    json["grid"] = grid_json(problem.grid());
     json["jacobian"] = to_string(problem.jacobian);
     json["orbit_residual"] = orbit.residual;
     json["orbit_periods"] = orbit.maps;

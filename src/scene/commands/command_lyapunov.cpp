@@ -42,6 +42,7 @@ int command_lyapunov(Config& config, const Invocation& inv) {
     j["steps"] = r.steps;
     j["h"] = problem.grid().h;
     j["events"] = to_string(problem.events);
+    j["grid"] = grid_json(problem.grid());
     j["jacobian"] = to_string(problem.jacobian);
     inv.out << j.dump(2) << "\n";
   } else {

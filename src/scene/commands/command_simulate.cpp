@@ -21,6 +21,7 @@
 #include "delayspec/builtin_analyses.hpp"
 #include "delayspec/simulation.hpp"
 #include "scene/output/metadata.hpp"
+#include "scene/output/output.hpp"
 #include "scene/problem/problem.hpp"
 
 namespace delayspec::cli {
@@ -126,6 +127,7 @@ int command_simulate(Config& config, const Invocation& inv) {
     json["N"] = problem.N;
     json["h"] = grid.h;
     json["events"] = to_string(problem.events);
+    json["grid"] = grid_json(grid);
     json["contact_substeps"] = problem.contact_substeps;
     json["t_start"] = options.t_start;
     json["t_end"] = options.t_end;

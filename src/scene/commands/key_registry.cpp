@@ -87,6 +87,7 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
       {"events", "impact events: on (located), linear (first-order estimate), off"},
       {"jacobian", "consistent (exact derivative of the discrete map) or frozen (the paper's)"},
       {"contact_substeps", "trapezoid sub-steps per piece of a step on the contact side, events on/linear"},
+      {"grid", "aligned (a node on every time switch, each piece uniform) or uniform (switches inside steps)"},
       {"zeta", "damping ratio"},
       {"e", "impact model: gap to the soft wall (contact where x > e)"},
       {"a", "impact: forcing amplitude; linear: coefficient of x(t) in x' = a x + b x(t - tau)"},

@@ -160,6 +160,7 @@ class ExplainedAnalyses final : public ModelAnalyses {
   double tau() const override { return inner_->tau(); }
   std::vector<double> delays() const override { return inner_->delays(); }
   double period() const override { return inner_->period(); }
+  std::vector<double> time_switches() const override { return inner_->time_switches(); }
   LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
                                    const OrbitRequest& request) const override {
     return explained([&] { return inner_->linearised_orbit(map, orbit, request); });

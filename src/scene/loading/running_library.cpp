@@ -8,8 +8,8 @@
 namespace delayspec::cli {
 
 std::filesystem::path running_library() {
-  // make_grid: any function defined in libdelayspec; dladdr names the object that holds it.
-  HistoryGrid (*const in_library)(double, double, int, int) = &make_grid;
+  // regrid: any function defined in libdelayspec; dladdr names the object that holds it.
+  HistoryGrid (*const in_library)(const HistoryGrid&, int) = &regrid;
   Dl_info info{};
   if (!dladdr(reinterpret_cast<const void*>(in_library), &info) || !info.dli_fname)
     throw BadInput("cannot locate the delayspec library of this process (dladdr)");

@@ -138,6 +138,18 @@ void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>
   if (!bars.note.empty()) out << "error bars: " << bars.note << "\n";
 }
 
+nlohmann::json grid_json(const HistoryGrid& grid) {
+  nlohmann::json j;
+  j["layout"] = grid.has_breakpoints() ? "aligned" : "uniform";
+  if (grid.has_breakpoints()) {
+    j["pattern"] = grid.pattern;
+    j["pieces"] = nlohmann::json::array();
+    for (size_t i = 0; i < grid.breakpoints.size(); ++i)
+      j["pieces"].push_back({{"start", grid.breakpoints[i]}, {"steps", grid.piece_steps[i]}});
+  }
+  return j;
+}
+
 nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& contacts) {
   nlohmann::json j;
   j["method"] = to_string(orbit.method);

@@ -56,6 +56,10 @@ void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>
 // "nodes_in_contact", "max_H", and for newton "newton_iterations", "newton_residuals",
 // "newton_step_fractions", "jacobian_reciprocal_condition", "jacobian_nonzeros", "factor_nonzeros"}.
 nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& contacts);
+// The grid's layout: {"layout": "aligned" | "uniform", and on a grid with breakpoints "pieces":
+// [{"start", "steps"}, ...] of one pattern and "pattern" (grid.hpp)}. A uniform grid is "uniform"
+// whatever was asked (a model without time switches, a fractional or several delays).
+nlohmann::json grid_json(const HistoryGrid& grid);
 // The same for people, one or two lines.
 void print_orbit(std::ostream& out, const PeriodicOrbit& orbit, const ContactSummary& contacts);
 

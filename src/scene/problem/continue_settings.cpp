@@ -11,8 +11,8 @@ namespace delayspec::cli {
 void require_parameter_key(const std::string& item, const std::string& key) {
   // Keys that are not a parameter of the model's equations: the discretisation, the model's name,
   // the commands' own keys.
-  for (const char* reserved : {"model", "N", "orbit_period", "events", "jacobian", "contact_substeps", "nev", "solver",
-                               "ncv", "tol", "seed", "orbit", "x0", "v0", "pitch_angles"})
+  for (const char* reserved : {"model", "N", "orbit_period", "events", "jacobian", "contact_substeps", "grid", "nev",
+                               "solver", "ncv", "tol", "seed", "orbit", "x0", "v0", "pitch_angles"})
     if (key == reserved) throw BadInput("`" + item + " = " + key + "`: not a model parameter that can be continued");
   for (const char* prefix : {"continue_", "boundary_"})
     if (key.rfind(prefix, 0) == 0) throw BadInput("`" + item + " = " + key + "`: not a model parameter");

@@ -95,6 +95,7 @@ StepOptions step_options(const Problem& problem) {
   options.events = problem.events;
   options.jacobian = problem.jacobian;
   options.contact_substeps = problem.contact_substeps;
+  options.grid = problem.grid_layout;
   return options;
 }
 
@@ -114,6 +115,8 @@ std::string to_string(EventMode mode) {
 }
 
 std::string to_string(JacobianMode mode) { return mode == JacobianMode::frozen ? "frozen" : "consistent"; }
+
+std::string to_string(GridLayout layout) { return layout == GridLayout::uniform ? "uniform" : "aligned"; }
 
 const std::vector<std::string>& event_mode_names() {
   static const std::vector<std::string> names = {"on", "linear", "off"};
@@ -190,6 +193,8 @@ Problem read_problem(Config& config, int default_N) {
                          : JacobianMode::consistent;
   problem.contact_substeps =
       static_cast<int>(config.get_int_in_range("contact_substeps", problem.contact_substeps, 1, 1000));
+  const bool uniform = config.get_choice("grid", "aligned", {"aligned", "uniform"}) == "uniform";
+  problem.grid_layout = uniform ? GridLayout::uniform : GridLayout::aligned;
   problem.grid();  // BadInput now when N does not fit the delay/period ratio
   return problem;
 }

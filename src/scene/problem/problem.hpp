@@ -32,6 +32,7 @@ struct Problem {
   EventMode events = EventMode::on;
   JacobianMode jacobian = JacobianMode::consistent;
   int contact_substeps = StepOptions{}.contact_substeps;  // trapezoid sub-steps per contact piece
+  GridLayout grid_layout = GridLayout::aligned;           // the key `grid` (step_options.hpp)
 
   // The grid of this problem: a function of (model, N, orbit_period), never a stored copy.
   HistoryGrid grid() const;
@@ -63,14 +64,16 @@ const std::vector<std::string>& model_names();
 // scene's [equations] table, equation_model.hpp).
 const std::vector<std::string>& model_choices();
 
-// The key values of `events` and `jacobian` (the JSON and text edge): "on", "linear", "off";
-// "consistent", "frozen". parse_* throw BadInput naming `key` for any other text.
+// The key values of `events`, `jacobian` and `grid` (the JSON and text edge): "on", "linear",
+// "off"; "consistent", "frozen"; "aligned", "uniform". parse_* throw BadInput naming `key` for any
+// other text.
 std::string to_string(EventMode mode);
 std::string to_string(JacobianMode mode);
+std::string to_string(GridLayout layout);
 EventMode parse_event_mode(const std::string& text, const std::string& key = "events");
 const std::vector<std::string>& event_mode_names();
 
-// Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps.
+// Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps, grid.
 // default_N is used when the key N is absent.
 Problem read_problem(Config& config, int default_N = 100);
 
