@@ -43,6 +43,7 @@ struct DelayTap {
   V w0;      // y(t - tau): the delayed state at the step's start
   V w1;      // y(t + h - tau): the delayed state at the step's end
   double t;  // the step's start time within the forcing period, (l mod K_1) h
+  double h;  // the step's length: h, or its piece's step on a grid with breakpoints
 };
 
 struct HistoryGrid {
@@ -82,24 +83,28 @@ struct HistoryGrid {
   template <class V, class Slot>
   DelayTap<V> delay_tap(long l, const Slot& b) const {
     const long j = delayed_slot(l);
-    const double t = time_in_period(l);
-    if (theta == 0) return {V(b(j)), V(b(j + 1)), t};
+    const StepSpan at = step_span(l);
+    if (theta == 0) return {V(b(j)), V(b(j + 1)), at.t, at.h};
     const double c0 = 1 - theta;
-    return {V(c0 * b(j) + theta * b(j - 1)), V(c0 * b(j + 1) + theta * b(j)), t};
+    return {V(c0 * b(j) + theta * b(j - 1)), V(c0 * b(j + 1) + theta * b(j)), at.t, at.h};
+  }
+  // Where step l lies in the period: its start and length (one place of l in the period, one
+  // test of the layout: the steppers' loops ask it once per step, through the tap).
+  struct StepSpan {
+    double t, h;
+  };
+  StepSpan step_span(long l) const {
+    const long j = l < steps_per_period ? l : l % steps_per_period;
+    if (nodes.empty()) return {static_cast<double>(j) * h, h};
+    const size_t i = static_cast<size_t>(j);
+    return {nodes[i], nodes[i + 1] - nodes[i]};
   }
   // The start of step l within the forcing period, (l mod K_1) h (or its node, with breakpoints).
   // l mod K_1 without a division where l < K_1 (every step of a one-period map): a 64-bit idiv
   // sat at the head of the step's dependency chain (t -> forcing -> S -> ...)
-  double time_in_period(long l) const {
-    const long j = l < steps_per_period ? l : l % steps_per_period;
-    return nodes.empty() ? static_cast<double>(j) * h : nodes[static_cast<size_t>(j)];
-  }
+  double time_in_period(long l) const { return step_span(l).t; }
   // The length of step l: h, or its piece's step with breakpoints.
-  double step_size(long l) const {
-    if (nodes.empty()) return h;
-    const size_t j = static_cast<size_t>(l < steps_per_period ? l : l % steps_per_period);
-    return nodes[j + 1] - nodes[j];
-  }
+  double step_size(long l) const { return step_span(l).h; }
   // The start of step l from the start of the run (l >= 0): l h, or (l div K_1) T + its node.
   double node_time(long l) const {
     if (nodes.empty()) return static_cast<double>(l) * h;
@@ -124,7 +129,9 @@ struct HistoryGrid {
       return delay_tap<W>(l, b);
     } else {
       DelayTap<W> tap;
-      tap.t = time_in_period(l);
+      const StepSpan at = step_span(l);
+      tap.t = at.t;
+      tap.h = at.h;
       constexpr int kDelays = W::RowsAtCompileTime / D;  // == delays.size()
       for (int i = 0; i < kDelays; ++i) {
         const long j = M + l - delays[static_cast<size_t>(i)].m;

@@ -205,7 +205,7 @@ LyapunovResult lyapunov_exponents(const StroboscopicMap<Model, Stepper>& map, co
     for (long l = 0; l < K; ++l) {
       const DelayTap<W> tap = g.template delay_taps<D, W>(l, slot);
       StepLinearisation<D, DW> step_linearisation;  // a local: kept in registers where the step inlines
-      u[M + l + 1] = stepper.step(tap.t, g.step_size(l), u[M + l], tap.w0, tap.w1, step_linearisation);
+      u[M + l + 1] = stepper.step(tap.t, tap.h, u[M + l], tap.w0, tap.w1, step_linearisation);
       // du_0(t+h) = P du_0 + Q dy_tau(t) + R dy_tau(t+h) for the k tangent vectors (the same
       // tap), P, Q, R not formed where the step is one sub-step (apply_step_linearisation)
       if constexpr (DW != D)

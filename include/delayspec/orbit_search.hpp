@@ -116,11 +116,10 @@ ContactSummary orbit_contacts(const StroboscopicMap<Model, Stepper>& map, std::v
     const int fixed = map.stepper().options().fixed_region;  // one field throughout (step_options.hpp)
     const auto region = [&](const V& y) { return fixed != 0 ? fixed : region_of(model, y); };
     for (long l = 0; l < K; ++l) {
-      const auto [w0, w1, t] = g.template delay_taps<Model::d, DelayedVec<Model>>(l, slot);
+      const auto [w0, w1, t, h] = g.template delay_taps<Model::d, DelayedVec<Model>>(l, slot);
       const V a = u(l), b = u(l + 1);
       const double Ha = model.H(a), Hb = model.H(b);
       const V grad = model.grad_H(a);
-      const double h = g.step_size(l);
       const double top = detail::hermite_maximum(Ha, Hb, grad.dot(model.f(region(a), t, a, w0)),
                                                  grad.dot(model.f(region(b), t + h, b, w1)), h);
       s.max_H = std::max(s.max_H, top);

@@ -106,7 +106,7 @@ SimulationRecord<Model::d> simulate(const TrapezoidStepper<Model>& before, const
     // Between periods a front end may stop the run (cancellation.hpp).
     if (l % grid.steps_per_period == 0) throw_if_cancelled();
     const DelayTap<DelayedVec<Model>> tap = grid.template delay_taps<D, DelayedVec<Model>>(l, slot);  // tap.t: the time in the period, as StroboscopicMap
-    const double t_abs = grid.node_time(l), h = grid.step_size(l);
+    const double t_abs = grid.node_time(l), h = tap.h;
     const TrapezoidStepper<Model>& stepper = t_abs >= options.switch_time ? after : before;
     const V u = slot(M + l);
     const V next = stepper.step(tap.t, h, u, tap.w0, tap.w1, scratch, &events);

@@ -121,7 +121,7 @@ Eigen::MatrixXd spectral_monodromy(const Model& model, const std::vector<double>
   M.block(0, dim - d, d, d).setIdentity();
   Eigen::MatrixXd left = M.topRows(d);  // y at the current piece's left end, as rows over U
   const Vec<d> s = balancing_scale(model, starts, T);
-  const Mat<d> to_z = s.cwiseInverse().asDiagonal(), from_z = s.asDiagonal();
+  const Mat<d> ratio = s.cwiseInverse() * s.transpose();  // (diag(s)^-1 X diag(s))_ij = X_ij s_j / s_i
   for (long p = 0; p < P; ++p) {
     const double a = starts[static_cast<size_t>(p)], b = p + 1 < P ? starts[static_cast<size_t>(p + 1)] : T;
     const double scale = 2 / (b - a);
@@ -131,13 +131,18 @@ Eigen::MatrixXd spectral_monodromy(const Model& model, const std::vector<double>
     Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n * d, n * d), rhs = Eigen::MatrixXd::Zero(n * d, dim);
     for (int k = 1; k <= n; ++k) {
       const double t = a + (b - a) * (1 + x[k]) / 2;
-      const Mat<d> A = to_z * model.A(branch, t, zero, w0) * from_z;
-      const Mat<d> B = to_z * model.B(branch, t, zero, w0) * from_z;
+      const Mat<d> A = model.A(branch, t, zero, w0).cwiseProduct(ratio);
+      const Mat<d> B = model.B(branch, t, zero, w0).cwiseProduct(ratio);
       const long row = static_cast<long>(k - 1) * d, node = 1 + p * n + (k - 1);  // the node's index in U
-      for (int j = 1; j <= n; ++j) S.block(row, static_cast<long>(j - 1) * d, d, d) += scale * D(k, j) * Mat<d>::Identity();
-      S.block(row, row, d, d) -= A;
+      // entry by entry (a fixed 1 x 1 block into a dynamic one: GCC 12's -Warray-bounds on Eigen's packets)
+      for (int i = 0; i < d; ++i) {
+        for (int j = 1; j <= n; ++j) S(row + i, static_cast<long>(j - 1) * d + i) += scale * D(k, j);
+        for (int c = 0; c < d; ++c) {
+          S(row + i, row + c) -= A(i, c);
+          rhs(row + i, node * d + c) += B(i, c);
+        }
+      }
       rhs.middleRows(row, d) -= scale * D(k, 0) * left;
-      rhs.block(row, node * d, d, d) += B;
     }
     const Eigen::MatrixXd X = Eigen::PartialPivLU<Eigen::MatrixXd>(S).solve(rhs);
     M.middleRows(d * (1 + p * n), n * d) = X;

@@ -61,7 +61,7 @@ class StroboscopicMap {
     auto slot = [&b](long i) -> const V& { return b[i]; };
     for (long l = 0; l < K; ++l) {
       const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
-      b[M + l + 1] = stepper_.step(tap.t, grid_.step_size(l), b[M + l], tap.w0, tap.w1, maps ? (*maps)[l] : scratch);
+      b[M + l + 1] = stepper_.step(tap.t, tap.h, b[M + l], tap.w0, tap.w1, maps ? (*maps)[l] : scratch);
       if (trajectory) trajectory->push_back(b[M + l + 1]);
     }
     Eigen::VectorXd out(dimension());
@@ -85,7 +85,7 @@ class StroboscopicMap {
       for (long l = 0; l < K; ++l) {
         const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
         StepMap<D, DW> step_map;
-        const double h = grid_.step_size(l);
+        const double h = tap.h;
         try {
           b[M + l + 1] = stepper_.step(tap.t, h, b[M + l], tap.w0, tap.w1, step_map);
         } catch (const NonFiniteStep& e) {

@@ -37,7 +37,7 @@ TEST(OrbitContacts, AContactInsideAStepIsCountedAsTheStepLocatesIt) {
   const auto u = [&](long l) { return Vec<2>(at.sequence.segment<2>(2 * (((l % K) + K) % K))); };
   long located = 0;
   for (long l = 0; l < K; ++l) {
-    const auto [w0, w1, t] = g.delay_taps<2, Vec<2>>(l, [&](long i) { return u(i - M); });
+    const auto [w0, w1, t, h] = g.delay_taps<2, Vec<2>>(l, [&](long i) { return u(i - M); });
     StepMap<2, 2> scratch;
     StepEvents events;
     map.stepper().step(t, g.h, u(l), w0, w1, scratch, &events);

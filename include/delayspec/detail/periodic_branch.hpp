@@ -178,8 +178,7 @@ class PeriodicBranch final : public BranchProblem {
     std::vector<double> node_H(K_), step_max_H(K_);  // the humps of H (contact_peaks.hpp)
     StepMap<D, delayed_rows<Model>> scratch;
     for (long l = 0; l < K_; ++l) {
-      const auto [w0, w1, t] = g.template delay_taps<D, DelayedVec<Model>>(l, slot);
-      const double h = g.step_size(l);
+      const auto [w0, w1, t, h] = g.template delay_taps<D, DelayedVec<Model>>(l, slot);
       const V a = u(l), b = u(l + 1);
       const int ja = region_of(model, a), jb = region_of(model, b);
       const V grad = model.grad_H(a);

@@ -82,7 +82,7 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
   static const std::map<std::string, std::string> meanings = {
       // the problem (problem.cpp)
       {"model", "the system: impact, linear, mathieu, mackey-glass, milling, equations (the scene's [equations])"},
-      {"N", "steps per delay (h = tau / N), integer >= 1"},
+      {"N", "steps per delay (h = tau / N; the mean step on a grid aligned with time switches), integer >= 1"},
       {"orbit_period", "forcing periods per stroboscopic map (period-p orbits; forced models only)"},
       {"events", "impact events: on (located), linear (first-order estimate), off"},
       {"jacobian", "consistent (exact derivative of the discrete map) or frozen (the paper's)"},
