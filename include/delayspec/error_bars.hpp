@@ -1,11 +1,15 @@
 #pragma once
 // Error bars for the Floquet multipliers computed at one resolution N, and the stability verdict
 // they allow (issue 32; design.md 1.8). The value at N is what a user reads; how far it is from
-// the N -> infinity value is estimated from two coarser levels, N/4 and N/16 (N/8 below N = 256;
-// the largest valid grids at or below them), with the convergence study's rules (convergence.hpp): tracks matched
+// the N -> infinity value is estimated from two coarser levels, N/4 and N/2 (the largest valid
+// grids at or below them), with the convergence study's rules (convergence.hpp): tracks matched
 // across the levels, Richardson on them with every column checked against its expected order
-// (richardson.hpp). The coarse levels cost about 1/4 + 1/16 of the solve at N for the Krylov
-// solvers (linear in N; 1/4 + 1/8 below N = 256) and 1/64 + ... for dense (cubic).
+// (richardson.hpp). The coarse levels cost about 1/4 + 1/2 of the solve at N for the Krylov
+// solvers (linear in N) and 1/64 + 1/8 for dense (cubic). Why not N/16 and N/4 (1/16 + 1/4, until
+// issue 58): the coarsest level must be in the asymptotic range for its order to show, and N/16
+// seldom is; measured on four charts (N = 200), the undecided points fell from 687, 318, 15 and
+// 252 to 201, 102, 6 and 68, and the paper's impacting orbit (aligned with its contacts) is
+// decided from N = 1600 on instead of 3200.
 //
 // Per multiplier mu_N:
 //   extrapolated       where the order is shown (column 0 consistent with its expected order over
@@ -41,10 +45,19 @@ namespace delayspec {
 enum class StabilityVerdict { stable, unstable, undecided };
 std::string to_string(StabilityVerdict verdict);  // "stable", "unstable", "undecided"
 
-// The coarser levels for N, coarsest first: the largest N' <= N / 4^j with valid(N') true (the
-// grid's rule: a delay/period ratio may need multiples), j = 2, 1; below N = 256 N/8 and N/4
-// (N/16 would be too coarse to be asymptotic); a level below `min_N` is left out.
-std::vector<int> coarser_levels(int N, const std::function<bool(int)>& valid, int min_N = 4);
+// How far apart the coarser levels are: N/4 and N/2 (halving, the default), or N/16 and N/4
+// (N/8 and N/4 below N = 256: quartering, the rule before issue 58). An autonomous orbit's
+// levels keep quartering: its steps per period, round(N T / tau), do not halve with N (62, 125,
+// 250 at N = 25, 50, 100 for Mackey-Glass, tau = 8), so its levels are not nested either way, and
+// over N = 25, 50, 100 the period's differences fall as a plateau's (no bar; measured) where 12,
+// 25, 100 show order 2 (autonomous_floquet.cpp; nesting them is issue 59's).
+enum class LevelSpacing { halving, quartering };
+
+// The coarser levels for N, coarsest first: the largest N' <= N / 2^j (halving) or N / 4^j
+// (quartering, N / 8 for j = 2 below N = 256) with valid(N') true (the grid's rule: a
+// delay/period ratio may need multiples), j = 2, 1; a level below `min_N` is left out.
+std::vector<int> coarser_levels(int N, const std::function<bool(int)>& valid, int min_N = 4,
+                                LevelSpacing spacing = LevelSpacing::halving);
 
 struct MultiplierErrorBar {
   double error_estimate = 0;  // of mu_N, absolute (infinity: none possible)

@@ -25,6 +25,7 @@
 //    whenever n / 2 >= kMinPatternSteps (the largest-remainder allocation is made once, at the
 //    odd part or at the first n of the halving chain below kMinPatternSteps), so that doubling N
 //    halves every step and the error keeps the even expansion h^2, h^4, ... that Richardson needs.
+#include <array>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,11 @@ struct GridBreaks {
   std::vector<double> times;     // switch times in [0, T), any order (time_switches_in_period)
   std::vector<int> piece_steps;  // empty: allocated from N (nested); else each piece's steps, as given
                                  // (a continuation keeps its start's allocation: the map smooth in p)
+  // An orbit's contacts (contact_aligned_orbit.hpp): the intervals [entry, exit) of the map's time
+  // [0, periods_per_map T) spent in region 1 (an exit before its entry wraps over the map's end).
+  // Non-empty: each step of the map is in one region throughout, region 1 where its midpoint lies
+  // in an interval, else 2 (HistoryGrid::step_region); their ends must be among `times`.
+  std::vector<std::array<double, 2>> region1;
 };
 
 // What step l of a map reads from the history (HistoryGrid::delay_tap).
@@ -64,6 +70,10 @@ struct HistoryGrid {
   std::vector<int> piece_steps;
   std::vector<double> nodes;
   double pattern = 0;  // P (0: uniform)
+  std::vector<signed char> step_regions;  // per step of a map (K): the fixed region; empty: each node's own
+
+  // The region step l is taken in throughout (GridBreaks::region1), or 0: the state's (automatic).
+  int step_region(long l) const { return step_regions.empty() ? 0 : step_regions[static_cast<size_t>(l % K)]; }
 
   bool aligned() const { return theta == 0; }
   bool has_breakpoints() const { return !nodes.empty(); }

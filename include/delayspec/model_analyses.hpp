@@ -9,14 +9,17 @@
 // model written as equations in a scene, inside the object compiled from those equations at run
 // time (docs/models.md): the per-step work is always compiled for the model, never interpreted,
 // and one virtual call per analysis is all the front ends add.
+#include <array>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "delayspec/autonomous_orbit.hpp"
 #include "delayspec/autonomous_shooting.hpp"
+#include "delayspec/contact_aligned_orbit.hpp"
 #include "delayspec/continuation.hpp"
 #include "delayspec/equilibrium.hpp"
 #include "delayspec/grid.hpp"
@@ -47,6 +50,12 @@ struct OrbitRequest {
   const Eigen::VectorXd* newton_guess = nullptr;
   // Fill LinearisedOrbit::sequence with the orbit's states u_0 .. u_{K-1} (nonlinear models).
   bool sequence = false;
+  // A model switching in its state, on an aligned grid (the default): the orbit and its monodromy
+  // on the grid aligned with the orbit's contacts (contact_aligned_orbit.hpp). false: on the
+  // uniform grid with the contacts located inside steps, as a branch of orbits is continued
+  // (continuation's grid cannot follow contacts that move with the parameter), so that a test
+  // function evaluated at one point agrees with the branch through it (boundary).
+  bool align_contacts = true;
 };
 
 // A periodic orbit and the map's linearisation along it.
@@ -55,6 +64,12 @@ struct LinearisedOrbit {
   ContactSummary contacts;                    // the orbit against H = 0 (no switching: zero)
   std::unique_ptr<LinearOperator> monodromy;  // Monodromy<d> of one map at the orbit
   Eigen::VectorXd sequence;                   // u_0 .. u_{K-1} when requested (empty for linear models)
+  HistoryGrid grid;                           // the grid of the orbit and its monodromy
+  // A switching model on an aligned grid (contact_aligned_orbit.hpp): the contacts the grid is
+  // aligned with, each alternation's largest move, or why it stayed uniform ("" when not tried).
+  std::vector<std::array<double, 2>> contact_times;
+  std::vector<double> contact_moves;
+  std::string alignment_note;
 };
 
 // A periodic orbit of unknown period (autonomous_orbit.hpp) and its monodromy over one period.
@@ -158,7 +173,6 @@ class ModelAnalysesFor final : public ModelAnalyses {
   LinearisedOrbit linearised_orbit(const MapSettings& s, const OrbitSettings& settings,
                                    const OrbitRequest& request) const override {
     const StroboscopicMap<Model> map = make_map(s);
-    const long K = map.grid().K;
     LinearisedOrbit out;
     OrbitLinearisation<D, DW> at_orbit;  // step maps and states of one map at the orbit
     if (request.newton_guess && !Model::is_linear) {
@@ -168,16 +182,30 @@ class ModelAnalysesFor final : public ModelAnalyses {
     } else {
       out.orbit = find_orbit(model_, map, settings, &at_orbit);
     }
-    if (request.sequence && !Model::is_linear) {
-      out.sequence.resize(static_cast<long>(D) * K);
-      for (long l = 0; l < K; ++l) out.sequence.template segment<D>(D * l) = at_orbit.states[l];
-    }
     // A model whose derivative is infinite on the orbit (x^(1/3) at 0) gives a monodromy that
     // no eigensolver can use: say at which step, once here (a pass over K small matrices).
     if (!all_finite(at_orbit)) map.throw_first_non_finite_step(out.orbit.history, 1, "the map at the periodic orbit");
-    out.contacts = orbit_contacts(map, std::move(at_orbit.states));
-    out.monodromy = std::make_unique<Monodromy<D, DW>>(map.grid(), std::move(at_orbit.maps));
-    return out;
+    // A switching orbit on an aligned grid: the contact times as nodes (contact_aligned_orbit.hpp)
+    if constexpr (Model::has_switching) {
+      const StepOptions& step = s.step;
+      if (request.align_contacts && step.grid == GridLayout::aligned && step.events != EventMode::off &&
+          step.fixed_region == 0 && step.jacobian == JacobianMode::consistent && map.grid().aligned() &&
+          map.grid().delays.empty()) {
+        ContactAlignmentOptions o;
+        o.shooting = settings.shooting;
+        if (auto aligned = contact_aligned_orbit(map, at_orbit.states, o, out.alignment_note)) {
+          const StroboscopicMap<Model> on_contacts(map.stepper(), aligned->grid);
+          // the orbit as found (method, iterations) at the aligned grid's history; the
+          // alignment's own solves are in contact_moves
+          out.orbit.history = std::move(aligned->orbit.history);
+          out.orbit.residual = aligned->orbit.residual;
+          out.contact_times = std::move(aligned->contacts);
+          out.contact_moves = std::move(aligned->moves);
+          return finish(on_contacts, std::move(aligned->at_orbit), request, std::move(out));
+        }
+      }
+    }
+    return finish(map, std::move(at_orbit), request, std::move(out));
   }
 
   EquilibriumResult equilibrium(const Eigen::VectorXd& guess, const EquilibriumOptions& options) const override {
@@ -278,6 +306,20 @@ class ModelAnalysesFor final : public ModelAnalyses {
                                         const ContinuationOptions& options) const override;
 
  private:
+  // The rest of linearised_orbit on the orbit's own map: its states as the sequence, its
+  // contacts, its monodromy and grid.
+  static LinearisedOrbit finish(const StroboscopicMap<Model>& map, OrbitLinearisation<D, DW> at_orbit,
+                                const OrbitRequest& request, LinearisedOrbit out) {
+    const long K = map.grid().K;
+    if (request.sequence && !Model::is_linear) {
+      out.sequence.resize(static_cast<long>(D) * K);
+      for (long l = 0; l < K; ++l) out.sequence.template segment<D>(D * l) = at_orbit.states[static_cast<size_t>(l)];
+    }
+    out.contacts = orbit_contacts(map, std::move(at_orbit.states));
+    out.grid = map.grid();
+    out.monodromy = std::make_unique<Monodromy<D, DW>>(map.grid(), std::move(at_orbit.maps));
+    return out;
+  }
   // Another level's orbit (any K) on this map's grid: on a grid with breakpoints, from that
   // level's grid (the same problem at N' = N K' / K; grid.hpp's regrid), else by index.
   static Eigen::VectorXd prolonged_guess(const Eigen::VectorXd& sequence, const HistoryGrid& grid) {

@@ -41,7 +41,10 @@ std::vector<double> time_switches_in_period(const Model& model) {
 template <class Model>
 GridBreaks grid_breaks(const Model& model, GridLayout layout, std::vector<int> piece_steps = {}) {
   if (layout != GridLayout::aligned) return {};
-  return {time_switches_in_period(model), std::move(piece_steps)};
+  GridBreaks breaks;
+  breaks.times = time_switches_in_period(model);
+  breaks.piece_steps = std::move(piece_steps);
+  return breaks;
 }
 
 // The model's grid at N steps per the longest delay, periods_per_map periods a map.

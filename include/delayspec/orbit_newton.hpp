@@ -86,7 +86,7 @@ class PeriodicOrbitProblem {
     for (long l = 0; l < K; ++l) {
       StepMap<D, DW>& map = step_maps ? (*step_maps)[static_cast<size_t>(l)] : one_map;
       const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
-      const V next = map_.stepper().step(tap.t, tap.h, V(u(l)), tap.w0, tap.w1, map);
+      const V next = map_.step(l, tap, V(u(l)), map);
       F.segment<D>(D * l) = u(l + 1) - next;  // F_l = u_{l+1} - S_l(u_l, w0_l, w1_l)
       if (!jacobian) continue;
       add_block(triplets, l, l + 1, Mat<D>::Identity());

@@ -151,6 +151,17 @@ class TrapezoidStepper {
   const Model& model() const { return model_; }
   const StepOptions& options() const { return options_; }
 
+  // The plain step with both nodes in `region` (a step of an aligned orbit's grid, inside one piece
+  // between its contacts: HistoryGrid::step_region), its map formed.
+  V region_step(double t, double h, const V& u0, const W& w0, const W& w1, int region, StepMap<D, DW>& map) const {
+    StepLinearisation<D, DW> linearisation;
+    int right_region;
+    linearisation.factored = true;
+    const V u1 = factored_sub_step(t, h, u0, w0, w1, region, region, linearisation.sub, right_region);
+    map = linearisation.formed();
+    return u1;
+  }
+
   // The step in options().fixed_region's field alone. Not inlined into step(): a second inlined
   // sub-step there made every step of the impact model's Lyapunov loop 10% slower (farm-bench).
   [[gnu::noinline]] V fixed_region_step(double t, double h, const V& u0, const W& w0, const W& w1,

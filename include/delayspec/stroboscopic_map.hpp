@@ -61,7 +61,7 @@ class StroboscopicMap {
     auto slot = [&b](long i) -> const V& { return b[i]; };
     for (long l = 0; l < K; ++l) {
       const DelayTap<W> tap = grid_.template delay_taps<D, W>(l, slot);
-      b[M + l + 1] = stepper_.step(tap.t, tap.h, b[M + l], tap.w0, tap.w1, maps ? (*maps)[l] : scratch);
+      b[M + l + 1] = step(l, tap, b[M + l], maps ? (*maps)[l] : scratch);
       if (trajectory) trajectory->push_back(b[M + l + 1]);
     }
     Eigen::VectorXd out(dimension());
@@ -87,7 +87,7 @@ class StroboscopicMap {
         StepMap<D, DW> step_map;
         const double h = tap.h;
         try {
-          b[M + l + 1] = stepper_.step(tap.t, h, b[M + l], tap.w0, tap.w1, step_map);
+          b[M + l + 1] = step(l, tap, b[M + l], step_map);
         } catch (const NonFiniteStep& e) {
           throw NonFiniteStep(what + " (" + which + std::to_string(l + 1) + "): " + e.what(), e.points());
         }
@@ -102,6 +102,15 @@ class StroboscopicMap {
       }
       for (long j = 0; j <= M; ++j) U.segment<D>(j * D) = b[K + j];
     }
+  }
+
+  // Step l from u with its tap: in the region the grid fixes for it (an orbit's grid aligned with
+  // its contacts, grid.hpp), else the stepper's step.
+  V step(long l, const DelayTap<W>& tap, const V& u, StepMap<D, DW>& map) const {
+    if constexpr (Model::has_switching) {
+      if (const int region = grid_.step_region(l)) return stepper_.region_step(tap.t, tap.h, u, tap.w0, tap.w1, region, map);
+    }
+    return stepper_.step(tap.t, tap.h, u, tap.w0, tap.w1, map);
   }
 
   // The monodromy at U (the Jacobian of apply at U).

@@ -21,12 +21,11 @@ std::string to_string(StabilityVerdict verdict) {
   return "undecided";
 }
 
-std::vector<int> coarser_levels(int N, const std::function<bool(int)>& valid, int min_N) {
+std::vector<int> coarser_levels(int N, const std::function<bool(int)>& valid, int min_N, LevelSpacing spacing) {
   std::vector<int> levels;
-  // N/16 and N/4 cost 1/16 + 1/4 of the solve at N; below N = 256, N/16 is a grid too coarse to
-  // be in the asymptotic range (an impacting orbit at N = 12 is not): N/8 and N/4 (1/8 + 1/4).
-  const int coarsest = N / 16 >= 16 ? 16 : 8;
-  for (int divisor : {coarsest, 4}) {
+  // N/4 and N/2 (error_bars.hpp: why not coarser); quartering: N/16 and N/4, below N = 256 N/8
+  const int coarsest = spacing == LevelSpacing::halving ? 4 : N / 16 >= 16 ? 16 : 8;
+  for (int divisor : {coarsest, spacing == LevelSpacing::halving ? 2 : 4}) {
     int candidate = N / divisor;
     while (candidate >= min_N && !valid(candidate)) --candidate;
     if (candidate >= min_N && (levels.empty() || candidate > levels.back()) && candidate < N)

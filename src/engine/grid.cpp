@@ -220,6 +220,23 @@ HistoryGrid make_grid(double tau, double period, int N, int periods_per_map, con
     g.M = g.theta > 0 ? g.m + 1 : g.m;
   }
   g.K = g.steps_per_period * periods_per_map;
+  if (!breaks.region1.empty()) {
+    if (!g.has_breakpoints())
+      throw BadInput("make_grid: fixed regions need a grid aligned with their ends (one aligned delay)");
+    const double span = g.period * periods_per_map;
+    g.step_regions.resize(static_cast<size_t>(g.K));
+    for (long l = 0; l < g.K; ++l) {
+      const double mid = g.node_time(l) + 0.5 * g.step_size(l);
+      bool inside = false;
+      for (const auto& [in, out] : breaks.region1) {
+        if (!(in >= 0 && in < span && out >= 0 && out <= span))
+          throw BadInput("make_grid: a region-1 interval [" + format_number(in) + ", " + format_number(out) +
+                         ") outside the map's time [0, " + format_number(span) + ")");
+        inside = inside || (in <= out ? (mid >= in && mid < out) : (mid >= in || mid < out));
+      }
+      g.step_regions[static_cast<size_t>(l)] = static_cast<signed char>(inside ? 1 : 2);
+    }
+  }
   return g;
 }
 

@@ -104,7 +104,7 @@ std::complex<double> upper(const nlohmann::json& e) { return {e["re"].get<double
 TEST(ConvergeCli, ImpactWithEventsClaimsAnErrorThatBoundsTheIndependentReference) {
   CliResult r = run({"converge", std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/default.toml", "--json", "--set",
                      "k=0", "--set", "orbit=newton", "--set", "orbit_guess_periods=30", "--set", "Ns=400,800,1600,3200",
-                     "--set", "nev=2", "--set", "events=on"});
+                     "--set", "nev=2", "--set", "events=on", "--set", "grid=uniform"});
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   const std::complex<double> reference(-0.7716866934, 0.5093824592);
@@ -134,7 +134,7 @@ TEST(ConvergeCli, ImpactWithEventsClaimsAnErrorThatBoundsTheIndependentReference
 // claim 1.8e-6 for an error of 3.1e-5; checked: 2 levels, error 2.4e-5, claim 1.0e-4.
 TEST(ConvergeCli, ImpactDefaultSceneClaimsAnErrorThatBoundsTheFineReference) {
   CliResult r = run({"converge", std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/default.toml", "--json", "--set",
-                     "Ns=100,200,400,800,1600,3200", "--set", "nev=2", "--set", "events=on"});
+                     "Ns=100,200,400,800,1600,3200", "--set", "nev=2", "--set", "events=on", "--set", "grid=uniform"});
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   const std::complex<double> reference(0.09681535694766724, 0.6142427096911214);
@@ -489,7 +489,8 @@ TEST(ConvergeCli, APlateauRefusesTheEstimateAndTheTarget) {
 TEST(ConvergeCli, AnImpactingOrbitGetsAnHonestBarFromTheWanderingSecondOrderColumn) {
   for (const auto& [k, exact] : {std::pair{"0.55", 0.82557832108367955172}, std::pair{"1.0", 0.93825120174378664294}}) {
     const CliResult r = run({"converge", "--json", "--set", "tau_over_T=1", "--set", std::string("k=") + k, "--set",
-                             "nev=2", "--set", "events=on", "--set", "Ns=800,1600,3200,6400,12800"});
+                             "nev=2", "--set", "events=on", "--set", "Ns=800,1600,3200,6400,12800", "--set",
+                             "grid=uniform"});
     ASSERT_EQ(r.status, 0) << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     const auto& e = j.at("extrapolated")[0];

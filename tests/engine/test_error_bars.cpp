@@ -40,18 +40,28 @@ std::vector<LevelResult> levels_of(const std::vector<Sequence>& sequences, const
   return levels;
 }
 
-TEST(ErrorBars, CoarserLevelsAreValidGridsAtN16AndN4OrN8AndN4BelowN256) {
+TEST(ErrorBars, CoarserLevelsAreValidGridsAtN4AndN2) {
   auto all = [](int) { return true; };
-  EXPECT_EQ(coarser_levels(400, all), (std::vector<int>{25, 100}));
-  EXPECT_EQ(coarser_levels(100000, all), (std::vector<int>{6250, 25000}));
-  EXPECT_EQ(coarser_levels(200, all), (std::vector<int>{25, 50}));
-  EXPECT_EQ(coarser_levels(100, all), (std::vector<int>{12, 25}));
+  EXPECT_EQ(coarser_levels(400, all), (std::vector<int>{100, 200}));
+  EXPECT_EQ(coarser_levels(100000, all), (std::vector<int>{25000, 50000}));
+  EXPECT_EQ(coarser_levels(100, all), (std::vector<int>{25, 50}));
   // A grid that needs multiples of 3: the largest valid one at or below.
   auto multiple_of_3 = [](int N) { return N % 3 == 0; };
-  EXPECT_EQ(coarser_levels(400, multiple_of_3), (std::vector<int>{24, 99}));
+  EXPECT_EQ(coarser_levels(400, multiple_of_3), (std::vector<int>{99, 198}));
   // Too coarse to be a level: left out.
-  EXPECT_EQ(coarser_levels(20, all), (std::vector<int>{5}));
-  EXPECT_TRUE(coarser_levels(8, all).empty());
+  EXPECT_EQ(coarser_levels(12, all), (std::vector<int>{6}));
+  EXPECT_TRUE(coarser_levels(7, all).empty());
+}
+
+TEST(ErrorBars, QuarteringLevelsAreN16AndN4OrN8AndN4BelowN256) {
+  auto all = [](int) { return true; };
+  const LevelSpacing q = LevelSpacing::quartering;
+  EXPECT_EQ(coarser_levels(400, all, 4, q), (std::vector<int>{25, 100}));
+  EXPECT_EQ(coarser_levels(100000, all, 4, q), (std::vector<int>{6250, 25000}));
+  EXPECT_EQ(coarser_levels(200, all, 4, q), (std::vector<int>{25, 50}));
+  EXPECT_EQ(coarser_levels(100, all, 4, q), (std::vector<int>{12, 25}));
+  EXPECT_EQ(coarser_levels(20, all, 4, q), (std::vector<int>{5}));
+  EXPECT_TRUE(coarser_levels(8, all, 4, q).empty());
 }
 
 TEST(ErrorBars, UnequalStepRatiosShowTheirOrder) {

@@ -21,6 +21,7 @@ TEST(OrbitContacts, AContactInsideAStepIsCountedAsTheStepLocatesIt) {
   const auto analyses = builtin_analyses(model);
   MapSettings settings;
   settings.N = 200;
+  settings.step.grid = GridLayout::uniform;  // the contact inside a step (aligned: its ends are nodes)
   OrbitSettings orbit;
   orbit.method = OrbitMethod::newton;
   OrbitRequest request;

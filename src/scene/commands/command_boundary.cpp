@@ -166,6 +166,7 @@ class TestFunctionAt {
     OrbitRequest request;
     request.sequence = !p.analyses->is_linear();
     request.newton_guess = guess;
+    request.align_contacts = false;  // as the curve's branches are continued (model_analyses.hpp)
     // A grazing curve: the orbit of the field below the surface (step_options.hpp's
     // fixed_region), smooth where the switched orbit starts to touch; the same orbit where max H <= 0.
     MapSettings map = p.map_settings();

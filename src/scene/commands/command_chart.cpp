@@ -57,8 +57,7 @@ ChartSettings read_chart_settings(Config& config) {
   if (s.x.name == s.y.name) throw BadInput("`chart_x = chart_y = " + s.x.name + "`: the two axes must differ");
   s.threads = read_threads(config);
   // Read (and validate) the problem once, as every point will. N = 200 by default: the levels of
-  // the error bars, N/8 and N/4, must show the order (at N = 40, 5 and 10 do not: 687 of the
-  // default plane's 961 points were undecided; at N = 200, 20).
+  // the error bars, N/4 and N/2, must show the order (error_bars.hpp).
   s.problem = read_problem(config, 200);
   s.orbit_settings = read_orbit_settings(config);
   read_floquet_options(config, 1);

@@ -61,6 +61,8 @@ int command_floquet(Config& config, const Invocation& inv) {
   FloquetResult result;
   PeriodicOrbit orbit;
   ContactSummary contacts;
+  HistoryGrid grid;  // the orbit's (aligned with its contacts where it could be: contact_aligned_orbit.hpp)
+  nlohmann::json alignment;
   double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
   LevelResult at_N;  // the solve's multipliers with their accuracy
   std::optional<ErrorBars> bars;
@@ -73,6 +75,8 @@ int command_floquet(Config& config, const Invocation& inv) {
     orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
     orbit = std::move(at_orbit.orbit);
     contacts = at_orbit.contacts;
+    grid = at_orbit.grid;
+    alignment = contact_alignment_json(at_orbit);
     result = floquet_multipliers(*at_orbit.monodromy, options);
     // Each multiplier's accuracy (multiplier_accuracy): the ones below it are not printed as values.
     at_N = level_result(result, n, problem.grid().K);
@@ -111,7 +115,8 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["h"] = problem.grid().h;
     json["steps_per_map"] = problem.grid().K;
     json["events"] = to_string(problem.events);
-    json["grid"] = grid_json(problem.grid());
+    json["grid"] = grid_json(grid);
+    if (!alignment.is_null()) json["grid"]["contacts"] = alignment;
     json["jacobian"] = to_string(problem.jacobian);
     json["orbit_residual"] = orbit.residual;
     json["orbit_periods"] = orbit.maps;
@@ -119,8 +124,7 @@ int command_floquet(Config& config, const Invocation& inv) {
     if (!result.note.empty()) json["note"] = result.note;
     inv.out << json.dump(2) << "\n";
   } else {
-    inv.out << "delayspec floquet: model " << problem.model_name << ", " << problem.grid().describe() << ", n = " << n
-            << "\n";
+    inv.out << "delayspec floquet: model " << problem.model_name << ", " << grid.describe() << ", n = " << n << "\n";
     print_orbit(inv.out, orbit, contacts);
     inv.out << "leading " << result.multipliers.size() << " Floquet multipliers (" << to_string(result.solver) << ", "
             << result.operator_applications << " operator applications):\n";

@@ -130,7 +130,7 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
       {"equilibrium_guess", "equilibrium: where Newton starts, one number per state component (default: the initial history)"},
       {"equilibrium_tolerance", "equilibrium: Newton's relative step at which the state and each root count as converged, (0, 1e-3]"},
       {"error_bars",
-       "on: each multiplier's distance to the N -> infinity value, from solves at N/16 and N/4 (about 1.3x the "
+       "on: each multiplier's distance to the N -> infinity value, from solves at N/4 and N/2 (about 1.75x the "
        "time), and a verdict stable / unstable / undecided; off: the solve at N alone"},
       {"solver",
        "eigensolver: auto (dense n <= 100, spectra n < 3000, else block), spectra, arpack, block, dense, dense-eigen"},

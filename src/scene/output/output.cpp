@@ -150,6 +150,18 @@ nlohmann::json grid_json(const HistoryGrid& grid) {
   return j;
 }
 
+nlohmann::json contact_alignment_json(const LinearisedOrbit& orbit) {
+  nlohmann::json j;
+  if (!orbit.contact_times.empty()) {
+    j["times"] = nlohmann::json::array();
+    for (const auto& [entry, exit] : orbit.contact_times) j["times"].push_back({entry, exit});
+    j["moves"] = orbit.contact_moves;
+  } else if (!orbit.alignment_note.empty()) {
+    j["not_aligned"] = orbit.alignment_note;
+  }
+  return j;
+}
+
 nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& contacts) {
   nlohmann::json j;
   j["method"] = to_string(orbit.method);

@@ -10,6 +10,7 @@
 #include "delayspec/equilibrium.hpp"
 #include "delayspec/error_bars.hpp"
 #include "delayspec/lyapunov.hpp"
+#include "delayspec/model_analyses.hpp"
 #include "delayspec/orbit_contacts.hpp"
 #include "delayspec/periodic_orbit.hpp"
 
@@ -60,6 +61,10 @@ nlohmann::json orbit_json(const PeriodicOrbit& orbit, const ContactSummary& cont
 // [{"start", "steps"}, ...] of one pattern and "pattern" (grid.hpp)}. A uniform grid is "uniform"
 // whatever was asked (a model without time switches, a fractional or several delays).
 nlohmann::json grid_json(const HistoryGrid& grid);
+// How the orbit's grid was aligned with its contacts: {"times": [[entry, exit], ...] (map time),
+// "moves": each alternation's largest move of a contact time / T} or {"not_aligned": why}; null
+// when not tried (contact_aligned_orbit.hpp).
+nlohmann::json contact_alignment_json(const LinearisedOrbit& orbit);
 // The same for people, one or two lines.
 void print_orbit(std::ostream& out, const PeriodicOrbit& orbit, const ContactSummary& contacts);
 

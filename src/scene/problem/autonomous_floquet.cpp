@@ -89,7 +89,8 @@ AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess
   if (!with_error_bars) return out;
   const auto start = std::chrono::steady_clock::now();
   // The coarser levels, each from the period found at N (the guess closest to their orbit).
-  std::vector<int> Ns = coarser_levels(problem.N, [](int N) { return N >= 8; });
+  // (quartering: error_bars.hpp says why an autonomous orbit's levels are not halved yet)
+  std::vector<int> Ns = coarser_levels(problem.N, [](int N) { return N >= 8; }, 4, LevelSpacing::quartering);
   std::vector<LevelResult> levels;
   for (int N : Ns) {
     LevelResult r;

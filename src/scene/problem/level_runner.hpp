@@ -91,7 +91,7 @@ class StudyLevels {
 };
 
 // floquet's error bars (delayspec/error_bars.hpp) for the multipliers `at_N` of the problem at
-// its N (level_result of its solve): the coarser levels (N/16 and N/4, valid grids on which the solver's options hold), each
+// its N (level_result of its solve): the coarser levels (N/4 and N/2, valid grids on which the solver's options hold), each
 // solved as a study level with nev + 2 candidates (a level whose orbit failed is retried by Newton
 // from `orbit_at_N`, the orbit's states at N, when given), then analysed. `seconds` receives what
 // the coarser levels cost.
