@@ -272,7 +272,11 @@ ConvergeSettings read_converge_settings(Config& config) {
   require_positive("extrapolation_order", s.x_order);
   require_positive("extrapolation_order_step", s.x_step);
   // More columns than levels is harmless (the table stops at the levels); the bound keeps the cast exact.
-  base.richardson.max_columns = static_cast<int>(config.get_int_in_range("extrapolation_levels", 4, 1, 1000));
+  // 6 (was 4 until issue 58): on an aligned grid the expansion is even and each column is used
+  // only where the one below shows its order, so more columns cost nothing where they do not
+  // apply and gain where they do (milling a/D = 1: 1.2e-11 with 4, 2.2e-12 with 6 from the same
+  // solves, issue 58)
+  base.richardson.max_columns = static_cast<int>(config.get_int_in_range("extrapolation_levels", 6, 1, 1000));
   base.target = config.get_double("converge_target", 0);
   base.max_N = static_cast<int>(config.get_int_in_range("converge_max_N", base.max_N, 1, 10'000'000));
   base.max_seconds = config.get_double("converge_max_seconds", base.max_seconds);
