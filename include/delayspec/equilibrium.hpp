@@ -70,6 +70,7 @@ struct EquilibriumResult {
   std::vector<CharacteristicRoot> roots;  // rightmost first (largest real part)
   int unstable = 0;                       // roots with Re lambda > error_bound
   int critical = 0;                       // roots with |Re lambda| <= error_bound: no sign to tell
+  std::string note;                       // when other than nroots roots come back: how many and why
   bool stable() const { return unstable == 0 && critical == 0; }
 };
 
@@ -112,7 +113,9 @@ CharacteristicRoot refined_root(const ConstantHistory& at_equilibrium, std::comp
 
 // Stage 3 for the multipliers mu of the monodromy over T (stage 2): each one's root (the branch
 // of log mu / T where Newton's step is shortest, then refined_root), two that refine to one root
-// counted once, sorted rightmost first, the nroots first kept, unstable and critical counted.
+// (within the sum of their error bounds) counted once, a complex root's conjugate added when
+// missing, sorted rightmost first, the nroots first kept (and the partner of a pair the cut would
+// split), unstable and critical counted; `note` says when other than nroots come back, and why.
 void refine_multipliers(const ConstantHistory& at_equilibrium, const Multipliers& mu, double T,
                         const EquilibriumOptions& o, EquilibriumResult& r);
 

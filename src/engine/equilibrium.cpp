@@ -142,6 +142,18 @@ CharacteristicRoot refined_root(const ConstantHistory& h, std::complex<double> l
   return root;
 }
 
+namespace {
+
+// Two refined roots are one root refined twice when their distance is within the sum of their
+// bounds (each within its error_bound of the root; issue 61: a distance of 1e3 tolerance (1 +
+// |lambda|) merged a complex pair with its conjugate at equilibrium_tolerance = 1e-3, and whole sets
+// of distinct roots at 2e-4 .. 5e-4).
+bool same_root(const CharacteristicRoot& a, const CharacteristicRoot& b) {
+  return std::abs(a.value - b.value) <= a.error_bound + b.error_bound;
+}
+
+}  // namespace
+
 void refine_multipliers(const ConstantHistory& h, const Multipliers& mu, double T, const EquilibriumOptions& o,
                         EquilibriumResult& r) {
   const double two_pi = 2 * std::numbers::pi;
@@ -156,15 +168,40 @@ void refine_multipliers(const ConstantHistory& h, const Multipliers& mu, double 
       if (step < shortest) shortest = step, start = l;
     }
     const CharacteristicRoot root = refined_root(h, start, o);
-    const bool seen = std::any_of(r.roots.begin(), r.roots.end(), [&](const CharacteristicRoot& other) {
-      return std::abs(other.value - root.value) <= 1e3 * o.tolerance * (1 + std::abs(root.value));
-    });
-    if (!seen) r.roots.push_back(root);
+    if (std::none_of(r.roots.begin(), r.roots.end(), [&](const CharacteristicRoot& other) { return same_root(other, root); }))
+      r.roots.push_back(root);
+  }
+  // Conjugates together: c has real coefficients, so conj(lambda) is a root with lambda, as
+  // accurate; one missing (its multiplier merged or not returned) is added.
+  const size_t found = r.roots.size();
+  for (size_t i = 0; i < found; ++i) {
+    CharacteristicRoot conjugate = r.roots[i];
+    if (!(std::abs(conjugate.value.imag()) > conjugate.error_bound)) continue;  // real to its bound
+    conjugate.value = std::conj(conjugate.value);
+    conjugate.discretised = std::conj(conjugate.discretised);
+    if (std::none_of(r.roots.begin(), r.roots.end(), [&](const CharacteristicRoot& other) { return same_root(other, conjugate); }))
+      r.roots.push_back(conjugate);
   }
   std::sort(r.roots.begin(), r.roots.end(), [](const CharacteristicRoot& p, const CharacteristicRoot& q) {
     return p.value.real() != q.value.real() ? p.value.real() > q.value.real() : p.value.imag() > q.value.imag();
   });
-  if (static_cast<int>(r.roots.size()) > o.nroots) r.roots.resize(static_cast<size_t>(o.nroots));
+  // The nroots rightmost, a pair not cut in two (the partner of the last kept comes with it)
+  size_t keep = std::min(r.roots.size(), static_cast<size_t>(o.nroots));
+  if (keep < r.roots.size() && keep > 0 && r.roots[keep - 1].value.imag() > r.roots[keep - 1].error_bound) {
+    CharacteristicRoot partner = r.roots[keep - 1];
+    partner.value = std::conj(partner.value);
+    if (same_root(r.roots[keep], partner)) ++keep;
+  }
+  r.roots.resize(keep);
+  r.note.clear();
+  if (static_cast<int>(r.roots.size()) < o.nroots)
+    r.note = std::to_string(r.roots.size()) + " of the " + std::to_string(o.nroots) +
+             " roots asked for: the monodromy at N = " + std::to_string(o.N) + " gave " + std::to_string(mu.size()) +
+             " multipliers (at most its dimension less 2), each refined to a root, the same root counted once; "
+             "a grid of N steps per tau_max resolves |Im lambda| < pi N / tau_max: raise N for more";
+  else if (static_cast<int>(r.roots.size()) > o.nroots)
+    r.note = "the last root's conjugate is returned with it (" + std::to_string(r.roots.size()) + " roots for nroots = " +
+             std::to_string(o.nroots) + "): a pair is not cut in two";
   r.unstable = r.critical = 0;
   for (const CharacteristicRoot& c : r.roots) {
     if (c.value.real() > c.error_bound) ++r.unstable;

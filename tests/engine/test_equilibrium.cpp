@@ -123,6 +123,44 @@ TEST(Equilibrium, TwoDelaySystemRootsAgainstItsCharacteristicFunction) {
   }
 }
 
+// Issue 61 item 2: Mackey-Glass at x* = 1, tau = 17: one unstable pair, then stable pairs (its
+// roots are Lambert-W values). With a loose equilibrium_tolerance
+// (1e-3 .. 2e-4) the same six roots come back, conjugates together and within their bounds of the
+// exact ones; before, roots within 1e3 tolerance (1 + |lambda|) of each other were merged: 1 root
+// instead of 6 at 1e-3 (its conjugate lost, "1 root with Re > 0" for 2), a non-rightmost set at
+// 2e-4 .. 5e-4. A cut through a pair keeps the pair (nroots = 1 gives both roots, with a note).
+TEST(Equilibrium, LooseTolerancesKeepEveryRootAndConjugatesTogether) {
+  MackeyGlassParameters p;
+  p.tau = p.period = 17;
+  const MackeyGlassModel model(p);
+  const double b = p.beta * (2 - p.n) / 4;
+  const std::vector<cd> exact = linear_dde_roots(-p.gamma, b, p.tau, 12);
+  for (double tolerance : {1e-3, 5e-4, 2e-4, 1e-12}) {
+    SCOPED_TRACE("tolerance " + std::to_string(tolerance));
+    EquilibriumOptions o;
+    o.tolerance = tolerance;
+    const EquilibriumResult r = find_equilibrium(model, Vec<1>(1.1), o);
+    ASSERT_EQ(r.roots.size(), 6u);
+    EXPECT_TRUE(r.note.empty()) << r.note;
+    EXPECT_EQ(r.unstable, 2);
+    for (size_t i = 0; i < 6; ++i) {
+      double nearest = INFINITY;
+      for (cd e : exact) nearest = std::min(nearest, std::abs(r.roots[i].value - e));
+      // within the root's bound, and the Lambert-W value's own rounding, 1e-14
+      EXPECT_LE(nearest, r.roots[i].error_bound + 1e-14) << r.roots[i].value;
+      EXPECT_NEAR(r.roots[i].value.real(), r.roots[i ^ 1].value.real(), 1e-15) << i;  // pairs side by side
+      EXPECT_EQ(r.roots[i].value.imag(), -r.roots[i ^ 1].value.imag()) << i;
+    }
+  }
+  EquilibriumOptions one;
+  one.nroots = 1;
+  const EquilibriumResult r = find_equilibrium(model, Vec<1>(1.1), one);
+  ASSERT_EQ(r.roots.size(), 2u);
+  EXPECT_EQ(r.roots[1].value, std::conj(r.roots[0].value));
+  EXPECT_NE(r.note.find("not cut in two"), std::string::npos) << r.note;
+  EXPECT_EQ(r.unstable, 2);
+}
+
 // x' = 1 + x(t - 1) - x: every constant history moves, no equilibrium (g = 1, g' = 0).
 struct NoEquilibrium {
   static constexpr int d = 1;

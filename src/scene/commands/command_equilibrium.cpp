@@ -28,6 +28,7 @@ nlohmann::json equilibrium_json(const Problem& problem, const EquilibriumResult&
   j["unstable"] = r.unstable;
   j["critical"] = r.critical;
   j["stable"] = r.stable();
+  if (!r.note.empty()) j["note"] = r.note;
   return j;
 }
 
@@ -52,6 +53,7 @@ void print_equilibrium(std::ostream& out, const Problem& problem, const Equilibr
   }
   out << "(+-: bound on the root's error; residual: sigma_min(Delta) / (|lambda| + |A| + sum |B_j|); moved: how far "
          "refinement moved the root from the discretisation's, its error at N)\n";
+  if (!r.note.empty()) out << "note: " << r.note << "\n";
   if (r.critical > 0)
     out << "stability: critical, " << r.critical
         << " root(s) on the imaginary axis within their error bound (a fold or Hopf point)\n";
