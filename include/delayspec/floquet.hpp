@@ -25,7 +25,9 @@
 // round-off, a multiplier below the operator's round-off level eps |M|) is not what Arnoldi
 // converged to. A failing pair is retried once with ncv doubled (at most n; Spectra also on a
 // scaled operator, krylov_spectra.cpp); if it still fails, NumericalFailure names the multiplier,
-// its residual and the bound. Never returned with exit 0.
+// its residual and the bound. Never returned with exit 0. Under solver = auto the other Krylov
+// backends are tried in turn, then dense for n <= 1500, before that failure; FloquetResult::solver
+// is the one that answered and `note` says what failed first.
 // Exception: multipliers at the operator's round-off level, |mu| <= r and |M v - mu v| <= r |v|
 // with r = 1e3 eps |M x| / |x| (exact zeros of a rank-deficient monodromy, e.g. k = 0 or b = 0,
 // or values far below eps |M|), are zero to working precision: returned as exactly 0, residual

@@ -258,6 +258,39 @@ TEST(Krylov, ForcedNonConvergenceThrowsForBothBackends) {
   }
 }
 
+// solver = auto (issue 61 item 1): where the backend chosen by size fails, the other Krylov
+// backends, then dense (n <= 1500), answer before any failure is reported; the answering one is
+// named. Forced here as above (one Arnoldi iteration cannot resolve 10 multipliers): every Krylov
+// backend fails, dense answers, equal to dense asked for directly; above n = 1500 the failure
+// names every backend.
+TEST(Krylov, AutoFallsBackToTheNextSolverBeforeFailing) {
+  FloquetOptions o;
+  o.nev = 10;
+  o.ncv = 12;
+  o.max_iterations = 1;
+  auto op = impact_orbit_monodromy(200);  // n = 402: auto picks spectra
+  const FloquetResult r = floquet_multipliers(op, o);
+  EXPECT_EQ(r.solver, FloquetSolver::dense_lapack);
+  for (const char* named : {"answered by dense", "spectra: ", "block: ", "arpack: "})
+    EXPECT_NE(r.note.find(named), std::string::npos) << named << " in: " << r.note;
+  FloquetOptions dense;
+  dense.nev = 10;
+  dense.solver = FloquetSolver::dense_lapack;
+  const FloquetResult d = floquet_multipliers(op, dense);
+  ASSERT_EQ(r.multipliers.size(), d.multipliers.size());
+  for (size_t k = 0; k < d.multipliers.size(); ++k) EXPECT_EQ(r.multipliers[k], d.multipliers[k]) << k;
+
+  auto large = impact_orbit_monodromy(1000);  // n = 2002: no dense fallback
+  try {
+    floquet_multipliers(large, o);
+    ADD_FAILURE() << "no exception";
+  } catch (const NumericalFailure& e) {
+    const std::string what = e.what();
+    for (const char* named : {"every eigensolver failed", "block: ", "spectra: ", "arpack: "})
+      EXPECT_NE(what.find(named), std::string::npos) << named << " in: " << what;
+  }
+}
+
 TEST(Krylov, SameStartVectorGivesReproducibleResults) {
   auto op = zero_orbit_monodromy(MathieuModel(), 100);
   for (FloquetSolver solver : {FloquetSolver::spectra, FloquetSolver::arpack, FloquetSolver::block}) {

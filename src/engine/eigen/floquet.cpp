@@ -387,6 +387,51 @@ void krylov_solve(const LinearOperator& op, const FloquetOptions& options, Floqu
   }
 }
 
+// solver = auto: the backend chosen by size first; where it fails (its residual gate after its
+// own retry, or no convergence), the other Krylov backends in turn, then the dense solver where n
+// is small enough for it (kDenseFallback: about a second); the backend that answered is returned,
+// and `note` says what failed before it. Only when every one fails, a NumericalFailure naming each
+// (issue 61: the block Krylov-Schur failed the gate on a 6th multiplier where ARPACK, Spectra and
+// dense all answered).
+constexpr long kDenseFallback = 1500;
+
+FloquetSolver automatic_krylov_solve(const LinearOperator& op, const FloquetOptions& options, FloquetResult& result) {
+  std::vector<FloquetSolver> order{options.solver};
+  for (FloquetSolver s : {FloquetSolver::block, FloquetSolver::spectra, FloquetSolver::arpack})
+    if (s != options.solver) order.push_back(s);
+  if (op.rows() <= kDenseFallback) order.push_back(FloquetSolver::dense_lapack);
+  std::string failures;
+  for (FloquetSolver s : order) {
+    FloquetResult attempt = result;
+    try {
+      if (s == FloquetSolver::dense_lapack) {
+        auto values = dense_eigenvalues(op.to_dense(), DenseBackend::lapack);
+        values.resize(static_cast<size_t>(options.nev));
+        attempt.multipliers = std::move(values);
+        attempt.converged = options.nev;
+      } else {
+        FloquetOptions o = options;
+        o.solver = s;
+        if (s == FloquetSolver::arpack) detail::arpack();
+        krylov_solve(op, o, attempt);
+      }
+    } catch (const NumericalFailure& e) {
+      failures += (failures.empty() ? "" : "; ") + to_string(s) + ": " + e.what();
+      continue;
+    } catch (const BadInput& e) {  // dense on an operator that is not finite: a numerical failure here
+      if (s != FloquetSolver::dense_lapack) throw;  // the options themselves (a start vector of the wrong size)
+      failures += (failures.empty() ? "" : "; ") + to_string(s) + ": " + e.what();
+      continue;
+    }
+    if (!failures.empty())
+      attempt.note += std::string(attempt.note.empty() ? "" : "; ") + "solver = auto: answered by " + to_string(s) +
+                      " after " + failures;
+    result = std::move(attempt);
+    return s;
+  }
+  throw NumericalFailure("solver = auto: every eigensolver failed (" + failures + ")");
+}
+
 }  // namespace
 
 FloquetResult floquet_multipliers(const LinearOperator& op, const FloquetOptions& requested) {
@@ -413,7 +458,13 @@ FloquetResult floquet_multipliers(const LinearOperator& op, const FloquetOptions
     case FloquetSolver::automatic:  // resolved above
     case FloquetSolver::spectra:
     case FloquetSolver::arpack:
-    case FloquetSolver::block: krylov_solve(op, options, result); break;
+    case FloquetSolver::block:
+      if (requested.solver == FloquetSolver::automatic) {
+        solver = automatic_krylov_solve(op, options, result);
+        break;
+      }
+      krylov_solve(op, options, result);
+      break;
     case FloquetSolver::dense_eigen:
     case FloquetSolver::dense_lapack: {
       const DenseBackend backend = solver == FloquetSolver::dense_eigen ? DenseBackend::eigen : DenseBackend::lapack;
