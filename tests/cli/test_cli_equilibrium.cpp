@@ -37,7 +37,9 @@ TEST(EquilibriumCli, LinearRootsAreTheLambertWRootsWithTheirStability) {
     // not cut in two, and the note says so)
     ASSERT_GE(j["roots"].size(), 6u);
     ASSERT_LE(j["roots"].size(), 7u);
-    if (j["roots"].size() == 7u) EXPECT_TRUE(contains(j["note"].get<std::string>(), "not cut in two")) << j;
+    if (j["roots"].size() == 7u) {
+      EXPECT_TRUE(contains(j["note"].get<std::string>(), "not cut in two")) << j;
+    }
     for (const auto& root : j["roots"]) {
       const std::complex<double> l(root["re"].get<double>(), root["im"].get<double>());
       double best = INFINITY;
