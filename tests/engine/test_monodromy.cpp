@@ -4,11 +4,15 @@
 
 #include <random>
 
+#include "delayspec/contact_aligned_orbit.hpp"
 #include "delayspec/errors.hpp"
+#include "delayspec/model_grid.hpp"
 #include "delayspec/model_impact.hpp"
 #include "delayspec/model_linear.hpp"
 #include "delayspec/model_mathieu.hpp"
+#include "delayspec/model_milling.hpp"
 #include "delayspec/monodromy.hpp"
+#include "delayspec/orbit_search.hpp"
 #include "delayspec/orbit_simulation.hpp"
 #include "delayspec/stroboscopic_map.hpp"
 #include "test_support.hpp"
@@ -154,4 +158,48 @@ TEST(Monodromy, MatchesFiniteDifferencesOfStroboscopicMap) {
     Eigen::VectorXd fd = (map.apply(U + e) - map.apply(U - e)) / (2 * delta);
     EXPECT_LE((fd - dense.col(c)).norm(), 1e-7 * (1 + dense.col(c).norm())) << "column " << c;
   }
+}
+
+// On a grid aligned with the switches (grid.hpp; issue 58): the monodromy applied matrix-free
+// equals its dense assembly (1e-13, as above), and its columns equal central differences of the
+// stroboscopic map. Milling at a/D = 0.05 is linear: the difference quotient is exact up to
+// rounding (1e-7 as above). The impact orbit on the grid aligned with its contact
+// (contact_aligned_orbit.hpp): every step in a fixed region, so the map is smooth in U near the
+// orbit and its difference quotient meets the step maps to O(delta^2) and rounding: 1e-6 with
+// delta = 1e-6 (|d2P| ~ beta = 28 within a contact's steps).
+TEST(Monodromy, OnAlignedGridsMatchesDenseAndFiniteDifferences) {
+  auto check = [](const auto& map, const Eigen::VectorXd& U, double tolerance) {
+    const auto op = map.monodromy(U);
+    ASSERT_TRUE(op.grid().has_breakpoints());
+    expect_apply_matches_dense(op);
+    const Eigen::MatrixXd dense = op.to_dense();
+    const double delta = 1e-6;
+    for (long c = 0; c < map.dimension(); c += 7) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(map.dimension());
+      e[c] = delta;
+      const Eigen::VectorXd fd = (map.apply(U + e) - map.apply(U - e)) / (2 * delta);
+      EXPECT_LE((fd - dense.col(c)).norm(), tolerance * (1 + dense.col(c).norm())) << "column " << c;
+    }
+  };
+  MillingParameters q;
+  q.radial_immersion = 0.05;
+  q.depth = 2e-3;
+  const MillingModel milling(q);
+  const StroboscopicMap<MillingModel> milling_map(TrapezoidStepper<MillingModel>(milling),
+                                                  model_grid(milling, 60, 1, GridLayout::aligned));
+  check(milling_map, random_matrix(milling_map.dimension(), 1, 5).col(0), 1e-7);
+
+  ImpactParameters p;
+  p.k = 0.2, p.x0 = -0.0566, p.v0 = 1.0101;
+  const ImpactModel impact(p);
+  const StroboscopicMap<ImpactModel> uniform(TrapezoidStepper<ImpactModel>(impact),
+                                             make_grid(impact.tau(), impact.period(), 400));
+  const PeriodicOrbit orbit = find_orbit(impact, uniform, OrbitSettings{});
+  std::vector<Vec<2>> states;
+  uniform.apply(orbit.history, nullptr, &states);
+  std::string why;
+  const auto aligned = contact_aligned_orbit(uniform, states, ContactAlignmentOptions{}, why);
+  ASSERT_TRUE(aligned) << why;
+  const StroboscopicMap<ImpactModel> on_contacts(uniform.stepper(), aligned->grid);
+  check(on_contacts, aligned->orbit.history, 1e-6);
 }
