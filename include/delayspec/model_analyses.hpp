@@ -30,6 +30,7 @@
 #include "delayspec/monodromy.hpp"
 #include "delayspec/orbit_search.hpp"
 #include "delayspec/simulation.hpp"
+#include "delayspec/spectral_reference.hpp"
 #include "delayspec/step_options.hpp"
 #include "delayspec/stepper.hpp"
 #include "delayspec/stroboscopic_map.hpp"
@@ -100,6 +101,10 @@ class ModelAnalyses {
   virtual double period() const = 0;
   // The model's time switches in [0, T) (model_grid.hpp; empty: none).
   virtual std::vector<double> time_switches() const = 0;
+  // Its multipliers by piecewise Chebyshev collocation (spectral_reference.hpp): a reference
+  // independent of the step maps. BadInput for a model it does not take (not linear, several
+  // delays, tau != T).
+  virtual SpectralResult spectral_reference(const SpectralOptions& options) const = 0;
   // The grid of these settings (model_grid.hpp: the switches as breakpoints when aligned).
   HistoryGrid grid(const MapSettings& s) const {
     GridBreaks breaks;
@@ -169,6 +174,14 @@ class ModelAnalysesFor final : public ModelAnalyses {
   std::vector<double> delays() const override { return delays_of(model_); }
   double period() const override { return model_.period(); }
   std::vector<double> time_switches() const override { return time_switches_in_period(model_); }
+  SpectralResult spectral_reference(const SpectralOptions& options) const override {
+    if constexpr (delay_count_of<Model>() == 1) {
+      return spectral_multipliers(model_, options);
+    } else {
+      throw BadInput("the spectral reference takes models with one delay; this one has " +
+                     std::to_string(delay_count_of<Model>()));
+    }
+  }
 
   LinearisedOrbit linearised_orbit(const MapSettings& s, const OrbitSettings& settings,
                                    const OrbitRequest& request) const override {

@@ -56,7 +56,8 @@ TEST(BenchCli, KrylovAndDenseAgreeAndMatchLambertW) {
 TEST(BenchCli, DenseStopsAtTheMemoryLimitWithAMessage) {
   // N = 800, d = 2: n = 1602, 3 n^2 doubles = 59 MB > 10 MB: dense must not run.
   CliResult r = run({"bench", "--json", "--set", "model=mathieu", "--set", "Ns=800", "--set", "nev=2", "--set",
-                     "solvers=spectra,dense-lapack", "--set", "dense_memory_limit_mb=10"});
+                     "solvers=spectra,dense-lapack", "--set", "dense_memory_limit_mb=10", "--set",
+                     "reference=extrapolated"});
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["rows"].size(), 2u);
@@ -72,7 +73,7 @@ TEST(BenchCli, DenseStopsAtTheMemoryLimitWithAMessage) {
 TEST(BenchCli, TextTableAndCsv) {
   const auto dir = delayspec::testing::fresh_dir("bench_out");
   CliResult r = run({"bench", "--out", dir.string(), "--set", "model=mathieu", "--set", "Ns=50,100,200", "--set",
-                     "nev=3", "--set", "solvers=spectra,dense"});
+                     "nev=3", "--set", "solvers=spectra,dense", "--set", "reference=extrapolated"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("faster than dense-lapack"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("reference extrapolated"), std::string::npos) << r.out;
@@ -122,3 +123,18 @@ INSTANTIATE_TEST_SUITE_P(Keys, BenchBadInput, ::testing::Values(
     BadValue{"solver", "spectra"}, BadValue{"dense_memory_limit_mb", "-1"}, BadValue{"dense_memory_limit_mb", "lots"},
     BadValue{"nev", "40"}, BadValue{"nev", "0"}, BadValue{"reference", "best"}, BadValue{"Ns", "40,20"}, BadValue{"repeats", "0"}));
 // clang-format on
+
+TEST(BenchCli, MillingIsScoredAgainstTheSpectralReference) {
+  // Milling's monodromy has no closed form; the engine's piecewise Chebyshev collocation
+  // (spectral_reference.hpp, converged to ~1e-13) is the reference, named as such. The error at
+  // N = 50 is the order-2 scheme's (~0.1 at a/D = 1), far above the reference's own error.
+  CliResult r = run({"bench", "--json", "--set", "model=milling", "--set", "Ns=50,100", "--set", "nev=2", "--set",
+                     "solvers=spectra"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("reference"), "exact");
+  EXPECT_EQ(j.at("reference_source"), "spectral");
+  ASSERT_EQ(j.at("rows").size(), 2u);
+  const double e50 = j["rows"][0].at("error"), e100 = j["rows"][1].at("error");
+  EXPECT_NEAR(e50 / e100, 4.0, 0.4) << "order 2 against the spectral value";
+}

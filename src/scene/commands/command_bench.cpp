@@ -97,7 +97,9 @@ struct BenchSettings {
   long repeats = 3;
   double limit_mb = 2048;
   long classic_max_N = 640;  // the classic rows stop here (O(N^3) each)
-  Multipliers exact;         // the exact multipliers when the model has them
+  Multipliers exact;         // reference multipliers no step map produced, when the model has them
+  double exact_precision = 1e-14;  // their relative accuracy
+  std::string exact_source;        // lambert_w or spectral (level_runner.hpp's exact_reference)
 };
 
 BenchSettings read_bench_settings(Config& config) {
@@ -151,7 +153,10 @@ BenchSettings read_bench_settings(Config& config) {
   if (krylov_listed && s.base.nev > n_min - 2)
     throw BadInput("`nev = " + std::to_string(s.base.nev) + "`: the Krylov solvers need nev <= n - 2 = " +
                    std::to_string(n_min - 2) + " at the coarsest N = " + std::to_string(s.Ns.front()));
-  s.exact = exact_multipliers(s.problem, s.base.nev);
+  const ExactReference exact = exact_reference(s.problem, s.base.nev);
+  s.exact = exact.multipliers;
+  s.exact_precision = exact.precision;
+  s.exact_source = exact.source;
   if (s.reference_kind == ReferenceKind::exact && s.exact.empty())
     throw BadInput("`reference = exact`: model `" + s.problem.model_name + "` has no exact multipliers");
   return s;
@@ -265,7 +270,7 @@ BenchReference bench_reference(const BenchSettings& s, const std::vector<BenchRo
   BenchReference reference;
   if (!s.exact.empty() && (s.reference_kind == ReferenceKind::exact || s.reference_kind == ReferenceKind::automatic)) {
     reference.values = s.exact;
-    reference.precision.assign(reference.values.size(), 1e-14);
+    reference.precision.assign(reference.values.size(), s.exact_precision);
     reference.used = "exact";
   } else {
     std::string best;
@@ -352,6 +357,7 @@ nlohmann::json bench_json(const BenchSettings& s, const std::vector<BenchRow>& r
   j["events"] = to_string(s.problem.events);
   j["nev"] = s.base.nev;
   j["reference"] = reference.used;
+  if (reference.used == "exact") j["reference_source"] = s.exact_source;  // lambert_w or spectral
   j["reference_values"] = multipliers_json(reference.values);
   if (!reference.note.empty()) j["reference_note"] = reference.note;
   j["dense_memory_limit_mb"] = s.limit_mb;
@@ -384,6 +390,7 @@ void print_bench(std::ostream& out, const BenchSettings& s, const std::vector<Be
                  const BenchReference& reference) {
   char line[300];
   out << "delayspec bench: model " << s.problem.model_name << ", nev " << s.base.nev << ", reference " << reference.used
+      << (reference.used == "exact" ? " (" + s.exact_source + ")" : "")
       << (reference.note.empty() ? "" : " (" + reference.note + ")") << "\n";
   std::snprintf(line, sizeof line, "  %6s  %7s  %-12s  %10s  %10s  %9s  %10s  %10s  %6s  %10s\n", "N", "n", "solver",
                 "seconds", "peak MB", "op.appl", "error", "max error", "digits", "vs dense");

@@ -44,10 +44,11 @@ std::string one_line(std::string text) {
   return text;
 }
 
-nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) {
+nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events, const std::string& source) {
   nlohmann::json j;
   j["events"] = events;
   j["reference"] = to_string(s.reference);
+  if (s.reference == ReferenceKind::exact) j["reference_source"] = source;  // lambert_w or spectral (level_runner.hpp)
   j["reference_values"] = multipliers_json(s.reference_values);
   j["reference_precision"] = s.reference_precision;
   nlohmann::json rows = nlohmann::json::array();
@@ -121,10 +122,12 @@ nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events) 
   return j;
 }
 
-void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string& events, bool switching) {
+void print_study(std::ostream& out, const ConvergenceStudy& s, const std::string& events, bool switching,
+                 const std::string& source) {
   char line[256];
   if (switching) out << "\nevents = " << events << "\n";
-  out << "reference: " << to_string(s.reference) << " (relative precision " << s.reference_precision[0] << ")\n";
+  out << "reference: " << to_string(s.reference) << (s.reference == ReferenceKind::exact ? " (" + source + ")" : "")
+      << " (relative precision " << s.reference_precision[0] << ")\n";
   std::snprintf(line, sizeof line, "  %6s  %10s  %8s  %20s  %10s  %6s  %6s\n", "N", "seconds", "op.appl", "|mu_1|",
                 "error", "digits", "order");
   out << line;
@@ -242,6 +245,7 @@ struct ConvergeSettings {
   bool order_given = false, step_given = false;  // else each variant's own expansion (error_expansion)
   double x_order = 2, x_step = 2;
   std::optional<double> period_guess;  // an autonomous orbit of unknown period (autonomous_floquet.hpp)
+  std::string reference_source;        // of the exact reference: lambert_w, spectral (exact_reference)
 };
 
 // Reads and checks the keys, the levels and the reference (the exact multipliers where a model has them).
@@ -297,7 +301,12 @@ ConvergeSettings read_converge_settings(Config& config) {
   coarsest.N = base.Ns.front();
   const long n_min = coarsest.dimension();
   validate_floquet_options(s.solver_options, n_min);  // at the coarsest N, the smallest n
-  base.exact = s.period_guess ? Multipliers{} : exact_multipliers(s.problem, base.nev + base.extra);
+  if (!s.period_guess) {
+    const ExactReference exact = exact_reference(s.problem, base.nev + base.extra);
+    base.exact = exact.multipliers;
+    base.exact_precision = exact.precision;
+    s.reference_source = exact.source;
+  }
   if (base.reference == ReferenceKind::exact && base.exact.empty())
     throw BadInput("`reference = exact`: model `" + s.problem.model_name +
                    "` has no exact multipliers (use extrapolated or finest)");
@@ -391,7 +400,7 @@ void write_converge_files(const Invocation& inv, const Config& config, const Con
 // The --json result: the first variant's study at the top level, every variant's under by_events.
 nlohmann::json converge_json(const ConvergeSettings& s, const std::vector<ConvergenceStudy>& studies,
                             const PeriodStudy& period) {
-  nlohmann::json j = study_json(studies.front(), s.events.front());
+  nlohmann::json j = study_json(studies.front(), s.events.front(), s.reference_source);
   if (s.period_guess) {
     j["period_guess"] = *s.period_guess;
     j["period"] = period_study_json(period);
@@ -401,7 +410,8 @@ nlohmann::json converge_json(const ConvergeSettings& s, const std::vector<Conver
   j["nev"] = s.base.nev;
   if (studies.size() > 1) {
     j["by_events"] = nlohmann::json::array();
-    for (size_t v = 0; v < studies.size(); ++v) j["by_events"].push_back(study_json(studies[v], s.events[v]));
+    for (size_t v = 0; v < studies.size(); ++v)
+      j["by_events"].push_back(study_json(studies[v], s.events[v], s.reference_source));
   }
   return j;
 }
@@ -452,7 +462,7 @@ int command_converge(Config& config, const Invocation& inv) {
   for (size_t i = 0; i < s.base.Ns.size(); ++i) inv.out << (i ? "," : "") << s.base.Ns[i];
   inv.out << "\n";
   if (s.period_guess) print_period_study(inv.out, period);
-  for (size_t v = 0; v < studies.size(); ++v) print_study(inv.out, studies[v], s.events[v], s.switching);
+  for (size_t v = 0; v < studies.size(); ++v) print_study(inv.out, studies[v], s.events[v], s.switching, s.reference_source);
   if (studies.size() > 1) print_side_by_side(inv.out, studies, s.events);
   return 0;
 }

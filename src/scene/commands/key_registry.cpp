@@ -157,7 +157,7 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
       {"Ns", "the list of N (comma-separated, increasing); instead of N_min..N_max"},
       {"N_min", "smallest N (N doubles up to N_max)"},
       {"N_max", "largest N"},
-      {"reference", "errors against: exact (linear, Lambert W), extrapolated, finest, auto"},
+      {"reference", "errors against: exact (Lambert W; Mathieu, milling: spectral), extrapolated, finest, auto"},
       {"extrapolation_order", "Richardson: leading error order p (impact with events off: 1)"},
       {"extrapolation_order_step", "Richardson: order step q of c1 h^p + c2 h^(p+q) + ..."},
       {"extrapolation_levels", "Richardson: most levels combined, >= 1"},

@@ -161,6 +161,9 @@ class ExplainedAnalyses final : public ModelAnalyses {
   std::vector<double> delays() const override { return inner_->delays(); }
   double period() const override { return inner_->period(); }
   std::vector<double> time_switches() const override { return inner_->time_switches(); }
+  SpectralResult spectral_reference(const SpectralOptions& options) const override {
+    return inner_->spectral_reference(options);
+  }
   LinearisedOrbit linearised_orbit(const MapSettings& map, const OrbitSettings& orbit,
                                    const OrbitRequest& request) const override {
     return explained([&] { return inner_->linearised_orbit(map, orbit, request); });

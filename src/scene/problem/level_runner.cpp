@@ -85,13 +85,39 @@ std::vector<std::string> read_word_list(Config& config, const std::string& key, 
   return words;
 }
 
-std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count) {
+ExactReference exact_reference(const Problem& problem, int count) {
+  ExactReference r;
   if (const auto* linear = problem.model ? std::get_if<LinearModel>(&*problem.model) : nullptr) {
     const LinearParameters& p = linear->parameters();
-    if (p.b == 0) return {};  // no delay term: Lambert W form does not apply
-    return linear_dde_multipliers(p.a, p.b, p.tau, p.period, count);
+    if (p.b != 0) {  // (no delay term: the Lambert W form does not apply)
+      r.multipliers = linear_dde_multipliers(p.a, p.b, p.tau, p.period, count);
+      r.source = "lambert_w";
+      return r;
+    }
   }
-  return {};
+  if (!problem.analyses->is_linear() || problem.analyses->delays().size() != 1 || problem.orbit_period != 1) return r;
+  SpectralOptions o;
+  o.degree = 32;
+  o.degree_step = 8;
+  o.pieces = 2;
+  o.nev = count;
+  SpectralResult spectral;
+  try {
+    spectral = problem.analyses->spectral_reference(o);
+  } catch (const BadInput&) {  // tau != T: no spectral reference, nothing else wrong
+    return r;
+  } catch (const NumericalFailure&) {
+    return r;
+  }
+  if (static_cast<int>(spectral.multipliers.size()) < count) return r;
+  double precision = 0;
+  for (size_t k = 0; k < spectral.multipliers.size(); ++k)
+    precision = std::max(precision, spectral.error_estimate[k] / std::abs(spectral.multipliers[k]));
+  if (!(precision <= 1e-10)) return r;
+  r.multipliers = std::move(spectral.multipliers);
+  r.precision = std::max(precision, 1e-14);
+  r.source = "spectral";
+  return r;
 }
 
 LevelResult level_result(const FloquetResult& result, long n, long K) {

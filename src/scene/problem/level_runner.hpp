@@ -30,8 +30,17 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
 std::vector<std::string> read_word_list(Config& config, const std::string& key, const std::string& fallback,
                                         const std::vector<std::string>& allowed);
 
-// The exact leading multipliers when the model has them (linear: Lambert W), else empty.
-std::vector<std::complex<double>> exact_multipliers(const Problem& problem, int count);
+// Reference multipliers that no step map produced, when the model has them: `source` "lambert_w"
+// (the built-in linear model: exact) or "spectral" (a linear model with one delay tau = T:
+// piecewise Chebyshev collocation at degree 32 and 40 on each half of every interval between
+// switches, spectral_reference.hpp, taken where its estimate is within 1e-10 of every multiplier
+// asked for), `precision` their relative accuracy; empty multipliers: none.
+struct ExactReference {
+  std::vector<std::complex<double>> multipliers;
+  double precision = 1e-14;
+  std::string source;
+};
+ExactReference exact_reference(const Problem& problem, int count);
 
 // Builds the problem at resolution N with the given events mode, finds its periodic orbit (as
 // `request` says: from another level's orbit by Newton, and whether to keep the sequence) and
