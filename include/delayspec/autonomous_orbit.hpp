@@ -45,6 +45,7 @@
 #include "delayspec/detail/sparse_lu.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec/grid.hpp"
+#include "delayspec/memory_budget.hpp"
 #include "delayspec/model.hpp"
 #include "delayspec/orbit_newton.hpp"
 #include "delayspec/step_options.hpp"
@@ -217,7 +218,7 @@ class PeriodNewton {
     try {
       step = SparseLU(bordered_matrix(Fx, FT, row_, 0.0)).solve(rhs);
     } catch (const NumericalFailure& e) {
-      why = std::string("the bordered Jacobian is singular (") + e.what() + ")";
+      why = std::string("the bordered Jacobian cannot be factored (") + e.what() + ")";
       return false;
     }
     return true;
@@ -279,6 +280,19 @@ template <class Model>
 AutonomousOrbit find_autonomous_orbit_with_steps(const Model& model, const AutonomousOrbitOptions& o, int K) {
   using Map = StroboscopicMap<TimeScaled<Model>>;
   constexpr int D = Model::d;
+  // Sizes before allocation (memory_budget.hpp): the sparse LU of the K D unknowns fills the band
+  // of the longest delay, M = K tau_max / T steps wide, so its factors hold at least K D x D M
+  // doubles (measured on the Pyragas orbit, D = 2, M = 200: 212 MB resident at K = 20000, where
+  // this bound says 128 MB). period_guess = 1e6 there asked for 190 GB and was killed by the kernel.
+  {
+    const std::vector<double> taus = delays_of(model);
+    const double band = static_cast<double>(K) * *std::max_element(taus.begin(), taus.end()) / o.period_guess;
+    require_memory(8.0 * K * D * D * std::max(1.0, band),
+                   "`period_guess = " + format_number(o.period_guess) + "` (" + std::to_string(K) +
+                       " steps per period at N = " + std::to_string(o.N) + ")",
+                   "the sparse LU of the orbit's " + std::to_string(static_cast<long>(K) * D) +
+                       " unknowns, its factors filling the band of the longest delay");
+  }
   AutonomousOrbit out;
   double T = o.period_guess;
   Eigen::VectorXd x = detail::simulated_guess(model, T, K, o);

@@ -48,6 +48,11 @@
 //     the expansion allows (pair order > 2 e_1 + 1), to round-off after one above it, or jumps
 //     up after a flat stretch (pair order < -1): a plateau, whose small last differences say
 //     nothing of the next jump (the impact orbit with events = off).
+//     With leading_term_may_hide (events = off on a switching model) a column 0 converging faster
+//     than h^{e_1} is believed only after six triples show it: the h^{e_1} term, whose size
+//     depends on where a switch falls in its step, can stay constant for several levels and come
+//     back. Before that, E is at least the column's largest difference scaled to the finest step
+//     like h^{e_1}, and infinity when no triple shows the h^{e_1} term (richardson.cpp).
 //   * When column J >= 1 is inconsistent, column J - 1 showed its order q = e_J: the data have
 //     an h^q term, but its coefficient is not constant (an event's place in the grid changes it
 //     from level to level: the impact orbit's raw order wanders over 1.89 .. 2.10). Column J
@@ -79,6 +84,10 @@ struct RichardsonOptions {
   double input_precision = 1e-14;
   bool check_orders = true;      // use a column only if the column below shows its expected order (above)
   double order_tolerance = 0.3;  // |observed - expected| order allowed by that check
+  // The h^order term's coefficient depends on where a switch falls inside its step (events = off
+  // on a switching model): it can vanish for several levels and come back, so a first column that
+  // converges faster than h^order is not taken at its word (richardson.cpp, hidden_leading_term).
+  bool leading_term_may_hide = false;
 };
 
 struct RichardsonTableau {

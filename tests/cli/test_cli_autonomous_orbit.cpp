@@ -4,7 +4,13 @@
 // default's), and bad input.
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -106,3 +112,42 @@ TEST(AutonomousOrbitCli, BadInputAndNoOrbit) {
 }
 
 }  // namespace
+
+// Issue 61 item 3: sizes bounded before allocation. A period_guess far beyond the orbit's asks for
+// an orbit system the machine cannot hold (Mackey-Glass, N = 200, tau = 17: 1.2e7 steps per
+// period, a sparse LU whose factors fill the delay's band, >= 19 GB); it used to grow until the
+// kernel killed it (exit 137, no message). Run in a forked child whose address space is limited
+// to what it has mapped plus 1.5 GB (`ulimit -v`; "plus" so that a sanitizer's reserved shadow
+// does not count): exit 2 naming the key, in milliseconds, before anything large is allocated.
+TEST(AutonomousOrbitCli, AnOrbitSystemBeyondTheMemoryIsRefusedNamingTheKey) {
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::close(pipe_fds[0]);
+    double mapped = 0;
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("VmSize:", 0) == 0) mapped = 1024.0 * std::strtod(line.c_str() + 7, nullptr);
+    rlimit limit{};
+    ::getrlimit(RLIMIT_AS, &limit);
+    limit.rlim_cur = static_cast<rlim_t>(mapped + 1.5e9);
+    if (::setrlimit(RLIMIT_AS, &limit) != 0) ::_exit(120);
+    const CliResult r = run({"floquet", "--set", "model=mackey-glass", "--set", "N=200", "--set", "period_guess=1e6"});
+    const std::string message = std::to_string(r.status) + "\n" + r.err;
+    if (::write(pipe_fds[1], message.data(), message.size()) < 0) ::_exit(121);
+    ::_exit(0);
+  }
+  ::close(pipe_fds[1]);
+  std::string message;
+  char buffer[4096];
+  for (ssize_t got; (got = ::read(pipe_fds[0], buffer, sizeof buffer)) > 0;) message.append(buffer, got);
+  ::close(pipe_fds[0]);
+  int child = 0;
+  ASSERT_EQ(::waitpid(pid, &child, 0), pid);
+  ASSERT_TRUE(WIFEXITED(child) && WEXITSTATUS(child) == 0) << "child status " << child << ": " << message;
+  EXPECT_EQ(message.substr(0, 2), "2\n") << message;
+  EXPECT_NE(message.find("`period_guess = 1e+06` (11764706 steps per period at N = 200) needs at least"), std::string::npos) << message;
+  EXPECT_NE(message.find("this process may use"), std::string::npos) << message;
+}

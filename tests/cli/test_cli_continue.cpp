@@ -352,3 +352,30 @@ TEST(ContinueCli, StartsAtTheEndOfAKeysRange) {
 }
 
 }  // namespace
+
+// Issue 61 items 5 and 7. The Mackey-Glass orbit scene sets period_guess (an orbit of unknown
+// period, floquet's); `continue` does not follow such orbits yet and used to ignore the scene's
+// key, following the map's fixed point over T = tau (the equilibrium) with exit 0, while
+// `--set period_guess` was refused. Both are refused now, naming the key and the way that exists.
+// Without period_guess, continuing an autonomous model says what it follows.
+TEST(ContinueCli, AnOrbitOfUnknownPeriodIsRefusedAndAnAutonomousModelSaysWhatIsFollowed) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/mackey_glass_orbit.toml";
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"continue", scene, "--set", "continue_key=beta", "--set", "continue_from=0.2", "--set",
+                                 "continue_to=0.21"},
+        std::vector<std::string>{"continue", "--set", "model=mackey-glass", "--set", "period_guess=20", "--set",
+                                 "continue_key=beta", "--set", "continue_from=0.2", "--set", "continue_to=0.21"}}) {
+    const CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("`period_guess`: `continue` does not follow an orbit of unknown period"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("continue_switch = true"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  const CliResult r = run({"continue", "--set", "model=mackey-glass", "--set", "continue_key=beta", "--set",
+                           "continue_from=0.2", "--set", "continue_to=0.21", "--set", "continue_step=0.005"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("model `mackey-glass` is autonomous: this follows the fixed point of the stroboscopic map"),
+            std::string::npos)
+      << r.err;
+}

@@ -326,3 +326,15 @@ TEST(FloquetRoundOff, MultipliersBelowTheirAccuracyAreNeverPrintedAsValues) {
 }
 
 }  // namespace
+
+// Issue 61 item 9: coarse levels that cannot be had (here N = 8, d = 1: N / 2 = 4 has n = 5
+// multipliers, not more than nev + 2 = 6) are said in the note, not dropped silently, and the
+// verdict without a bar says so rather than "the unit circle is within an error bar".
+TEST(FloquetErrorBarsCli, CoarseLevelsThatCannotBeHadAreSaid) {
+  const CliResult r = run({"floquet", "--set", "model=linear", "--set", "a=-1", "--set", "b=0.5", "--set", "N=8",
+                           "--set", "nev=4", "--set", "error_bars=on"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("0 coarse level(s) of the two wanted: below N = 8"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("more than nev + 2 = 6 multipliers"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("within an error bar"), std::string::npos) << r.out;
+}

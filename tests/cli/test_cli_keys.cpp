@@ -239,3 +239,20 @@ TEST(Scenes, Fig63RunsWithRunAtReducedSize) {
   EXPECT_TRUE(fs::exists(dir / "impacts.csv"));
   EXPECT_TRUE(fs::exists(dir / "run.json"));
 }
+
+// Issue 61 item 9: a scene's unknown top-level key with control characters (an escape sequence
+// that would recolour or rewrite the terminal) is named with \xNN escapes, as inside [equations],
+// by `floquet` and by `run` (its own key check), never raw.
+TEST(Keys, AnUnknownKeyWithControlCharactersIsEscapedInTheMessage) {
+  const fs::path dir = fresh_dir("keys_control_characters");
+  fs::create_directories(dir);
+  const fs::path scene = dir / "scene.toml";
+  std::ofstream(scene) << "\"nev\\u001b[2J\" = 2\n";
+  for (const char* command : {"floquet", "run"}) {
+    const CliResult r = run({command, scene.string()});
+    EXPECT_EQ(r.status, 2) << command << ": " << r.err;
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << command << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "nev\\x1B[2J")) << command << ": " << r.err;
+  }
+  fs::remove_all(dir);
+}

@@ -55,7 +55,7 @@ TEST_P(LyapunovBadInput, ExitsTwoNamingKeyAndValue) {
 // clang-format off
 INSTANTIATE_TEST_SUITE_P(Keys, LyapunovBadInput, ::testing::Values(
     LyapunovBadValue{"exponents", "0"}, LyapunovBadValue{"exponents", "12"}, LyapunovBadValue{"exponents", "two"},
-    LyapunovBadValue{"periods", "1"}, LyapunovBadValue{"periods", "-5"}, LyapunovBadValue{"periods", "1e3"},
+    LyapunovBadValue{"periods", "1"}, LyapunovBadValue{"periods", "-5"}, LyapunovBadValue{"periods", "1e-3"},
     LyapunovBadValue{"transient", "-1"}, LyapunovBadValue{"transient", "x"}, LyapunovBadValue{"seed", "-3"}, LyapunovBadValue{"seed", "abc"},
     LyapunovBadValue{"qr_every", "0"}, LyapunovBadValue{"qr_every", "3"}, LyapunovBadValue{"batches", "1"}, LyapunovBadValue{"N", "0"},
     // issue 13: upper bounds checked before anything is allocated (exit 2, not 1 from

@@ -117,3 +117,13 @@ TEST(MillingCli, ClassicPathsRefuseModelsTheyDoNotCover) {
 }
 
 }  // namespace
+
+// Issue 61 item 9: `--help` prints `pitch_angles = equal` as the default; `--set` takes it and
+// gives the equal pitch, the same numbers as without the key.
+TEST(MillingCli, PitchAnglesEqualAsHelpPrintsItIsTheEqualPitch) {
+  const CliResult plain = run({"floquet", "--json", "--set", "model=milling", "--set", "N=40"});
+  const CliResult equal = run({"floquet", "--json", "--set", "model=milling", "--set", "N=40", "--set", "pitch_angles=equal"});
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  ASSERT_EQ(equal.status, 0) << equal.err;
+  EXPECT_EQ(nlohmann::json::parse(plain.out).at("multipliers"), nlohmann::json::parse(equal.out).at("multipliers"));
+}

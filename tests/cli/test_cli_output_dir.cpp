@@ -118,6 +118,22 @@ TEST(OutputDirectory, SecondRunWhileTheLockIsHeldExitsTwo) {
   fs::remove_all(dir);
 }
 
+// The lock is never opened through a symbolic link (issue 61 item 5): a link planted as
+// `DIR/.delayspec-lock` (another user, in a shared directory) pointing elsewhere used to make the
+// run create and lock the target. Now: exit 2 naming the link, and no target created.
+TEST(OutputDirectory, ALockThatIsASymbolicLinkIsRefusedAndNotFollowed) {
+  const fs::path dir = fresh_dir("outdir_lock_link");
+  fs::create_directories(dir);
+  const fs::path target = dir.parent_path() / "outdir_lock_link_target";
+  fs::remove(target);
+  fs::create_symlink(target, dir / ".delayspec-lock");
+  const CliResult r = run({"simulate", "--out", dir.string(), "--set", "N=8"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, ".delayspec-lock` is a symbolic link")) << r.err;
+  EXPECT_FALSE(fs::exists(target)) << "the link was followed";
+  fs::remove_all(dir);
+}
+
 // A directory that does not exist yet is created, and locked, by the run's first write, so a run
 // stopped by bad input creates nothing. If another run created it meanwhile (holding its lock,
 // or already finished), this run writes nothing there.

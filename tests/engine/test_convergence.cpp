@@ -179,6 +179,56 @@ TEST(Richardson, AWanderingSecondOrderCoefficientGetsABarFromColumnTwosSpread) {
   EXPECT_LT(ratios[ratios.size() / 2], 40.0);
 }
 
+// A first-order term that hides (issue 61 item 10): a switch inside a step (events = off) leaves
+// an error c phi(theta) h, theta = frac(t_s N) the switch's place in its step, phi(theta) =
+// 4 theta (1 - theta) (zero with the switch on a node). Doubling N doubles theta mod 1, so with
+// theta_1600 = 1/2 + 2^-12 it drops to 2^-11 at N = 3200 and the term, ~4 c t_s, stays nearly
+// constant up to N = 25600 (theta 2^-8): the raw values there converge like h^2 (A h^2) and
+// their last differences say 2e-8 for an error of 6e-7, the impact orbit's case (3.8e-6 for
+// 8.4e-5). Where the term showed (N = 400 .. 1600), its differences scaled to the finest step
+// like h bound it; with only the levels that hide it, no estimate.
+TEST(Richardson, AHiddenFirstOrderTermIsBoundedWhereItShowedOrNotAtAll) {
+  const double t_s = (0.5 + std::ldexp(1.0, -12)) / 1600, x0 = 0.93, c = 1.0, A = 1.0;
+  auto value = [&](int N) {
+    const double theta = t_s * N - std::floor(t_s * N), h = 1.0 / N;
+    return cd(x0 + c * 4 * theta * (1 - theta) * h + A * h * h, 0);
+  };
+  const RichardsonOptions first_order{.order = 1, .order_step = 1, .max_columns = 6, .leading_term_may_hide = true};
+  std::vector<double> h;
+  std::vector<cd> v;
+  for (int N = 25; N <= 25600; N *= 2) {
+    h.push_back(1.0 / N);
+    v.push_back(value(N));
+  }
+  const Extrapolation e = richardson_extrapolate(h, v, first_order);
+  const double error = std::abs(e.value - x0);
+  EXPECT_GT(error, 5e-7);  // the hidden term: 4 theta (1 - theta) h at theta = 2^-8, N = 25600
+  EXPECT_LT(std::abs(v.back() - v[v.size() - 2]), error / 10) << "the last difference alone is far short";
+  ASSERT_TRUE(std::isfinite(e.error_estimate)) << e.note;
+  EXPECT_GE(e.error_estimate, error) << e.note;
+  EXPECT_NE(e.note.find("showed at coarser levels"), std::string::npos) << e.note;
+
+  // The four levels that hide it: nothing bounds the term.
+  const std::vector<double> h_fine(h.end() - 4, h.end());
+  const std::vector<cd> v_fine(v.end() - 4, v.end());
+  const Extrapolation hidden = richardson_extrapolate(h_fine, v_fine, first_order);
+  EXPECT_EQ(hidden.error_estimate, INFINITY) << hidden.note;
+  EXPECT_NE(hidden.note.find("no level shows the order-1 term"), std::string::npos) << hidden.note;
+
+  // A long run (8 levels, 6 triples) of clean h^2 under an expected h: accepted, the textbook tail.
+  std::vector<double> h2;
+  std::vector<cd> v2;
+  for (int N = 25; N <= 3200; N *= 2) {
+    h2.push_back(1.0 / N);
+    v2.push_back(cd(x0 + A / (double(N) * N), 0));
+  }
+  const Extrapolation clean = richardson_extrapolate(h2, v2, first_order);
+  ASSERT_TRUE(std::isfinite(clean.error_estimate)) << clean.note;
+  EXPECT_GE(clean.error_estimate, std::abs(clean.value - x0));
+  // the tail, max(d_last, d_prev) = d_prev here: not the spread of the coarse levels (1e-3)
+  EXPECT_LE(clean.error_estimate, 1.0001 * std::abs(v2[v2.size() - 2] - v2[v2.size() - 3])) << clean.note;
+}
+
 // Round-off does not stop a column: a smooth sequence whose higher columns reach the rounding
 // level of the inputs (relative 1e-14) keeps using them (consistent within the noise allowance).
 TEST(Richardson, ColumnsAtRoundOffAreNotHeldAgainst) {

@@ -121,6 +121,19 @@ TEST(ConfigErrors, IntegerNotAnIntegerOrOverflow) {
   }
 }
 
+// --help writes ranges as 1..1e7 (issue 61 item 9): an exact integer in exponent notation is that
+// integer; a fraction in it is not.
+TEST(ConfigErrors, AnIntegerInExponentNotationIsThatInteger) {
+  Config a = with("N", "1e7"), b = with("N", "2.5e1");
+  EXPECT_EQ(a.get_int("N", 0), 10000000);
+  EXPECT_EQ(b.get_int("N", 0), 25);
+  for (const char* bad : {"1.5e0", "1e-3", "1e30"}) {
+    Config c = with("N", bad);
+    const std::string m = bad_input_message([&] { c.get_int("N", 0); });
+    EXPECT_TRUE(contains(m, std::string("`N = ") + bad + "`: not an integer")) << bad << ": " << m;
+  }
+}
+
 TEST(ConfigErrors, ChoiceListsAllowedValues) {
   Config c = with("events", "maybe");
   const std::string m = bad_input_message([&] { c.get_choice("events", "on", {"on", "linear", "off"}); });

@@ -381,6 +381,17 @@ TEST(EquationModels, SeveralDelaysBadInputNamesTheDelay) {
       {with("tau1 = \"s\"", "x = \"s\""), {}, "`equations.delays.x`: `x` is also a state"},
       {with("tau1 = \"s\"", "a = \"s\""), {}, "`equations.delays.a`: `a` is also a parameter"},
       {with("s = 1 }", "s = 1, x_tau1 = 2 }"), {}, "the delayed state `x_tau1` would be the parameter"},
+      // states u, u_v and delays v_w, w: `u_v_w` is u delayed by v_w and u_v delayed by w (issue 61 item 5)
+      {R"(model = "equations"
+[equations]
+state = ["u", "u_v"]
+period = "1"
+delays = { v_w = "1", w = "0.5" }
+rhs = ["-u + 0.1*u_v_w", "-u_v"]
+history = { u = 1, u_v = 0 }
+)",
+       {},
+       "the delayed state `u_v_w` would mean both `u` delayed by `v_w` and `u_v` delayed by `w`"},
       {kTwoDelayScene, {{"s", "0.001"}, {"N", "100"}}, "`equations.delays.tau1` = 0.001 is shorter than one step"},
       {with("period = \"1\"", "period = \"1\"\ndelay = \"1\""), {}, "are both given"},
       {kTwoDelayScene, {{"tau_over_T", "1"}}, "this model has 2"},
@@ -409,6 +420,37 @@ TEST(EquationModels, ImpactWithItsFeedbackSplitOverTwoEqualDelaysIsTheBuiltInMod
   EXPECT_TRUE(eq.analyses->switches_in_state());
   ASSERT_EQ(eq.analyses->delays().size(), 2u);
   expect_same_multipliers(spectrum(eq, 6), spectrum(builtin, 6));
+}
+
+// Issue 61 item 6: an autonomous model with one delay needs no `period` (it has no forcing; the
+// period is then the delay, the sampling time of lyapunov and simulate), and its multipliers are
+// the same as with `period` stated as the delay. A forced model without it is refused.
+TEST(EquationModels, AnAutonomousModelWithOneDelayDefaultsThePeriodToTheDelay) {
+  const std::string stated = R"(model = "equations"
+[equations]
+state = ["x"]
+parameters = { a = -1.0, b = 0.5 }
+period = "1.5"
+delay = "1.5"
+rhs = ["a*x + b*x_tau"]
+history = { x = 1 }
+)";
+  std::string defaulted = stated;
+  defaulted.erase(defaulted.find("period = \"1.5\"\n"), std::string("period = \"1.5\"\n").size());
+  const Spectrum a = spectrum(problem_from(stated, {{"N", "30"}}), 3),
+                 b = spectrum(problem_from(defaulted, {{"N", "30"}}), 3);
+  ASSERT_EQ(a.multipliers.size(), b.multipliers.size());
+  for (size_t k = 0; k < a.multipliers.size(); ++k) EXPECT_EQ(a.multipliers[k], b.multipliers[k]) << k;
+  std::string forced = defaulted;
+  forced.replace(forced.find("a*x + b*x_tau"), std::string("a*x + b*x_tau").size(), "a*x + b*x_tau + cos(t)");
+  try {
+    problem_from(forced, {});
+    FAIL() << "a forced model without period was accepted";
+  } catch (const BadInput& e) {
+    EXPECT_NE(std::string(e.what()).find("`equations.period` is required: the right-hand side depends on t"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

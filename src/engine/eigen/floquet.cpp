@@ -10,6 +10,7 @@
 
 #include "delayspec/dense_spectrum.hpp"
 #include "delayspec/errors.hpp"
+#include "delayspec/memory_budget.hpp"
 #include "engine/linalg/blas.hpp"
 #include "engine/linalg/linear_algebra.hpp"
 #include "engine/eigen/krylov.hpp"
@@ -301,6 +302,9 @@ void krylov_solve(const LinearOperator& op, const FloquetOptions& options, Floqu
     result.note = "ncv = " + std::to_string(settings.ncv) + " reduced to the dimension n = " + std::to_string(n);
     settings.ncv = static_cast<int>(n);
   }
+  require_memory(8.0 * static_cast<double>(n) * settings.ncv,
+                 "`ncv = " + std::to_string(settings.ncv) + "` with n = " + std::to_string(n),
+                 "the Krylov basis: ncv vectors of the history's n = d (N + 1) doubles");
   Eigen::VectorXd start;
   if (options.start.size() == 0) {
     start = start_vector(n, options.seed);

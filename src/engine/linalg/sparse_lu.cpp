@@ -44,6 +44,13 @@ void check_status(int status, const char* stage, long n, double rcond) {
     throw NumericalFailure(std::string("sparse LU (UMFPACK ") + stage + "): the " + std::to_string(n) + " x " +
                            std::to_string(n) + " matrix is singular (reciprocal condition estimate " +
                            format_number(rcond) + ")");
+  // Out of memory is said as such (it used to reach the user as "the bordered Jacobian is
+  // singular"); the int interface (umfpack_di) also caps the factors' entries at 2^31 - 1.
+  if (status == UMFPACK_ERROR_out_of_memory)
+    throw NumericalFailure(std::string("sparse LU (UMFPACK ") + stage + "): out of memory factoring the " +
+                           std::to_string(n) + " x " + std::to_string(n) +
+                           " matrix (UMFPACK_ERROR_out_of_memory: the machine's memory, or the 2^31 entries its "
+                           "int indices allow); reduce N or the period");
   throw NumericalFailure(std::string("sparse LU (UMFPACK ") + stage + ") failed: " + umfpack_status_name(status));
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -129,10 +130,17 @@ class EquationsReader {
       }
     }
     const size_t d = m_.state.size();
+    // STATE_DELAY must name one delayed state: with states u, u_v and delays v_w, w, `u_v_w` would
+    // be both u delayed by v_w and u_v delayed by w, one picked silently (issue 61 item 5).
+    std::map<std::string, std::string> reading;  // delayed name -> "STATE delayed by DELAY"
     for (size_t k = 0; k < m_.delay_names.size(); ++k)
       for (size_t i = 0; i < d; ++i) {
         m_.z.emplace_back("z[" + std::to_string(k * d + i) + "]");
         const std::string delayed = m_.delayed_name(k * d + i);
+        const std::string meaning = "`" + m_.state[i] + "` delayed by `" + m_.delay_names[k] + "`";
+        if (const auto [it, fresh] = reading.emplace(delayed, meaning); !fresh)
+          throw BadInput("`equations.delays`: the delayed state `" + printable(delayed) + "` would mean both " +
+                         it->second + " and " + meaning + ": rename a state or a delay");
         for (const auto* names : {&m_.state, &m_.parameters})
           if (std::find(names->begin(), names->end(), delayed) != names->end())
             throw BadInput("`equations.delays." + printable(m_.delay_names[k]) + "`: the delayed state `" + delayed +
@@ -188,15 +196,28 @@ class EquationsReader {
   }
 
   void read_constants() {
+    // The period T: the forcing's for a forced model; for an autonomous one only the sampling time
+    // of lyapunov and simulate (an orbit's own period is period_guess's), so there it defaults to
+    // the one delay (issue 61 item 6: it had to be stated, "the forcing period", for a model with
+    // none). A forced model must state it (checked in differentiate, once t's presence is known).
     const toml::node* period = table_.get("period");
-    if (!period) throw BadInput("`equations.period` is required (the forcing period T, e.g. \"2*pi/omega\")");
-    m_.period = expression(*period, item_of("period"), constants_);
+    if (period) m_.period = expression(*period, item_of("period"), constants_);
     if (const toml::table* delays = table_.get("delays") ? table_.get("delays")->as_table() : nullptr) {
       for (const auto& [key, value] : *delays)
         m_.delays.push_back(expression(value, "equations.delays." + std::string(key.str()), constants_));
-    } else {
-      const toml::node* delay = table_.get("delay");
-      m_.delays = {delay ? expression(*delay, item_of("delay"), constants_) : m_.period};  // tau = T by default
+    } else if (const toml::node* delay = table_.get("delay")) {
+      m_.delays = {expression(*delay, item_of("delay"), constants_)};
+    } else if (period) {
+      m_.delays = {m_.period};  // tau = T by default
+    }
+    if (!period) {
+      if (m_.delays.size() != 1)
+        throw BadInput(std::string("`equations.period` is required") +
+                       (m_.delays.empty() ? " (or `equations.delay`)" : " with several delays") +
+                       ": the forcing period T, e.g. \"2*pi/omega\"; for an autonomous model the sampling time of "
+                       "lyapunov and simulate, e.g. the longest delay");
+      m_.period = m_.delays.front();
+      period_defaulted_ = true;
     }
     m_.history.assign(m_.state.size(), 0);
     const toml::node* history = table_.get("history");
@@ -341,6 +362,9 @@ class EquationsReader {
     m_.autonomous = m_.switch_kind == SwitchKind::none &&
                     std::all_of(m_.fields.front().f_t.begin(), m_.fields.front().f_t.end(),
                                 [](const GiNaC::ex& e) { return e.normal().is_zero(); });
+    if (period_defaulted_ && !m_.autonomous)
+      throw BadInput("`equations.period` is required: the right-hand side depends on t (or switches), a forced "
+                     "model, whose forcing period T is not the delay's by default (e.g. \"2*pi/omega\")");
   }
 
   const toml::table& table_;
@@ -348,6 +372,7 @@ class EquationsReader {
   SymbolicEquationModel m_;
   ExpressionScope constants_, fields_;
   std::vector<GiNaC::ex> rhs_, rhs_switched_;
+  bool period_defaulted_ = false;  // no `period`: the one delay (read_constants)
 };
 
 }  // namespace

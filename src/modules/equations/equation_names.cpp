@@ -52,20 +52,6 @@ const std::vector<std::string>& equation_functions() {
   return functions;
 }
 
-std::string printable(const std::string& text) {
-  std::string out;
-  for (unsigned char c : text) {
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\x%02X", c);
-      out += buffer;
-    }
-  }
-  return out;
-}
-
 void check_equation_name(const std::string& item, const std::string& name) {
   const std::string head = "`" + item + "`: `" + printable(name) + "` ";
   if (!is_plain_identifier(name)) throw BadInput(head + "is not a plain name (a letter, then letters, digits or _)");

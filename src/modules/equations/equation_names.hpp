@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "delayspec/printable.hpp"  // printable: a name in a message
+
 namespace delayspec::cli {
 
 // The elementary functions an expression may call (each of one argument), in the order docs list them.
@@ -14,9 +16,5 @@ const std::vector<std::string>& equation_functions();
 
 // BadInput "`item`: ..." naming `name` and the rule it breaks, unless the name is allowed.
 void check_equation_name(const std::string& item, const std::string& name);
-
-// A name for a message: the name itself if it is printable ASCII, else with \xNN escapes
-// (a scene's bytes are not echoed raw to a terminal).
-std::string printable(const std::string& text);
 
 }  // namespace delayspec::cli

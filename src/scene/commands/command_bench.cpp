@@ -109,6 +109,7 @@ BenchSettings read_bench_settings(Config& config) {
   if (config.has("solver") && config.origin("solver") == "--set")
     throw BadInput("`solver = " + config.get_string("solver", "") +
                    "`: bench compares several: use `solvers` (a comma list)");
+  use_first_level_as_N(config);
   s.problem = read_problem(config, 100);
   s.orbit = read_orbit_settings(config);
   s.Ns = read_N_list(config, s.problem, 100, 400);

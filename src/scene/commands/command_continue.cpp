@@ -265,8 +265,23 @@ int command_continue(Config& config, const Invocation& inv) {
   // continue_object = equilibrium: the branch of equilibria (continue_equilibria.hpp)
   if (config.get_choice("continue_object", "orbit", {"orbit", "equilibrium"}) == "equilibrium")
     return continue_equilibria(config, inv);
+  // An orbit of unknown period is not continued yet (docs/autonomous.md, "Limits"): refused, from
+  // a scene as from --set. It used to follow the map's fixed point over the sampling period
+  // instead (the equilibrium, for Mackey-Glass's orbit scene), exit 0 (issue 61 item 5).
+  if (config.has("period_guess"))
+    throw BadInput("`period_guess`: `continue` does not follow an orbit of unknown period yet (the branch born at a "
+                   "Hopf point is followed with `continue_object = equilibrium` and `continue_switch = true`); "
+                   "remove period_guess to follow the fixed point of the stroboscopic map");
   const auto start = std::chrono::steady_clock::now();
   const ContinueRun run = read_continue_run(config);
+  // An autonomous model has no forcing period: what is followed is the fixed point of the map
+  // over the sampling period T (an equilibrium, or an orbit whose period divides T), wherever
+  // the history leads; said, so that it is not taken for the orbit (issue 61 item 7).
+  if (run.problem.analyses->is_autonomous() && !inv.quiet)
+    inv.err << "delayspec continue: note: model `" << run.problem.model_name
+            << "` is autonomous: this follows the fixed point of the stroboscopic map over the sampling period "
+               "(what the history reaches, often an equilibrium); for equilibria and their Hopf points use "
+               "`continue_object = equilibrium`, for the orbits born there add `continue_switch = true`\n";
   const ContinueOutcome out = compute_continue(config, run, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const json j = continue_json(run, out, seconds);

@@ -254,6 +254,7 @@ ConvergeSettings read_converge_settings(Config& config) {
   // events may be a list here (side by side); the problem reads the first of them.
   // Models that switch (the impact wall, milling's cutting windows): located and not, side by side.
   // Whether the model switches is the model's own (its analyses); `events` is read after it.
+  use_first_level_as_N(config);
   Config first = config;
   first.set("events", "on", "converge");
   const bool switching_default = read_problem(first, 100).switching();
@@ -326,6 +327,7 @@ std::vector<ConvergenceStudy> run_studies(const ConvergeSettings& s, const Invoc
     const RichardsonOptions expansion = error_expansion(with_events);  // h, h^2 with events = off
     options.richardson.order = s.order_given ? s.x_order : expansion.order;
     options.richardson.order_step = s.step_given ? s.x_step : expansion.order_step;
+    options.richardson.leading_term_may_hide = expansion.leading_term_may_hide;
     if (s.period_guess) {  // each level's orbit and period from the guess; the trivial multiplier apart
       studies.push_back(run_convergence_study(
           [&](int N, int count) {
@@ -412,6 +414,17 @@ nlohmann::json converge_json(const ConvergeSettings& s, const std::vector<Conver
     j["by_events"] = nlohmann::json::array();
     for (size_t v = 0; v < studies.size(); ++v)
       j["by_events"].push_back(study_json(studies[v], s.events[v], s.reference_source));
+    // The top level's target_met is every variant's: it said true while the events = off study
+    // missed the target (issue 61 item 9); target_note names the ones that missed it.
+    std::string missed;
+    for (size_t v = 0; v < studies.size(); ++v)
+      if (studies[v].target_met && !*studies[v].target_met)
+        missed += (missed.empty() ? "" : "; ") + std::string("events = ") + s.events[v] + ": not met (" +
+                  studies[v].stopped_by + ")";
+    if (!missed.empty()) {
+      j["target_met"] = false;
+      j["target_note"] = missed;
+    }
   }
   return j;
 }

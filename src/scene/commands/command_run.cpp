@@ -20,6 +20,7 @@
 #include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "delayspec/errors.hpp"
+#include "delayspec/printable.hpp"
 #include "scene/points/distributed_points.hpp"
 #include "scene/commands/key_registry.hpp"
 #include "scene/output/metadata.hpp"
@@ -130,7 +131,7 @@ RunPlan plan_run(Config& config) {
   for (const auto& [key, value] : config.values()) {
     if (plan.known_keys.count(key)) continue;
     const auto model = config.values().find("model");
-    throw BadInput(unread_key_message(key_index(), key, "(= " + value + ")", plan.analyses,
+    throw BadInput(unread_key_message(key_index(), printable(key), "(= " + printable(value) + ")", plan.analyses,
                                       model == config.values().end() ? "" : model->second, plan.known_keys));
   }
   return plan;

@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "delayspec/errors.hpp"
+#include "delayspec/printable.hpp"
 
 namespace delayspec::cli {
 
@@ -323,7 +324,18 @@ long Config::get_int(const std::string& key, long fallback) {
   const std::string& s = *text;
   errno = 0;
   char* end = nullptr;
-  const long value = std::strtol(s.c_str(), &end, 10);
+  long value = std::strtol(s.c_str(), &end, 10);
+  if (!s.empty() && end != s.c_str() + s.size() && errno != ERANGE) {
+    // An exact integer in exponent notation (`1e7`, as --help writes the ranges) is that integer;
+    // 1.5e0 or 1e30 are not (issue 61 item 9).
+    char* real_end = nullptr;
+    const double real = std::strtod(s.c_str(), &real_end);
+    if (real_end == s.c_str() + s.size() && std::isfinite(real) && real == std::floor(real) &&
+        std::abs(real) <= 9e15) {
+      value = static_cast<long>(real);
+      end = real_end;
+    }
+  }
   if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE)
     throw BadInput("`" + key + " = " + s + "`: not an integer");
   note_value(key, std::to_string(value));
@@ -394,9 +406,11 @@ std::vector<long> Config::get_int_list(const std::string& key, const std::vector
 namespace {
 
 // Text for a message: at most 80 characters, a longer text cut with its length stated.
+// A key or value in a message: cut to 80 characters, control bytes escaped (printable.hpp: a
+// scene's key is not echoed raw to a terminal, issue 61 item 9).
 std::string shortened(const std::string& text) {
-  if (text.size() <= 80) return text;
-  return text.substr(0, 60) + "... (" + std::to_string(text.size()) + " characters)";
+  if (text.size() <= 80) return printable(text);
+  return printable(text.substr(0, 60)) + "... (" + std::to_string(text.size()) + " characters)";
 }
 
 }  // namespace

@@ -128,7 +128,14 @@ void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>
   }
   out << "verdict: " << to_string(bars.verdict);
   if (bars.verdict == StabilityVerdict::undecided) {
-    out << " (the unit circle is within an error bar";
+    // "within an error bar" only where there is one: a multiplier without a bar (the levels did
+    // not show their order) decides nothing either way, and that is what is said then.
+    bool straddled = false;
+    for (size_t i = 0; i < bars.bars.size() && i < values.size(); ++i)
+      straddled = straddled || (std::isfinite(bars.bars[i].error_estimate) &&
+                                std::abs(std::abs(values[i]) - 1) <= bars.bars[i].error_estimate);
+    out << (straddled ? " (the unit circle is within an error bar"
+                      : " (the leading multiplier has no error bar");
     if (bars.deciding_N > 0)
       out << "; about N = " << bars.deciding_N << " would decide it if the error falls like N^-"
           << format_number(bars.expected_order);

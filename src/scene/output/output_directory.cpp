@@ -60,7 +60,11 @@ void OutputDirectory::acquire() {
     created_ = true;
   }
   const fs::path lock_path = dir_ / lock_name;
-  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Never through a symbolic link (as the cache's lock): a link planted in a shared directory
+  // would make this run create or lock a file elsewhere (issue 61 item 5). ELOOP: it is a link.
+  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd < 0 && errno == ELOOP)
+    throw BadInput("`" + lock_path.string() + "` is a symbolic link: delayspec does not lock through links; remove it");
   if (fd < 0) throw BadInput("cannot write `" + lock_path.string() + "`: " + std::strerror(errno));
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     const int error = errno;

@@ -26,6 +26,12 @@ bool valid_grid(const Problem& problem, long N) {
 
 }  // namespace
 
+void use_first_level_as_N(Config& config) {
+  if (!config.has("Ns")) return;
+  const std::vector<long> Ns = config.get_int_list("Ns", {});
+  if (!Ns.empty() && Ns.front() >= 1 && Ns.front() <= INT_MAX) config.set("N", std::to_string(Ns.front()), "Ns");
+}
+
 std::vector<int> read_N_list(Config& config, const Problem& problem, int default_min, int default_max) {
   std::vector<int> Ns;
   const bool has_list = config.has("Ns");
@@ -136,6 +142,7 @@ RichardsonOptions error_expansion(const Problem& problem) {
   const bool first_order = problem.switching() && problem.events == EventMode::off;
   options.order = first_order ? 1 : 2;
   options.order_step = first_order ? 1 : 2;
+  options.leading_term_may_hide = first_order;
   return options;
 }
 
@@ -210,7 +217,14 @@ ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit,
   Ns.push_back(problem.N);
   results.push_back(at_N);
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return error_bars(Ns, results, error_expansion(problem));
+  ErrorBars bars = error_bars(Ns, results, error_expansion(problem));
+  // A coarse level that cannot be had is said, not dropped silently (issue 61 item 9).
+  if (Ns.size() < 3)
+    bars.note += (bars.note.empty() ? "" : "; ") + std::to_string(Ns.size() - 1) +
+                 " coarse level(s) of the two wanted: below N = " + std::to_string(problem.N) +
+                 ", a level needs a grid the delays fit and more than nev + 2 = " +
+                 std::to_string(coarse.nev) + " multipliers (its dimension d (N + 1))";
+  return bars;
 }
 
 }  // namespace delayspec::cli

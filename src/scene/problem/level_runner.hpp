@@ -20,6 +20,12 @@
 
 namespace delayspec::cli {
 
+// With `Ns` the levels are the list's and the scene's N is not one of them: the problem is built
+// at the list's first N, so that an N no level uses is not checked against the grid (tau/T =
+// 19/13 needs N divisible by 19: a scene's N = 100 refused `converge` with valid Ns, issue 61
+// item 6). Call before read_problem.
+void use_first_level_as_N(Config& config);
+
 // `Ns` (comma list), or `N_min` .. `N_max` doubling (N_min, 2 N_min, ... <= N_max); defaults
 // when neither is given (moved up to the first valid N when the grid needs multiples: 26, 52, ...
 // for tau/T = 2). Validated: each N >= 1, strictly increasing, and a valid grid for the

@@ -3,6 +3,7 @@
 #include <climits>
 
 #include "delayspec/errors.hpp"
+#include "delayspec/memory_budget.hpp"
 #include "delayspec/grid.hpp"
 #include "scene/equations/equation_model.hpp"
 #include "scene/problem/models_module_loader.hpp"
@@ -71,7 +72,8 @@ AnyModel read_milling(Config& c) {
   // The model names the allowed range (1..kMaxTeeth) in its own message; the wide range here
   // only keeps the cast safe.
   p.teeth = static_cast<int>(c.get_int_in_range("teeth", p.teeth, 1, MillingModel::kMaxTeeth));
-  p.pitch_angles = c.get_double_list("pitch_angles", "equal");
+  // `equal` (what --help prints as the default) is accepted as a value too: the equal pitch.
+  if (c.get_string("pitch_angles", "equal") != "equal") p.pitch_angles = c.get_double_list("pitch_angles", "equal");
   p.Kt = c.get_double("Kt", p.Kt);
   p.Kn = c.get_double("Kn", p.Kn);
   p.omega_n = c.get_double("omega_n", p.omega_n);
@@ -195,7 +197,12 @@ Problem read_problem(Config& config, int default_N) {
       static_cast<int>(config.get_int_in_range("contact_substeps", problem.contact_substeps, 1, 1000));
   const bool uniform = config.get_choice("grid", "aligned", {"aligned", "uniform"}) == "uniform";
   problem.grid_layout = uniform ? GridLayout::uniform : GridLayout::aligned;
-  problem.grid();  // BadInput now when N does not fit the delay/period ratio
+  // BadInput now when N does not fit the delay/period ratio, or when two histories (the state and
+  // the vector a step map is applied to: the least any analysis holds) exceed the memory
+  // (memory_budget.hpp; each analysis bounds its own larger arrays before allocating them).
+  const long n = problem.grid().dimension(problem.state_dimension());
+  require_memory(2 * 8.0 * static_cast<double>(n), "`N = " + std::to_string(problem.N) + "`",
+                 "two histories of d (N + 1) = " + std::to_string(n) + " doubles");
   return problem;
 }
 
