@@ -311,3 +311,27 @@ TEST(EquilibriumCli, FewerRootsThanAskedAreSaidSo) {
   ASSERT_EQ(text.status, 0) << text.err;
   EXPECT_TRUE(contains(text.out, "note: " + std::to_string(j["roots"].size()) + " of the 1000 roots")) << text.out;
 }
+
+// Issue 61 item 4: `equilibrium` of a forced equations model (t in the right-hand side) is refused
+// from the symbolic table, before the compile (it compiled for 13 s first): in a fresh cache
+// directory nothing is compiled or written besides the directory itself.
+TEST(EquilibriumCli, AForcedEquationsModelIsRefusedBeforeItIsCompiled) {
+  const std::filesystem::path cache = delayspec::testing::fresh_dir("equilibrium_forced_cache");
+  const std::filesystem::path scene = cache.string() + "-scene.toml";
+  std::ofstream(scene) << "model = \"equations\"\n[equations]\nstate = [\"x\"]\nparameters = { a = -1.0 }\n"
+                          "period = \"2*pi\"\nrhs = [\"a*x + 0.5*x_tau + cos(t)\"]\n";
+  for (const char* command : {"equilibrium", "continue"}) {
+    std::vector<std::string> args{command, scene.string(), "--set", "model_cache=" + cache.string()};
+    if (std::string(command) == "continue")
+      args.insert(args.end(), {"--set", "continue_object=equilibrium", "--set", "continue_key=a", "--set",
+                               "continue_from=-1", "--set", "continue_to=0"});
+    const CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << command << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "`model = equations` is not autonomous: its right-hand side depends on t")) << r.err;
+  }
+  if (std::filesystem::exists(cache))
+    for (const auto& entry : std::filesystem::directory_iterator(cache))
+      ADD_FAILURE() << "written to the cache: " << entry.path().filename();
+  std::filesystem::remove_all(cache);
+  std::filesystem::remove(scene);
+}

@@ -24,6 +24,8 @@
 #include <sstream>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_test_support.hpp"
 #include "delayspec_test_paths.hpp"
 #include "scene/equations/equation_plugin.hpp"
@@ -403,6 +405,17 @@ TEST_F(ModelCache, HeadersComeOnlyFromTheBuildOrASafelyOwnedInstall) {
                   fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
                       fs::perms::others_exec,
                   fs::perm_options::replace);
+  // PREFIX/include itself, searched before the system's headers: world-writable, a planted
+  // `cmath` there would be compiled into the model (issue 61 item 4). Refused likewise.
+  const fs::perms include_perms = fs::status(prefix / "include").permissions();
+  fs::permissions(prefix / "include", fs::perms::all);
+  try {
+    delayspec::cli::model_headers(prefix / "lib");
+    ADD_FAILURE() << "a world-writable PREFIX/include was accepted";
+  } catch (const delayspec::BadInput& e) {
+    EXPECT_TRUE(contains(e.what(), "the installed include directory")) << e.what();
+  }
+  fs::permissions(prefix / "include", include_perms, fs::perm_options::replace);
   const auto installed = delayspec::cli::model_headers(prefix / "lib");
   ASSERT_FALSE(installed.include_dirs.empty());
   EXPECT_EQ(installed.include_dirs.front(), (prefix / "include").string());
@@ -428,6 +441,43 @@ TEST_F(ModelCache, ACompilersGroupWritableObjectIsMadePrivateNotRefused) {
   fs::permissions(cache / "made.so", fs::perms::owner_all | fs::perms::group_write, fs::perm_options::replace);
   dir.make_private("link.so");
   EXPECT_EQ(fs::status(cache / "made.so").permissions(), fs::perms::owner_all | fs::perms::group_write);
+}
+
+// Issue 61 item 4: a cache entry's object is bound to its entry. Two models compiled into one
+// cache, then their objects and checksum records swapped pair for pair (each pair valid on its
+// own): model A run in a new process (this one keeps what it loaded) must not run B's code. It
+// used to (exit 0, B's multipliers); now the record names its entry, the lookup finds another
+// name, and each model is compiled again: its own multipliers.
+TEST_F(ModelCache, AnotherEntrysObjectAndRecordAreNotLoadedAsThisOne) {
+  const fs::path cache = dir_ / "cache";
+  const fs::path scene_a = dir_ / "a.toml", scene_b = dir_ / "b.toml";
+  write(scene_a, std::string("model = \"equations\"\n") + kEquations);
+  std::string b = kEquations;
+  b.replace(b.find("a*x + b*x_tau"), std::string("a*x + b*x_tau").size(), "a*x - b*x_tau");
+  write(scene_b, "model = \"equations\"\n" + b);
+  // the multipliers from a new process of the program
+  auto leading = [&](const fs::path& scene) {
+    const fs::path out = dir_ / "out.json";
+    const std::string command = std::string(DELAYSPEC_CLI_PATH) + " floquet " + scene.string() +
+                                " --json --set model_cache=" + cache.string() + " --set N=20 --set nev=1 > " +
+                                out.string() + " 2>/dev/null";
+    EXPECT_EQ(std::system(command.c_str()), 0) << read_text(out);
+    const nlohmann::json j = nlohmann::json::parse(read_text(out), nullptr, false);
+    return j.is_object() && j.contains("multipliers") ? j.at("multipliers").dump() : read_text(out);
+  };
+  const std::string a = leading(scene_a), b_values = leading(scene_b);
+  ASSERT_NE(a, b_values) << "the two models must differ";
+  std::vector<std::string> stems;
+  for (const auto& e : fs::directory_iterator(cache))
+    if (e.path().extension() == ".so") stems.push_back(e.path().stem().string());
+  ASSERT_EQ(stems.size(), 2u);
+  for (const char* ext : {".so", ".sum"}) {
+    fs::rename(cache / (stems[0] + ext), dir_ / "swap");
+    fs::rename(cache / (stems[1] + ext), cache / (stems[0] + ext));
+    fs::rename(dir_ / "swap", cache / (stems[1] + ext));
+  }
+  EXPECT_EQ(leading(scene_a), a);
+  EXPECT_EQ(leading(scene_b), b_values);
 }
 
 }  // namespace

@@ -69,7 +69,7 @@ void print_equilibrium(std::ostream& out, const Problem& problem, const Equilibr
 
 int command_equilibrium(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
-  Problem problem = read_problem(config, 100);
+  Problem problem = read_problem(config, 100, ModelNeed::autonomous);
   const EquilibriumSettings settings = read_equilibrium_settings(config, problem);
   config.check_all_used();
   require_autonomous(problem);

@@ -237,7 +237,7 @@ EquilibriaRun read_equilibria_run(Config& config) {
                    "discretisation error to extrapolate (continue_Ns gives the error bars of the orbit branches "
                    "born at its Hopf points)");
   config.set(run.settings.key, format_number(run.settings.options.from), "continue_from");
-  run.problem = read_problem(config, 100);
+  run.problem = read_problem(config, 100, ModelNeed::autonomous);
   run.eq = read_equilibrium_settings(config, run.problem);
   run.orbit_options = run.settings.options;
   static_cast<BranchRange&>(run.orbit_options) = checked_range(run.settings.options);

@@ -282,7 +282,8 @@ std::vector<std::string> engine_keys(const KeyIndex& index) {
 }
 
 EquationModel read_equation_model(Config& config,
-                                  const std::function<void(const std::vector<double>&, const std::vector<std::string>&, double)>& check_grid) {
+                                  const std::function<void(const std::vector<double>&, const std::vector<std::string>&, double)>& check_grid,
+                                  const std::function<void(bool)>& check_autonomy) {
   if (!config.has("equations"))
     throw BadInput("`model = equations`: the scene has no [equations] table (docs/models.md shows its format)");
   const std::string text = config.get_string("equations", "");
@@ -340,6 +341,8 @@ EquationModel read_equation_model(Config& config,
     const std::vector<double> exact = constants_at(*src, p);
     history_from(exact);
     check_grid(delays_from(exact), delay_items, period_from(exact));
+    // equilibrium of a forced model compiled for 13 s before refusing it (issue 61 item 4)
+    if (check_autonomy) check_autonomy(src->shape.autonomous);
     loaded = LoadedEquations{&compiled(*src, text, cache_dir), names};
   }
   const EquationPlugin& plugin = *loaded->plugin;

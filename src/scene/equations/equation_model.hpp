@@ -27,9 +27,12 @@ struct EquationModel {
 // tau_over_T and model_cache. BadInput for every input error, naming the item. `check_grid(taus,
 // names, period)` is called with the delays (and their items, for messages) and period before the model is compiled, so that a grid that
 // cannot be made (a delay shorter than a step, too many steps) is refused in milliseconds.
+// `check_autonomy(autonomous)` likewise, when the model is compiled in this run (a cached one
+// costs nothing to load; its analyses say it then).
 EquationModel read_equation_model(Config& config,
                                   const std::function<void(const std::vector<double>& taus, const std::vector<std::string>& names,
-                                                           double period)>& check_grid);
+                                                           double period)>& check_grid,
+                                  const std::function<void(bool autonomous)>& check_autonomy = {});
 
 // The keys an equation parameter may not be named after: those the engine reads whatever the
 // model (N, nev, seed, ...: keys_of_every_model), and model, equations, tau_over_T and model_cache.

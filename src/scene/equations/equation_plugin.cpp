@@ -152,6 +152,16 @@ std::string delayspec_headers(const std::vector<std::string>& includes, bool bui
     const std::filesystem::path root = std::filesystem::path(dir) / "delayspec";
     std::error_code ec;
     if (!std::filesystem::is_directory(root, ec)) continue;
+    // PREFIX/include itself is on the compiler's search path before the system's: a `cmath`
+    // planted there (world-writable) would be compiled into the model (issue 61 item 4). Its
+    // group may write it (Debian's /usr/local/include can be root:staff 2775, by policy).
+    struct stat include_stat {};
+    if (!build_tree && (::lstat(dir.c_str(), &include_stat) != 0 ||
+                        (include_stat.st_uid != 0 && include_stat.st_uid != ::geteuid()) ||
+                        (include_stat.st_mode & S_IWOTH) != 0))
+      throw BadInput("equations: the installed include directory " + dir +
+                     " is not root's or yours, or anyone can write it (a header planted there would be compiled "
+                     "into the model): fix its permissions or reinstall delayspec");
     if (!build_tree && !owned_safely(root))
       throw BadInput("equations: the installed headers " + root.string() +
                      " are not root's or yours, or others can write them: reinstall delayspec");
@@ -214,6 +224,8 @@ Toolchain toolchain() {
               "-shared",
               "-fvisibility=hidden",
               "-fvisibility-inlines-hidden",
+              // no assembler temporary (cc*.s in TMPDIR) left behind when the compile is killed
+              "-pipe",
               "-w"};
   for (const auto& f : split_words(DELAYSPEC_PLUGIN_FLAGS)) tc.flags.push_back(f);
   for (const auto& dir : headers.include_dirs) tc.flags.push_back("-I" + dir);
@@ -234,8 +246,11 @@ Toolchain toolchain() {
 // Not a signature: what keeps others' code out is that only this user can write the directory
 // (model_cache.hpp); the checksum makes sure that what is opened is byte for byte the object this
 // program compiled and recorded, not a file truncated, replaced or put there by hand.
-std::string object_checksum(const std::string& bytes) {
-  return "fnv1a64 " + hash_hex(bytes) + " " + std::to_string(bytes.size()) + "\n";
+// The entry's own name is part of the record: swapping eq-A.so and eq-A.sum for eq-B's (both
+// valid pairs) made model A run B's code (issue 61 item 4); B's record names B, so A's lookup
+// finds no match and compiles A again.
+std::string object_checksum(const std::string& bytes, const std::string& name) {
+  return "fnv1a64 " + hash_hex(bytes) + " " + std::to_string(bytes.size()) + " " + name + "\n";
 }
 
 std::string read_fd(int fd) {
@@ -305,7 +320,7 @@ std::optional<EquationPlugin> cached_object(const ModelCacheDir& cache, const st
   if (!recorded) return std::nullopt;
   UniqueFd object = cache.open_entry(name + ".so");
   if (!object) return std::nullopt;
-  if (object_checksum(read_fd(object.get())) != *recorded) return std::nullopt;
+  if (object_checksum(read_fd(object.get()), name) != *recorded) return std::nullopt;
   const detail::SharedObject model = open_checked_object(object);
   if (!model.is_open())
     throw BadInput("equations: the cached model " + cache.entry_path(name + ".so").string() +
@@ -415,7 +430,7 @@ EquationPlugin compile_plugin(const Toolchain& tc, const ModelCacheDir& cache, c
     cache.remove_entry(tmp);
     throw;
   }
-  cache.write_entry(name + ".sum", object_checksum(bytes));
+  cache.write_entry(name + ".sum", object_checksum(bytes, name));
   cache.rename_entry(tmp, name + ".so");
   return plugin;
 }

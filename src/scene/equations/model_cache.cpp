@@ -99,8 +99,14 @@ std::optional<std::string> ModelCacheDir::read_entry(const std::string& name) co
 }
 
 UniqueFd ModelCacheDir::create_entry(const std::string& name) const {
-  UniqueFd fd(::openat(dir_.get(), name.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0600));
+  UniqueFd fd(::openat(dir_.get(), name.c_str(), O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0600));
   if (!fd) throw BadInput("`model_cache`: cannot write " + entry_path(name).string() + " (" + reason() + ")");
+  // An entry that exists already (the compiler's source or log) must be the user's too, as every
+  // entry read is: another user's world-writable file would be written and then compiled
+  // (issue 61 item 4). Checked before it is truncated.
+  require_private_file(fd, entry_path(name), "write");
+  if (::ftruncate(fd.get(), 0) != 0)
+    throw BadInput("`model_cache`: cannot write " + entry_path(name).string() + " (" + reason() + ")");
   return fd;
 }
 

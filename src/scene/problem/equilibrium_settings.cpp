@@ -31,10 +31,7 @@ EquilibriumSettings read_equilibrium_settings(Config& config, const Problem& pro
 }
 
 void require_autonomous(const Problem& problem) {
-  if (!problem.analyses->is_autonomous())
-    throw BadInput("`model = " + problem.model_name + "` is not autonomous: " +
-                   (problem.model ? "its forcing depends on t" : "its right-hand side depends on t, or it switches") +
-                   "; equilibria are for models with no forcing (linear, mackey-glass, or equations without t)");
+  require_autonomous_model(problem.analyses->is_autonomous(), problem.model_name, problem.model.has_value());
 }
 
 }  // namespace delayspec::cli

@@ -162,7 +162,14 @@ const std::vector<std::string>& model_choices() {
   return names;
 }
 
-Problem read_problem(Config& config, int default_N) {
+void require_autonomous_model(bool autonomous, const std::string& model_name, bool builtin) {
+  if (!autonomous)
+    throw BadInput("`model = " + model_name + "` is not autonomous: " +
+                   (builtin ? "its forcing depends on t" : "its right-hand side depends on t, or it switches") +
+                   "; equilibria are for models with no forcing (linear, mackey-glass, or equations without t)");
+}
+
+Problem read_problem(Config& config, int default_N, ModelNeed need) {
   Problem problem;
   problem.model_name = config.get_choice("model", model_names().front(), model_choices());
   const BuiltinModel* builtin = nullptr;
@@ -175,10 +182,14 @@ Problem read_problem(Config& config, int default_N) {
     problem.forced = builtin->forced;
   } else {
     EquationModel equations = read_equation_model(
-        config, [&](const std::vector<double>& taus, const std::vector<std::string>& names, double period) {
+        config,
+        [&](const std::vector<double>& taus, const std::vector<std::string>& names, double period) {
           make_grid(taus, period, static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000)),
                     static_cast<int>(config.get_int_in_range("orbit_period", 1, 1, 1000)), names);
-    });
+        },
+        [&](bool autonomous) {
+          if (need == ModelNeed::autonomous) require_autonomous_model(autonomous, "equations", false);
+        });
     problem.analyses = std::move(equations.analyses);
     problem.state_names = std::move(equations.state);
   }

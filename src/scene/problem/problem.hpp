@@ -73,8 +73,16 @@ std::string to_string(GridLayout layout);
 EventMode parse_event_mode(const std::string& text, const std::string& key = "events");
 const std::vector<std::string>& event_mode_names();
 
+// What a command needs of the model, checked as early as it can be: an equations model that
+// equilibrium cannot take is refused before its compile (seconds), not after.
+enum class ModelNeed { any, autonomous };
+
 // Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps, grid.
 // default_N is used when the key N is absent.
-Problem read_problem(Config& config, int default_N = 100);
+Problem read_problem(Config& config, int default_N = 100, ModelNeed need = ModelNeed::any);
+
+// BadInput unless the model is autonomous (equilibria need a model with no forcing). builtin:
+// the model is one of the built-in ones (its forcing, else the equations' t or switch, named).
+void require_autonomous_model(bool autonomous, const std::string& model_name, bool builtin);
 
 }  // namespace delayspec::cli
