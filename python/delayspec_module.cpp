@@ -82,13 +82,36 @@ bool on_main_thread() {
   return PyThread_get_thread_ident() == main_ident;
 }
 
+// A Python str as UTF-8. BadInput naming `what` when it has none: a lone surrogate ("\ud800")
+// made pybind11's cast raise a bare RuntimeError (issue 61 item 9).
+std::string utf8_text(const std::string& what, py::handle text) {
+  Py_ssize_t size = 0;
+  const char* data = PyUnicode_AsUTF8AndSize(text.ptr(), &size);
+  if (!data) {
+    PyErr_Clear();
+    throw BadInput(what + ": a string that is not valid Unicode (a lone surrogate such as \\ud800): give text "
+                   "that UTF-8 can hold");
+  }
+  return std::string(data, static_cast<size_t>(size));
+}
+
+// bytes and bytearray are sequences of integers to Python: as a key's value they were taken as a
+// list of numbers (b"ab" -> "97,98"). Refused, naming the key.
+void refuse_bytes(const std::string& key, py::handle value) {
+  if (PyBytes_Check(value.ptr()) || PyByteArray_Check(value.ptr()))
+    throw BadInput("`" + key + "`: a value of Python type " +
+                   py::str(py::type::handle_of(value).attr("__name__")).cast<std::string>() +
+                   " (give a str: decode the bytes first)");
+}
+
 // A Python value -> the text `--set KEY=VALUE` would carry (and a TOML scene value becomes,
 // config.cpp): booleans true/false, integers in decimal, floats in the shortest round-trip form,
 // sequences joined by commas (Ns = [100, 200] -> "100,200"); numpy scalars and arrays likewise.
 // `nested`: value is an element of a list.
 std::string key_text(const std::string& key, py::handle value, bool nested = false) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
-  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  if (py::isinstance<py::str>(value)) return utf8_text("`" + key + "`", value);
+  refuse_bytes(key, value);
   // numpy scalars and arrays as the Python values they hold (an array's __index__ would fail).
   if (py::hasattr(value, "__array__") && py::hasattr(value, "ndim"))
     return key_text(key, value.attr(value.attr("ndim").cast<int>() == 0 ? "item" : "tolist")(), nested);
@@ -128,11 +151,12 @@ template <class Container>
 void add_scene_value(Container& into, const std::string& key, py::handle value) {
   if (py::isinstance<py::dict>(value)) {
     toml::table table;
-    for (auto [k, v] : value.cast<py::dict>()) add_scene_value(table, py::str(k), v);
+    for (auto [k, v] : value.cast<py::dict>()) add_scene_value(table, utf8_text("a key of `" + key + "`", py::str(k)), v);
     return add(into, key, std::move(table));
   }
   if (py::isinstance<py::bool_>(value)) return add(into, key, value.cast<bool>());
-  if (py::isinstance<py::str>(value)) return add(into, key, value.cast<std::string>());
+  if (py::isinstance<py::str>(value)) return add(into, key, utf8_text("`" + key + "`", value));
+  refuse_bytes(key, value);
   if (py::hasattr(value, "__array__") && py::hasattr(value, "ndim"))
     return add_scene_value(into, key, value.attr(value.attr("ndim").cast<int>() == 0 ? "item" : "tolist")());
   PyObject* p = value.ptr();
@@ -159,7 +183,7 @@ Config make_config(const py::object& scene, const py::dict& keys, std::optional<
   Config config;
   if (py::isinstance<py::dict>(scene)) {
     toml::table table;
-    for (auto [k, v] : scene.cast<py::dict>()) add_scene_value(table, py::str(k), v);
+    for (auto [k, v] : scene.cast<py::dict>()) add_scene_value(table, utf8_text("a key of the scene dict", py::str(k)), v);
     config = Config::from_scene_table(table, "the scene dict");
   } else if (!scene.is_none()) {
     scene_path = py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>();
@@ -167,8 +191,9 @@ Config make_config(const py::object& scene, const py::dict& keys, std::optional<
   }
   for (auto [k, v] : keys) {
     if (v.is_none()) continue;  // None: the key's default (or the scene's value)
-    const std::string key = py::str(k);
-    config.set(key, key_text(key, v), "--set");
+    const std::string key = utf8_text("a keyword's name", py::str(k));
+    // the origin messages name: "(= 4, from a Python keyword)", not "from --set" (issue 61 item 9)
+    config.set(key, key_text(key, v), "a Python keyword");
   }
   return config;
 }

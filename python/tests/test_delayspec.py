@@ -304,7 +304,8 @@ def test_bad_input_raises_with_the_cli_message(keys):
     assert err.startswith(prefix)
     with pytest.raises(delayspec.BadInput) as caught:
         delayspec.floquet(**keys)
-    assert str(caught.value) == err[len(prefix):].rstrip("\n")
+    # the same message, the key's origin named as the caller gave it
+    assert str(caught.value) == err[len(prefix):].rstrip("\n").replace("from --set", "from a Python keyword")
     assert isinstance(caught.value, ValueError)
 
 
@@ -320,6 +321,25 @@ def test_bad_scene_file_raises_bad_input(tmp_path):
 def test_bad_value_type_raises_bad_input():
     with pytest.raises(delayspec.BadInput, match="`k`: a value of Python type object"):
         delayspec.floquet(k=object())
+
+
+def test_bytes_and_strings_without_utf8_raise_bad_input_naming_the_key():
+    """Issue 61 item 9: bytes were read as lists of integers (b"ab" -> 97,98) and a lone surrogate
+    raised a bare RuntimeError; both are BadInput naming the key, for keywords and scene dicts."""
+    with pytest.raises(delayspec.BadInput, match="`model`: a value of Python type bytes"):
+        delayspec.floquet(model=b"linear")
+    with pytest.raises(delayspec.BadInput, match="`Ns`: a value of Python type bytearray"):
+        delayspec.converge(Ns=bytearray(b"\x19\x32"))
+    with pytest.raises(delayspec.BadInput, match="`model`: a string that is not valid Unicode"):
+        delayspec.floquet(model="linear\ud800")
+    with pytest.raises(delayspec.BadInput, match="`model`: a string that is not valid Unicode"):
+        delayspec.floquet({"model": "\udfff"})
+
+
+def test_a_keyword_a_command_does_not_read_is_named_as_a_keyword():
+    """Issue 61 item 9: equilibrium(out=DIR) (equilibrium writes no files) said "from --set"."""
+    with pytest.raises(delayspec.BadInput, match=r"`out` \(= /tmp, from a Python keyword\)"):
+        delayspec.equilibrium(model="linear", out="/tmp")
 
 
 def test_keys_help_of_an_unknown_command_raises_bad_input():

@@ -289,18 +289,45 @@ ConvergenceStudy analyse_levels(const std::vector<LevelResult>& levels, const Co
     anchors.assign(finest.begin(), finest.begin() + nev);
   }
   // Match from the finest level down: each level against the next finer one.
+  // A match is ambiguous where another candidate lies within twice the distance the track moves
+  // there: the distance the matched one moved, or, if larger, the previous (finer) step's move
+  // scaled by the expansion's leading term (h^p: (h_i^p - h_{i+1}^p) / (h_{i+1}^p - h_{i+2}^p), 4 for
+  // p = 2 and halving), since a wrong partner can be nearer than the true one, which has moved that
+  // far. Two multipliers closer than the discretisation moves them (the Pyragas orbit's two pairs
+  // 1e-3 apart) can be swapped between levels, and extrapolating a swapped track gave bars
+  // 1.2-3.6x short (issue 61 item 10). first_clear[k]: the coarsest level from which track k's
+  // matches are all unambiguous; coarser levels are left out of its extrapolation.
+  constexpr double kAmbiguity = 2;
+  std::vector<double> previous_move(nev, 0);
+  const double p = options.richardson.order;
+  const auto hp = [&](size_t i) { return std::pow(1.0 / options.Ns[i], p); };
   std::vector<Multipliers> matched(L);
   std::vector<std::vector<double>> accuracy(L);  // of the matched values
+  std::vector<size_t> first_clear(nev, 0);
+  std::vector<bool> still_clear(nev, true);
   Multipliers targets = anchors;
   for (size_t step = 0; step < L; ++step) {
     const size_t i = L - 1 - step;
-    const std::vector<int> a = match_by_proximity(targets, levels[i].multipliers);
+    const Multipliers& candidates = levels[i].multipliers;
+    const std::vector<int> a = match_by_proximity(targets, candidates);
     matched[i].resize(nev);
     accuracy[i].resize(nev);
     for (int k = 0; k < nev; ++k) {
-      matched[i][k] = levels[i].multipliers[a[k]];
+      matched[i][k] = candidates[a[k]];
       accuracy[i][k] = levels[i].accuracy.empty() ? options.richardson.input_precision * std::abs(matched[i][k])
                                                   : levels[i].accuracy[a[k]];
+      if (step == 0 || !still_clear[k]) continue;  // the finest level is the anchor's own
+      // (a candidate equal to the matched one within its accuracy, a double multiplier, swaps harmlessly)
+      double moved = std::abs(matched[i][k] - targets[k]);
+      if (i + 2 < L) moved = std::max(moved, previous_move[k] * (hp(i) - hp(i + 1)) / (hp(i + 1) - hp(i + 2)));
+      previous_move[k] = std::abs(matched[i][k] - targets[k]);
+      for (size_t j = 0; j < candidates.size(); ++j)
+        if (static_cast<int>(j) != a[k] && std::abs(candidates[j] - targets[k]) < kAmbiguity * moved &&
+            std::abs(candidates[j] - matched[i][k]) > 2 * accuracy[i][k]) {
+          still_clear[k] = false;
+          first_clear[k] = i + 1;
+          break;
+        }
     }
     targets = matched[i];
   }
@@ -317,11 +344,18 @@ ConvergenceStudy analyse_levels(const std::vector<LevelResult>& levels, const Co
   std::vector<double> h(L);
   for (size_t i = 0; i < L; ++i) h[i] = 1.0 / options.Ns[i];  // relative step: h = tau / N
 
-  // Extrapolated multipliers (every study with >= 2 levels reports them).
+  // Extrapolated multipliers (every study with >= 2 levels reports them), each over its clear levels.
   if (L >= 2)
     for (int k = 0; k < nev; ++k) {
-      const Extrapolation e = richardson_extrapolate(h, track(k), options.richardson, track_accuracy(k));
-      study.extrapolated.push_back({e.value, e.error_estimate, e.levels, e.note});
+      const size_t from = first_clear[k];
+      const auto tail = [&](auto v) { return decltype(v)(v.begin() + static_cast<long>(from), v.end()); };
+      const Extrapolation e = richardson_extrapolate(tail(h), tail(track(k)), options.richardson, tail(track_accuracy(k)));
+      std::string note = e.note;
+      if (from > 0)
+        note = "N = " + std::to_string(options.Ns[from - 1]) + (from > 1 ? " and coarser" : "") +
+               " left out: matched ambiguously (another multiplier within twice the distance this one moved "
+               "between levels); " + note;
+      study.extrapolated.push_back({e.value, e.error_estimate, e.levels, note});
     }
 
   // The reference and its relative precision, per track.

@@ -8,11 +8,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli_test_support.hpp"
@@ -140,12 +143,24 @@ TEST(AutonomousOrbitCli, AnOrbitSystemBeyondTheMemoryIsRefusedNamingTheKey) {
     ::_exit(0);
   }
   ::close(pipe_fds[1]);
+  // The child runs in a copy of this (threaded) process without exec: should it ever hang, it is
+  // killed after a minute and the test fails, rather than CI hanging.
+  int child = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  pid_t done = 0;
+  while ((done = ::waitpid(pid, &child, WNOHANG)) == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (done == 0) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &child, 0);
+    ::close(pipe_fds[0]);
+    FAIL() << "the child did not finish within 60 s";
+  }
+  ASSERT_EQ(done, pid);
   std::string message;
   char buffer[4096];
   for (ssize_t got; (got = ::read(pipe_fds[0], buffer, sizeof buffer)) > 0;) message.append(buffer, got);
   ::close(pipe_fds[0]);
-  int child = 0;
-  ASSERT_EQ(::waitpid(pid, &child, 0), pid);
   ASSERT_TRUE(WIFEXITED(child) && WEXITSTATUS(child) == 0) << "child status " << child << ": " << message;
   EXPECT_EQ(message.substr(0, 2), "2\n") << message;
   EXPECT_NE(message.find("`period_guess = 1e+06` (11764706 steps per period at N = 200) needs at least"), std::string::npos) << message;

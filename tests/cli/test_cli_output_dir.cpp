@@ -274,6 +274,9 @@ TEST(OutputDirectory, KilledRunIsIncompleteAndResumesToTheSameTables) {
   const auto marker = nlohmann::json::parse(read_text(dir / "complete.json"));
   EXPECT_EQ(marker["command"], "run");
   EXPECT_TRUE(contains(marker["files"].dump(), "\"run.json\"")) << marker.dump();
+  // the settings the resumed points were checked against belong to the finished set too (issue
+  // 61 item 9: the resumed run's complete.json left them out)
+  EXPECT_TRUE(contains(marker["files"].dump(), "\"sweep_settings.json\"")) << marker.dump();
   EXPECT_LE(nlohmann::json::parse(read_text(dir / "sweep.json"))["points_computed_now"].get<long>(), 200 - seen);
 
   CliResult alone = run({"run", scene.string(), "--out", reference.string(), "--quiet"});  // uninterrupted

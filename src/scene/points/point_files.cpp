@@ -112,6 +112,9 @@ std::map<long, json> PointFiles::start(bool resume, long count) const {
     throw BadInput("`--resume`: `" + settings_path().string() + "` is not valid JSON");
   }
   if (stored != settings_) settings_differ(settings_, stored, command_);
+  // The settings are part of the resumed run's files (complete.json lists them; it did not after
+  // --resume, issue 61 item 9). An existing file: abandon() leaves it for the next --resume.
+  if (inv_.output) inv_.output->note_write(settings_path());
 
   std::map<long, json> finished;
   std::error_code ec;
