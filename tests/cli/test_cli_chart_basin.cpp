@@ -139,3 +139,14 @@ INSTANTIATE_TEST_SUITE_P(Keys, GridBadInput, ::testing::Values(
     BadKey{"basin", "basin_x", "kappa", "`basin_y = v0`: not a numeric parameter of model mathieu"},
     BadKey{"basin", "basin_x_range", "3,3", "`basin_x_range = 3,3`"}));
 // clang-format on
+
+// Issue 61 item 7: a chart of an autonomous model follows the map's fixed point (Mackey-Glass:
+// the equilibrium, over T = tau); it says so and where orbits and equilibria are followed instead.
+TEST(ChartCli, AnAutonomousModelSaysWhatIsCharted) {
+  const CliResult r = run({"chart", "--set", "model=mackey-glass", "--set", "N=20", "--set", "chart_x=beta", "--set",
+                           "chart_x_range=0.19,0.2", "--set", "chart_x_points=2", "--set", "chart_y=gamma", "--set",
+                           "chart_y_range=0.09,0.1", "--set", "chart_y_points=2", "--set", "threads=1"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "chart: note: model `mackey-glass` is autonomous")) << r.err;
+  EXPECT_TRUE(contains(r.err, "`floquet` with `period_guess`")) << r.err;
+}

@@ -553,6 +553,8 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out
 int command_boundary(Config& config, const Invocation& inv) {
   const auto start_time = std::chrono::steady_clock::now();
   const BoundaryRun run = read_boundary_run(config);
+  if (const std::string note = autonomous_fixed_point_note(run.problem); !note.empty() && !inv.quiet)
+    inv.err << "delayspec boundary: note: " << note << "\n";
   const Outcome out = compute_boundary(config, run, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   const json j = boundary_json(run, out, seconds);

@@ -205,6 +205,8 @@ void print_chart(const Invocation& inv, const ChartSettings& s, const ChartTally
 int command_chart(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
   const ChartSettings s = read_chart_settings(config);
+  if (const std::string note = autonomous_fixed_point_note(s.problem); !note.empty() && !inv.quiet)
+    inv.err << "delayspec chart: note: " << note << "\n";
   ChartPoints pts(s.count);
   PointLoop loop{.command = "chart", .count = s.count, .threads = s.threads, .per_point_keys = {s.x.name, s.y.name}};
   loop.record = [&](long i) { return chart_record(s, pts, i); };

@@ -277,11 +277,8 @@ int command_continue(Config& config, const Invocation& inv) {
   // An autonomous model has no forcing period: what is followed is the fixed point of the map
   // over the sampling period T (an equilibrium, or an orbit whose period divides T), wherever
   // the history leads; said, so that it is not taken for the orbit (issue 61 item 7).
-  if (run.problem.analyses->is_autonomous() && !inv.quiet)
-    inv.err << "delayspec continue: note: model `" << run.problem.model_name
-            << "` is autonomous: this follows the fixed point of the stroboscopic map over the sampling period "
-               "(what the history reaches, often an equilibrium); for equilibria and their Hopf points use "
-               "`continue_object = equilibrium`, for the orbits born there add `continue_switch = true`\n";
+  if (const std::string note = autonomous_fixed_point_note(run.problem); !note.empty() && !inv.quiet)
+    inv.err << "delayspec continue: note: " << note << "\n";
   const ContinueOutcome out = compute_continue(config, run, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const json j = continue_json(run, out, seconds);

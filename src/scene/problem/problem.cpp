@@ -162,6 +162,15 @@ const std::vector<std::string>& model_choices() {
   return names;
 }
 
+std::string autonomous_fixed_point_note(const Problem& problem) {
+  if (!problem.analyses->is_autonomous()) return "";
+  return "model `" + problem.model_name +
+         "` is autonomous: this follows the fixed point of the stroboscopic map over the sampling period (what the "
+         "history reaches, often an equilibrium); for equilibria and their Hopf points use `continue` with "
+         "`continue_object = equilibrium`, for the orbits born there add `continue_switch = true`, for one orbit "
+         "`floquet` with `period_guess`";
+}
+
 void require_autonomous_model(bool autonomous, const std::string& model_name, bool builtin) {
   if (!autonomous)
     throw BadInput("`model = " + model_name + "` is not autonomous: " +

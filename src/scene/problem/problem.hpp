@@ -81,6 +81,11 @@ enum class ModelNeed { any, autonomous };
 // default_N is used when the key N is absent.
 Problem read_problem(Config& config, int default_N = 100, ModelNeed need = ModelNeed::any);
 
+// For the commands that follow the fixed point of the stroboscopic map (continue, chart,
+// boundary): on an autonomous model, which has no forcing period, what that fixed point is and
+// where the orbits and equilibria are followed instead; empty for a forced model (issue 61 item 7).
+std::string autonomous_fixed_point_note(const Problem& problem);
+
 // BadInput unless the model is autonomous (equilibria need a model with no forcing). builtin:
 // the model is one of the built-in ones (its forcing, else the equations' t or switch, named).
 void require_autonomous_model(bool autonomous, const std::string& model_name, bool builtin);
