@@ -328,6 +328,19 @@ std::vector<BadTable> bad_tables() {
   add("two arguments", impact_rhs2("sin(x, v)"), {"`equations.rhs[2]`", "`,`", "position 6", "one argument"});
   add("function without argument", impact_rhs2("sin*x"), {"`equations.rhs[2]`", "`sin` without an argument"});
   add("number out of range", impact_rhs2("1e999*x"), {"`equations.rhs[2]`", "out of range"});
+  // issue 61 item 3: the symbolic stage bounded before it runs for minutes. A product of 300
+  // binomials in x and x_tau (over 60 s of GiNaC before; its first derivatives have some 4.5e5
+  // nodes) and 129 delays are refused, naming the entry.
+  {
+    std::string product = "-x";
+    for (int k = 0; k < 300; ++k) product += "*(x + " + std::to_string(k + 1) + "*x_tau)";
+    add("derivatives too large", scalar_table(product), {"`equations.rhs[1]`", "its derivatives have more than"});
+    toml::table many;
+    for (int k = 0; k < 129; ++k) many.insert("d" + std::to_string(k), "1");
+    toml::table with_many = impact_without("delay");
+    with_many.insert_or_assign("delays", many);
+    add("too many delays", with_many, {"`equations.delays`", "129 delays, at most 128"});
+  }
   add("product out of range", impact_rhs2("1e300*1e300*x"), {"`equations.rhs[2]`", "beyond the range of a double"});
   // names in expressions
   add("unknown name", impact_rhs2("a*omgea^2*sin(omega*t)"),

@@ -117,6 +117,12 @@ class EquationsReader {
       const toml::table* delays = several->as_table();
       if (!delays || delays->empty())
         throw BadInput("`equations.delays`: must be a table of named delays, e.g. { tau1 = \"1\", tau2 = \"sqrt(2)\" }");
+      // The symbolic stage and the generated code grow with the delays (d per delay delayed
+      // states, each differentiated): 300 took 12 s, 2000 did not finish (issue 61 item 3).
+      constexpr size_t kMaxDelays = 128;
+      if (delays->size() > kMaxDelays)
+        throw BadInput("`equations.delays`: " + std::to_string(delays->size()) + " delays, at most " +
+                       std::to_string(kMaxDelays) + " (the symbolic stage and the compiled model grow with each)");
       for (const auto& [key, value] : *delays) {  // sorted by name
         const std::string name(key.str());
         const std::string item = "equations.delays." + printable(name);
@@ -320,7 +326,19 @@ class EquationsReader {
     }
   }
 
+  // The expression's size in nodes (every sub-expression counted once per occurrence), stopping
+  // once it passes `limit`.
+  static size_t nodes(const GiNaC::ex& e, size_t limit) {
+    size_t count = 1;
+    for (size_t k = 0; k < e.nops() && count <= limit; ++k) count += nodes(e.op(k), limit - count);
+    return count;
+  }
+
   SymbolicField differentiate_field(const std::vector<GiNaC::ex>& f, const std::string& entry) const {
+    // The derivatives are printed as C++ and compiled: beyond this many nodes in one component's
+    // (a product of 300 binomials in x and x_tau has some 1.8e5) the compile takes minutes and
+    // the model is better written another way (issue 61 item 3).
+    constexpr size_t kMaxNodes = 100'000;
     SymbolicField field;
     field.entry = entry;
     field.text = field_text(entry);
@@ -336,6 +354,13 @@ class EquationsReader {
       } catch (const std::exception& e) {
         throw BadInput("`" + item_of(entry, i) + "`: cannot be differentiated: " + e.what());
       }
+      size_t size = 0;
+      for (const auto* row : {&field.A[i], &field.B[i]})
+        for (const auto& derivative : *row) size += nodes(derivative, kMaxNodes - std::min(size, kMaxNodes));
+      if (size > kMaxNodes)
+        throw BadInput("`" + item_of(entry, i) + "`: its derivatives have more than " + std::to_string(kMaxNodes) +
+                       " terms and factors in all, more than delayspec compiles (expand or factor it by hand, or "
+                       "write it with fewer products)");
     }
     return field;
   }
