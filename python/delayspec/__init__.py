@@ -263,7 +263,24 @@ class GridResult(Result):
 class ContinueResult(SweepResult):
     """`continue`: per-point fields stacked over the branch's points (`parameter`, `multipliers`:
     points x nev complex128, `verdict`: "stable", "unstable" or "undecided" for N -> infinity, ...),
-    and the CLI's fields (`bifurcations`, `Ns`, `verdicts_note`, ...; see docs/continuation.md)."""
+    and the CLI's fields (`bifurcations`, `Ns`, `verdicts_note`, ...; see docs/continuation.md).
+    With `continue_switch` on a branch of equilibria, `hopf_branch(i)` is the branch of orbits born
+    at its i-th Hopf point, as a ContinueResult of its own (`parameter`, `period`, ... stacked)."""
+
+    def hopf_branch(self, index=0):
+        """The branch of orbits born at the index-th Hopf point (`hopf_branches[index]` of the
+        JSON) with its points' fields stacked as arrays, as for the branch itself; the period at the
+        Hopf point (the JSON's branch-level `period`) is `from_period`."""
+        branches = self._data.get("hopf_branches") or []
+        if not 0 <= index < len(branches):
+            raise IndexError(f"hopf_branch({index}): this result has {len(branches)} branch(es) born at Hopf "
+                             "points (continue_object = equilibrium with continue_switch = true)")
+        branch = dict(branches[index])
+        # the branch's own `period` is the one at the Hopf point (2 pi / omega): `from_period` here,
+        # beside `from_parameter`, so that `period` is the points' (stacked)
+        if "period" in branch:
+            branch["from_period"] = branch.pop("period")
+        return ContinueResult(self.command, branch, {}, self.status)
 
 
 class BoundaryResult(Result):

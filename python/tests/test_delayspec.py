@@ -342,6 +342,22 @@ def test_a_keyword_a_command_does_not_read_is_named_as_a_keyword():
         delayspec.equilibrium(model="linear", out="/tmp")
 
 
+def test_the_orbits_born_at_a_hopf_point_come_as_arrays():
+    """Issue 61 item 8: the Hopf branches were nested dicts only; hopf_branch(i) stacks their
+    points' fields as the branch's own (the CLI test checks the numbers against the closed form:
+    tests/cli/test_cli_equilibrium.cpp)."""
+    r = delayspec.continue_(model="mackey-glass", continue_object="equilibrium", continue_key="tau",
+                            continue_from=3, continue_to=14, equilibrium_guess=1.1, continue_switch=True)
+    points = r["hopf_branches"][0]["points"]
+    b = r.hopf_branch(0)
+    assert b.parameter.shape == (len(points),) and b.period.shape == (len(points),)
+    assert b.period[0] == points[0]["period"] and b.parameter[-1] == points[-1]["parameter"]
+    assert np.all(np.diff(b.period) > 0)  # the period grows with tau (as in the CLI test)
+    assert b.from_period == r["hopf_branches"][0]["period"]  # 2 pi / omega at the Hopf point
+    with pytest.raises(IndexError, match="1 branch"):
+        r.hopf_branch(1)
+
+
 def test_keys_help_of_an_unknown_command_raises_bad_input():
     """Issue 31: keys_help("nope") returned "" (an empty help, as if the command read no keys)."""
     with pytest.raises(delayspec.BadInput, match=r"unknown command `nope` \(commands: .*floquet.*sweep"):
