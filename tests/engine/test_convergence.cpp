@@ -383,10 +383,14 @@ TEST(Matching, SurvivesTwoMultipliersSwappingRankInModulus) {
 // levels matched ambiguously are left out of each track's extrapolation, and the note says so:
 // every bar then covers the exact value, or there is none.
 TEST(Matching, LevelsMatchedAmbiguouslyAreLeftOutOfTheExtrapolation) {
-  auto values = [](int N) {
-    const double s = 1.0 / (double(N) * N);
-    return Multipliers{0.602 - 4 * s, 0.598 + 4 * s, 0.1 + s};
+  // two tracks c1 - 4 h^2 and c2 + 4 h^2 beside a small third multiplier
+  auto two_tracks = [](double c1, double c2) {
+    return [c1, c2](int N) {
+      const double s = 1.0 / (double(N) * N);
+      return Multipliers{c1 - 4 * s, c2 + 4 * s, 0.1 + s};
+    };
   };
+  const auto values = two_tracks(0.602, 0.598);
   const Multipliers exact{0.602, 0.598};
   ConvergenceOptions o;
   o.Ns = {10, 20, 40, 80, 160, 320};
@@ -404,11 +408,7 @@ TEST(Matching, LevelsMatchedAmbiguouslyAreLeftOutOfTheExtrapolation) {
   }
   EXPECT_TRUE(left_out);
   // Far apart (0.9 and 0.3), nothing is left out: the same h^2 tracks extrapolate exactly.
-  auto apart = [](int N) {
-    const double s = 1.0 / (double(N) * N);
-    return Multipliers{0.9 - 4 * s, 0.3 + 4 * s, 0.1 + s};
-  };
-  const ConvergenceStudy far = run_convergence_study(synthetic(apart), o);
+  const ConvergenceStudy far = run_convergence_study(synthetic(two_tracks(0.9, 0.3)), o);
   for (int k = 0; k < 2; ++k) {
     EXPECT_EQ(far.extrapolated[k].note.find("matched ambiguously"), std::string::npos) << far.extrapolated[k].note;
     EXPECT_LT(std::abs(far.extrapolated[k].value - (k == 0 ? 0.9 : 0.3)), 1e-12);

@@ -426,15 +426,11 @@ TEST(EquationModels, ImpactWithItsFeedbackSplitOverTwoEqualDelaysIsTheBuiltInMod
 // period is then the delay, the sampling time of lyapunov and simulate), and its multipliers are
 // the same as with `period` stated as the delay. A forced model without it is refused.
 TEST(EquationModels, AnAutonomousModelWithOneDelayDefaultsThePeriodToTheDelay) {
-  const std::string stated = R"(model = "equations"
-[equations]
-state = ["x"]
-parameters = { a = -1.0, b = 0.5 }
-period = "1.5"
-delay = "1.5"
-rhs = ["a*x + b*x_tau"]
-history = { x = 1 }
-)";
+  // kLinearScene with its period and delay 1.5 (not 1, so that a default that ignored the delay
+  // would show); without its period it must be the same model
+  std::string stated = kLinearScene;
+  const std::string constants = "period = \"1\"\ndelay = \"1\"\n";
+  stated.replace(stated.find(constants), constants.size(), "period = \"1.5\"\ndelay = \"1.5\"\n");
   std::string defaulted = stated;
   defaulted.erase(defaulted.find("period = \"1.5\"\n"), std::string("period = \"1.5\"\n").size());
   const Spectrum a = spectrum(problem_from(stated, {{"N", "30"}}), 3),

@@ -128,14 +128,10 @@ void print_error_bars(std::ostream& out, const std::vector<std::complex<double>>
   }
   out << "verdict: " << to_string(bars.verdict);
   if (bars.verdict == StabilityVerdict::undecided) {
-    // "within an error bar" only where there is one: a multiplier without a bar (the levels did
-    // not show their order) decides nothing either way, and that is what is said then.
-    bool straddled = false;
-    for (size_t i = 0; i < bars.bars.size() && i < values.size(); ++i)
-      straddled = straddled || (std::isfinite(bars.bars[i].error_estimate) &&
-                                std::abs(std::abs(values[i]) - 1) <= bars.bars[i].error_estimate);
-    out << (straddled ? " (the unit circle is within an error bar"
-                      : " (the leading multiplier has no error bar");
+    // Undecided comes from the leading multiplier (error_bars.cpp): its bar holds the unit circle,
+    // or it has none (the levels did not show their order), and then that is what is said.
+    const bool barred = !bars.bars.empty() && std::isfinite(bars.bars[0].error_estimate);
+    out << (barred ? " (the unit circle is within an error bar" : " (the leading multiplier has no error bar");
     if (bars.deciding_N > 0)
       out << "; about N = " << bars.deciding_N << " would decide it if the error falls like N^-"
           << format_number(bars.expected_order);
