@@ -35,6 +35,7 @@
 // names the check.
 #include <complex>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,14 +43,18 @@
 
 #include "delayspec/continuation.hpp"
 #include "delayspec/equilibrium.hpp"
+#include "delayspec/hopf_normal_form.hpp"
 
 namespace delayspec {
 
 // The model at parameter p: its values on a constant history, and its equilibrium near a guess
-// with its `nroots` rightmost roots (find_equilibrium with EquilibriumOptions::nroots = nroots).
+// with its `nroots` rightmost roots (find_equilibrium with EquilibriumOptions::nroots = nroots);
+// its Jacobian [A B] on any history (current state y, delayed states `delayed`), for the normal
+// form of each Hopf point (hopf_normal_form.hpp; empty: no normal forms).
 struct EquilibriumFamily {
   std::function<ConstantHistory(const Eigen::VectorXd& y, double p)> at;
   std::function<EquilibriumResult(const Eigen::VectorXd& guess, double p, int nroots)> equilibrium;
+  std::function<Eigen::MatrixXd(const Eigen::VectorXd& y, const Eigen::VectorXd& delayed, double p)> jacobian;
 };
 
 // Roots tracked beyond those with Re >= 0: a complex pair and a real root about to cross, and one
@@ -74,6 +79,7 @@ struct EquilibriumBifurcation {
   Eigen::VectorXd state;       // the equilibrium there
   CharacteristicRoot root;     // the critical root (Im >= 0), refined there
   double omega = 0, period = 0;  // Hopf: Im lambda and 2 pi / omega (0 otherwise)
+  std::optional<HopfNormalForm> normal_form;  // Hopf, where the family has a Jacobian: l1 and criticality
   int evaluations = 0;           // branch points computed to locate it
 };
 

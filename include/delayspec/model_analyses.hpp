@@ -122,6 +122,10 @@ class ModelAnalyses {
   // f, A, the B_i and the delays on the constant history y (d entries): what an equilibrium's
   // Newton and its characteristic function need (equilibrium.hpp). BadInput as equilibrium().
   virtual ConstantHistory at_constant_history(const Eigen::VectorXd& y) const = 0;
+  // [A B] (d x d (n + 1)) on the history with current state y and delayed states `delayed`
+  // (d n): the Jacobian whose differences give a Hopf point's normal form (hopf_normal_form.hpp).
+  // BadInput as equilibrium().
+  virtual Eigen::MatrixXd jacobian_at(const Eigen::VectorXd& y, const Eigen::VectorXd& delayed) const = 0;
   // A periodic orbit of unknown period near the guess (autonomous_orbit.hpp) and its monodromy.
   // BadInput for a model that is not autonomous, or linear (no isolated orbits).
   virtual AutonomousLinearisedOrbit autonomous_orbit(const AutonomousOrbitOptions& options) const = 0;
@@ -237,6 +241,22 @@ class ModelAnalysesFor final : public ModelAnalyses {
       if (y.size() != D)
         throw BadInput("the state has " + std::to_string(D) + " entries, not " + std::to_string(y.size()));
       return constant_history(model_, Vec<D>(y));
+    } else {
+      throw BadInput(kNotAutonomous);
+    }
+  }
+  Eigen::MatrixXd jacobian_at(const Eigen::VectorXd& y, const Eigen::VectorXd& delayed) const override {
+    if constexpr (AutonomousModel<Model>) {
+      constexpr int NT = delay_count_of<Model>();
+      if (y.size() != D || delayed.size() != D * NT)
+        throw BadInput("the Jacobian takes " + std::to_string(D) + " states and " + std::to_string(D * NT) +
+                       " delayed values, not " + std::to_string(y.size()) + " and " + std::to_string(delayed.size()));
+      const Vec<D> now(y);
+      const Vec<D * NT> w(delayed);
+      Eigen::MatrixXd J(D, D * (NT + 1));  // block writes: `J << A, B` trips GCC 12's -Warray-bounds at d = 1
+      J.leftCols(D) = model_.A(1, 0.0, now, w);
+      J.rightCols(D * NT) = model_.B(1, 0.0, now, w);
+      return J;
     } else {
       throw BadInput(kNotAutonomous);
     }

@@ -358,6 +358,16 @@ def test_the_orbits_born_at_a_hopf_point_come_as_arrays():
         r.hopf_branch(1)
 
 
+def test_hopf_points_carry_their_criticality():
+    """Issue 60: each Hopf point's first Lyapunov coefficient reaches Python with its bar; the
+    reference -13.342516550137968 is scripts/hopf_normal_form_reference.py's (mpmath, 40 digits)."""
+    r = delayspec.continue_(model="mackey-glass", continue_object="equilibrium", continue_key="tau",
+                            continue_from=3, continue_to=6, equilibrium_guess=1.1)
+    hopf = r["bifurcations"][0]
+    assert hopf["criticality"] == "supercritical"
+    assert abs(hopf["l1"] + 13.342516550137968) <= hopf["l1_bound"] <= 1.4e-7
+
+
 def test_keys_help_of_an_unknown_command_raises_bad_input():
     """Issue 31: keys_help("nope") returned "" (an empty help, as if the command read no keys)."""
     with pytest.raises(delayspec.BadInput, match=r"unknown command `nope` \(commands: .*floquet.*sweep"):

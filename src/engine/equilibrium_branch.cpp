@@ -349,6 +349,12 @@ EquilibriumBranch continue_equilibrium(const EquilibriumFamily& family, const Ei
         if (b.type != EquilibriumBifurcationType::hopf)
           b.type = here.tangent(d) * next.tangent(d) < 0 ? EquilibriumBifurcationType::fold
                                                          : EquilibriumBifurcationType::branch_point;
+        else if (family.jacobian)
+          b.normal_form = hopf_normal_form(
+              [&family, p = b.parameter](const Eigen::VectorXd& y, const Eigen::VectorXd& delayed) {
+                return family.jacobian(y, delayed, p);
+              },
+              family.at(b.state, b.parameter), b.state, b.root);
         if (!past_to || (b.parameter - o.to) * direction <= 0) found.emplace_back(s, std::move(b));
       }
     } catch (const Unverified& e) {

@@ -114,11 +114,22 @@ TEST(EquilibriumCli, ContinueLocatesTheMackeyGlassHopfPoint) {
   EXPECT_NEAR(h["parameter"].get<double>(), tau_H, 1e-10);
   EXPECT_NEAR(h["omega"].get<double>(), omega, 1e-10);
   EXPECT_NEAR(h["period"].get<double>(), 2 * M_PI / omega, 1e-9);
+  // its first Lyapunov coefficient (issue 60): scripts/hopf_normal_form_reference.py (mpmath, 40
+  // digits) gives -13.342516550137967989; the bar covers the error and is 1e-8 of it at most
+  // (measured: error 3e-11, bar 2.6e-10)
+  EXPECT_EQ(h["criticality"], "supercritical");
+  EXPECT_LE(std::abs(h["l1"].get<double>() + 13.342516550137967989), h["l1_bound"].get<double>());
+  EXPECT_LE(h["l1_bound"].get<double>(), 1.4e-7);
   EXPECT_EQ(j["points"].front()["unstable"], 0);
   EXPECT_EQ(j["points"].back()["unstable"], 2);
   // the files: one row per point and per bifurcation after the metadata lines
   for (const char* file : {"equilibria.csv", "equilibrium_bifurcations.csv", "continue.json"})
     EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / file)) << file;
+  std::ifstream csv(std::filesystem::path(dir) / "equilibrium_bifurcations.csv");
+  std::string line, last;
+  while (std::getline(csv, line))
+    if (!line.empty() && line[0] != '#') last = line;
+  EXPECT_TRUE(contains(last, ",supercritical")) << last;
   // and `plot` draws them (gnuplot: a CI dependency)
   const CliResult plot = run({"plot", dir});
   ASSERT_EQ(plot.status, 0) << plot.err;
@@ -231,6 +242,48 @@ TEST(EquilibriumCli, ContinueSwitchFollowsTheOrbitsBornAtTheHopfPoint) {
     EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / file)) << file;
 }
 
+// Issue 60: the first Lyapunov coefficient against the orbits themselves. Near the Hopf point the
+// orbit is y* + 2 Re(z v e^{i omega t}), |v| = 1, |z|^2 = -mu (tau - tau_H) / Re c1, mu = Re lambda'(tau_H),
+// so its amplitude a (half of max - min) has a^2 / (tau - tau_H) -> -4 mu / (omega l1). The branch
+// of orbits (Newton on the periodic orbit at N = 400, hopf_branch.hpp: no normal form in it) gives
+// a^2 over tau; a quadratic fitted to it has slope S at its root (the discrete Hopf point). mu from
+// the closed form: lambda = a + b e^{-lambda tau} gives lambda' = -lambda (lambda - a) / (1 + tau (lambda - a)).
+// Measured: S and -4 mu / (omega l1) agree to 8e-5 (the O(h^2) of N = 400 and the fit); 1e-3 fails
+// for a wrong normalisation, a wrong sign or a missing term of c1 (each changes l1 by O(1)).
+TEST(EquilibriumCli, TheFirstLyapunovCoefficientPredictsTheOrbitsAmplitude) {
+  const CliResult r = run({"continue", "--json", "--set", "model=mackey-glass", "--set", "continue_object=equilibrium",
+                           "--set", "continue_key=tau", "--set", "continue_from=3", "--set", "continue_to=5.2",
+                           "--set", "equilibrium_guess=1.1", "--set", "continue_switch=true", "--set", "N=400",
+                           "--set", "continue_step_max=0.05"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& hopf = j["bifurcations"][0];
+  const double l1 = hopf["l1"], omega = hopf["omega"], tau_H = hopf["parameter"];
+  const std::complex<double> lambda(0, omega), e = lambda + 0.1;  // lambda - a, a = -gamma = -0.1
+  const double mu = (-lambda * e / (1.0 + tau_H * e)).real();
+  const double predicted = -4 * mu / (omega * l1);
+  // least squares a^2 = c0 + c1 x + c2 x^2, x = tau - tau_H, over the branch's points
+  double m[3][4] = {};
+  for (const auto& p : j["hopf_branches"][0]["points"]) {
+    const double x = p["parameter"].get<double>() - tau_H;
+    const double a = (p["measures"]["max"][0].get<double>() - p["measures"]["min"][0].get<double>()) / 2;
+    const double row[3] = {1, x, x * x};
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) m[i][k] += row[i] * row[k];
+      m[i][3] += row[i] * a * a;
+    }
+  }
+  for (int i = 0; i < 3; ++i)  // Gauss-Jordan on the 3 x 3 normal equations
+    for (int k = 0; k < 3; ++k)
+      if (k != i)
+        for (int c = 3; c >= i; --c) m[k][c] -= m[k][i] / m[i][i] * m[i][c];
+  const double c0 = m[0][3] / m[0][0], c1 = m[1][3] / m[1][1], c2 = m[2][3] / m[2][2];
+  const double root = (-c1 + std::sqrt(c1 * c1 - 4 * c2 * c0)) / (2 * c2);  // the one near x = 0 (c2 < 0 here)
+  ASSERT_LT(std::abs(root), 1e-3);
+  const double slope = c1 + 2 * c2 * root;
+  EXPECT_NEAR(slope / predicted, 1, 1e-3) << slope << " " << predicted;
+}
+
 TEST(EquilibriumCli, ContinueEquilibriaBadInput) {
   const std::vector<std::string> base = {"continue", "--set", "continue_object=equilibrium", "--set", "continue_key=tau",
                                          "--set", "continue_from=3", "--set", "continue_to=6"};
@@ -286,6 +339,15 @@ history = { Ex = 0, Ey = 0, Nc = -0.2 }
     ASSERT_EQ(j["bifurcations"].size(), 1u) << j["bifurcations"].dump();
     EXPECT_EQ(j["bifurcations"][0]["type"], "hopf");
     EXPECT_NEAR(j["bifurcations"][0]["parameter"].get<double>(), hopf, 1.5e-10);
+    // issue 60: the equation model's Jacobian gives the normal form; at kappa = 0.3 the
+    // reference (scripts/hopf_normal_form_reference.py) is l1 = -3.5959434300579441391 (measured:
+    // error 2e-14, bar 2.6e-13: f is polynomial, the bar is rounding)
+    if (std::string(kappa) == "0.3") {
+      EXPECT_EQ(j["bifurcations"][0]["criticality"], "supercritical");
+      EXPECT_LE(std::abs(j["bifurcations"][0]["l1"].get<double>() + 3.5959434300579441391),
+                j["bifurcations"][0]["l1_bound"].get<double>());
+      EXPECT_LE(j["bifurcations"][0]["l1_bound"].get<double>(), 1e-10);
+    }
   }
   std::filesystem::remove_all(dir);
 }

@@ -234,7 +234,8 @@ EquilibriumFamily family_of(Make make) {
             EquilibriumOptions o;
             o.nroots = nroots;
             return find_equilibrium(make(p), Vec<Model::d>(guess), o);
-          }};
+          },
+          nullptr};  // no normal forms here: test_hopf_normal_form.cpp
 }
 
 TEST(EquilibriumBranch, MackeyGlassHopfPointInTauIsTheClosedForm) {

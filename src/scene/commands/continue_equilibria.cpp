@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -60,6 +63,13 @@ json branch_json(const Problem& problem, const std::string& key, const Equilibri
     if (f.type == EquilibriumBifurcationType::hopf) {
       fj["omega"] = f.omega;
       fj["period"] = f.period;
+      if (f.normal_form) {
+        const HopfNormalForm& n = *f.normal_form;
+        fj["l1"] = std::isfinite(n.l1) ? json(n.l1) : json(nullptr);
+        fj["l1_bound"] = std::isfinite(n.l1_bound) ? json(n.l1_bound) : json(nullptr);
+        fj["criticality"] = to_string(n.criticality);
+        if (!n.note.empty()) fj["criticality_note"] = n.note;
+      }
     }
     fj["evaluations"] = f.evaluations;
     j["bifurcations"].push_back(fj);
@@ -93,12 +103,16 @@ std::string points_csv(const std::string& header, const Problem& problem, const 
 
 std::string equilibrium_bifurcations_csv(const std::string& header, const EquilibriumBranch& b) {
   std::ostringstream rows;
-  rows << header << "type,parameter,parameter_bound,omega,period,lambda_re,lambda_im\n";
-  for (const EquilibriumBifurcation& f : b.bifurcations)
+  rows << header << "type,parameter,parameter_bound,omega,period,lambda_re,lambda_im,l1,l1_bound,criticality\n";
+  for (const EquilibriumBifurcation& f : b.bifurcations) {
+    const HopfNormalForm* n = f.normal_form ? &*f.normal_form : nullptr;
     rows << to_string(f.type) << "," << csv_number(f.parameter) << "," << csv_number(f.parameter_bound) << ","
          << csv_number(f.type == EquilibriumBifurcationType::hopf ? f.omega : NAN) << ","
          << csv_number(f.type == EquilibriumBifurcationType::hopf ? f.period : NAN) << ","
-         << csv_number(f.root.value.real()) << "," << csv_number(f.root.value.imag()) << "\n";
+         << csv_number(f.root.value.real()) << "," << csv_number(f.root.value.imag()) << ","
+         << csv_number(n ? n->l1 : NAN) << "," << csv_number(n ? n->l1_bound : NAN) << ","
+         << (n ? to_string(n->criticality) : "") << "\n";
+  }
   return rows.str();
 }
 
@@ -189,6 +203,19 @@ void print_hopf_branches(std::ostream& os, const std::string& key, const std::ve
   }
 }
 
+// "first Lyapunov coefficient l1 = -0.2141309224 +- 3.1e-13: supercritical (a stable orbit is born)"
+std::string criticality_line(const HopfNormalForm& n) {
+  if (!n.note.empty()) return n.note;
+  std::string line = "first Lyapunov coefficient l1 = " + format_number(n.l1) + " +- " + format_number(n.l1_bound, 2) +
+                     ": " + to_string(n.criticality);
+  switch (n.criticality) {
+    case HopfCriticality::supercritical: return line + " (a stable orbit is born)";
+    case HopfCriticality::subcritical: return line + " (an unstable orbit collapses onto the equilibrium)";
+    case HopfCriticality::degenerate: return line + " (l1 = 0 within its bar: the cubic term does not decide)";
+  }
+  return line;
+}
+
 void print_branch(std::ostream& os, const Problem& problem, const std::string& key, const EquilibriumBranchOptions& o,
                   const EquilibriumBranch& b, double seconds) {
   os << "delayspec continue: model " << problem.model_name << ", equilibria in " << key << " from "
@@ -212,6 +239,7 @@ void print_branch(std::ostream& os, const Problem& problem, const std::string& k
     if (f.type == EquilibriumBifurcationType::hopf)
       os << ", omega = " << format_number(f.omega) << ", period of the orbit born 2 pi / omega = "
          << format_number(f.period);
+    if (f.normal_form) os << "\n    " << criticality_line(*f.normal_form);
     os << "\n";
   }
   os << "time: " << seconds << " s\n";
@@ -300,6 +328,12 @@ int continue_equilibria(Config& config, const Invocation& inv) {
         EquilibriumOptions with = eq;
         with.nroots = nroots;
         return at(p)->equilibrium(guess, with);
+      },
+      // a normal form asks for some 700 Jacobians at one p: the model is read once for them
+      [&at, last = std::make_shared<std::pair<double, std::shared_ptr<const ModelAnalyses>>>()](
+          const Eigen::VectorXd& y, const Eigen::VectorXd& delayed, double p) {
+        if (!last->second || last->first != p) *last = {p, at(p)};
+        return last->second->jacobian_at(y, delayed);
       }};
   const EquilibriumBranch branch = continue_equilibrium(family, run.eq.guess, o);
   const std::vector<HopfBranch> orbits =

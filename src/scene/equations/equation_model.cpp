@@ -177,6 +177,9 @@ class ExplainedAnalyses final : public ModelAnalyses {
   ConstantHistory at_constant_history(const Eigen::VectorXd& y) const override {
     return inner_->at_constant_history(y);
   }
+  Eigen::MatrixXd jacobian_at(const Eigen::VectorXd& y, const Eigen::VectorXd& delayed) const override {
+    return inner_->jacobian_at(y, delayed);
+  }
   LyapunovResult lyapunov(const MapSettings& map, const LyapunovOptions& options) const override {
     return explained([&] { return inner_->lyapunov(map, options); });
   }

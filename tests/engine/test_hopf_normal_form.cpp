@@ -1,0 +1,179 @@
+// The first Lyapunov coefficient of Hopf points (hopf_normal_form.hpp), against values the engine
+// does not produce:
+//  * Wright's equation y' = -r y(t - 1) (1 + y) at r = pi/2 (Hutchinson's x' = r x (1 - x(t - 1))
+//    at x* = 1): its orbit's amplitude is known in closed form (Chow and Mallet-Paret 1977),
+//    y = sqrt(40 (r - pi/2) / (3 pi - 2)) cos(pi t / 2) + ..., which with
+//    |z|^2 = -Re lambda'(r) (r - pi/2) / Re c1, amplitude 2 |z| (|v| = 1, d = 1) and
+//    Re lambda'(pi/2) = (pi/2) / (1 + pi^2/4) gives l1 = Re c1 / omega = -(3 pi - 2) / (10 (1 + pi^2/4));
+//  * the cubic c y(t - 1)^3 added: it acts through C alone, C(Phi, Phi, conj Phi) = 6 c |Phi_1|^2 Phi_1
+//    = -6 c i (v = 1, Phi_1 = e^{-i pi/2}), and conj(u) = 1 / Delta'(i pi/2) = 1 / (1 + i pi/2)
+//    (Delta' = 1 - r e^{-i omega}), so it adds -3 c / (1 + pi^2/4) to l1: c = -(3 pi - 2) / 30 makes the
+//    Hopf point degenerate (l1 = 0), a larger c supercritical, a smaller one subcritical;
+//  * Mackey-Glass and the Lang-Kobayashi laser: scripts/hopf_normal_form_reference.py, which locates
+//    the Hopf points itself and differentiates f at 40 digits with mpmath.
+// The bars: every l1 is within its l1_bound of the reference, and the bound is tight (a polynomial
+// f leaves rounding only: 1e-11 relative; Mackey-Glass's x^10 / (1 + x^10) differences of the
+// Jacobian: measured 4e-10 relative, asserted 1e-7 so that the bar stays useful).
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "delayspec/equilibrium.hpp"
+#include "delayspec/equilibrium_branch.hpp"
+#include "delayspec/hopf_normal_form.hpp"
+#include "delayspec/model_mackey_glass.hpp"
+
+namespace delayspec {
+namespace {
+
+using std::numbers::pi;
+
+// y' = -r y(t - 1) (1 + y) + c y(t - 1)^3, equilibrium 0
+struct WrightCubic {
+  static constexpr int d = 1;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double r = pi / 2, c = 0;
+  double tau() const { return 1; }
+  double period() const { return 1; }
+  Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const {
+    return Vec<1>(-r * w[0] * (1 + y[0]) + c * w[0] * w[0] * w[0]);
+  }
+  Mat<1> A(int, double, const Vec<1>&, const Vec<1>& w) const { return Mat<1>::Constant(-r * w[0]); }
+  Mat<1> B(int, double, const Vec<1>& y, const Vec<1>& w) const {
+    return Mat<1>::Constant(-r * (1 + y[0]) + 3 * c * w[0] * w[0]);
+  }
+  Vec<1> initial_state() const { return Vec<1>(0.1); }
+};
+
+// The model's J = [A B] on any history: what ModelAnalyses::jacobian_at gives the scene
+template <class Model>
+JacobianAt jacobian_of(const Model& m) {
+  return [m](const Eigen::VectorXd& y, const Eigen::VectorXd& w) {
+    Eigen::MatrixXd J(Model::d, 2 * Model::d);
+    J.leftCols(Model::d) = m.A(1, 0.0, Vec<Model::d>(y), Vec<Model::d>(w));
+    J.rightCols(Model::d) = m.B(1, 0.0, Vec<Model::d>(y), Vec<Model::d>(w));
+    return J;
+  };
+}
+
+HopfNormalForm wright_normal_form(double c) {
+  const WrightCubic m{pi / 2, c};
+  CharacteristicRoot root;
+  root.value = {0, pi / 2};
+  root.error_bound = 4e-16;
+  return hopf_normal_form(jacobian_of(m), constant_history(m, Vec<1>(0)), Vec<1>(0), root);
+}
+
+TEST(HopfNormalForm, WrightsEquationIsTheClosedForm) {
+  const double exact = -(3 * pi - 2) / (10 * (1 + pi * pi / 4));
+  const HopfNormalForm n = wright_normal_form(0);
+  EXPECT_TRUE(n.note.empty()) << n.note;
+  EXPECT_LE(std::abs(n.l1 - exact), n.l1_bound) << n.l1 - exact;
+  EXPECT_LE(n.l1_bound, 1e-11 * std::abs(exact));
+  EXPECT_EQ(n.criticality, HopfCriticality::supercritical);
+  EXPECT_NEAR(std::abs(n.eigenvector[0]), 1, 1e-15);
+}
+
+TEST(HopfNormalForm, TheCubicTermDecidesTheSignAndZeroIsDegenerate) {
+  // the cubic alone: the quadratic part of Wright's equation is there too, and adds its l1
+  const double quadratic = -(3 * pi - 2) / (10 * (1 + pi * pi / 4));
+  for (const double c : {1.0, -1.0, -(3 * pi - 2) / 30}) {
+    SCOPED_TRACE("c = " + std::to_string(c));
+    const double exact = quadratic - 3 * c / (1 + pi * pi / 4);
+    const HopfNormalForm n = wright_normal_form(c);
+    EXPECT_LE(std::abs(n.l1 - exact), n.l1_bound) << n.l1 - exact;
+    EXPECT_LE(n.l1_bound, 1e-11);
+    EXPECT_EQ(n.criticality, exact > 1e-10   ? HopfCriticality::subcritical
+                             : exact < -1e-10 ? HopfCriticality::supercritical
+                                              : HopfCriticality::degenerate);
+  }
+}
+
+template <class Model, class Make>
+EquilibriumFamily normal_form_family(Make make) {
+  return {[make](const Eigen::VectorXd& y, double p) { return constant_history(make(p), Vec<Model::d>(y)); },
+          [make](const Eigen::VectorXd& guess, double p, int nroots) {
+            EquilibriumOptions o;
+            o.nroots = nroots;
+            return find_equilibrium(make(p), Vec<Model::d>(guess), o);
+          },
+          [make](const Eigen::VectorXd& y, const Eigen::VectorXd& w, double p) { return jacobian_of(make(p))(y, w); }};
+}
+
+// Along a branch: every Hopf point gets its l1 (the first two of Mackey-Glass in tau, references
+// from scripts/hopf_normal_form_reference.py).
+TEST(HopfNormalForm, MackeyGlassHopfPointsAlongTheBranchAreTheReference) {
+  const EquilibriumFamily family = normal_form_family<MackeyGlassModel>([](double tau) {
+    MackeyGlassParameters p;
+    p.tau = p.period = tau;
+    return MackeyGlassModel(p);
+  });
+  EquilibriumBranchOptions o;
+  o.from = 3, o.to = 22;
+  const EquilibriumBranch branch = continue_equilibrium(family, Vec<1>(1.1), o);
+  ASSERT_EQ(branch.end, BranchEnd::to) << branch.failure;
+  ASSERT_EQ(branch.bifurcations.size(), 2u);
+  const double reference[] = {-13.342516550137967989, -3.940663596488831527};
+  for (int k = 0; k < 2; ++k) {
+    const EquilibriumBifurcation& h = branch.bifurcations[static_cast<size_t>(k)];
+    ASSERT_TRUE(h.normal_form.has_value());
+    const HopfNormalForm& n = *h.normal_form;
+    EXPECT_LE(std::abs(n.l1 - reference[k]), n.l1_bound) << k << ": " << n.l1 - reference[k];
+    EXPECT_LE(n.l1_bound, 1e-7 * std::abs(reference[k])) << k;
+    EXPECT_EQ(n.criticality, HopfCriticality::supercritical);
+  }
+}
+
+// A family without a Jacobian gives no normal form (and the branch is as before)
+TEST(HopfNormalForm, NoJacobianNoNormalForm) {
+  EquilibriumFamily family = normal_form_family<MackeyGlassModel>([](double tau) {
+    MackeyGlassParameters p;
+    p.tau = p.period = tau;
+    return MackeyGlassModel(p);
+  });
+  family.jacobian = nullptr;
+  EquilibriumBranchOptions o;
+  o.from = 3, o.to = 6;
+  const EquilibriumBranch branch = continue_equilibrium(family, Vec<1>(1.1), o);
+  ASSERT_EQ(branch.bifurcations.size(), 1u);
+  EXPECT_FALSE(branch.bifurcations[0].normal_form.has_value());
+}
+
+// A zero root beside the pair (a zero-Hopf point): Delta(0) singular, no l1, said so.
+// y1' = -r y1(t - 1) (1 + y2), y2' = y1 y1(t-1): the second component's root is 0 for every r.
+struct ZeroHopf {
+  static constexpr int d = 2;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double r = pi / 2;
+  double tau() const { return 1; }
+  double period() const { return 1; }
+  Vec<2> f(int, double, const Vec<2>& y, const Vec<2>& w) const {
+    return Vec<2>(-r * w[0] * (1 + y[1]), y[0] * w[0]);
+  }
+  Mat<2> A(int, double, const Vec<2>&, const Vec<2>& w) const {
+    Mat<2> a;
+    a << 0, -r * w[0], w[0], 0;
+    return a;
+  }
+  Mat<2> B(int, double, const Vec<2>& y, const Vec<2>&) const {
+    Mat<2> b;
+    b << -r * (1 + y[1]), 0, y[0], 0;
+    return b;
+  }
+  Vec<2> initial_state() const { return Vec<2>(0, 0); }
+};
+
+TEST(HopfNormalForm, AZeroHopfPointHasNoFirstLyapunovCoefficient) {
+  const ZeroHopf m;
+  CharacteristicRoot root;
+  root.value = {0, pi / 2};
+  const Vec<2> zero = Vec<2>::Zero();
+  const HopfNormalForm n = hopf_normal_form(jacobian_of(m), constant_history(m, zero), zero, root);
+  EXPECT_EQ(n.criticality, HopfCriticality::degenerate);
+  EXPECT_TRUE(std::isnan(n.l1));
+  EXPECT_NE(n.note.find("zero-Hopf"), std::string::npos) << n.note;
+}
+
+}  // namespace
+}  // namespace delayspec
