@@ -76,4 +76,25 @@ ContinuationResult continue_from_hopf(const ModelAt& model_at, const Equilibrium
   return continuation_detail::trace_branch(branch, start, o, &tangent, hopf.parameter);
 }
 
+// The branch of orbits of unknown period through `orbit` (autonomous_orbit.hpp: found at
+// p = options.from, on its grid of K steps per period), followed in p as the branch from a Hopf
+// point is (K fixed along it): Newton at `from` from (the orbit's sequence, its period) with the
+// phase condition, then pseudo-arclength with the same detection and location of folds, period
+// doublings and Neimark-Sacker points among the multipliers other than the trivial one (issue 60,
+// item 5: an orbit found by `floquet` with period_guess, continued from there).
+template <class Model, class ModelAt>
+ContinuationResult continue_autonomous_orbit(const ModelAt& model_at, const AutonomousOrbit& orbit,
+                                             const ContinuationOptions& options) {
+  static_assert(AutonomousModel<Model>, "an orbit of unknown period needs an autonomous model (model.hpp)");
+  const int K = orbit.grid.K;
+  if (orbit.sequence.size() != static_cast<long>(Model::d) * K || !(orbit.period > 0))
+    throw BadInput("continue_autonomous_orbit: needs a solved orbit (" + std::to_string(orbit.sequence.size()) +
+                   " states for K = " + std::to_string(K) + ", period " + format_number(orbit.period) + ")");
+  Eigen::VectorXd start(orbit.sequence.size() + 1);
+  start << orbit.sequence, orbit.period;
+  const ContinuationOptions o = continuation_detail::checked_options(options);
+  const continuation_detail::AutonomousBranch<Model, ModelAt> branch(model_at, K, o);
+  return continuation_detail::trace_branch(branch, start, o, nullptr, o.from);
+}
+
 }  // namespace delayspec

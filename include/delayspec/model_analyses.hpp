@@ -154,6 +154,12 @@ class ModelAnalyses {
   // (hopf_branch.hpp: continue_from_hopf). BadInput for a model that is not autonomous, or linear.
   virtual ContinuationResult continue_from_hopf(const AnalysesAt& at, const EquilibriumBifurcation& hopf,
                                                 const ContinuationOptions& options) const = 0;
+  // The branch of periodic orbits of unknown period through this model's orbit found as `orbit`
+  // says (autonomous_orbit.hpp; orbit.N must be options.N), continued in p over the family `at`
+  // (hopf_branch.hpp: continue_autonomous_orbit). BadInput for a model that is not autonomous, or
+  // linear; NumericalFailure when no orbit is found.
+  virtual ContinuationResult continue_autonomous_orbit(const AnalysesAt& at, const AutonomousOrbitOptions& orbit,
+                                                       const ContinuationOptions& options) const = 0;
 
  protected:
   ModelAnalyses() = default;
@@ -253,9 +259,12 @@ class ModelAnalysesFor final : public ModelAnalyses {
                        " delayed values, not " + std::to_string(y.size()) + " and " + std::to_string(delayed.size()));
       const Vec<D> now(y);
       const Vec<D * NT> w(delayed);
-      Eigen::MatrixXd J(D, D * (NT + 1));  // block writes: `J << A, B` trips GCC 12's -Warray-bounds at d = 1
-      J.leftCols(D) = model_.A(1, 0.0, now, w);
-      J.rightCols(D * NT) = model_.B(1, 0.0, now, w);
+      // entry by entry: Eigen's vectorised copy of a 1 x 1 block trips GCC 12's -Warray-bounds
+      const auto A = model_.A(1, 0.0, now, w);
+      const auto B = model_.B(1, 0.0, now, w);
+      Eigen::MatrixXd J(D, D * (NT + 1));
+      for (int c = 0; c < D * (NT + 1); ++c)
+        for (int r = 0; r < D; ++r) J(r, c) = c < D ? A(r, c) : B(r, c - D);
       return J;
     } else {
       throw BadInput(kNotAutonomous);
@@ -337,6 +346,8 @@ class ModelAnalysesFor final : public ModelAnalyses {
                                              const ContinuationOptions& options) const override;
   ContinuationResult continue_from_hopf(const AnalysesAt& at, const EquilibriumBifurcation& hopf,
                                         const ContinuationOptions& options) const override;
+  ContinuationResult continue_autonomous_orbit(const AnalysesAt& at, const AutonomousOrbitOptions& orbit,
+                                               const ContinuationOptions& options) const override;
 
  private:
   // The rest of linearised_orbit on the orbit's own map: its states as the sequence, its

@@ -55,6 +55,23 @@ ContinuationResult ModelAnalysesFor<Model>::continue_from_hopf(const AnalysesAt&
   }
 }
 
+template <class Model>
+ContinuationResult ModelAnalysesFor<Model>::continue_autonomous_orbit(const AnalysesAt& at,
+                                                                      const AutonomousOrbitOptions& orbit,
+                                                                      const ContinuationOptions& options) const {
+  if constexpr (AutonomousModel<Model> && !Model::is_linear) {
+    if (orbit.N != options.N)
+      throw BadInput("continue_autonomous_orbit: the orbit's N (" + std::to_string(orbit.N) +
+                     ") differs from the branch's (" + std::to_string(options.N) + ")");
+    return delayspec::continue_autonomous_orbit<Model>(detail::model_at<Model>(at), autonomous_orbit(orbit).orbit,
+                                                       options);
+  } else if constexpr (AutonomousModel<Model>) {
+    throw BadInput("a linear model has no isolated periodic orbits to continue");
+  } else {
+    throw BadInput(kNotAutonomous);
+  }
+}
+
 }  // namespace delayspec
 
 // The explicit instantiation of Model's continuation, beside `template class ModelAnalysesFor<Model>`
@@ -65,4 +82,6 @@ ContinuationResult ModelAnalysesFor<Model>::continue_from_hopf(const AnalysesAt&
   template ContinuationResult ModelAnalysesFor<Model>::continue_period_doubled(                           \
       const AnalysesAt&, const Bifurcation&, const ContinuationOptions&) const;                           \
   template ContinuationResult ModelAnalysesFor<Model>::continue_from_hopf(                                \
-      const AnalysesAt&, const EquilibriumBifurcation&, const ContinuationOptions&) const;
+      const AnalysesAt&, const EquilibriumBifurcation&, const ContinuationOptions&) const;                 \
+  template ContinuationResult ModelAnalysesFor<Model>::continue_autonomous_orbit(                         \
+      const AnalysesAt&, const AutonomousOrbitOptions&, const ContinuationOptions&) const;

@@ -353,25 +353,59 @@ TEST(ContinueCli, StartsAtTheEndOfAKeysRange) {
 
 }  // namespace
 
-// Issue 61 items 5 and 7. The Mackey-Glass orbit scene sets period_guess (an orbit of unknown
-// period, floquet's); `continue` does not follow such orbits yet and used to ignore the scene's
-// key, following the map's fixed point over T = tau (the equilibrium) with exit 0, while
-// `--set period_guess` was refused. Both are refused now, naming the key and the way that exists.
-// Without period_guess, continuing an autonomous model says what it follows.
-TEST(ContinueCli, AnOrbitOfUnknownPeriodIsRefusedAndAnAutonomousModelSaysWhatIsFollowed) {
-  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/mackey_glass_orbit.toml";
-  for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"continue", scene, "--set", "continue_key=beta", "--set", "continue_from=0.2", "--set",
-                                 "continue_to=0.21"},
-        std::vector<std::string>{"continue", "--set", "model=mackey-glass", "--set", "period_guess=20", "--set",
-                                 "continue_key=beta", "--set", "continue_from=0.2", "--set", "continue_to=0.21"}}) {
-    const CliResult r = run(args);
-    EXPECT_EQ(r.status, 2) << r.err;
-    EXPECT_NE(r.err.find("`period_guess`: `continue` does not follow an orbit of unknown period"), std::string::npos)
-        << r.err;
-    EXPECT_NE(r.err.find("continue_switch = true"), std::string::npos) << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
+// Issue 60 item 5: `continue` with period_guess follows the orbit of unknown period from where
+// `floquet` finds it (before, issue 61 item 5 refused it: it had followed the map's fixed point,
+// the equilibrium, with exit 0). Mackey-Glass from tau = 6 (period ~20) to 14 at N = 100, 200, 400:
+//  * the first point is floquet's orbit at tau = 6, N = 400 (the same discrete problem: its period
+//    to the Newton tolerances, 1e-9 relative);
+//  * the period doubling is found at every N and extrapolated with a bar (measured: 13.249212 +-
+//    1.8e-4, order 1.98); checked outside the continuation: `floquet` at N = 1600 (a finer,
+//    independent discretisation: the orbit's own K) has its multiplier through -1 between the
+//    extrapolated location minus and plus its bar (|mu_1| < 1 below, > 1 above);
+//  * continue_switch (the period-2 branch) and a linear model are refused, naming why.
+TEST(ContinueCli, AnOrbitOfUnknownPeriodIsFollowedFromWhereFloquetFindsIt) {
+  const CliResult r = run({"continue", "--json", "--set", "model=mackey-glass", "--set", "tau=6", "--set",
+                           "period_guess=20", "--set", "continue_key=tau", "--set", "continue_from=6", "--set",
+                           "continue_to=14", "--set", "continue_Ns=100,200,400"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("fixed point of the stroboscopic map"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["period_guess"], 20);
+  const auto floquet_at = [](const std::string& tau, const std::string& period_guess, int N) {
+    const CliResult f = run({"floquet", "--json", "--set", "model=mackey-glass", "--set", "tau=" + tau, "--set",
+                             "period_guess=" + period_guess, "--set", "N=" + std::to_string(N), "--set", "nev=3",
+                             "--set", "error_bars=off"});
+    EXPECT_EQ(f.status, 0) << f.err;
+    return nlohmann::json::parse(f.out);
+  };
+  const auto start = floquet_at("6", "20", 400);
+  EXPECT_NEAR(j["points"][0]["period"].get<double>(), start["period"].get<double>(),
+              1e-9 * start["period"].get<double>());
+  ASSERT_EQ(j["bifurcations"].size(), 1u);
+  const auto& pd = j["bifurcations"][0];
+  EXPECT_EQ(pd["type"], "period-doubling");
+  ASSERT_EQ(pd["by_N"].size(), 3u);
+  const double at = pd["extrapolated"].get<double>(), bar = pd["error_estimate"].get<double>();
+  EXPECT_LT(bar, 1e-3);
+  const double below = floquet_at(delayspec::format_number(at - bar), "39.2", 1600)["multipliers"][0]["abs"];
+  const double above = floquet_at(delayspec::format_number(at + bar), "39.2", 1600)["multipliers"][0]["abs"];
+  EXPECT_LT(below, 1);
+  EXPECT_GT(above, 1);
+
+  for (const auto& [extra, says] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"continue_switch=true"}, "`continue_switch = true` with `period_guess`"},
+           {{"model=linear", "continue_key=b", "continue_from=-1", "continue_to=-2"}, "a linear model has no isolated"}}) {
+    std::vector<std::string> args = {"continue", "--set", "model=mackey-glass", "--set", "period_guess=20", "--set",
+                                     "continue_key=tau", "--set", "continue_from=6", "--set", "continue_to=7"};
+    for (const std::string& e : extra) args.insert(args.end(), {"--set", e});
+    const CliResult bad = run(args);
+    EXPECT_EQ(bad.status, 2) << says << ": " << bad.err;
+    EXPECT_NE(bad.err.find(says), std::string::npos) << bad.err;
   }
+}
+
+// Issue 61 item 7: without period_guess, continuing an autonomous model says what it follows.
+TEST(ContinueCli, AnAutonomousModelSaysWhatIsFollowed) {
   const CliResult r = run({"continue", "--set", "model=mackey-glass", "--set", "continue_key=beta", "--set",
                            "continue_from=0.2", "--set", "continue_to=0.21", "--set", "continue_step=0.005"});
   EXPECT_EQ(r.status, 0) << r.err;

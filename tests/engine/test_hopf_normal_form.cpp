@@ -50,9 +50,12 @@ struct WrightCubic {
 template <class Model>
 JacobianAt jacobian_of(const Model& m) {
   return [m](const Eigen::VectorXd& y, const Eigen::VectorXd& w) {
-    Eigen::MatrixXd J(Model::d, 2 * Model::d);
-    J.leftCols(Model::d) = m.A(1, 0.0, Vec<Model::d>(y), Vec<Model::d>(w));
-    J.rightCols(Model::d) = m.B(1, 0.0, Vec<Model::d>(y), Vec<Model::d>(w));
+    constexpr int D = Model::d;
+    const auto A = m.A(1, 0.0, Vec<D>(y), Vec<D>(w));
+    const auto B = m.B(1, 0.0, Vec<D>(y), Vec<D>(w));
+    Eigen::MatrixXd J(D, 2 * D);  // entry by entry: a 1 x 1 block copy trips GCC 12's -Warray-bounds
+    for (int c = 0; c < 2 * D; ++c)
+      for (int r = 0; r < D; ++r) J(r, c) = c < D ? A(r, c) : B(r, c - D);
     return J;
   };
 }

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -26,6 +27,7 @@
 #include "scene/output/output_directory.hpp"
 #include "scene/commands/commands.hpp"
 #include "scene/commands/continue_equilibria.hpp"
+#include "scene/problem/autonomous_floquet.hpp"
 #include "scene/problem/continue_settings.hpp"
 #include "delayspec/branch_verdicts.hpp"
 #include "delayspec/continuation.hpp"
@@ -61,12 +63,17 @@ Level level_at(const Config& config, const std::string& key, double p, int N, Co
   return level;
 }
 
-// The branch at one N: the start orbit at `from`, then continue_orbit.
+// The branch at one N: the start orbit at `from`, then continue_orbit; with period_guess the
+// orbit of unknown period found as `floquet` finds it, then continue_autonomous_orbit.
 ContinuationResult branch_at(const Config& config, const ContinueSettings& settings,
-                             const OrbitSettings& orbit_settings, ContinuationOptions options, int N,
-                             Progress& progress) {
+                             const OrbitSettings& orbit_settings, const std::optional<double>& period_guess,
+                             ContinuationOptions options, int N, Progress& progress) {
   const Level level = level_at(config, settings.key, options.from, N, options, progress);
-  return level.problem.analyses->continue_orbit(analyses_with_key(level.config, settings.key), orbit_settings, options);
+  const AnalysesAt at = analyses_with_key(level.config, settings.key);
+  if (period_guess)
+    return level.problem.analyses->continue_autonomous_orbit(
+        at, autonomous_orbit_options(level.problem, N, *period_guess, orbit_settings), options);
+  return level.problem.analyses->continue_orbit(at, orbit_settings, options);
 }
 
 // The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
@@ -84,6 +91,7 @@ struct ContinueRun {
   Problem problem;         // at continue_from
   std::vector<int> Ns;     // continue_Ns, or the one level N
   bool switching = false;  // the model switches in the state (its extrapolation order)
+  std::optional<double> period_guess;  // an autonomous orbit of unknown period (issue 60 item 5)
 };
 
 // Reads the keys and the problem at the start value, and rejects what continue cannot take.
@@ -99,7 +107,11 @@ ContinueRun read_continue_run(Config& config) {
   // it as used (a key no model reads is then reported as unknown).
   config.set(run.settings.key, format_number(run.options.from), "continue_from");
   run.problem = read_problem(config, 100);
+  run.period_guess = read_period_guess(config, run.problem);
   config.check_all_used();
+  if (run.period_guess && run.settings.switch_period_doubling)
+    throw BadInput("`continue_switch = true` with `period_guess`: the period-2 branch of an orbit of unknown period "
+                   "is not followed yet (its period doublings are located and extrapolated)");
   run.Ns = run.settings.Ns.empty() ? std::vector<int>{run.problem.N} : run.settings.Ns;
   run.switching = run.problem.analyses->switches_in_state();
   return run;
@@ -123,7 +135,8 @@ ContinueOutcome compute_continue(const Config& config, const ContinueRun& run, c
   const ContinuationOptions& options = run.options;
   ContinueOutcome out;
   Progress progress(inv.err, "continue", 0, inv.quiet);
-  for (int N : run.Ns) out.levels.push_back(branch_at(config, run.settings, run.orbit_settings, options, N, progress));
+  for (int N : run.Ns)
+    out.levels.push_back(branch_at(config, run.settings, run.orbit_settings, run.period_guess, options, N, progress));
   std::vector<std::vector<Bifurcation>> by_N;
   for (const auto& r : out.levels) by_N.push_back(r.bifurcations);
   // the floor of the bars: the locations' tolerance (its default filled in), or the refined one
@@ -185,6 +198,7 @@ json continue_json(const ContinueRun& run, const ContinueOutcome& out, double se
   j["Ns"] = run.Ns;
   j["events"] = to_string(run.problem.events);
   j["jacobian"] = to_string(run.problem.jacobian);
+  if (run.period_guess) j["period_guess"] = *run.period_guess;
   j["end"] = to_string(branch.end);
   if (!out.failures.empty()) j["failure"] = out.failures;
   j["points"] = points_json(branch.points, out.verdicts.verdicts);
@@ -233,13 +247,17 @@ void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutc
   for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
   os << "\nbranch (N = " << run.Ns.back() << "): " << branch.points.size() << " points, ended at `"
      << to_string(branch.end) << "`\n";
-  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s  %s\n", key.c_str(), "|mu_1|", "unstable", "max y1",
-                "verdict");
+  // an orbit of unknown period: its period too (the multipliers are the others than the trivial one)
+  const bool with_period = run.period_guess.has_value();
+  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s%s  %s\n", key.c_str(), "|mu_1|", "unstable", "max y1",
+                with_period ? "            period" : "", "verdict");
   os << line;
   for (size_t i = 0; i < branch.points.size(); ++i) {
     const ContinuationPoint& p = branch.points[i];
-    std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g  %s\n", p.parameter,
-                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0],
+    char period[32] = "";
+    if (with_period) std::snprintf(period, sizeof period, "  %16.10g", p.period);
+    std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g%s  %s\n", p.parameter,
+                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0], period,
                   to_string(out.verdicts.verdicts.at(i)).c_str());
     os << line;
   }
@@ -265,19 +283,13 @@ int command_continue(Config& config, const Invocation& inv) {
   // continue_object = equilibrium: the branch of equilibria (continue_equilibria.hpp)
   if (config.get_choice("continue_object", "orbit", {"orbit", "equilibrium"}) == "equilibrium")
     return continue_equilibria(config, inv);
-  // An orbit of unknown period is not continued yet (docs/autonomous.md, "Limits"): refused, from
-  // a scene as from --set. It used to follow the map's fixed point over the sampling period
-  // instead (the equilibrium, for Mackey-Glass's orbit scene), exit 0 (issue 61 item 5).
-  if (config.has("period_guess"))
-    throw BadInput("`period_guess`: `continue` does not follow an orbit of unknown period yet (the branch born at a "
-                   "Hopf point is followed with `continue_object = equilibrium` and `continue_switch = true`); "
-                   "remove period_guess to follow the fixed point of the stroboscopic map");
   const auto start = std::chrono::steady_clock::now();
   const ContinueRun run = read_continue_run(config);
   // An autonomous model has no forcing period: what is followed is the fixed point of the map
   // over the sampling period T (an equilibrium, or an orbit whose period divides T), wherever
   // the history leads; said, so that it is not taken for the orbit (issue 61 item 7).
-  if (const std::string note = autonomous_fixed_point_note(run.problem); !note.empty() && !inv.quiet)
+  if (const std::string note = autonomous_fixed_point_note(run.problem);
+      !note.empty() && !run.period_guess && !inv.quiet)
     inv.err << "delayspec continue: note: " << note << "\n";
   const ContinueOutcome out = compute_continue(config, run, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

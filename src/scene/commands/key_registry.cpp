@@ -124,7 +124,7 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
       {"orbit_guess_periods", "newton, auto, shooting: periods simulated from the initial history before the guess"},
       {"orbit_coarse_N", "auto, shooting: levels N, N/8, ... down to the last >= this, then this; one level below 2x it"},
       {"nev", "multipliers wanted, >= 1"},
-      {"period_guess", "autonomous models: the orbit's period is an unknown, found by Newton from this guess (time units); continue: refused (not yet)"},
+      {"period_guess", "autonomous models: the orbit's period is an unknown, found by Newton from this guess (time units); continue: the branch of such orbits from the one found at continue_from"},
       // equilibrium (equilibrium_settings.cpp)
       {"nroots", "equilibrium: rightmost characteristic roots wanted, 1..1000"},
       {"equilibrium_guess", "equilibrium: where Newton starts, one number per state component (default: the initial history)"},

@@ -205,6 +205,10 @@ class ExplainedAnalyses final : public ModelAnalyses {
                                         const ContinuationOptions& options) const override {
     return explained([&] { return inner_->continue_from_hopf(unwrapped(at), hopf, options); });
   }
+  ContinuationResult continue_autonomous_orbit(const AnalysesAt& at, const AutonomousOrbitOptions& orbit,
+                                               const ContinuationOptions& options) const override {
+    return explained([&] { return inner_->continue_autonomous_orbit(unwrapped(at), orbit, options); });
+  }
 
  private:
   // The family `at` gives explained analyses; the plugin's own continuation takes its own.

@@ -19,8 +19,8 @@ std::optional<double> read_period_guess(Config& config, const Problem& problem) 
   return guess;
 }
 
-AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess,
-                                        const OrbitSettings& orbit, const FloquetOptions& solver) {
+AutonomousOrbitOptions autonomous_orbit_options(const Problem& problem, int N, double period_guess,
+                                                const OrbitSettings& orbit) {
   AutonomousOrbitOptions o;
   o.period_guess = period_guess;
   o.N = N;
@@ -34,7 +34,12 @@ AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double pe
     throw BadInput("`orbit = simulate` with `period_guess`: an orbit of unknown period is solved for with its "
                    "period (orbit = newton, shooting or auto)");
   o.method = orbit.method == OrbitMethod::newton ? AutonomousOrbitMethod::newton : AutonomousOrbitMethod::shooting;
-  AutonomousLinearisedOrbit at = problem.analyses->autonomous_orbit(o);
+  return o;
+}
+
+AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess,
+                                        const OrbitSettings& orbit, const FloquetOptions& solver) {
+  AutonomousLinearisedOrbit at = problem.analyses->autonomous_orbit(autonomous_orbit_options(problem, N, period_guess, orbit));
   AutonomousFloquetLevel level;
   level.N = N;
   level.orbit = std::move(at.orbit);

@@ -50,6 +50,10 @@ struct AutonomousFloquet {
 // number, or given for a model that is not autonomous (its orbit has the forcing's period).
 std::optional<double> read_period_guess(Config& config, const Problem& problem);
 
+// How the orbit at N is found from period_guess (below). BadInput: orbit = simulate.
+AutonomousOrbitOptions autonomous_orbit_options(const Problem& problem, int N, double period_guess,
+                                                const OrbitSettings& orbit);
+
 // One level: the orbit at N from period_guess (its guess simulated for orbit.guess_periods
 // periods; orbit = newton: sparse LU on the whole period, auto or shooting: nested shooting,
 // autonomous_shooting.hpp) and nev + 1 multipliers, split into the trivial one and the others.
