@@ -101,6 +101,62 @@ BoundaryFigure read_boundary_figure(const std::filesystem::path& dir) {
 
 }  // namespace
 
+void plot_hopf_curves(FigureRenderer& renderer, const std::filesystem::path& dir) {
+  const nlohmann::json j = read_json_file(dir / "boundary.json");
+  const JsonField root(j, "boundary.json", "");
+  // Points by criticality, a blank line where a run of one kind ends (gnuplot breaks the line
+  // there); consecutive points of different kinds share their meeting point so the curve is whole.
+  std::map<std::string, std::string> by_kind;
+  std::string marks, labels;
+  int label = 0;
+  for (const JsonField& c : root.at("curves").elements()) {
+    std::string previous;
+    std::pair<double, double> last{NAN, NAN};
+    for (const JsonField& p : c.at("points").elements()) {
+      const double x = p.at("x").number(), y = p.at("y").number();
+      const auto kind = p.find("criticality");
+      const std::string k = kind ? kind->text() : "degenerate";
+      if (k != previous) {
+        if (!previous.empty()) by_kind[previous] += "\n";
+        if (std::isfinite(last.first))
+          by_kind[k] += gnuplot_number(last.first) + " " + gnuplot_number(last.second) + "\n";
+      }
+      by_kind[k] += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
+      previous = k;
+      last = {x, y};
+    }
+    for (auto& [kind, block] : by_kind) block += "\n";
+    for (const JsonField& g : c.at("generalised_hopf").elements()) {
+      const double x = g.at("x").number(), y = g.at("y").number();
+      marks += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
+      labels += "set label " + std::to_string(++label) + " 'GH' at " + gnuplot_number(x) + "," + gnuplot_number(y) +
+                " offset 1,-1 front boxed font ',9'\n";
+    }
+  }
+  std::ostringstream gp;
+  for (const auto& [kind, block] : by_kind) gp << gnuplot_datablock(kind, block);
+  gp << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
+  gp << figure_title("", "Hopf curves of the equilibrium");
+  gp << "set xlabel " << key_axis_label(root.at("boundary_x").text()) << "\nset ylabel "
+     << key_axis_label(root.at("boundary_y").text())
+     << "\nset grid\nset key outside bottom center horizontal\nset style textbox opaque noborder\n" << labels;
+  const std::vector<JsonField> x_range = root.at("x_range").elements(), y_range = root.at("y_range").elements();
+  gp << "set xrange [" << gnuplot_number(std::min(x_range.at(0).number(), x_range.at(1).number())) << ":"
+     << gnuplot_number(std::max(x_range.at(0).number(), x_range.at(1).number())) << "]\nset yrange ["
+     << gnuplot_number(std::min(y_range.at(0).number(), y_range.at(1).number())) << ":"
+     << gnuplot_number(std::max(y_range.at(0).number(), y_range.at(1).number())) << "]\n";
+  std::string plot = "plot ";
+  const auto add = [&](const std::string& item) { plot += (plot == "plot " ? "" : ", \\\n     ") + item; };
+  const std::map<std::string, std::string> style = {
+      {"supercritical", "lw 2 lc rgb '#1f77b4' title 'Hopf, supercritical (l1 < 0)'"},
+      {"subcritical", "lw 2 dt 2 lc rgb '#d62728' title 'Hopf, subcritical (l1 > 0)'"},
+      {"degenerate", "lw 2 dt 3 lc rgb '#7f7f7f' title 'Hopf, l1 = 0 within its bar'"}};
+  for (const auto& [kind, block] : by_kind) add("$" + kind + " using 1:2 with lines " + style.at(kind));
+  if (!marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'generalised Hopf'");
+  gp << plot << "\n";
+  renderer.figure("hopf_curves", gp.str());
+}
+
 void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir) {
   const BoundaryFigure f = read_boundary_figure(dir);
   // One datablock per type (curves separated by blank lines): one colour and one legend entry each.

@@ -10,5 +10,8 @@
 namespace delayspec::cli {
 
 void plot_boundary(FigureRenderer& renderer, const std::filesystem::path& dir);
+// boundary_object = equilibrium: the Hopf curves from boundary.json, drawn by criticality, the
+// generalised Hopf points marked.
+void plot_hopf_curves(FigureRenderer& renderer, const std::filesystem::path& dir);
 
 }  // namespace delayspec::cli

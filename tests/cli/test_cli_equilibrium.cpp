@@ -284,6 +284,42 @@ TEST(EquilibriumCli, TheFirstLyapunovCoefficientPredictsTheOrbitsAmplitude) {
   EXPECT_NEAR(slope / predicted, 1, 1e-3) << slope << " " << predicted;
 }
 
+// Issue 60 items 1 and 3: `boundary` with boundary_object = equilibrium on the shipped scene
+// (Wright's equation with a cubic, an equation model): one Hopf curve, r = pi/2 across the range,
+// and its generalised Hopf point at the closed form c* = -(3 pi - 2) / 30 within its bound
+// (measured: error 7e-12, bound 2.1e-10), supercritical on the right, subcritical on the left.
+// A forced model is refused (exit 2).
+TEST(EquilibriumCli, BoundaryOfAnEquilibriumFollowsItsHopfCurveToTheGeneralisedHopfPoint) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/wright_generalised_hopf.toml";
+  const std::string dir = delayspec::testing::fresh_dir("boundary_equilibria").string();
+  const CliResult r = run({"boundary", scene, "--json", "--out", dir, "--set",
+                           std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["boundary_object"], "equilibrium");
+  ASSERT_EQ(j["curves"].size(), 1u);
+  const auto& c = j["curves"][0];
+  EXPECT_EQ(c["end"], "to");
+  for (const auto& p : c["points"]) EXPECT_NEAR(p["y"].get<double>(), M_PI / 2, 1e-10);
+  EXPECT_EQ(c["points"].front()["criticality"], "subcritical");
+  EXPECT_EQ(c["points"].back()["criticality"], "supercritical");
+  ASSERT_EQ(c["generalised_hopf"].size(), 1u);
+  const auto& gh = c["generalised_hopf"][0];
+  EXPECT_LE(std::abs(gh["x"].get<double>() + (3 * M_PI - 2) / 30), gh["bound"].get<double>());
+  EXPECT_LE(gh["bound"].get<double>(), 1e-8);
+  for (const char* file : {"hopf_curves.csv", "boundary.json"})
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / file)) << file;
+  const CliResult plot = run({"plot", dir});
+  ASSERT_EQ(plot.status, 0) << plot.err;
+  EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / "plots/hopf_curves.png"));
+
+  const CliResult forced = run({"boundary", "--set", "model=impact", "--set", "boundary_object=equilibrium", "--set",
+                                "boundary_x=k", "--set", "boundary_y=e", "--set", "boundary_x_from=0.1", "--set",
+                                "boundary_x_to=0.2", "--set", "boundary_y_from=0.9", "--set", "boundary_y_to=1"});
+  EXPECT_EQ(forced.status, 2) << forced.err;
+  EXPECT_TRUE(contains(forced.err, "is not autonomous")) << forced.err;
+}
+
 TEST(EquilibriumCli, ContinueEquilibriaBadInput) {
   const std::vector<std::string> base = {"continue", "--set", "continue_object=equilibrium", "--set", "continue_key=tau",
                                          "--set", "continue_from=3", "--set", "continue_to=6"};

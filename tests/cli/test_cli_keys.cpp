@@ -210,7 +210,8 @@ TEST(Scenes, EveryShippedSceneIsAcceptedByRun) {
                                                        {"equilibrium_neuron_ring", "equilibrium"},
                                                        {"mackey_glass_hopf", "equilibrium,continue"},
                                                        {"mackey_glass_orbit", "floquet"},
-                                                       {"pyragas_oscillator", "floquet"}};
+                                                       {"pyragas_oscillator", "floquet"},
+                                                       {"wright_generalised_hopf", "boundary"}};
   const fs::path cache = DELAYSPEC_TEST_MODEL_CACHE;  // equation models compile here
   int scenes = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(DELAYSPEC_SOURCE_DIR) / "data/scenes")) {

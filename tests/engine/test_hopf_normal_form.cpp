@@ -20,8 +20,10 @@
 #include <gtest/gtest.h>
 
 #include "delayspec/equilibrium.hpp"
+#include "delayspec/equilibrium_boundary.hpp"
 #include "delayspec/equilibrium_branch.hpp"
 #include "delayspec/hopf_normal_form.hpp"
+#include "delayspec/model_linear.hpp"
 #include "delayspec/model_mackey_glass.hpp"
 
 namespace delayspec {
@@ -176,6 +178,78 @@ TEST(HopfNormalForm, AZeroHopfPointHasNoFirstLyapunovCoefficient) {
   EXPECT_EQ(n.criticality, HopfCriticality::degenerate);
   EXPECT_TRUE(std::isnan(n.l1));
   EXPECT_NE(n.note.find("zero-Hopf"), std::string::npos) << n.note;
+}
+
+// ---- Hopf curves in two parameters (equilibrium_boundary.hpp) ----
+
+template <class Model, class Make>
+EquilibriumFamily2 family_in_two(Make make) {
+  return {[make](const Eigen::VectorXd& s, double x, double y) { return constant_history(make(x, y), Vec<Model::d>(s)); },
+          [make](const Eigen::VectorXd& guess, double x, double y, int nroots) {
+            EquilibriumOptions o;
+            o.nroots = nroots;
+            const Model m = make(x, y);
+            return find_equilibrium(m, guess.size() ? Vec<Model::d>(guess) : m.initial_state(), o);
+          },
+          [make](const Eigen::VectorXd& s, const Eigen::VectorXd& w, double x, double y) {
+            return jacobian_of(make(x, y))(s, w);
+          }};
+}
+
+// x' = a x + b x(t - 1) in (a, b): i omega = a + b e^{-i omega} gives the curve
+// a = omega cot omega, b = -omega / sin omega (0 < omega < pi). Every point the tracer returns is
+// on it to the locator's accuracy: from the point's omega, a and b agree with the closed form to
+// 1e-9 (the points are corrected to 1e-10 of the range in the scaled plane, and the root to 1e-12).
+TEST(HopfCurves, LinearHopfCurveIsTheClosedForm) {
+  HopfCurveOptions o;
+  o.boundary.x_from = -1, o.boundary.x_to = 0.9, o.boundary.y_from = -0.5, o.boundary.y_to = -3;
+  const HopfCurves r = hopf_curves(family_in_two<LinearModel>([](double a, double b) {
+                                     LinearParameters p;
+                                     p.a = a, p.b = b;
+                                     return LinearModel(p);
+                                   }),
+                                   Eigen::VectorXd(), o);
+  ASSERT_EQ(r.curves.size(), 1u);
+  const HopfCurve& c = r.curves[0];
+  EXPECT_EQ(c.end, BoundaryEnd::to) << c.note;
+  ASSERT_GE(c.points.size(), 10u);
+  EXPECT_EQ(c.points.front().x, -1);
+  EXPECT_NEAR(c.points.back().x, 0.9, 1e-12);
+  for (const HopfCurvePoint& p : c.points) {
+    const double w = p.root.value.imag();
+    EXPECT_NEAR(p.x, w / std::tan(w), 1e-9) << w;
+    EXPECT_NEAR(p.y, -w / std::sin(w), 1e-9) << w;
+    // a linear model's Hopf points are degenerate: l1 = 0 exactly
+    ASSERT_TRUE(p.normal_form.has_value());
+    EXPECT_EQ(p.normal_form->criticality, HopfCriticality::degenerate);
+  }
+  EXPECT_TRUE(c.generalised_hopf.empty());
+}
+
+// Wright's equation with the cubic c y(t - 1)^3 in (c, r): the Hopf curve is r = pi/2 for every c
+// (the linearisation does not see c), and l1 = -(3 pi - 2) / (10 (1 + pi^2/4)) - 3 c / (1 + pi^2/4)
+// (the closed forms above) vanishes at c* = -(3 pi - 2) / 30: the generalised Hopf point, located
+// on the curve within its bound, and the bound small (l1's bar is rounding here: 1e-8 leaves
+// the location's tolerance and l1_bound / |dl1/dc| ~ 1e-13 far behind).
+TEST(HopfCurves, WrightCubicGeneralisedHopfPointIsTheClosedForm) {
+  HopfCurveOptions o;
+  o.boundary.x_from = -1, o.boundary.x_to = 1, o.boundary.y_from = 1, o.boundary.y_to = 2;
+  const HopfCurves r = hopf_curves(family_in_two<WrightCubic>([](double c, double rr) { return WrightCubic{rr, c}; }),
+                                   Vec<1>(0.1), o);
+  ASSERT_EQ(r.curves.size(), 1u);
+  const HopfCurve& c = r.curves[0];
+  EXPECT_EQ(c.end, BoundaryEnd::to) << c.note;
+  for (const HopfCurvePoint& p : c.points) EXPECT_NEAR(p.y, pi / 2, 1e-10);
+  ASSERT_EQ(c.generalised_hopf.size(), 1u);
+  const GeneralisedHopfPoint& gh = c.generalised_hopf[0];
+  const double exact = -(3 * pi - 2) / 30;
+  EXPECT_LE(std::abs(gh.x - exact), gh.bound) << gh.x - exact;
+  EXPECT_LE(gh.bound, 1e-8);
+  EXPECT_NEAR(gh.y, pi / 2, 1e-10);
+  EXPECT_NEAR(gh.omega, pi / 2, 1e-10);
+  // subcritical on the left of c*, supercritical on the right
+  EXPECT_EQ(c.points.front().normal_form->criticality, HopfCriticality::subcritical);
+  EXPECT_EQ(c.points.back().normal_form->criticality, HopfCriticality::supercritical);
 }
 
 }  // namespace

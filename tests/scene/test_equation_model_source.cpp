@@ -119,7 +119,8 @@ TEST(EquationModelSource, EveryShippedEquationSceneHasAPrebuiltShape) {
         << static_cast<int>(s.shape.switching) << ", autonomous " << s.shape.autonomous << ", affine "
         << s.shape.affine_in_state << ", linear " << s.shape.is_linear;
   }
-  EXPECT_EQ(scenes, 5);  // equations_impact, _two_delays, _two_oscillators, equilibrium_neuron_ring, pyragas_oscillator
+  EXPECT_EQ(scenes, 6);  // equations_impact, _two_delays, _two_oscillators, equilibrium_neuron_ring, pyragas_oscillator,
+                        // wright_generalised_hopf
 }
 
 TEST(EquationModelSource, FlagsFollowTheSecondDerivatives) {

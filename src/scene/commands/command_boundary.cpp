@@ -29,12 +29,14 @@
 
 #include "delayspec/boundary.hpp"
 #include "delayspec/richardson.hpp"
+#include "scene/commands/boundary_equilibria.hpp"
 #include "scene/commands/commands.hpp"
 #include "scene/output/metadata.hpp"
 #include "scene/output/output.hpp"
 #include "scene/output/output_directory.hpp"
 #include "scene/output/progress.hpp"
 #include "scene/points/parallel_points.hpp"
+#include "scene/problem/boundary_settings.hpp"
 #include "scene/problem/continue_settings.hpp"
 #include "scene/problem/floquet_settings.hpp"
 #include "scene/problem/orbit_settings.hpp"
@@ -62,46 +64,17 @@ struct BoundaryRun {
 
 BoundaryRun read_boundary_run(Config& config) {
   BoundaryRun run;
-  for (const char* key : {"boundary_x", "boundary_y"})
-    if (!config.has(key)) throw BadInput(std::string("missing key `") + key + "` (a model parameter, e.g. depth)");
-  run.x_key = config.get_string("boundary_x", "");
-  run.y_key = config.get_string("boundary_y", "");
-  require_parameter_key("boundary_x", run.x_key);
-  require_parameter_key("boundary_y", run.y_key);
-  if (run.x_key == run.y_key)
-    throw BadInput("`boundary_x = boundary_y = " + run.x_key + "`: two different model keys are needed");
-  BoundaryOptions& o = run.options;
-  o.x_from = config.require_double("boundary_x_from");
-  o.x_to = config.require_double("boundary_x_to");
-  o.y_from = config.require_double("boundary_y_from");
-  o.y_to = config.require_double("boundary_y_to");
-  if (o.x_from == o.x_to) throw BadInput("`boundary_x_from = boundary_x_to = " + format_number(o.x_from) + "`: an empty range");
-  if (o.y_from == o.y_to) throw BadInput("`boundary_y_from = boundary_y_to = " + format_number(o.y_from) + "`: an empty range");
+  const BoundarySettings settings = read_boundary_settings(config);
+  run.x_key = settings.x_key;
+  run.y_key = settings.y_key;
+  run.options = settings.options;
+  run.scan_points = settings.scan_points;
+  const BoundaryOptions& o = run.options;
   const std::string type = config.get_choice("boundary_type", "any",
                                              {"any", "neimark-sacker", "period-doubling", "fold", "grazing"});
   for (BifurcationType t : {BifurcationType::neimark_sacker, BifurcationType::period_doubling, BifurcationType::fold,
                             BifurcationType::grazing})
     if (type == to_string(t)) run.type = t;
-  const bool scan = config.get_choice("boundary_starts", "first", {"first", "scan"}) == "scan";
-  const int scan_points = static_cast<int>(config.get_int_in_range("boundary_scan_points", 20, 2, 100000));
-  if (scan) run.scan_points = scan_points;
-  o.step = config.get_double("boundary_step", 0.02);
-  o.step_min = config.get_double("boundary_step_min", 1e-6);
-  o.step_max = config.get_double("boundary_step_max", 0.1);
-  for (const auto& [name, value] : {std::pair{"boundary_step", o.step}, std::pair{"boundary_step_min", o.step_min},
-                                    std::pair{"boundary_step_max", o.step_max}})
-    if (!(value > 0) || !std::isfinite(value))
-      throw BadInput("`" + std::string(name) + " = " + format_number(value) + "`: must be > 0");
-  if (o.step_min > o.step_max)
-    throw BadInput("`boundary_step_min = " + format_number(o.step_min) + "` exceeds `boundary_step_max = " +
-                   format_number(o.step_max) + "`");
-  o.max_points = static_cast<int>(config.get_int_in_range("boundary_max_points", 5000, 2, 10'000'000));
-  o.chord_error = config.get_double("boundary_chord_error", 1e-4);
-  if (!(o.chord_error > 0) || !std::isfinite(o.chord_error))
-    throw BadInput("`boundary_chord_error = " + format_number(o.chord_error) + "`: must be > 0");
-  o.tolerance = config.get_double("boundary_tolerance", 1e-10);
-  if (!(o.tolerance > 0) || !std::isfinite(o.tolerance))
-    throw BadInput("`boundary_tolerance = " + format_number(o.tolerance) + "`: must be > 0");
   for (long N : config.get_int_list("boundary_Ns", {})) {
     if (N < 1 || N > 10'000'000) throw BadInput("`boundary_Ns`: N = " + std::to_string(N) + " must be between 1 and 1e7");
     if (!run.Ns.empty() && N <= run.Ns.back())
@@ -551,6 +524,9 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const Outcome& out
 }  // namespace
 
 int command_boundary(Config& config, const Invocation& inv) {
+  // boundary_object = equilibrium: Hopf curves of an equilibrium (boundary_equilibria.hpp)
+  if (config.get_choice("boundary_object", "orbit", {"orbit", "equilibrium"}) == "equilibrium")
+    return boundary_equilibria(config, inv);
   const auto start_time = std::chrono::steady_clock::now();
   const BoundaryRun run = read_boundary_run(config);
   if (const std::string note = autonomous_fixed_point_note(run.problem); !note.empty() && !inv.quiet)

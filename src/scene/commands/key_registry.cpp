@@ -214,6 +214,7 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"continue_solver",
        "continue: the corrector's linear solver: krylov (GMRES on the condensed system, matrix-free), lu (sparse LU), "
        "auto (krylov, lu where GMRES fails)"},
+      {"boundary_object", "boundary: orbit (stability curves of the periodic orbit) or equilibrium (an autonomous model's Hopf curves, with l1 and generalised Hopf points)"},
       {"boundary_x", "boundary: the model key stepped along the curve (e.g. spindle_rpm)"},
       {"boundary_y", "boundary: the model key solved for (e.g. depth)"},
       {"boundary_x_from", "boundary: where the curve starts (x)"},

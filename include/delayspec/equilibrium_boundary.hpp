@@ -1,0 +1,88 @@
+#pragma once
+// Hopf curves of an equilibrium in two parameters (issue 60, item 1), on the exact characteristic
+// function, with the criticality along them and the generalised Hopf points where it changes
+// (item 3).
+//
+// The curve is the zero set of g(x, y) = Re lambda(x, y), lambda the critical root followed from
+// the start: at each evaluation the equilibrium by Newton from the last one (equilibrium_state)
+// and lambda by Newton on c(lambda) = det Delta(lambda) from the last root (refined_root), so g
+// carries no discretisation error and the curve is located to the tracer's tolerance. g is
+// followed by the boundary tracer (boundary.hpp: pseudo-arclength in the scaled plane, step
+// control by the chord, turning points passed), which ends the curve at x_to, back at x_from, or
+// where it leaves the y range. g is undefined (the tracer halves its step) where Newton fails or
+// the root followed jumps (moves by more than a tenth of its size and 0.1 in one evaluation: it
+// would be another root), and where the pair turns real (omega -> 0: a Bogdanov-Takens or
+// zero-Hopf point ends the curve there, a failure named).
+//
+// Starts: on the line x = x_from (and with scan_lines > 1 on scan_lines lines x = const across
+// the range), the branch of equilibria in y (continue_equilibrium, every Hopf point located and
+// checked as in one parameter); each Hopf point not already on a traced curve starts one, traced
+// both ways (trace_boundary_both_ways).
+//
+// Along each curve every point gets omega and, with a Jacobian in the family, its first Lyapunov
+// coefficient (hopf_normal_form.hpp). Where l1 changes sign between two points, each decided
+// (|l1| > l1_bound), the generalised Hopf point between them is located: Illinois on l1 along the
+// chord between the two points, each trial point moved onto the curve along the chord's normal
+// (boundary_offset_along); its bar is the final bracket plus l1_bound / |dl1/ds| (how far l1's own
+// error moves the zero), in the plane's units.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "delayspec/boundary.hpp"
+#include "delayspec/equilibrium.hpp"
+#include "delayspec/equilibrium_branch.hpp"
+#include "delayspec/hopf_normal_form.hpp"
+
+namespace delayspec {
+
+// The model at the parameter pair (x, y), as EquilibriumFamily is at one parameter.
+struct EquilibriumFamily2 {
+  std::function<ConstantHistory(const Eigen::VectorXd& state, double x, double y)> at;
+  std::function<EquilibriumResult(const Eigen::VectorXd& guess, double x, double y, int nroots)> equilibrium;
+  // [A B] on any history (hopf_normal_form.hpp); empty: no l1 along the curves
+  std::function<Eigen::MatrixXd(const Eigen::VectorXd& state, const Eigen::VectorXd& delayed, double x, double y)>
+      jacobian;
+};
+
+struct HopfCurveOptions {
+  BoundaryOptions boundary;       // the ranges, steps and tolerance of the tracer (scaled plane)
+  EquilibriumOptions equilibrium;  // Newton's tolerance, nroots and N of the starting roots
+  int scan_lines = 1;              // lines x = const searched for starts (1: x_from only)
+};
+
+struct HopfCurvePoint {
+  double x = 0, y = 0;
+  Eigen::VectorXd state;
+  CharacteristicRoot root;  // the critical root, Im > 0
+  std::optional<HopfNormalForm> normal_form;
+};
+
+struct GeneralisedHopfPoint {
+  double x = 0, y = 0;
+  double bound = 0;  // on its distance from the exact point, in the plane's units (max over x and y)
+  Eigen::VectorXd state;
+  double omega = 0;
+  int evaluations = 0;
+};
+
+struct HopfCurve {
+  std::vector<HopfCurvePoint> points;
+  BoundaryEnd end = BoundaryEnd::max_points;
+  std::string note;
+  std::vector<GeneralisedHopfPoint> generalised_hopf;
+  std::vector<std::string> notes;  // a sign change of l1 that could not be located: where and why
+};
+
+struct HopfCurves {
+  std::vector<HopfCurve> curves;
+  std::vector<std::string> notes;  // a line whose equilibria could not be followed: where and why
+};
+
+// BadInput for options out of range (boundary.hpp's, scan_lines < 1); NumericalFailure when the
+// equilibrium at (x_from, y_from) cannot be found from `guess`.
+HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& guess, const HopfCurveOptions& options);
+
+}  // namespace delayspec

@@ -1,0 +1,206 @@
+// Hopf curves of an equilibrium in two parameters: the method is in equilibrium_boundary.hpp.
+#include "delayspec/equilibrium_boundary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+
+#include "delayspec/detail/illinois.hpp"
+#include "delayspec/errors.hpp"
+
+namespace delayspec {
+
+namespace {
+
+using cd = std::complex<double>;
+
+// g(x, y) = Re lambda of the root followed (header comment). Every successful evaluation is kept:
+// the next one starts Newton from the nearest in the scaled plane (the tracer comes back to its
+// start for the curve's second half, and its trial points jump about a point).
+class HopfTest {
+ public:
+  HopfTest(const EquilibriumFamily2& family, const HopfCurveOptions& o, double x, double y, Eigen::VectorXd state,
+           cd root)
+      : family_(family), o_(o) {
+    known_.push_back({x, y, std::move(state), root});
+  }
+
+  BoundarySample operator()(double x, double y) {
+    BoundarySample s;
+    HopfCurvePoint p;
+    s.reason = evaluate(x, y, p, false);
+    s.defined = s.reason.empty();
+    if (s.defined) s.value = p.root.value.real();
+    return s;
+  }
+
+  // The point at (x, y) with its normal form; the reason when g is undefined there.
+  std::string point(double x, double y, HopfCurvePoint& p) { return evaluate(x, y, p, true); }
+
+ private:
+  struct Known {
+    double x, y;
+    Eigen::VectorXd state;
+    cd root;
+  };
+
+  const Known& nearest(double x, double y) const {
+    const double sx = std::abs(o_.boundary.x_to - o_.boundary.x_from), sy = std::abs(o_.boundary.y_to - o_.boundary.y_from);
+    const Known* best = &known_.front();
+    double least = std::numeric_limits<double>::infinity();
+    for (const Known& k : known_) {
+      const double d = std::hypot((k.x - x) / sx, (k.y - y) / sy);
+      if (d < least) least = d, best = &k;
+    }
+    return *best;
+  }
+
+  std::string evaluate(double x, double y, HopfCurvePoint& p, bool with_normal_form) {
+    const Known& from = nearest(x, y);
+    const cd start = from.root;
+    try {
+      EquilibriumResult r;
+      equilibrium_state([&](const Eigen::VectorXd& s) { return family_.at(s, x, y); }, from.state, o_.equilibrium, r);
+      const ConstantHistory h = family_.at(r.state, x, y);
+      const CharacteristicRoot root = refined_root(h, start, o_.equilibrium);
+      const double moved = std::abs(root.value - start);
+      if (moved > 0.1 * std::abs(start) && moved > 0.1)
+        return "the root followed jumped from " + format_complex(start) + " to " + format_complex(root.value) +
+               " at (" + format_number(x) + ", " + format_number(y) + ")";
+      if (!(root.value.imag() > 1e-8 * (1 + std::abs(root.value))))
+        return "the critical pair turned real at (" + format_number(x) + ", " + format_number(y) +
+               "): omega = " + format_number(root.value.imag()) + " (a Bogdanov-Takens or zero-Hopf point)";
+      p.x = x, p.y = y, p.state = r.state, p.root = root;
+      if (with_normal_form && family_.jacobian)
+        p.normal_form = hopf_normal_form(
+            [&](const Eigen::VectorXd& s, const Eigen::VectorXd& w) { return family_.jacobian(s, w, x, y); }, h,
+            r.state, root);
+      if (known_.size() < 100000) known_.push_back({x, y, r.state, root.value});
+      return "";
+    } catch (const NumericalFailure& e) {
+      return std::string("at (") + format_number(x) + ", " + format_number(y) + "): " + e.what();
+    }
+  }
+
+  const EquilibriumFamily2& family_;
+  const HopfCurveOptions& o_;
+  std::vector<Known> known_;
+};
+
+bool decided(const HopfCurvePoint& p) {
+  return p.normal_form && std::isfinite(p.normal_form->l1) && std::abs(p.normal_form->l1) > p.normal_form->l1_bound;
+}
+
+// The generalised Hopf point between curve points a and b (l1 of opposite signs): Illinois in the
+// position t along the chord, each trial moved onto the curve along the chord's normal.
+std::optional<GeneralisedHopfPoint> generalised_hopf(HopfTest& test, const HopfCurvePoint& a, const HopfCurvePoint& b,
+                                                     const BoundaryOptions& o, std::string& why) {
+  const double sx = std::abs(o.x_to - o.x_from), sy = std::abs(o.y_to - o.y_from);
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  const double chord = std::hypot(dx / sx, dy / sy);  // scaled
+  // the normal in the scaled plane, back in the plane's units
+  const double nx = -dy / sy / chord * sx, ny = dx / sx / chord * sy;
+  const BoundaryFunction g = [&test](double x, double y) { return test(x, y); };
+  GeneralisedHopfPoint out;
+  HopfCurvePoint at;
+  double lo = 0, hi = 1;
+  detail::IllinoisValues illinois{a.normal_form->l1, b.normal_form->l1};
+  for (int k = 0; k < 60 && (hi - lo) * chord > o.tolerance; ++k) {
+    const double t = std::clamp(illinois.root(lo, hi), lo + 0.01 * (hi - lo), hi - 0.01 * (hi - lo));
+    const double x0 = a.x + t * dx, y0 = a.y + t * dy;
+    const double s = boundary_offset_along(g, x0, y0, nx, ny, 1e-3 * chord, o.tolerance);
+    if (!std::isfinite(s)) {
+      why = "no point of the curve on the chord's normal at t = " + format_number(t);
+      return std::nullopt;
+    }
+    if (const std::string reason = test.point(x0 + s * nx, y0 + s * ny, at); !reason.empty() || !at.normal_form) {
+      why = reason.empty() ? "no normal form" : reason;
+      return std::nullopt;
+    }
+    ++out.evaluations;
+    const double l1 = at.normal_form->l1;
+    if (l1 == 0) {
+      lo = hi = t;
+      break;
+    }
+    (illinois.replace(l1) < 0 ? lo : hi) = t;
+  }
+  out.x = at.x, out.y = at.y, out.state = at.state, out.omega = at.root.value.imag();
+  // l1's own error moves its zero by l1_bound / |dl1/dt| (the secant slope of the whole chord)
+  const double slope = std::abs(b.normal_form->l1 - a.normal_form->l1);
+  const double t_spread = (hi - lo) + (at.normal_form ? at.normal_form->l1_bound / slope : 0);
+  out.bound = std::max(std::abs(dx), std::abs(dy)) * t_spread + o.tolerance * std::max(sx, sy);
+  return out;
+}
+
+}  // namespace
+
+HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& guess, const HopfCurveOptions& o) {
+  const BoundaryOptions& b = o.boundary;
+  if (o.scan_lines < 1) throw BadInput("`HopfCurveOptions::scan_lines = " + std::to_string(o.scan_lines) + "`: must be >= 1");
+  if (b.x_from == b.x_to || b.y_from == b.y_to) throw BadInput("hopf_curves: an empty range");
+  HopfCurves out;
+  std::vector<BoundaryCurve> traced;
+  Eigen::VectorXd line_guess = guess;
+  for (int line = 0; line < o.scan_lines; ++line) {
+    const double x = o.scan_lines == 1 ? b.x_from : b.x_from + (b.x_to - b.x_from) * line / (o.scan_lines - 1);
+    const EquilibriumFamily along{
+        [&family, x](const Eigen::VectorXd& s, double y) { return family.at(s, x, y); },
+        [&family, x](const Eigen::VectorXd& g, double y, int nroots) { return family.equilibrium(g, x, y, nroots); },
+        nullptr};
+    EquilibriumBranchOptions bo;
+    bo.from = b.y_from, bo.to = b.y_to;
+    bo.newton_tolerance = o.equilibrium.tolerance;
+    bo.nroots = o.equilibrium.nroots;
+    EquilibriumBranch branch;
+    try {
+      branch = continue_equilibrium(along, line_guess, bo);
+    } catch (const NumericalFailure& e) {
+      if (line == 0) throw;
+      out.notes.push_back("the line x = " + format_number(x) + ": " + e.what());
+      continue;
+    }
+    line_guess = branch.points.front().equilibrium.state;
+    if (branch.end == BranchEnd::failure) out.notes.push_back("the line x = " + format_number(x) + ": " + branch.failure);
+    for (const EquilibriumBifurcation& h : branch.bifurcations) {
+      if (h.type != EquilibriumBifurcationType::hopf) continue;
+      if (on_boundary_curve(traced, x, h.parameter, 1e-3 * std::abs(b.y_to - b.y_from))) continue;  // as orbit curves
+      HopfTest test(family, o, x, h.parameter, h.state, h.root.value);
+      const BoundaryFunction g = [&test](double px, double py) { return test(px, py); };
+      BoundaryCurve c;
+      try {
+        c = trace_boundary_both_ways(g, b, x, h.parameter);
+      } catch (const NumericalFailure& e) {
+        out.notes.push_back("the Hopf point at (" + format_number(x) + ", " + format_number(h.parameter) + "): " + e.what());
+        continue;
+      }
+      HopfCurve curve;
+      curve.end = c.end;
+      curve.note = c.note;
+      for (const BoundaryPoint& bp : c.points) {
+        HopfCurvePoint p;
+        if (const std::string why = test.point(bp.x, bp.y, p); !why.empty()) {
+          curve.notes.push_back("a point left out: " + why);
+          continue;
+        }
+        curve.points.push_back(std::move(p));
+      }
+      for (size_t i = 0; i + 1 < curve.points.size(); ++i) {
+        const HopfCurvePoint &p = curve.points[i], &q = curve.points[i + 1];
+        if (!decided(p) || !decided(q) || (p.normal_form->l1 > 0) == (q.normal_form->l1 > 0)) continue;
+        std::string why;
+        if (auto gh = generalised_hopf(test, p, q, b, why))
+          curve.generalised_hopf.push_back(std::move(*gh));
+        else
+          curve.notes.push_back("l1 changes sign between (" + format_number(p.x) + ", " + format_number(p.y) + ") and (" +
+                                format_number(q.x) + ", " + format_number(q.y) + "), not located: " + why);
+      }
+      traced.push_back(std::move(c));
+      out.curves.push_back(std::move(curve));
+    }
+  }
+  return out;
+}
+
+}  // namespace delayspec

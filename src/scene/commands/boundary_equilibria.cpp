@@ -1,0 +1,208 @@
+#include "scene/commands/boundary_equilibria.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <sstream>
+#include <tuple>
+
+#include <nlohmann/json.hpp>
+
+#include "delayspec/equilibrium_boundary.hpp"
+#include "delayspec/errors.hpp"
+#include "scene/output/metadata.hpp"
+#include "scene/output/output.hpp"
+#include "scene/output/output_directory.hpp"
+#include "scene/problem/boundary_settings.hpp"
+#include "scene/problem/equilibrium_settings.hpp"
+#include "scene/problem/problem.hpp"
+
+namespace delayspec::cli {
+
+namespace {
+
+using nlohmann::json;
+
+struct EquilibriaBoundaryRun {
+  BoundarySettings settings;
+  EquilibriumSettings eq;
+  Problem problem;  // at (x_from, y_from)
+};
+
+EquilibriaBoundaryRun read_run(Config& config) {
+  EquilibriaBoundaryRun run;
+  run.settings = read_boundary_settings(config);
+  const BoundaryOptions& o = run.settings.options;
+  config.set(run.settings.x_key, format_number(o.x_from), "boundary_x_from");
+  config.set(run.settings.y_key, format_number(o.y_from), "boundary_y_from");
+  run.problem = read_problem(config, 100, ModelNeed::autonomous);
+  run.eq = read_equilibrium_settings(config, run.problem);
+  config.check_all_used();
+  require_autonomous(run.problem);
+  return run;
+}
+
+// The model at (x, y): the scene with both keys set, read once per pair (Newton asks for the same
+// pair several times in a row).
+class ModelAtPair {
+ public:
+  ModelAtPair(const Config& base, const std::string& x_key, const std::string& y_key)
+      : config_(base), x_key_(x_key), y_key_(y_key) {}
+  std::shared_ptr<const ModelAnalyses> operator()(double x, double y) {
+    if (!analyses_ || x != x_ || y != y_) {
+      config_.set(x_key_, format_number(x), "boundary");
+      config_.set(y_key_, format_number(y), "boundary");
+      analyses_ = read_problem(config_, 100).analyses;
+      x_ = x, y_ = y;
+    }
+    return analyses_;
+  }
+
+ private:
+  Config config_;
+  std::string x_key_, y_key_;
+  std::shared_ptr<const ModelAnalyses> analyses_;
+  double x_ = 0, y_ = 0;
+};
+
+json point_json(const HopfCurvePoint& p) {
+  json j;
+  j["x"] = p.x;
+  j["y"] = p.y;
+  j["omega"] = p.root.value.imag();
+  j["period"] = 2 * std::numbers::pi / p.root.value.imag();
+  j["equilibrium"] = std::vector<double>(p.state.data(), p.state.data() + p.state.size());
+  if (p.normal_form) {
+    j["l1"] = std::isfinite(p.normal_form->l1) ? json(p.normal_form->l1) : json(nullptr);
+    j["l1_bound"] = std::isfinite(p.normal_form->l1_bound) ? json(p.normal_form->l1_bound) : json(nullptr);
+    j["criticality"] = to_string(p.normal_form->criticality);
+  }
+  return j;
+}
+
+json curves_json(const EquilibriaBoundaryRun& run, const HopfCurves& r, double seconds) {
+  json j;
+  j["model"] = run.problem.model_name;
+  j["boundary_object"] = "equilibrium";
+  j["boundary_x"] = run.settings.x_key;
+  j["boundary_y"] = run.settings.y_key;
+  const BoundaryOptions& o = run.settings.options;
+  j["x_range"] = {o.x_from, o.x_to};
+  j["y_range"] = {o.y_from, o.y_to};
+  j["curves"] = json::array();
+  for (const HopfCurve& c : r.curves) {
+    json cj;
+    cj["type"] = "hopf";
+    cj["end"] = to_string(c.end);
+    if (!c.note.empty()) cj["note"] = c.note;
+    cj["points"] = json::array();
+    for (const HopfCurvePoint& p : c.points) cj["points"].push_back(point_json(p));
+    cj["generalised_hopf"] = json::array();
+    for (const GeneralisedHopfPoint& g : c.generalised_hopf)
+      cj["generalised_hopf"].push_back({{"x", g.x}, {"y", g.y}, {"bound", g.bound}, {"omega", g.omega},
+                                        {"evaluations", g.evaluations}});
+    cj["notes"] = c.notes;
+    j["curves"].push_back(cj);
+  }
+  j["notes"] = r.notes;
+  j["seconds"] = seconds;
+  return j;
+}
+
+std::string curves_csv(const std::string& header, const HopfCurves& r) {
+  std::ostringstream rows;
+  rows << header << "curve,x,y,omega,period,l1,l1_bound,criticality\n";
+  for (size_t k = 0; k < r.curves.size(); ++k)
+    for (const HopfCurvePoint& p : r.curves[k].points) {
+      const HopfNormalForm* n = p.normal_form ? &*p.normal_form : nullptr;
+      rows << k + 1 << "," << csv_number(p.x) << "," << csv_number(p.y) << "," << csv_number(p.root.value.imag()) << ","
+           << csv_number(2 * std::numbers::pi / p.root.value.imag()) << "," << csv_number(n ? n->l1 : NAN) << ","
+           << csv_number(n ? n->l1_bound : NAN) << "," << (n ? to_string(n->criticality) : "") << "\n";
+    }
+  return rows.str();
+}
+
+void print_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const HopfCurves& r, double seconds) {
+  const std::string &x = run.settings.x_key, &y = run.settings.y_key;
+  const BoundaryOptions& o = run.settings.options;
+  os << "delayspec boundary: model " << run.problem.model_name << ", Hopf curves of the equilibrium in (" << x << ", "
+     << y << ") over [" << format_number(o.x_from) << ", " << format_number(o.x_to) << "] x ["
+     << format_number(o.y_from) << ", " << format_number(o.y_to)
+     << "], on the exact characteristic function\ncurves: " << r.curves.size() << "\n";
+  for (size_t k = 0; k < r.curves.size(); ++k) {
+    const HopfCurve& c = r.curves[k];
+    os << "  curve " << k + 1 << ": " << c.points.size() << " points, ended at `" << to_string(c.end) << "`"
+       << (c.note.empty() ? "" : " (" + c.note + ")") << "\n";
+    if (!c.points.empty()) {
+      const HopfCurvePoint &a = c.points.front(), &b = c.points.back();
+      os << "    from (" << format_number(a.x) << ", " << format_number(a.y) << ") to (" << format_number(b.x) << ", "
+         << format_number(b.y) << "), omega " << format_number(a.root.value.imag(), 6) << " .. "
+         << format_number(b.root.value.imag(), 6) << "\n";
+    }
+    for (const GeneralisedHopfPoint& g : c.generalised_hopf)
+      os << "    generalised Hopf point (l1 = 0) at " << x << " = " << format_number(g.x) << ", " << y << " = "
+         << format_number(g.y) << " +- " << format_number(g.bound, 2) << ", omega = " << format_number(g.omega) << "\n";
+    for (const std::string& n : c.notes) os << "    note: " << n << "\n";
+  }
+  for (const std::string& n : r.notes) os << "note: " << n << "\n";
+  os << "time: " << seconds << " s\n";
+}
+
+}  // namespace
+
+int boundary_equilibria(Config& config, const Invocation& inv) {
+  const auto start = std::chrono::steady_clock::now();
+  const EquilibriaBoundaryRun run = read_run(config);
+  auto at = std::make_shared<ModelAtPair>(config, run.settings.x_key, run.settings.y_key);
+  const EquilibriumOptions& eq = run.eq.options;
+  const EquilibriumFamily2 family{
+      [at](const Eigen::VectorXd& s, double x, double y) { return (*at)(x, y)->at_constant_history(s); },
+      [at, &eq](const Eigen::VectorXd& guess, double x, double y, int nroots) {
+        EquilibriumOptions with = eq;
+        with.nroots = nroots;
+        return (*at)(x, y)->equilibrium(guess, with);
+      },
+      [at](const Eigen::VectorXd& s, const Eigen::VectorXd& w, double x, double y) {
+        return (*at)(x, y)->jacobian_at(s, w);
+      }};
+  HopfCurveOptions o;
+  o.boundary = run.settings.options;
+  o.equilibrium = eq;
+  o.scan_lines = std::max(1, run.settings.scan_points);
+  const HopfCurves curves = hopf_curves(family, run.eq.guess, o);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const json j = curves_json(run, curves, seconds);
+  std::string failures;
+  for (const HopfCurve& c : curves.curves)
+    if (c.end == BoundaryEnd::failure) failures += (failures.empty() ? "" : "; ") + c.note;
+  if (inv.out_dir) {
+    const std::filesystem::path dir(*inv.out_dir);
+    const OutputMetadata metadata = make_metadata("boundary", inv.scene, config, j, seconds);
+    std::string header = metadata_comment_lines(metadata);
+    if (!failures.empty()) header += "# INCOMPLETE: a curve ended in a failure: " + failures + "\n";
+    write_output(inv, dir / "hopf_curves.csv", curves_csv(header, curves));
+    json file = j;
+    file["metadata"] = metadata_json(metadata);
+    write_output(inv, dir / "boundary.json", file.dump(2) + "\n");
+  }
+  if (!failures.empty()) {
+    inv.err << "delayspec boundary: numerical failure: " << failures
+            << (inv.out_dir ? "; the curves so far are in " + *inv.out_dir : std::string()) << "\n";
+    return 3;
+  }
+  if (curves.curves.empty()) {
+    inv.err << "delayspec boundary: numerical failure: no Hopf point of the equilibrium for " << run.settings.y_key
+            << " in [" << format_number(o.boundary.y_from) << ", " << format_number(o.boundary.y_to) << "] at "
+            << run.settings.x_key << " = " << format_number(o.boundary.x_from)
+            << (o.scan_lines > 1 ? " .. " + format_number(o.boundary.x_to) : std::string()) << "\n";
+    return 3;
+  }
+  if (inv.json)
+    inv.out << j.dump(2) << "\n";
+  else
+    print_curves(inv.out, run, curves, seconds);
+  return 0;
+}
+
+}  // namespace delayspec::cli
