@@ -20,11 +20,16 @@
 // both ways (trace_boundary_both_ways).
 //
 // Along each curve every point gets omega and, with a Jacobian in the family, its first Lyapunov
-// coefficient (hopf_normal_form.hpp). Where l1 changes sign between two points, each decided
-// (|l1| > l1_bound), the generalised Hopf point between them is located: Illinois on l1 along the
-// chord between the two points, each trial point moved onto the curve along the chord's normal
-// (boundary_offset_along); its bar is the final bracket plus l1_bound / |dl1/ds| (how far l1's own
-// error moves the zero), in the plane's units.
+// coefficient (hopf_normal_form.hpp), and its other rightmost roots (the family's equilibrium,
+// nroots of them). Codim-2 points between two consecutive points: a generalised Hopf point where
+// l1 changes sign, each decided (|l1| > l1_bound); a double Hopf point (a second pair) or a
+// zero-Hopf point (a real root) where the count of the other roots with Re > 0 changes, the root
+// that crossed followed back by Newton on c. Each is located by Illinois on its scalar (l1, or Re
+// of the other root) along the chord between the two points, each trial point moved onto the
+// curve along the chord's normal (boundary_offset_along); its bound is the final bracket plus the
+// scalar's own error over its slope (how far that error moves the zero), in the plane's units.
+#include <complex>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,11 +65,21 @@ struct HopfCurvePoint {
   std::optional<HopfNormalForm> normal_form;
 };
 
-struct GeneralisedHopfPoint {
+enum class HopfCodim2Kind {
+  generalised_hopf,  // l1 = 0
+  double_hopf,       // a second pair on the axis
+  zero_hopf          // a real root at 0 (fold-Hopf)
+};
+// "generalised_hopf", "double_hopf", "zero_hopf".
+std::string to_string(HopfCodim2Kind kind);
+
+struct HopfCodim2Point {
+  HopfCodim2Kind kind = HopfCodim2Kind::generalised_hopf;
   double x = 0, y = 0;
   double bound = 0;  // on its distance from the exact point, in the plane's units (max over x and y)
   Eigen::VectorXd state;
-  double omega = 0;
+  double omega = 0;                 // the curve's pair
+  std::complex<double> second_root;  // double and zero Hopf: the other root on the axis
   int evaluations = 0;
 };
 
@@ -72,8 +87,8 @@ struct HopfCurve {
   std::vector<HopfCurvePoint> points;
   BoundaryEnd end = BoundaryEnd::max_points;
   std::string note;
-  std::vector<GeneralisedHopfPoint> generalised_hopf;
-  std::vector<std::string> notes;  // a sign change of l1 that could not be located: where and why
+  std::vector<HopfCodim2Point> codim2;  // in order along the curve
+  std::vector<std::string> notes;       // a change that could not be located, a point left out: where and why
 };
 
 struct HopfCurves {

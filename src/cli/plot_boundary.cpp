@@ -126,11 +126,13 @@ void plot_hopf_curves(FigureRenderer& renderer, const std::filesystem::path& dir
       last = {x, y};
     }
     for (auto& [kind, block] : by_kind) block += "\n";
-    for (const JsonField& g : c.at("generalised_hopf").elements()) {
+    for (const JsonField& g : c.at("codim2").elements()) {
       const double x = g.at("x").number(), y = g.at("y").number();
+      const std::string kind = g.at("kind").text();
       marks += gnuplot_number(x) + " " + gnuplot_number(y) + "\n";
-      labels += "set label " + std::to_string(++label) + " 'GH' at " + gnuplot_number(x) + "," + gnuplot_number(y) +
-                " offset 1,-1 front boxed font ',9'\n";
+      labels += "set label " + std::to_string(++label) + " " +
+                gnuplot_string(kind == "generalised_hopf" ? "GH" : kind == "double_hopf" ? "HH" : "ZH") + " at " +
+                gnuplot_number(x) + "," + gnuplot_number(y) + " offset 1,-1 front boxed font ',9'\n";
     }
   }
   std::ostringstream gp;
@@ -152,7 +154,7 @@ void plot_hopf_curves(FigureRenderer& renderer, const std::filesystem::path& dir
       {"subcritical", "lw 2 dt 2 lc rgb '#d62728' title 'Hopf, subcritical (l1 > 0)'"},
       {"degenerate", "lw 2 dt 3 lc rgb '#7f7f7f' title 'Hopf, l1 = 0 within its bar'"}};
   for (const auto& [kind, block] : by_kind) add("$" + kind + " using 1:2 with lines " + style.at(kind));
-  if (!marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'generalised Hopf'");
+  if (!marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'codim 2 (GH: l1 = 0, HH: double Hopf, ZH: zero-Hopf)'");
   gp << plot << "\n";
   renderer.figure("hopf_curves", gp.str());
 }

@@ -103,7 +103,15 @@ void equilibrium_state(const std::function<ConstantHistory(const Eigen::VectorXd
   for (;; ++r.newton_iterations) {
     const ConstantHistory h = at(y);
     r.residual = h.f.lpNorm<Eigen::Infinity>();
-    const Eigen::FullPivLU<Eigen::MatrixXd> lu(h.jacobian());
+    const Eigen::MatrixXd jacobian = h.jacobian();
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(jacobian);
+    // A singular Jacobian at an iterate that already solves f to the tolerance (a Newton step
+    // would move it by less, in every direction the Jacobian sees): an equilibrium where the
+    // branch of equilibria bifurcates (a pitchfork or transcritical point, e.g. a zero-Hopf point
+    // of a Hopf curve). Accepted as it is; not isolated, so nothing else to solve for.
+    if (!lu.isInvertible() &&
+        r.residual <= o.tolerance * jacobian.lpNorm<Eigen::Infinity>() * (1 + y.lpNorm<Eigen::Infinity>()))
+      break;
     if (!lu.isInvertible())
       throw NumericalFailure("equilibrium: the Jacobian A + sum B of f(y, ..., y) is singular at the iterate " +
                              std::to_string(r.newton_iterations) + " (|f|_inf = " + format_number(r.residual) +

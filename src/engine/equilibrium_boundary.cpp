@@ -4,12 +4,23 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <limits>
+#include <utility>
 
 #include "delayspec/detail/illinois.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {
+
+std::string to_string(HopfCodim2Kind kind) {
+  switch (kind) {
+    case HopfCodim2Kind::generalised_hopf: return "generalised_hopf";
+    case HopfCodim2Kind::double_hopf: return "double_hopf";
+    case HopfCodim2Kind::zero_hopf: return "zero_hopf";
+  }
+  return "generalised_hopf";
+}
 
 namespace {
 
@@ -92,20 +103,27 @@ bool decided(const HopfCurvePoint& p) {
   return p.normal_form && std::isfinite(p.normal_form->l1) && std::abs(p.normal_form->l1) > p.normal_form->l1_bound;
 }
 
-// The generalised Hopf point between curve points a and b (l1 of opposite signs): Illinois in the
-// position t along the chord, each trial moved onto the curve along the chord's normal.
-std::optional<GeneralisedHopfPoint> generalised_hopf(HopfTest& test, const HopfCurvePoint& a, const HopfCurvePoint& b,
-                                                     const BoundaryOptions& o, std::string& why) {
+// A scalar along the curve at a point (a trial moved onto it): its value and a bound on its
+// error; nullopt with the reason when it cannot be had there.
+using CurveValue = std::function<std::optional<std::pair<double, double>>(const HopfCurvePoint&, std::string&)>;
+
+// The codim-2 point between curve points a and b where `value` changes sign (va, vb: its values at
+// them): Illinois in the position t along the chord, each trial moved onto the curve along the
+// chord's normal. Its bound: the final bracket plus how far the value's own error moves its zero
+// (error / |dvalue/dt|, the slope the chord's secant), and the curve's tolerance.
+std::optional<HopfCodim2Point> locate_between(HopfTest& test, const HopfCurvePoint& a, const HopfCurvePoint& b,
+                                              double va, double vb, const CurveValue& value, const BoundaryOptions& o,
+                                              std::string& why) {
   const double sx = std::abs(o.x_to - o.x_from), sy = std::abs(o.y_to - o.y_from);
   const double dx = b.x - a.x, dy = b.y - a.y;
   const double chord = std::hypot(dx / sx, dy / sy);  // scaled
   // the normal in the scaled plane, back in the plane's units
   const double nx = -dy / sy / chord * sx, ny = dx / sx / chord * sy;
   const BoundaryFunction g = [&test](double x, double y) { return test(x, y); };
-  GeneralisedHopfPoint out;
+  HopfCodim2Point out;
   HopfCurvePoint at;
-  double lo = 0, hi = 1;
-  detail::IllinoisValues illinois{a.normal_form->l1, b.normal_form->l1};
+  double lo = 0, hi = 1, error = 0;
+  detail::IllinoisValues illinois{va, vb};
   for (int k = 0; k < 60 && (hi - lo) * chord > o.tolerance; ++k) {
     const double t = std::clamp(illinois.root(lo, hi), lo + 0.01 * (hi - lo), hi - 0.01 * (hi - lo));
     const double x0 = a.x + t * dx, y0 = a.y + t * dy;
@@ -114,24 +132,111 @@ std::optional<GeneralisedHopfPoint> generalised_hopf(HopfTest& test, const HopfC
       why = "no point of the curve on the chord's normal at t = " + format_number(t);
       return std::nullopt;
     }
-    if (const std::string reason = test.point(x0 + s * nx, y0 + s * ny, at); !reason.empty() || !at.normal_form) {
-      why = reason.empty() ? "no normal form" : reason;
+    if (const std::string reason = test.point(x0 + s * nx, y0 + s * ny, at); !reason.empty()) {
+      why = reason;
       return std::nullopt;
     }
+    const auto v = value(at, why);
+    if (!v) return std::nullopt;
     ++out.evaluations;
-    const double l1 = at.normal_form->l1;
-    if (l1 == 0) {
+    error = v->second;
+    if (v->first == 0) {
       lo = hi = t;
       break;
     }
-    (illinois.replace(l1) < 0 ? lo : hi) = t;
+    (illinois.replace(v->first) < 0 ? lo : hi) = t;
   }
   out.x = at.x, out.y = at.y, out.state = at.state, out.omega = at.root.value.imag();
-  // l1's own error moves its zero by l1_bound / |dl1/dt| (the secant slope of the whole chord)
-  const double slope = std::abs(b.normal_form->l1 - a.normal_form->l1);
-  const double t_spread = (hi - lo) + (at.normal_form ? at.normal_form->l1_bound / slope : 0);
+  const double t_spread = (hi - lo) + error / std::abs(vb - va);
   out.bound = std::max(std::abs(dx), std::abs(dy)) * t_spread + o.tolerance * std::max(sx, sy);
   return out;
+}
+
+// The roots of the equilibrium at a curve point other than the critical pair, rightmost first.
+std::vector<CharacteristicRoot> other_roots(const EquilibriumFamily2& family, const HopfCurvePoint& p,
+                                            const EquilibriumOptions& o) {
+  std::vector<CharacteristicRoot> out;
+  const cd c = p.root.value;
+  for (const CharacteristicRoot& r : family.equilibrium(p.state, p.x, p.y, o.nroots).roots)
+    if (std::abs(r.value - c) > 1e-6 * (1 + std::abs(c)) && std::abs(r.value - std::conj(c)) > 1e-6 * (1 + std::abs(c)))
+      out.push_back(r);
+  return out;
+}
+
+int count_right(const std::vector<CharacteristicRoot>& roots) {
+  return static_cast<int>(std::count_if(roots.begin(), roots.end(), [](const CharacteristicRoot& r) {
+    return r.value.real() > 0 && r.value.imag() >= 0;  // a pair counted once
+  }));
+}
+
+// Along one traced curve: the generalised Hopf points (l1 changes sign between two decided points)
+// and where another root crosses the axis (the count of the other roots with Re > 0 changes): a
+// double Hopf point (a second pair) or a zero-Hopf point (a real root), each located between the
+// two points (locate_between).
+void codim2_points(HopfTest& test, const EquilibriumFamily2& family, const HopfCurveOptions& o, HopfCurve& curve) {
+  const auto note = [&](const HopfCurvePoint& p, const HopfCurvePoint& q, const std::string& what, const std::string& why) {
+    curve.notes.push_back(what + " between (" + format_number(p.x) + ", " + format_number(p.y) + ") and (" +
+                          format_number(q.x) + ", " + format_number(q.y) + "), not located: " + why);
+  };
+  std::vector<std::vector<CharacteristicRoot>> others;
+  for (const HopfCurvePoint& p : curve.points) {
+    try {
+      others.push_back(other_roots(family, p, o.equilibrium));
+    } catch (const NumericalFailure& e) {
+      others.emplace_back();
+      curve.notes.push_back("the other roots at (" + format_number(p.x) + ", " + format_number(p.y) + "): " + e.what());
+    }
+  }
+  for (size_t i = 0; i + 1 < curve.points.size(); ++i) {
+    const HopfCurvePoint &p = curve.points[i], &q = curve.points[i + 1];
+    std::string why;
+    if (decided(p) && decided(q) && (p.normal_form->l1 > 0) != (q.normal_form->l1 > 0)) {
+      const CurveValue l1 = [](const HopfCurvePoint& at, std::string& reason) -> std::optional<std::pair<double, double>> {
+        if (!at.normal_form || !std::isfinite(at.normal_form->l1)) {
+          reason = at.normal_form ? at.normal_form->note : "no normal form";
+          return std::nullopt;
+        }
+        return std::pair{at.normal_form->l1, at.normal_form->l1_bound};
+      };
+      if (auto gh = locate_between(test, p, q, p.normal_form->l1, q.normal_form->l1, l1, o.boundary, why)) {
+        gh->kind = HopfCodim2Kind::generalised_hopf;
+        curve.codim2.push_back(std::move(*gh));
+      } else {
+        note(p, q, "l1 changes sign", why);
+      }
+    }
+    if (others[i].empty() || others[i + 1].empty() || count_right(others[i]) == count_right(others[i + 1])) continue;
+    // the root that crossed: of q's others the one nearest the axis, followed back to p
+    const CharacteristicRoot* crossing = &others[i + 1].front();
+    for (const CharacteristicRoot& r : others[i + 1])
+      if (r.value.imag() >= 0 && std::abs(r.value.real()) < std::abs(crossing->value.real())) crossing = &r;
+    cd followed = crossing->value;
+    const CurveValue re = [&](const HopfCurvePoint& at, std::string& reason) -> std::optional<std::pair<double, double>> {
+      try {
+        const CharacteristicRoot r = refined_root(family.at(at.state, at.x, at.y), followed, o.equilibrium);
+        followed = r.value;
+        return std::pair{r.value.real(), r.error_bound};
+      } catch (const NumericalFailure& e) {
+        reason = e.what();
+        return std::nullopt;
+      }
+    };
+    const auto at_p = re(p, why);
+    const double vq = crossing->value.real();
+    followed = crossing->value;
+    if (!at_p || (at_p->first > 0) == (vq > 0)) {
+      note(p, q, "another root crosses the axis", at_p ? "the root followed back does not change sign" : why);
+      continue;
+    }
+    if (auto point = locate_between(test, p, q, at_p->first, vq, re, o.boundary, why)) {
+      point->second_root = followed;
+      point->kind = std::abs(followed.imag()) > 1e-6 * (1 + std::abs(followed)) ? HopfCodim2Kind::double_hopf
+                                                                                : HopfCodim2Kind::zero_hopf;
+      curve.codim2.push_back(std::move(*point));
+    } else {
+      note(p, q, "another root crosses the axis", why);
+    }
+  }
 }
 
 }  // namespace
@@ -186,16 +291,7 @@ HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& 
         }
         curve.points.push_back(std::move(p));
       }
-      for (size_t i = 0; i + 1 < curve.points.size(); ++i) {
-        const HopfCurvePoint &p = curve.points[i], &q = curve.points[i + 1];
-        if (!decided(p) || !decided(q) || (p.normal_form->l1 > 0) == (q.normal_form->l1 > 0)) continue;
-        std::string why;
-        if (auto gh = generalised_hopf(test, p, q, b, why))
-          curve.generalised_hopf.push_back(std::move(*gh));
-        else
-          curve.notes.push_back("l1 changes sign between (" + format_number(p.x) + ", " + format_number(p.y) + ") and (" +
-                                format_number(q.x) + ", " + format_number(q.y) + "), not located: " + why);
-      }
+      codim2_points(test, family, o, curve);
       traced.push_back(std::move(c));
       out.curves.push_back(std::move(curve));
     }

@@ -303,8 +303,9 @@ TEST(EquilibriumCli, BoundaryOfAnEquilibriumFollowsItsHopfCurveToTheGeneralisedH
   for (const auto& p : c["points"]) EXPECT_NEAR(p["y"].get<double>(), M_PI / 2, 1e-10);
   EXPECT_EQ(c["points"].front()["criticality"], "subcritical");
   EXPECT_EQ(c["points"].back()["criticality"], "supercritical");
-  ASSERT_EQ(c["generalised_hopf"].size(), 1u);
-  const auto& gh = c["generalised_hopf"][0];
+  ASSERT_EQ(c["codim2"].size(), 1u);
+  const auto& gh = c["codim2"][0];
+  EXPECT_EQ(gh["kind"], "generalised_hopf");
   EXPECT_LE(std::abs(gh["x"].get<double>() + (3 * M_PI - 2) / 30), gh["bound"].get<double>());
   EXPECT_LE(gh["bound"].get<double>(), 1e-8);
   for (const char* file : {"hopf_curves.csv", "boundary.json"})

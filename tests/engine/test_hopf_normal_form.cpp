@@ -223,7 +223,7 @@ TEST(HopfCurves, LinearHopfCurveIsTheClosedForm) {
     ASSERT_TRUE(p.normal_form.has_value());
     EXPECT_EQ(p.normal_form->criticality, HopfCriticality::degenerate);
   }
-  EXPECT_TRUE(c.generalised_hopf.empty());
+  EXPECT_TRUE(c.codim2.empty());
 }
 
 // Wright's equation with the cubic c y(t - 1)^3 in (c, r): the Hopf curve is r = pi/2 for every c
@@ -240,8 +240,9 @@ TEST(HopfCurves, WrightCubicGeneralisedHopfPointIsTheClosedForm) {
   const HopfCurve& c = r.curves[0];
   EXPECT_EQ(c.end, BoundaryEnd::to) << c.note;
   for (const HopfCurvePoint& p : c.points) EXPECT_NEAR(p.y, pi / 2, 1e-10);
-  ASSERT_EQ(c.generalised_hopf.size(), 1u);
-  const GeneralisedHopfPoint& gh = c.generalised_hopf[0];
+  ASSERT_EQ(c.codim2.size(), 1u);
+  const HopfCodim2Point& gh = c.codim2[0];
+  EXPECT_EQ(gh.kind, HopfCodim2Kind::generalised_hopf);
   const double exact = -(3 * pi - 2) / 30;
   EXPECT_LE(std::abs(gh.x - exact), gh.bound) << gh.x - exact;
   EXPECT_LE(gh.bound, 1e-8);
@@ -250,6 +251,73 @@ TEST(HopfCurves, WrightCubicGeneralisedHopfPointIsTheClosedForm) {
   // subcritical on the left of c*, supercritical on the right
   EXPECT_EQ(c.points.front().normal_form->criticality, HopfCriticality::subcritical);
   EXPECT_EQ(c.points.back().normal_form->criticality, HopfCriticality::supercritical);
+}
+
+// Two Wright-like components side by side, the first in p1 with delay 1 (its Hopf curve p1 = pi/2,
+// omega = pi/2), the second in p2: with `delayed`, y2' = -p2 y2(t - 2) (1 + y2), whose pair reaches
+// the axis at p2 = pi/4 (i w = -p2 e^{-2 i w}: 2 w = pi/2, p2 = w = pi/4); otherwise
+// y2' = (p2 - 1) y2 - y2^3, whose real root p2 - 1 crosses 0 at p2 = 1.
+struct TwoComponents {
+  static constexpr int d = 2, delay_count = 2;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double p1 = 1.5, p2 = 0.5;
+  bool delayed = true;
+  std::array<double, 2> delays() const { return {1, 2}; }
+  double tau() const { return 2; }
+  double period() const { return 2; }
+  Vec<2> f(int, double, const Vec<2>& y, const Vec<4>& z) const {
+    return Vec<2>(-p1 * z[0] * (1 + y[0]), delayed ? -p2 * z[3] * (1 + y[1]) : (p2 - 1) * y[1] - y[1] * y[1] * y[1]);
+  }
+  Mat<2> A(int, double, const Vec<2>& y, const Vec<4>& z) const {
+    Mat<2> a = Mat<2>::Zero();
+    a(0, 0) = -p1 * z[0];
+    a(1, 1) = delayed ? -p2 * z[3] : (p2 - 1) - 3 * y[1] * y[1];
+    return a;
+  }
+  RectMat<2, 4> B(int, double, const Vec<2>& y, const Vec<4>&) const {
+    RectMat<2, 4> b = RectMat<2, 4>::Zero();
+    b(0, 0) = -p1 * (1 + y[0]);
+    if (delayed) b(1, 3) = -p2 * (1 + y[1]);
+    return b;
+  }
+  Vec<2> initial_state() const { return Vec<2>(0.1, 0.1); }
+};
+
+// Along the Hopf curve p1 = pi/2 in (p2, p1), the second component's root reaches the axis: a
+// double Hopf point at p2 = pi/4 (second pair i pi/4) or a zero-Hopf point at p2 = 1, each at its
+// closed form within its bound (the root is refined on c: the bound is the tolerance's, <= 1e-8).
+TEST(HopfCurves, DoubleAndZeroHopfPointsAreTheClosedForms) {
+  for (const bool delayed : {true, false}) {
+    SCOPED_TRACE(delayed ? "double Hopf" : "zero-Hopf");
+    const auto make = [delayed](double p2, double p1) { return TwoComponents{p1, p2, delayed}; };
+    const EquilibriumFamily2 family{
+        [make](const Eigen::VectorXd& s, double x, double y) { return constant_history(make(x, y), Vec<2>(s)); },
+        [make](const Eigen::VectorXd& guess, double x, double y, int nroots) {
+          EquilibriumOptions o;
+          o.nroots = nroots;
+          return find_equilibrium(make(x, y), Vec<2>(guess), o);
+        },
+        [make](const Eigen::VectorXd& s, const Eigen::VectorXd& w, double x, double y) {
+          const TwoComponents m = make(x, y);
+          Eigen::MatrixXd J(2, 6);
+          J << m.A(1, 0.0, Vec<2>(s), Vec<4>(w)), m.B(1, 0.0, Vec<2>(s), Vec<4>(w));
+          return J;
+        }};
+    HopfCurveOptions o;
+    o.boundary.x_from = 0.5, o.boundary.x_to = 1.5, o.boundary.y_from = 1, o.boundary.y_to = 2;
+    const HopfCurves r = hopf_curves(family, Vec<2>(0.01, 0.01), o);
+    ASSERT_GE(r.curves.size(), 1u);
+    const HopfCurve& c = r.curves[0];
+    for (const HopfCurvePoint& p : c.points) EXPECT_NEAR(p.y, pi / 2, 1e-10);
+    ASSERT_EQ(c.codim2.size(), 1u) << (c.notes.empty() ? "" : c.notes[0]);
+    const HopfCodim2Point& h = c.codim2[0];
+    EXPECT_EQ(h.kind, delayed ? HopfCodim2Kind::double_hopf : HopfCodim2Kind::zero_hopf);
+    const double exact = delayed ? pi / 4 : 1;
+    EXPECT_LE(std::abs(h.x - exact), h.bound) << h.x - exact;
+    EXPECT_LE(h.bound, 1e-8);
+    EXPECT_NEAR(h.omega, pi / 2, 1e-9);
+    EXPECT_NEAR(std::abs(h.second_root.imag()), delayed ? pi / 4 : 0, 1e-9);
+  }
 }
 
 }  // namespace

@@ -98,10 +98,14 @@ json curves_json(const EquilibriaBoundaryRun& run, const HopfCurves& r, double s
     if (!c.note.empty()) cj["note"] = c.note;
     cj["points"] = json::array();
     for (const HopfCurvePoint& p : c.points) cj["points"].push_back(point_json(p));
-    cj["generalised_hopf"] = json::array();
-    for (const GeneralisedHopfPoint& g : c.generalised_hopf)
-      cj["generalised_hopf"].push_back({{"x", g.x}, {"y", g.y}, {"bound", g.bound}, {"omega", g.omega},
-                                        {"evaluations", g.evaluations}});
+    cj["codim2"] = json::array();
+    for (const HopfCodim2Point& g : c.codim2) {
+      json gj = {{"kind", to_string(g.kind)}, {"x", g.x},         {"y", g.y},
+                 {"bound", g.bound},         {"omega", g.omega}, {"evaluations", g.evaluations}};
+      if (g.kind != HopfCodim2Kind::generalised_hopf)
+        gj["second_root"] = {{"re", g.second_root.real()}, {"im", g.second_root.imag()}};
+      cj["codim2"].push_back(gj);
+    }
     cj["notes"] = c.notes;
     j["curves"].push_back(cj);
   }
@@ -140,9 +144,15 @@ void print_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const Hopf
          << format_number(b.y) << "), omega " << format_number(a.root.value.imag(), 6) << " .. "
          << format_number(b.root.value.imag(), 6) << "\n";
     }
-    for (const GeneralisedHopfPoint& g : c.generalised_hopf)
-      os << "    generalised Hopf point (l1 = 0) at " << x << " = " << format_number(g.x) << ", " << y << " = "
-         << format_number(g.y) << " +- " << format_number(g.bound, 2) << ", omega = " << format_number(g.omega) << "\n";
+    for (const HopfCodim2Point& g : c.codim2) {
+      const char* what = g.kind == HopfCodim2Kind::generalised_hopf ? "generalised Hopf point (l1 = 0)"
+                         : g.kind == HopfCodim2Kind::double_hopf    ? "double Hopf point (a second pair on the axis)"
+                                                                    : "zero-Hopf point (a real root at 0)";
+      os << "    " << what << " at " << x << " = " << format_number(g.x) << ", " << y << " = " << format_number(g.y)
+         << " +- " << format_number(g.bound, 2) << ", omega = " << format_number(g.omega);
+      if (g.kind == HopfCodim2Kind::double_hopf) os << " and " << format_number(std::abs(g.second_root.imag()));
+      os << "\n";
+    }
     for (const std::string& n : c.notes) os << "    note: " << n << "\n";
   }
   for (const std::string& n : r.notes) os << "note: " << n << "\n";
