@@ -368,6 +368,22 @@ def test_hopf_points_carry_their_criticality():
     assert abs(hopf["l1"] + 13.342516550137968) <= hopf["l1_bound"] <= 1.4e-7
 
 
+def test_hopf_curves_of_an_equilibrium_in_two_parameters():
+    """Issue 60: boundary with boundary_object = "equilibrium" from Python. Mackey-Glass in (n, tau):
+    the curve from n = 10 starts at the Hopf point of the one-parameter branch (4.7081962893608,
+    docs/autonomous.md) and every point has omega = sqrt(b^2 - gamma^2), b = beta (2 - n) / 4 at the
+    equilibrium x* = 1 (beta / gamma = 2 for every n): the closed form along the whole curve."""
+    r = delayspec.boundary(model="mackey-glass", boundary_object="equilibrium", boundary_x="n", boundary_y="tau",
+                           boundary_x_from=10, boundary_x_to=6, boundary_y_from=3, boundary_y_to=30,
+                           equilibrium_guess=1.1)
+    points = r["curves"][0]["points"]
+    assert abs(points[0]["y"] - 4.7081962893608) < 1e-9
+    for p in points:
+        b = 0.2 * (2 - p["x"]) / 4
+        assert abs(p["omega"] - np.sqrt(b * b - 0.01)) < 1e-9
+        assert p["criticality"] in ("supercritical", "subcritical", "degenerate")
+
+
 def test_keys_help_of_an_unknown_command_raises_bad_input():
     """Issue 31: keys_help("nope") returned "" (an empty help, as if the command read no keys)."""
     with pytest.raises(delayspec.BadInput, match=r"unknown command `nope` \(commands: .*floquet.*sweep"):
