@@ -100,4 +100,39 @@ struct HopfCurves {
 // equilibrium at (x_from, y_from) cannot be found from `guess`.
 HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& guess, const HopfCurveOptions& options);
 
+// Fold curves: where the equilibrium itself folds (a real root at 0, J = A + sum B_i singular),
+// the nested form above cannot work (on one side of the curve there is no equilibrium to solve
+// for), so the curve is traced on the extended system in z = (y*, x, y), d + 2 unknowns:
+//
+//   f(y*, ..., y*; x, y) = 0   (d equations),   g(y*; x, y) = 0,
+//
+// g the last entry of the bordered solve [J b; c^T 0] (v, g) = (0, 1) (Govaerts), b and c the
+// left and right singular vectors of J's least singular value at the start: g is smooth, vanishes
+// exactly where J is singular, and is of J's scale. Pseudo-arclength in (y*, u, v), u and v the
+// parameters scaled to [0, 1] by the ranges; the extended system's Jacobian by central differences
+// (relative step 1e-7: a Jacobian error ~1e-7 slows Newton, not its solution); predictor along the
+// tangent (the kernel of that Jacobian, oriented as before), corrector Newton with the arclength
+// row, converged at |dz| <= tolerance; a failed correction halves the step, an easy one (<= 3
+// iterations) grows it by 1.5 up to step_max. Ends: a point past x_to, back past x_from or out of
+// the y range is corrected onto the edge (the crossed coordinate fixed) and ends the curve there;
+// max_points; a step below step_min (failure, named). Starts: the folds of the branch of
+// equilibria in y at x_from (and scan lines), each not already on a curve, traced both ways.
+struct FoldCurvePoint {
+  double x = 0, y = 0;
+  Eigen::VectorXd state;
+};
+
+struct FoldCurve {
+  std::vector<FoldCurvePoint> points;
+  BoundaryEnd end = BoundaryEnd::max_points;
+  std::string note;
+};
+
+struct FoldCurves {
+  std::vector<FoldCurve> curves;
+  std::vector<std::string> notes;
+};
+
+FoldCurves fold_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& guess, const HopfCurveOptions& options);
+
 }  // namespace delayspec

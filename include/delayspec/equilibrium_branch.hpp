@@ -24,8 +24,9 @@
 //  * every point tracks `nroots` roots and at least kRootMargin more than it has with Re >= 0, so
 //    a root about to cross is among them;
 //  * following back must be one to one (no two roots of the later point onto one root of the
-//    earlier) and land on a root the earlier point lists, and the crossings found must account
-//    for the change in the count of roots with Re > 0 (a pair counts 2, a real root 1);
+//    earlier) and land on a root the earlier point lists (or stay in the left half-plane at both
+//    ends, where it is no crossing whichever root it reached), and the crossings found must
+//    account for the change in the count of roots with Re > 0 (a pair counts 2, a real root 1);
 //  * a segment with more than one crossing is halved (each is located on its own only once the
 //    step is down to step_min);
 //  * while locating, every refined root lies within half the bracket's spread of the root

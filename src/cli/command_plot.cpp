@@ -545,7 +545,7 @@ int command_plot(Config& config, const Invocation& inv) {
   if (present(dir, "branch.csv")) plot_continuation(renderer, dir);
   if (present(dir, "equilibria.csv")) plot_equilibria(renderer, dir);
   if (present(dir, "boundary.csv")) plot_boundary(renderer, dir);
-  if (present(dir, "hopf_curves.csv")) plot_hopf_curves(renderer, dir);
+  if (present(dir, "hopf_curves.csv") || present(dir, "fold_curves.csv")) plot_hopf_curves(renderer, dir);
   if (present(dir, "converge.json")) {
     converge = read_json_file(dir / "converge.json");
     const JsonField j(converge, "converge.json", "");
@@ -562,7 +562,7 @@ int command_plot(Config& config, const Invocation& inv) {
     throw BadInput("`" + dir.string() +
                    "`: nothing to plot (looked for floquet.json, chart.csv, basin.csv, converge.json, bench.json, "
                    "exponents.csv, section.csv, trajectory.csv, impacts.csv, branch.csv, equilibria.csv, boundary.csv, "
-                   "hopf_curves.csv; see docs/formats.md)");
+                   "hopf_curves.csv, fold_curves.csv; see docs/formats.md)");
   if (inv.json) inv.out << Json{{"directory", dir.string()}, {"files", renderer.written()}}.dump(2) << "\n";
   return 0;
 }

@@ -115,7 +115,7 @@ void plot_hopf_curves(FigureRenderer& renderer, const std::filesystem::path& dir
     for (const JsonField& p : c.at("points").elements()) {
       const double x = p.at("x").number(), y = p.at("y").number();
       const auto kind = p.find("criticality");
-      const std::string k = kind ? kind->text() : "degenerate";
+      const std::string k = kind ? kind->text() : c.at("type").text() == "fold" ? "fold" : "degenerate";
       if (k != previous) {
         if (!previous.empty()) by_kind[previous] += "\n";
         if (std::isfinite(last.first))
@@ -138,7 +138,7 @@ void plot_hopf_curves(FigureRenderer& renderer, const std::filesystem::path& dir
   std::ostringstream gp;
   for (const auto& [kind, block] : by_kind) gp << gnuplot_datablock(kind, block);
   gp << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
-  gp << figure_title("", "Hopf curves of the equilibrium");
+  gp << figure_title("", "Curves of the equilibrium's bifurcations");
   gp << "set xlabel " << key_axis_label(root.at("boundary_x").text()) << "\nset ylabel "
      << key_axis_label(root.at("boundary_y").text())
      << "\nset grid\nset key outside bottom center horizontal\nset style textbox opaque noborder\n" << labels;
@@ -152,7 +152,8 @@ void plot_hopf_curves(FigureRenderer& renderer, const std::filesystem::path& dir
   const std::map<std::string, std::string> style = {
       {"supercritical", "lw 2 lc rgb '#1f77b4' title 'Hopf, supercritical (l1 < 0)'"},
       {"subcritical", "lw 2 dt 2 lc rgb '#d62728' title 'Hopf, subcritical (l1 > 0)'"},
-      {"degenerate", "lw 2 dt 3 lc rgb '#7f7f7f' title 'Hopf, l1 = 0 within its bar'"}};
+      {"degenerate", "lw 2 dt 3 lc rgb '#7f7f7f' title 'Hopf, l1 = 0 within its bar'"},
+      {"fold", "lw 2 lc rgb '#2ca02c' title 'fold'"}};
   for (const auto& [kind, block] : by_kind) add("$" + kind + " using 1:2 with lines " + style.at(kind));
   if (!marks.empty()) add("$marks using 1:2 with points pt 6 ps 1.5 lc rgb '#000000' title 'codim 2 (GH: l1 = 0, HH: double Hopf, ZH: zero-Hopf)'");
   gp << plot << "\n";

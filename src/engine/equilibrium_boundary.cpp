@@ -8,6 +8,9 @@
 #include <limits>
 #include <utility>
 
+#include <Eigen/Dense>
+#include <Eigen/SVD>
+
 #include "delayspec/detail/illinois.hpp"
 #include "delayspec/errors.hpp"
 
@@ -239,14 +242,16 @@ void codim2_points(HopfTest& test, const EquilibriumFamily2& family, const HopfC
   }
 }
 
-}  // namespace
 
-HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& guess, const HopfCurveOptions& o) {
+// The lines x = const searched for starts (scan_lines of them across the range, or x_from) and the
+// branch of equilibria in y along each (its bifurcations located and checked, equilibrium_branch.hpp):
+// `visit(x, branch)` for each; a line whose branch cannot start is noted (the first one throws).
+template <class Visit>
+void search_lines(const EquilibriumFamily2& family, const Eigen::VectorXd& guess, const HopfCurveOptions& o,
+                  std::vector<std::string>& notes, Visit visit) {
   const BoundaryOptions& b = o.boundary;
   if (o.scan_lines < 1) throw BadInput("`HopfCurveOptions::scan_lines = " + std::to_string(o.scan_lines) + "`: must be >= 1");
-  if (b.x_from == b.x_to || b.y_from == b.y_to) throw BadInput("hopf_curves: an empty range");
-  HopfCurves out;
-  std::vector<BoundaryCurve> traced;
+  if (b.x_from == b.x_to || b.y_from == b.y_to) throw BadInput("equilibrium curves: an empty range");
   Eigen::VectorXd line_guess = guess;
   for (int line = 0; line < o.scan_lines; ++line) {
     const double x = o.scan_lines == 1 ? b.x_from : b.x_from + (b.x_to - b.x_from) * line / (o.scan_lines - 1);
@@ -263,11 +268,22 @@ HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& 
       branch = continue_equilibrium(along, line_guess, bo);
     } catch (const NumericalFailure& e) {
       if (line == 0) throw;
-      out.notes.push_back("the line x = " + format_number(x) + ": " + e.what());
+      notes.push_back("the line x = " + format_number(x) + ": " + e.what());
       continue;
     }
     line_guess = branch.points.front().equilibrium.state;
-    if (branch.end == BranchEnd::failure) out.notes.push_back("the line x = " + format_number(x) + ": " + branch.failure);
+    if (branch.end == BranchEnd::failure) notes.push_back("the line x = " + format_number(x) + ": " + branch.failure);
+    visit(x, branch);
+  }
+}
+
+}  // namespace
+
+HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& guess, const HopfCurveOptions& o) {
+  const BoundaryOptions& b = o.boundary;
+  HopfCurves out;
+  std::vector<BoundaryCurve> traced;
+  search_lines(family, guess, o, out.notes, [&](double x, const EquilibriumBranch& branch) {
     for (const EquilibriumBifurcation& h : branch.bifurcations) {
       if (h.type != EquilibriumBifurcationType::hopf) continue;
       if (on_boundary_curve(traced, x, h.parameter, 1e-3 * std::abs(b.y_to - b.y_from))) continue;  // as orbit curves
@@ -295,7 +311,186 @@ HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& 
       traced.push_back(std::move(c));
       out.curves.push_back(std::move(curve));
     }
+  });
+  return out;
+}
+
+namespace {
+
+// The extended system of a fold curve (equilibrium_boundary.hpp) in z = (y*, u, v), u and v the
+// parameters scaled to [0, 1] by the ranges.
+class FoldSystem {
+ public:
+  FoldSystem(const EquilibriumFamily2& family, const BoundaryOptions& o, long d) : family_(family), o_(o), d_(d) {}
+
+  double x(const Eigen::VectorXd& z) const { return o_.x_from + z[d_] * (o_.x_to - o_.x_from); }
+  double y(const Eigen::VectorXd& z) const { return o_.y_from + z[d_ + 1] * (o_.y_to - o_.y_from); }
+  Eigen::VectorXd z_of(const Eigen::VectorXd& state, double x, double y) const {
+    Eigen::VectorXd z(d_ + 2);
+    z << state, (x - o_.x_from) / (o_.x_to - o_.x_from), (y - o_.y_from) / (o_.y_to - o_.y_from);
+    return z;
   }
+
+  // The borders: J's singular vectors of its least singular value at z (fixed for a curve).
+  void set_borders(const Eigen::VectorXd& z) {
+    const Eigen::MatrixXd J = family_.at(z.head(d_), x(z), y(z)).jacobian();
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    left_ = svd.matrixU().col(d_ - 1);
+    right_ = svd.matrixV().col(d_ - 1);
+  }
+
+  // (f, g) at z: d + 1 values
+  Eigen::VectorXd F(const Eigen::VectorXd& z) const {
+    const ConstantHistory h = family_.at(z.head(d_), x(z), y(z));
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d_ + 1, d_ + 1);
+    M.topLeftCorner(d_, d_) = h.jacobian();
+    M.topRightCorner(d_, 1) = left_;
+    M.bottomLeftCorner(1, d_) = right_.transpose();
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(d_ + 1);
+    rhs[d_] = 1;
+    Eigen::VectorXd out(d_ + 1);
+    out << h.f, M.fullPivLu().solve(rhs)[d_];
+    return out;
+  }
+
+  // dF/dz by central differences, relative step 1e-7
+  Eigen::MatrixXd jacobian(const Eigen::VectorXd& z) const {
+    Eigen::MatrixXd D(d_ + 1, d_ + 2);
+    for (long i = 0; i < d_ + 2; ++i) {
+      const double delta = 1e-7 * (1 + std::abs(z[i]));
+      Eigen::VectorXd a = z, b = z;
+      a[i] += delta, b[i] -= delta;
+      D.col(i) = (F(a) - F(b)) / (a[i] - b[i]);
+    }
+    return D;
+  }
+
+  // The unit tangent (kernel of dF/dz), oriented along `previous` (or towards u increasing)
+  Eigen::VectorXd tangent(const Eigen::VectorXd& z, const Eigen::VectorXd* previous) const {
+    const Eigen::MatrixXd D = jacobian(z);
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(D, Eigen::ComputeFullV);
+    Eigen::VectorXd t = svd.matrixV().col(d_ + 1);
+    if (previous ? t.dot(*previous) < 0 : t[d_] < 0) t = -t;
+    return t;
+  }
+
+  // Newton on (F, row . z - target) from z; nullopt when it does not converge in 8 iterations
+  std::optional<Eigen::VectorXd> correct(Eigen::VectorXd z, const Eigen::VectorXd& row, double target, int& iterations) const {
+    for (iterations = 1; iterations <= 8; ++iterations) {
+      Eigen::MatrixXd M(d_ + 2, d_ + 2);
+      M.topRows(d_ + 1) = jacobian(z);
+      M.row(d_ + 1) = row.transpose();
+      Eigen::VectorXd r(d_ + 2);
+      r << F(z), row.dot(z) - target;
+      const Eigen::VectorXd dz = M.fullPivLu().solve(r);
+      if (!dz.allFinite()) return std::nullopt;
+      z -= dz;
+      if (dz.lpNorm<Eigen::Infinity>() <= o_.tolerance * (1 + z.lpNorm<Eigen::Infinity>())) return z;
+    }
+    return std::nullopt;
+  }
+
+  long d() const { return d_; }
+
+ private:
+  const EquilibriumFamily2& family_;
+  const BoundaryOptions& o_;
+  long d_;
+  Eigen::VectorXd left_, right_;
+};
+
+// One way from z0 along +-t0: the points after z0, the end and its note.
+FoldCurve trace_fold_one_way(FoldSystem& sys, const BoundaryOptions& o, const Eigen::VectorXd& z0,
+                             Eigen::VectorXd t, bool& ok) {
+  const long d = sys.d();
+  FoldCurve out;
+  Eigen::VectorXd z = z0;
+  double ds = o.step;
+  const auto point_of = [&](const Eigen::VectorXd& q) { return FoldCurvePoint{sys.x(q), sys.y(q), q.head(d)}; };
+  ok = true;
+  while (static_cast<int>(out.points.size()) < o.max_points) {
+    int iterations = 0;
+    const Eigen::VectorXd predicted = z + ds * t;
+    const auto next = sys.correct(predicted, t, t.dot(predicted), iterations);
+    if (!next || (*next - z).norm() > 2 * ds) {
+      ds /= 2;
+      if (ds < o.step_min) {
+        out.end = BoundaryEnd::failure;
+        out.note = "no step could be corrected onto the fold curve at (" + format_number(sys.x(z)) + ", " +
+                   format_number(sys.y(z)) + "), down to boundary_step_min = " + format_number(o.step_min);
+        ok = false;
+        return out;
+      }
+      continue;
+    }
+    // out of the box [0, 1]^2 in (u, v): the crossed coordinate fixed at its edge, the point
+    // corrected there, the curve's end
+    const double u = (*next)[d], v = (*next)[d + 1];
+    if (u > 1 || u < 0 || v > 1 || v < 0) {
+      const bool in_u = u > 1 || u < 0;
+      const long k = in_u ? d : d + 1;
+      const double edge = (in_u ? u : v) > 1 ? 1 : 0;
+      const double w = (edge - z[k]) / ((*next)[k] - z[k]);
+      Eigen::VectorXd row = Eigen::VectorXd::Zero(d + 2);
+      row[k] = 1;
+      int it = 0;
+      if (const auto landed = sys.correct(z + w * (*next - z), row, edge, it)) out.points.push_back(point_of(*landed));
+      out.end = !in_u ? BoundaryEnd::y_range : edge == 1 ? BoundaryEnd::to : BoundaryEnd::from;
+      if (out.end == BoundaryEnd::y_range)
+        out.note = "left the y range at x = " + format_number(out.points.empty() ? sys.x(z) : out.points.back().x);
+      return out;
+    }
+    const Eigen::VectorXd t_new = sys.tangent(*next, &t);
+    z = *next;
+    t = t_new;
+    out.points.push_back(point_of(z));
+    if (iterations <= 3) ds = std::min(1.5 * ds, o.step_max);
+  }
+  out.end = BoundaryEnd::max_points;
+  return out;
+}
+
+}  // namespace
+
+FoldCurves fold_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& guess, const HopfCurveOptions& o) {
+  const BoundaryOptions& b = o.boundary;
+  FoldCurves out;
+  std::vector<BoundaryCurve> traced;  // for on_boundary_curve
+  search_lines(family, guess, o, out.notes, [&](double x, const EquilibriumBranch& branch) {
+    for (const EquilibriumBifurcation& f : branch.bifurcations) {
+      if (f.type != EquilibriumBifurcationType::fold) continue;
+      if (on_boundary_curve(traced, x, f.parameter, 1e-3 * std::abs(b.y_to - b.y_from))) continue;
+      const long d = f.state.size();
+      FoldSystem sys(family, b, d);
+      Eigen::VectorXd z = sys.z_of(f.state, x, f.parameter);
+      sys.set_borders(z);
+      int iterations = 0;
+      Eigen::VectorXd t = sys.tangent(z, nullptr);
+      const auto start = sys.correct(z, t, t.dot(z), iterations);
+      if (!start) {
+        out.notes.push_back("the fold at (" + format_number(x) + ", " + format_number(f.parameter) +
+                            "): not corrected onto the extended system");
+        continue;
+      }
+      z = *start;
+      t = sys.tangent(z, &t);
+      bool ok_forward = true, ok_back = true;
+      FoldCurve forward = trace_fold_one_way(sys, b, z, t, ok_forward);
+      FoldCurve back = trace_fold_one_way(sys, b, z, -t, ok_back);
+      FoldCurve curve;
+      for (auto it = back.points.rbegin(); it != back.points.rend(); ++it) curve.points.push_back(*it);
+      curve.points.push_back({sys.x(z), sys.y(z), z.head(d)});
+      curve.points.insert(curve.points.end(), forward.points.begin(), forward.points.end());
+      // the worse half's end (a failure first)
+      const FoldCurve& worse = !ok_back ? back : forward;
+      curve.end = worse.end;
+      curve.note = worse.note;
+      BoundaryCurve as_boundary;
+      for (const FoldCurvePoint& p : curve.points) as_boundary.points.push_back({p.x, p.y, NAN, 0});
+      traced.push_back(std::move(as_boundary));
+      out.curves.push_back(std::move(curve));
+    }
+  });
   return out;
 }
 

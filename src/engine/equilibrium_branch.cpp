@@ -156,6 +156,11 @@ SegmentCrossings crossing_roots(const Tracer& tracer, const OnBranch& a, const E
     if (it == ra.roots.end()) {
       // Left of every root a lists and on b's side of the axis: no crossing, nothing to match.
       if (back.value.real() < leftmost_a && (back.value.real() > 0) == (root.value.real() > 0)) continue;
+      // In the left half-plane at both ends: not a crossing, whichever root Newton reached (two
+      // real roots 5e-6 apart near -1, one of a decoupled decay z' = -z, swapped places:
+      // measured). Should a root that crossed to the left have been followed onto it, the count
+      // check below still fails: the crossings found would not account for the change.
+      if (back.value.real() < 0 && root.value.real() < 0) continue;
       out.why = "the root " + format_complex(root.value) + " followed back to p = " + format_number(a.p()) +
                 " landed on " + format_complex(back.value) + ", which is not among that point's roots";
       return out;

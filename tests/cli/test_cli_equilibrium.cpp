@@ -321,6 +321,55 @@ TEST(EquilibriumCli, BoundaryOfAnEquilibriumFollowsItsHopfCurveToTheGeneralisedH
   EXPECT_TRUE(contains(forced.err, "is not autonomous")) << forced.err;
 }
 
+// Issue 60 item 1: fold curves of an equilibrium (boundary_type = fold), on a cusp with a decoupled
+// decay beside it, x' = p + q x - x^3 + c (x(t - 1) - x), z' = -z (an equation model of a prebuilt
+// shape): J = diag(q - 3 x^2, -1) folds where q = 3 x^2, p = -2 x^3, so both curves' points have
+// their equilibrium x on that closed form (measured: 4e-16; 1e-9 is the extended system's Newton
+// tolerance). The same model in one parameter finds both folds: before, the x root near -1 and the
+// decay's exact -1 (5e-6 apart) swapped places when followed back and the branch ended in exit 3.
+TEST(EquilibriumCli, FoldCurvesOfACuspAreTheClosedForm) {
+  const std::filesystem::path dir = delayspec::testing::fresh_dir("fold_curves");
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "cusp.toml").string();
+  std::ofstream(scene) << R"toml(model = "equations"
+equilibrium_guess = [-1.4, 0]
+[equations]
+state = ["x", "z"]
+parameters = { p = -2, q = 0.5, c = 0.5 }
+period = "1"
+delay = "1"
+rhs = ["p + q*x - x^3 + c*(x_tau - x)", "-z"]
+history = { x = -1.4, z = 0 }
+)toml";
+  const std::string cache = std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE;
+  const CliResult r = run({"boundary", scene, "--json", "--set", "boundary_object=equilibrium", "--set",
+                           "boundary_type=fold", "--set", "boundary_x=q", "--set", "boundary_y=p", "--set",
+                           "boundary_x_from=0.5", "--set", "boundary_x_to=2", "--set", "boundary_y_from=-2", "--set",
+                           "boundary_y_to=2", "--set", cache});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["curves"].size(), 2u);
+  for (const auto& c : j["curves"]) {
+    EXPECT_EQ(c["type"], "fold");
+    EXPECT_EQ(c["end"], "to");
+    for (const auto& p : c["points"]) {
+      const double x = p["equilibrium"][0];
+      EXPECT_NEAR(p["x"].get<double>(), 3 * x * x, 1e-9);
+      EXPECT_NEAR(p["y"].get<double>(), -2 * x * x * x, 1e-9);
+    }
+  }
+  const CliResult one = run({"continue", scene, "--json", "--set", "continue_object=equilibrium", "--set",
+                             "continue_key=p", "--set", "continue_from=-2", "--set", "continue_to=2", "--set", cache});
+  ASSERT_EQ(one.status, 0) << one.err;
+  const auto b = nlohmann::json::parse(one.out)["bifurcations"];
+  ASSERT_EQ(b.size(), 2u);
+  for (const auto& f : b) {
+    EXPECT_EQ(f["type"], "fold");
+    EXPECT_NEAR(std::abs(f["parameter"].get<double>()), 2 * std::pow(0.5 / 3, 1.5), 1.5e-9);  // tolerance 1e-10 * 4
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(EquilibriumCli, ContinueEquilibriaBadInput) {
   const std::vector<std::string> base = {"continue", "--set", "continue_object=equilibrium", "--set", "continue_key=tau",
                                          "--set", "continue_from=3", "--set", "continue_to=6"};

@@ -320,5 +320,46 @@ TEST(HopfCurves, DoubleAndZeroHopfPointsAreTheClosedForms) {
   }
 }
 
+// x' = p + q x - x^3 + c (x(t - 1) - x): J = A + B = q - 3 x^2 (the delay cancels at a constant
+// history), so the equilibria fold where q = 3 x^2, p = -2 x^3: the two fold curves of a cusp,
+// p = -+2 (q / 3)^{3/2}. The branch in p at q = 0.5 passes both folds (lower branch up, middle
+// back, upper up); each starts a curve traced on the extended system, every point of which has its
+// equilibrium x on the closed form to 1e-9 (Newton's tolerance 1e-10 in the scaled plane, a
+// Jacobian by differences: the solution is exact to the tolerance).
+struct CuspModel {
+  static constexpr int d = 1;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double p = -2, q = 0.5, c = 0.5;
+  double tau() const { return 1; }
+  double period() const { return 1; }
+  Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const {
+    return Vec<1>(p + q * y[0] - y[0] * y[0] * y[0] + c * (w[0] - y[0]));
+  }
+  Mat<1> A(int, double, const Vec<1>& y, const Vec<1>&) const { return Mat<1>::Constant(q - 3 * y[0] * y[0] - c); }
+  Mat<1> B(int, double, const Vec<1>&, const Vec<1>&) const { return Mat<1>::Constant(c); }
+  Vec<1> initial_state() const { return Vec<1>(-1.4); }
+};
+
+TEST(FoldCurves, TheCuspsTwoFoldCurvesAreTheClosedForm) {
+  HopfCurveOptions o;
+  o.boundary.x_from = 0.5, o.boundary.x_to = 2, o.boundary.y_from = -2, o.boundary.y_to = 2;
+  const FoldCurves r = fold_curves(family_in_two<CuspModel>([](double q, double p) { return CuspModel{p, q, 0.5}; }),
+                                   Vec<1>(-1.4), o);
+  ASSERT_EQ(r.curves.size(), 2u);
+  for (const FoldCurve& c : r.curves) {
+    EXPECT_EQ(c.end, BoundaryEnd::to) << c.note;
+    ASSERT_GE(c.points.size(), 5u);
+    EXPECT_NEAR(c.points.front().x, 0.5, 1e-9);
+    EXPECT_NEAR(c.points.back().x, 2, 1e-9);
+    for (const FoldCurvePoint& p : c.points) {
+      const double x = p.state[0];
+      EXPECT_NEAR(p.x, 3 * x * x, 1e-9);
+      EXPECT_NEAR(p.y, -2 * x * x * x, 1e-9);
+    }
+  }
+  // one curve on each side: p > 0 on the lower branch's fold (x < 0), p < 0 on the upper's
+  EXPECT_LT(r.curves[0].points.back().y * r.curves[1].points.back().y, 0);
+}
+
 }  // namespace
 }  // namespace delayspec

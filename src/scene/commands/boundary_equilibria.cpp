@@ -26,6 +26,7 @@ using nlohmann::json;
 
 struct EquilibriaBoundaryRun {
   BoundarySettings settings;
+  bool folds = false;  // boundary_type = fold (default hopf)
   EquilibriumSettings eq;
   Problem problem;  // at (x_from, y_from)
 };
@@ -33,6 +34,7 @@ struct EquilibriaBoundaryRun {
 EquilibriaBoundaryRun read_run(Config& config) {
   EquilibriaBoundaryRun run;
   run.settings = read_boundary_settings(config);
+  run.folds = config.get_choice("boundary_type", "hopf", {"hopf", "fold"}) == "fold";
   const BoundaryOptions& o = run.settings.options;
   config.set(run.settings.x_key, format_number(o.x_from), "boundary_x_from");
   config.set(run.settings.y_key, format_number(o.y_from), "boundary_y_from");
@@ -79,6 +81,49 @@ json point_json(const HopfCurvePoint& p) {
     j["criticality"] = to_string(p.normal_form->criticality);
   }
   return j;
+}
+
+json fold_curves_json(const EquilibriaBoundaryRun& run, const FoldCurves& r, double seconds) {
+  json j;
+  j["model"] = run.problem.model_name;
+  j["boundary_object"] = "equilibrium";
+  j["boundary_type"] = "fold";
+  j["boundary_x"] = run.settings.x_key;
+  j["boundary_y"] = run.settings.y_key;
+  const BoundaryOptions& o = run.settings.options;
+  j["x_range"] = {o.x_from, o.x_to};
+  j["y_range"] = {o.y_from, o.y_to};
+  j["curves"] = json::array();
+  for (const FoldCurve& c : r.curves) {
+    json cj;
+    cj["type"] = "fold";
+    cj["end"] = to_string(c.end);
+    if (!c.note.empty()) cj["note"] = c.note;
+    cj["points"] = json::array();
+    for (const FoldCurvePoint& p : c.points)
+      cj["points"].push_back(
+          {{"x", p.x}, {"y", p.y}, {"equilibrium", std::vector<double>(p.state.data(), p.state.data() + p.state.size())}});
+    cj["codim2"] = json::array();
+    cj["notes"] = json::array();
+    j["curves"].push_back(cj);
+  }
+  j["notes"] = r.notes;
+  j["seconds"] = seconds;
+  return j;
+}
+
+std::string fold_curves_csv(const std::string& header, const Problem& problem, const FoldCurves& r) {
+  std::ostringstream rows;
+  rows << header << "curve,x,y";
+  for (const std::string& name : problem.state_names) rows << "," << name;
+  rows << "\n";
+  for (size_t k = 0; k < r.curves.size(); ++k)
+    for (const FoldCurvePoint& p : r.curves[k].points) {
+      rows << k + 1 << "," << csv_number(p.x) << "," << csv_number(p.y);
+      for (long i = 0; i < p.state.size(); ++i) rows << "," << csv_number(p.state[i]);
+      rows << "\n";
+    }
+  return rows.str();
 }
 
 json curves_json(const EquilibriaBoundaryRun& run, const HopfCurves& r, double seconds) {
@@ -159,6 +204,24 @@ void print_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const Hopf
   os << "time: " << seconds << " s\n";
 }
 
+void print_fold_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const FoldCurves& r, double seconds) {
+  const BoundaryOptions& o = run.settings.options;
+  os << "delayspec boundary: model " << run.problem.model_name << ", fold curves of the equilibrium in ("
+     << run.settings.x_key << ", " << run.settings.y_key << ") over [" << format_number(o.x_from) << ", "
+     << format_number(o.x_to) << "] x [" << format_number(o.y_from) << ", " << format_number(o.y_to)
+     << "], on the extended system (f = 0, J singular)\ncurves: " << r.curves.size() << "\n";
+  for (size_t k = 0; k < r.curves.size(); ++k) {
+    const FoldCurve& c = r.curves[k];
+    os << "  curve " << k + 1 << ": " << c.points.size() << " points, ended at `" << to_string(c.end) << "`"
+       << (c.note.empty() ? "" : " (" + c.note + ")") << "\n";
+    if (!c.points.empty())
+      os << "    from (" << format_number(c.points.front().x) << ", " << format_number(c.points.front().y) << ") to ("
+         << format_number(c.points.back().x) << ", " << format_number(c.points.back().y) << ")\n";
+  }
+  for (const std::string& n : r.notes) os << "note: " << n << "\n";
+  os << "time: " << seconds << " s\n";
+}
+
 }  // namespace
 
 int boundary_equilibria(Config& config, const Invocation& inv) {
@@ -180,18 +243,30 @@ int boundary_equilibria(Config& config, const Invocation& inv) {
   o.boundary = run.settings.options;
   o.equilibrium = eq;
   o.scan_lines = std::max(1, run.settings.scan_points);
-  const HopfCurves curves = hopf_curves(family, run.eq.guess, o);
+  HopfCurves curves;
+  FoldCurves folds;
+  if (run.folds)
+    folds = fold_curves(family, run.eq.guess, o);
+  else
+    curves = hopf_curves(family, run.eq.guess, o);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const json j = curves_json(run, curves, seconds);
+  const json j = run.folds ? fold_curves_json(run, folds, seconds) : curves_json(run, curves, seconds);
   std::string failures;
   for (const HopfCurve& c : curves.curves)
     if (c.end == BoundaryEnd::failure) failures += (failures.empty() ? "" : "; ") + c.note;
+  for (const FoldCurve& c : folds.curves)
+    if (c.end == BoundaryEnd::failure) failures += (failures.empty() ? "" : "; ") + c.note;
+  const size_t count = run.folds ? folds.curves.size() : curves.curves.size();
+  const char* kind = run.folds ? "fold" : "Hopf";
   if (inv.out_dir) {
     const std::filesystem::path dir(*inv.out_dir);
     const OutputMetadata metadata = make_metadata("boundary", inv.scene, config, j, seconds);
     std::string header = metadata_comment_lines(metadata);
     if (!failures.empty()) header += "# INCOMPLETE: a curve ended in a failure: " + failures + "\n";
-    write_output(inv, dir / "hopf_curves.csv", curves_csv(header, curves));
+    if (run.folds)
+      write_output(inv, dir / "fold_curves.csv", fold_curves_csv(header, run.problem, folds));
+    else
+      write_output(inv, dir / "hopf_curves.csv", curves_csv(header, curves));
     json file = j;
     file["metadata"] = metadata_json(metadata);
     write_output(inv, dir / "boundary.json", file.dump(2) + "\n");
@@ -201,8 +276,8 @@ int boundary_equilibria(Config& config, const Invocation& inv) {
             << (inv.out_dir ? "; the curves so far are in " + *inv.out_dir : std::string()) << "\n";
     return 3;
   }
-  if (curves.curves.empty()) {
-    inv.err << "delayspec boundary: numerical failure: no Hopf point of the equilibrium for " << run.settings.y_key
+  if (count == 0) {
+    inv.err << "delayspec boundary: numerical failure: no " << kind << " point of the equilibrium for " << run.settings.y_key
             << " in [" << format_number(o.boundary.y_from) << ", " << format_number(o.boundary.y_to) << "] at "
             << run.settings.x_key << " = " << format_number(o.boundary.x_from)
             << (o.scan_lines > 1 ? " .. " + format_number(o.boundary.x_to) : std::string()) << "\n";
@@ -210,6 +285,8 @@ int boundary_equilibria(Config& config, const Invocation& inv) {
   }
   if (inv.json)
     inv.out << j.dump(2) << "\n";
+  else if (run.folds)
+    print_fold_curves(inv.out, run, folds, seconds);
   else
     print_curves(inv.out, run, curves, seconds);
   return 0;
