@@ -52,6 +52,9 @@ class HopfTest {
   // The point at (x, y) with its normal form; the reason when g is undefined there.
   std::string point(double x, double y, HopfCurvePoint& p) { return evaluate(x, y, p, true); }
 
+  // The last (x, y) where the pair turned real (omega -> 0), if any
+  const std::optional<std::pair<double, double>>& turned_real() const { return turned_real_; }
+
  private:
   struct Known {
     double x, y;
@@ -82,9 +85,11 @@ class HopfTest {
       if (moved > 0.1 * std::abs(start) && moved > 0.1)
         return "the root followed jumped from " + format_complex(start) + " to " + format_complex(root.value) +
                " at (" + format_number(x) + ", " + format_number(y) + ")";
-      if (!(root.value.imag() > 1e-8 * (1 + std::abs(root.value))))
+      if (!(root.value.imag() > 1e-8 * (1 + std::abs(root.value)))) {
+        turned_real_ = {x, y};
         return "the critical pair turned real at (" + format_number(x) + ", " + format_number(y) +
                "): omega = " + format_number(root.value.imag()) + " (a Bogdanov-Takens or zero-Hopf point)";
+      }
       p.x = x, p.y = y, p.state = r.state, p.root = root;
       if (with_normal_form && family_.jacobian)
         p.normal_form = hopf_normal_form(
@@ -100,6 +105,7 @@ class HopfTest {
   const EquilibriumFamily2& family_;
   const HopfCurveOptions& o_;
   std::vector<Known> known_;
+  std::optional<std::pair<double, double>> turned_real_;
 };
 
 bool decided(const HopfCurvePoint& p) {
@@ -299,6 +305,16 @@ HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& 
       HopfCurve curve;
       curve.end = c.end;
       curve.note = c.note;
+      // A curve that could go no further because its pair turned real right ahead (within 1e-3
+      // of the range) ends at a Bogdanov-Takens or zero-Hopf point, not in a failure; the point
+      // is named, not located (omega -> 0 leaves no scalar that changes sign there).
+      if (const auto& at = test.turned_real(); c.end == BoundaryEnd::failure && at && !c.points.empty() &&
+                                                std::hypot((at->first - c.points.back().x) / (b.x_to - b.x_from),
+                                                           (at->second - c.points.back().y) / (b.y_to - b.y_from)) < 1e-3) {
+        curve.end = BoundaryEnd::codim2;
+        curve.note = "omega -> 0 at (" + format_number(at->first) + ", " + format_number(at->second) +
+                     "): a Bogdanov-Takens point (or zero-Hopf where omega stays away from 0), not located";
+      }
       for (const BoundaryPoint& bp : c.points) {
         HopfCurvePoint p;
         if (const std::string why = test.point(bp.x, bp.y, p); !why.empty()) {

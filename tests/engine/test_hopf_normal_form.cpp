@@ -226,6 +226,26 @@ TEST(HopfCurves, LinearHopfCurveIsTheClosedForm) {
   EXPECT_TRUE(c.codim2.empty());
 }
 
+// The same curve runs into its Bogdanov-Takens point (a, b) = (1, -1) (omega -> 0 as a -> 1): the
+// curve ends there as a codim-2 end, named, not as a failure; its last point within 1e-4 of it
+// (the tracer halves its step towards it down to step_min 1e-6 of the range).
+TEST(HopfCurves, AHopfCurveEndsAtItsBogdanovTakensPoint) {
+  HopfCurveOptions o;
+  o.boundary.x_from = -1, o.boundary.x_to = 1.2, o.boundary.y_from = -0.5, o.boundary.y_to = -3;
+  const HopfCurves r = hopf_curves(family_in_two<LinearModel>([](double a, double b) {
+                                     LinearParameters p;
+                                     p.a = a, p.b = b;
+                                     return LinearModel(p);
+                                   }),
+                                   Eigen::VectorXd(), o);
+  ASSERT_EQ(r.curves.size(), 1u);
+  const HopfCurve& c = r.curves[0];
+  EXPECT_EQ(c.end, BoundaryEnd::codim2) << c.note;
+  EXPECT_NE(c.note.find("Bogdanov-Takens"), std::string::npos) << c.note;
+  EXPECT_NEAR(c.points.back().x, 1, 1e-4);
+  EXPECT_NEAR(c.points.back().y, -1, 1e-4);
+}
+
 // Wright's equation with the cubic c y(t - 1)^3 in (c, r): the Hopf curve is r = pi/2 for every c
 // (the linearisation does not see c), and l1 = -(3 pi - 2) / (10 (1 + pi^2/4)) - 3 c / (1 + pi^2/4)
 // (the closed forms above) vanishes at c* = -(3 pi - 2) / 30: the generalised Hopf point, located
