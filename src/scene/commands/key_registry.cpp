@@ -214,14 +214,14 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"continue_solver",
        "continue: the corrector's linear solver: krylov (GMRES on the condensed system, matrix-free), lu (sparse LU), "
        "auto (krylov, lu where GMRES fails)"},
-      {"boundary_object", "boundary: orbit (stability curves of the periodic orbit) or equilibrium (an autonomous model's Hopf curves, with l1 and generalised Hopf points)"},
+      {"boundary_object", "boundary: orbit (stability curves of the periodic orbit) or equilibrium (an autonomous model's Hopf curves, with l1 and their codim-2 points, or fold curves)"},
       {"boundary_x", "boundary: the model key stepped along the curve (e.g. spindle_rpm)"},
       {"boundary_y", "boundary: the model key solved for (e.g. depth)"},
       {"boundary_x_from", "boundary: where the curve starts (x)"},
       {"boundary_x_to", "boundary: where the curve ends (x), landed on exactly"},
       {"boundary_y_from", "boundary: start of the y range (the start is searched by continue in y over the range)"},
       {"boundary_y_to", "boundary: end of the y range (a curve that leaves it ends there)"},
-      {"boundary_type", "boundary: neimark-sacker, period-doubling, fold, grazing (max H = 0), or any (the first found at x_from but grazing)"},
+      {"boundary_type", "boundary: neimark-sacker, period-doubling, fold, grazing (max H = 0), or any (the first found at x_from but grazing); with boundary_object = equilibrium: hopf (default) or fold"},
       {"boundary_starts", "boundary: first (the first bifurcation in y at x_from) or scan (the first in y at each of "
                           "boundary_scan_points values of x: every curve met, e.g. the lobes of a speed range)"},
       {"boundary_scan_points", "boundary: values of x searched for starts with boundary_starts = scan, 2..1e5"},
