@@ -196,6 +196,15 @@ EquilibriumFamily2 family_in_two(Make make) {
           }};
 }
 
+// x' = a x + b x(t - 1) in (a, b)
+EquilibriumFamily2 linear_in_a_b() {
+  return family_in_two<LinearModel>([](double a, double b) {
+    LinearParameters p;
+    p.a = a, p.b = b;
+    return LinearModel(p);
+  });
+}
+
 // x' = a x + b x(t - 1) in (a, b): i omega = a + b e^{-i omega} gives the curve
 // a = omega cot omega, b = -omega / sin omega (0 < omega < pi). Every point the tracer returns is
 // on it to the locator's accuracy: from the point's omega, a and b agree with the closed form to
@@ -203,11 +212,7 @@ EquilibriumFamily2 family_in_two(Make make) {
 TEST(HopfCurves, LinearHopfCurveIsTheClosedForm) {
   HopfCurveOptions o;
   o.boundary.x_from = -1, o.boundary.x_to = 0.9, o.boundary.y_from = -0.5, o.boundary.y_to = -3;
-  const HopfCurves r = hopf_curves(family_in_two<LinearModel>([](double a, double b) {
-                                     LinearParameters p;
-                                     p.a = a, p.b = b;
-                                     return LinearModel(p);
-                                   }),
+  const HopfCurves r = hopf_curves(linear_in_a_b(),
                                    Eigen::VectorXd(), o);
   ASSERT_EQ(r.curves.size(), 1u);
   const HopfCurve& c = r.curves[0];
@@ -232,11 +237,7 @@ TEST(HopfCurves, LinearHopfCurveIsTheClosedForm) {
 TEST(HopfCurves, AHopfCurveEndsAtItsBogdanovTakensPoint) {
   HopfCurveOptions o;
   o.boundary.x_from = -1, o.boundary.x_to = 1.2, o.boundary.y_from = -0.5, o.boundary.y_to = -3;
-  const HopfCurves r = hopf_curves(family_in_two<LinearModel>([](double a, double b) {
-                                     LinearParameters p;
-                                     p.a = a, p.b = b;
-                                     return LinearModel(p);
-                                   }),
+  const HopfCurves r = hopf_curves(linear_in_a_b(),
                                    Eigen::VectorXd(), o);
   ASSERT_EQ(r.curves.size(), 1u);
   const HopfCurve& c = r.curves[0];

@@ -68,13 +68,15 @@ class ModelAtPair {
   double x_ = 0, y_ = 0;
 };
 
+std::vector<double> state_values(const Eigen::VectorXd& y) { return {y.data(), y.data() + y.size()}; }
+
 json point_json(const HopfCurvePoint& p) {
   json j;
   j["x"] = p.x;
   j["y"] = p.y;
   j["omega"] = p.root.value.imag();
   j["period"] = 2 * std::numbers::pi / p.root.value.imag();
-  j["equilibrium"] = std::vector<double>(p.state.data(), p.state.data() + p.state.size());
+  j["equilibrium"] = state_values(p.state);
   if (p.normal_form) {
     j["l1"] = std::isfinite(p.normal_form->l1) ? json(p.normal_form->l1) : json(nullptr);
     j["l1_bound"] = std::isfinite(p.normal_form->l1_bound) ? json(p.normal_form->l1_bound) : json(nullptr);
@@ -83,28 +85,39 @@ json point_json(const HopfCurvePoint& p) {
   return j;
 }
 
-json fold_curves_json(const EquilibriaBoundaryRun& run, const FoldCurves& r, double seconds) {
+// What every result of this command starts with: the model, the keys and the ranges.
+json run_json(const EquilibriaBoundaryRun& run) {
   json j;
   j["model"] = run.problem.model_name;
   j["boundary_object"] = "equilibrium";
-  j["boundary_type"] = "fold";
+  j["boundary_type"] = run.folds ? "fold" : "hopf";
   j["boundary_x"] = run.settings.x_key;
   j["boundary_y"] = run.settings.y_key;
   const BoundaryOptions& o = run.settings.options;
   j["x_range"] = {o.x_from, o.x_to};
   j["y_range"] = {o.y_from, o.y_to};
   j["curves"] = json::array();
+  return j;
+}
+
+// A curve's own fields but its points and codim-2 points.
+json curve_json(const char* type, BoundaryEnd end, const std::string& note, const std::vector<std::string>& notes) {
+  json cj;
+  cj["type"] = type;
+  cj["end"] = to_string(end);
+  if (!note.empty()) cj["note"] = note;
+  cj["points"] = json::array();
+  cj["codim2"] = json::array();
+  cj["notes"] = notes;
+  return cj;
+}
+
+json fold_curves_json(const EquilibriaBoundaryRun& run, const FoldCurves& r, double seconds) {
+  json j = run_json(run);
   for (const FoldCurve& c : r.curves) {
-    json cj;
-    cj["type"] = "fold";
-    cj["end"] = to_string(c.end);
-    if (!c.note.empty()) cj["note"] = c.note;
-    cj["points"] = json::array();
+    json cj = curve_json("fold", c.end, c.note, {});
     for (const FoldCurvePoint& p : c.points)
-      cj["points"].push_back(
-          {{"x", p.x}, {"y", p.y}, {"equilibrium", std::vector<double>(p.state.data(), p.state.data() + p.state.size())}});
-    cj["codim2"] = json::array();
-    cj["notes"] = json::array();
+      cj["points"].push_back({{"x", p.x}, {"y", p.y}, {"equilibrium", state_values(p.state)}});
     j["curves"].push_back(cj);
   }
   j["notes"] = r.notes;
@@ -127,23 +140,10 @@ std::string fold_curves_csv(const std::string& header, const Problem& problem, c
 }
 
 json curves_json(const EquilibriaBoundaryRun& run, const HopfCurves& r, double seconds) {
-  json j;
-  j["model"] = run.problem.model_name;
-  j["boundary_object"] = "equilibrium";
-  j["boundary_x"] = run.settings.x_key;
-  j["boundary_y"] = run.settings.y_key;
-  const BoundaryOptions& o = run.settings.options;
-  j["x_range"] = {o.x_from, o.x_to};
-  j["y_range"] = {o.y_from, o.y_to};
-  j["curves"] = json::array();
+  json j = run_json(run);
   for (const HopfCurve& c : r.curves) {
-    json cj;
-    cj["type"] = "hopf";
-    cj["end"] = to_string(c.end);
-    if (!c.note.empty()) cj["note"] = c.note;
-    cj["points"] = json::array();
+    json cj = curve_json("hopf", c.end, c.note, c.notes);
     for (const HopfCurvePoint& p : c.points) cj["points"].push_back(point_json(p));
-    cj["codim2"] = json::array();
     for (const HopfCodim2Point& g : c.codim2) {
       json gj = {{"kind", to_string(g.kind)}, {"x", g.x},         {"y", g.y},
                  {"bound", g.bound},         {"omega", g.omega}, {"evaluations", g.evaluations}};
@@ -151,7 +151,6 @@ json curves_json(const EquilibriaBoundaryRun& run, const HopfCurves& r, double s
         gj["second_root"] = {{"re", g.second_root.real()}, {"im", g.second_root.imag()}};
       cj["codim2"].push_back(gj);
     }
-    cj["notes"] = c.notes;
     j["curves"].push_back(cj);
   }
   j["notes"] = r.notes;
