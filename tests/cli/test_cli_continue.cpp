@@ -243,7 +243,7 @@ INSTANTIATE_TEST_SUITE_P(
     Keys, ContinueBadInput,
     ::testing::Values(
         BadContinue{{"continue_from=0", "continue_to=1"}, "continue_key"},
-        BadContinue{{"continue_key=bb", "continue_from=0", "continue_to=1"}, "`bb`"},
+        BadContinue{{"continue_key=bb", "continue_from=0", "continue_to=1"}, "`continue_key = bb`: not a model parameter"},
         BadContinue{{"continue_key=b", "continue_from=0.3", "continue_to=0.3"}, "empty range"},
         BadContinue{{"continue_key=b", "continue_to=0.3"}, "continue_from"},
         BadContinue{{"continue_key=N", "continue_from=10", "continue_to=20"}, "`continue_key = N`"},

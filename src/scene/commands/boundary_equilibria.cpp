@@ -29,6 +29,7 @@ struct EquilibriaBoundaryRun {
   bool folds = false;  // boundary_type = fold (default hopf)
   EquilibriumSettings eq;
   Problem problem;  // at (x_from, y_from)
+  int x_index = -1, y_index = -1;  // the keys' parameters in problem.family
 };
 
 EquilibriaBoundaryRun read_run(Config& config) {
@@ -36,34 +37,40 @@ EquilibriaBoundaryRun read_run(Config& config) {
   run.settings = read_boundary_settings(config);
   run.folds = config.get_choice("boundary_type", "hopf", {"hopf", "fold"}) == "fold";
   const BoundaryOptions& o = run.settings.options;
-  config.set(run.settings.x_key, format_number(o.x_from), "boundary_x_from");
-  config.set(run.settings.y_key, format_number(o.y_from), "boundary_y_from");
   run.problem = read_problem(config, 100, ModelNeed::autonomous);
   run.eq = read_equilibrium_settings(config, run.problem);
+  run.problem = starting_problem(run.problem, config,
+                                 {{"boundary_x", run.settings.x_key, o.x_from, "boundary_x_from"},
+                                  {"boundary_y", run.settings.y_key, o.y_from, "boundary_y_from"}});
+  run.x_index = family_parameter(run.problem, "boundary_x", run.settings.x_key);
+  run.y_index = family_parameter(run.problem, "boundary_y", run.settings.y_key);
   config.check_all_used();
   require_autonomous(run.problem);
   return run;
 }
 
-// The model at (x, y): the scene with both keys set, read once per pair (Newton asks for the same
-// pair several times in a row).
+// The model at (x, y) from the problem's family, made once per pair (Newton asks for the same
+// pair several times in a row). BadInput with the model's reason where it refuses the pair.
 class ModelAtPair {
  public:
-  ModelAtPair(const Config& base, const std::string& x_key, const std::string& y_key)
-      : config_(base), x_key_(x_key), y_key_(y_key) {}
+  explicit ModelAtPair(const EquilibriaBoundaryRun& run)
+      : problem_(run.problem), values_(run.problem.parameter_values), x_index_(run.x_index), y_index_(run.y_index) {}
   std::shared_ptr<const ModelAnalyses> operator()(double x, double y) {
     if (!analyses_ || x != x_ || y != y_) {
-      config_.set(x_key_, format_number(x), "boundary");
-      config_.set(y_key_, format_number(y), "boundary");
-      analyses_ = read_problem(config_, 100).analyses;
+      values_[static_cast<size_t>(x_index_)] = x;
+      values_[static_cast<size_t>(y_index_)] = y;
+      const FamilyMember member = problem_.family->at(values_, problem_.map_settings());
+      if (!member) throw BadInput(member.rejected);
+      analyses_ = member.analyses;
       x_ = x, y_ = y;
     }
     return analyses_;
   }
 
  private:
-  Config config_;
-  std::string x_key_, y_key_;
+  const Problem& problem_;
+  std::vector<double> values_;
+  int x_index_, y_index_;
   std::shared_ptr<const ModelAnalyses> analyses_;
   double x_ = 0, y_ = 0;
 };
@@ -226,7 +233,7 @@ void print_fold_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const
 int boundary_equilibria(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
   const EquilibriaBoundaryRun run = read_run(config);
-  auto at = std::make_shared<ModelAtPair>(config, run.settings.x_key, run.settings.y_key);
+  auto at = std::make_shared<ModelAtPair>(run);
   const EquilibriumOptions& eq = run.eq.options;
   const EquilibriumFamily2 family{
       [at](const Eigen::VectorXd& s, double x, double y) { return (*at)(x, y)->at_constant_history(s); },

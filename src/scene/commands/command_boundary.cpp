@@ -60,6 +60,14 @@ struct BoundaryRun {
   OrbitSettings orbit_settings;
   FloquetOptions floquet;
   Problem problem;  // at (x_from, y_from)
+  int x_index = -1, y_index = -1;  // the keys' parameters in problem.family
+  // The problem at (x, y) and resolution N (its family's model, no scene read); nothing, with
+  // the model's reason in `rejected`, where the model refuses them.
+  std::optional<Problem> at(double x, double y, int N, std::string& rejected) const {
+    const std::vector<double> values =
+        ProblemFamily::with(ProblemFamily::with(problem.parameter_values, x_index, x), y_index, y);
+    return problem_at(problem, values, N, rejected);
+  }
 };
 
 BoundaryRun read_boundary_run(Config& config) {
@@ -85,9 +93,11 @@ BoundaryRun read_boundary_run(Config& config) {
   run.threads = read_threads(config);
   run.orbit_settings = read_orbit_settings(config);
   run.floquet = read_floquet_options(config);
-  config.set(run.x_key, format_number(o.x_from), "boundary_x_from");
-  config.set(run.y_key, format_number(o.y_from), "boundary_y_from");
-  run.problem = read_problem(config, 100);
+  run.problem = starting_problem(read_problem(config, 100), config,
+                                 {{"boundary_x", run.x_key, o.x_from, "boundary_x_from"},
+                                  {"boundary_y", run.y_key, o.y_from, "boundary_y_from"}});
+  run.x_index = family_parameter(run.problem, "boundary_x", run.x_key);
+  run.y_index = family_parameter(run.problem, "boundary_y", run.y_key);
   if (run.type == BifurcationType::grazing && !run.problem.analyses->switches_in_state())
     throw BadInput("`boundary_type = grazing`: model " + run.problem.model_name +
                    " has no switching surface H(y) = 0 for its orbit to graze");
@@ -98,15 +108,14 @@ BoundaryRun read_boundary_run(Config& config) {
   return run;
 }
 
-// The test function of `type` at (x, y) at one N: the scene with both keys set, its orbit and
+// The test function of `type` at (x, y) at one N: the model at both values, its orbit and
 // leading multipliers. A nonlinear model's orbit is found by Newton from the last one found.
 // at_point: at a point of the traced curve, whose sample also carries where it meets a curve of
 // the other kind (boundary.hpp's at_points): on a grazing curve this needs the multipliers too.
 class TestFunctionAt {
  public:
-  TestFunctionAt(const Config& base, const BoundaryRun& run, BifurcationType type, int N)
-      : at_(base), run_(run), type_(type), orbit_settings_(run.orbit_settings) {
-    at_.set("N", std::to_string(N), "boundary_Ns");
+  TestFunctionAt(const BoundaryRun& run, BifurcationType type, int N)
+      : run_(run), type_(type), N_(N), orbit_settings_(run.orbit_settings) {
     // From the last point's orbit: one Newton step even when it meets the tolerance (orbit_newton.hpp)
     orbit_settings_.newton.min_iterations = 1;
   }
@@ -115,18 +124,18 @@ class TestFunctionAt {
 
  private:
   BoundarySample evaluate(double x, double y, bool on_curve) const {
-    at_.set(run_.x_key, format_number(x), "boundary");
-    at_.set(run_.y_key, format_number(y), "boundary");
+    std::string rejected;
+    const std::optional<Problem> p = run_.at(x, y, N_, rejected);
+    if (!p) return undefined(rejected);  // a value the model refuses
     try {
-      const Problem p = read_problem(at_, 100);
       if (last_orbit_.size() > 0) {
         try {
-          return sample(p, &last_orbit_, on_curve);
+          return sample(*p, &last_orbit_, on_curve);
         } catch (const NumericalFailure&) {  // Newton from the last orbit: the search from scratch below
         }
       }
-      return sample(p, nullptr, on_curve);
-    } catch (const BadInput& e) {  // a value the model rejects
+      return sample(*p, nullptr, on_curve);
+    } catch (const BadInput& e) {  // an analysis that refuses this point
       return undefined(e.what());
     } catch (const NumericalFailure& e) {  // an orbit or an eigensolver that fails
       return undefined(e.what());
@@ -165,12 +174,10 @@ class TestFunctionAt {
     s.reason = reason;
     return s;
   }
-  // The scene at the last point evaluated: x and y replaced in place, not a copy of the scene's
-  // keys per evaluation (4 % of a lobe diagram's time); an object serves one thread, as its
-  // last orbit does.
-  mutable Config at_;
+  // An object serves one thread, as its last orbit does.
   const BoundaryRun& run_;
   BifurcationType type_;
+  int N_;
   OrbitSettings orbit_settings_;
   mutable Eigen::VectorXd last_orbit_;
 };
@@ -189,12 +196,11 @@ struct Search {
   bool stable_at_y_from = false;
   std::string found, failure;
 };
-Search search_at(const Config& config, const BoundaryRun& run, double x, int N) {
-  Config at_x = config;
-  at_x.set("N", std::to_string(N), "boundary_Ns");
-  at_x.set(run.x_key, format_number(x), "boundary");
-  at_x.set(run.y_key, format_number(run.options.y_from), "boundary_y_from");
-  const Problem problem = read_problem(at_x, 100);
+Search search_at(const BoundaryRun& run, double x, int N) {
+  std::string rejected;
+  const std::optional<Problem> at_x = run.at(x, run.options.y_from, N, rejected);
+  if (!at_x) throw BadInput(rejected);
+  const Problem& problem = *at_x;
   ContinuationOptions search;
   search.from = run.options.y_from;
   search.to = run.options.y_to;
@@ -206,7 +212,7 @@ Search search_at(const Config& config, const BoundaryRun& run, double x, int N) 
   search.newton.tolerance = run.orbit_settings.newton.tolerance;
   search.start_iterations = run.orbit_settings.newton.max_iterations;
   const ContinuationResult branch =
-      problem.analyses->continue_orbit(analyses_with_key(at_x, run.y_key), run.orbit_settings, search);
+      problem.analyses->continue_orbit(analyses_along(problem, run.y_index), run.orbit_settings, search);
   Search out;
   out.stable_at_y_from = !branch.points.empty() && branch.points.front().stable();
   out.failure = branch.failure;
@@ -225,8 +231,8 @@ Search search_at(const Config& config, const BoundaryRun& run, double x, int N) 
 // lobes lie apart in speed). Whatever root it finds is a point of a curve of that type at the
 // finest N: the curve's start checks it (trace_boundary), the scan skips it when it is on a
 // curve already followed.
-std::optional<Start> at_finest_N(const Config& config, const BoundaryRun& run, const Start& coarse) {
-  const TestFunctionAt g(config, run, coarse.type, run.Ns.back());
+std::optional<Start> at_finest_N(const BoundaryRun& run, const Start& coarse) {
+  const TestFunctionAt g(run, coarse.type, run.Ns.back());
   const double range = run.options.y_to - run.options.y_from;
   const double s = boundary_offset_along(std::cref(g), coarse.x, coarse.y, 0, range, 1e-6, run.options.tolerance);
   if (!(std::abs(s) <= 0.1)) return std::nullopt;
@@ -237,19 +243,19 @@ std::optional<Start> at_finest_N(const Config& config, const BoundaryRun& run, c
 // the finest (at_finest_N): on milling_lobes_curves.toml the 40 starts' search took 0.26 s instead
 // of 0.36-0.44 at N = 400 (a `continue` at N = 100 costs half one at 400: its fixed costs
 // dominate). Searched at the finest N where the coarsest finds none or the move fails.
-Search first_start_at(const Config& config, const BoundaryRun& run, double x) {
+Search first_start_at(const BoundaryRun& run, double x) {
   if (run.Ns.size() > 1) {
     try {
-      Search coarse = search_at(config, run, x, run.Ns.front());
+      Search coarse = search_at(run, x, run.Ns.front());
       if (!coarse.starts.empty())
-        if (const std::optional<Start> start = at_finest_N(config, run, coarse.starts.front())) {
+        if (const std::optional<Start> start = at_finest_N(run, coarse.starts.front())) {
           coarse.starts = {*start};
           return coarse;
         }
     } catch (const NumericalFailure&) {  // (the finest N's search below says what fails)
     }
   }
-  return search_at(config, run, x, run.Ns.back());
+  return search_at(run, x, run.Ns.back());
 }
 
 // The starts of the curves: the first bifurcation of the type at x_from (boundary_starts = first),
@@ -258,7 +264,7 @@ Search first_start_at(const Config& config, const BoundaryRun& run, double x) {
 // at every x searched (the side of the curves a chart would call stable). NumericalFailure when
 // there is no start at all, with what was found.
 template <class Follow>
-bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<BoundaryCurve>& curves,
+bool follow_starts(const BoundaryRun& run, std::vector<BoundaryCurve>& curves,
                    std::vector<BifurcationType>& types, Follow follow) {
   const BoundaryOptions& o = run.options;
   const int count = run.scan_points > 0 ? run.scan_points : 1;
@@ -269,7 +275,7 @@ bool follow_starts(const Config& config, const BoundaryRun& run, std::vector<Bou
   std::vector<std::string> failed(static_cast<size_t>(count));  // a search's NumericalFailure
   parallel_points(count, run.threads, [&](long i) {
     try {
-      searches[static_cast<size_t>(i)] = first_start_at(config, run, x_of(i));
+      searches[static_cast<size_t>(i)] = first_start_at(run, x_of(i));
     } catch (const NumericalFailure& e) {  // (one x of a scan: the others may still start curves)
       if (count == 1) throw;
       failed[static_cast<size_t>(i)] = e.what();
@@ -320,7 +326,7 @@ std::pair<double, double> study_at_level(const BoundaryPointStudy& study, int N)
 }
 
 // Each point's study (boundary_point_study) against the curves of the coarser N.
-std::vector<BoundaryPointStudy> study_points(const Config& config, const BoundaryRun& run, BifurcationType type,
+std::vector<BoundaryPointStudy> study_points(const BoundaryRun& run, BifurcationType type,
                                              const BoundaryCurve& curve, Progress& progress, long& evaluations) {
   RichardsonOptions richardson;
   if (run.problem.analyses->switches_in_state() && run.problem.events == EventMode::off)
@@ -335,8 +341,8 @@ std::vector<BoundaryPointStudy> study_points(const Config& config, const Boundar
   std::atomic<long> counted_evaluations{0};
   parallel_points(static_cast<long>((n + kBlock - 1) / kBlock), run.threads, [&](long block) {
     std::vector<TestFunctionAt> at_N;
-    for (size_t i = 0; i + 1 < run.Ns.size(); ++i) at_N.emplace_back(config, run, type, run.Ns[i]);
-    for (int N : run.finer_Ns) at_N.emplace_back(config, run, type, N);  // (the last ones)
+    for (size_t i = 0; i + 1 < run.Ns.size(); ++i) at_N.emplace_back(run, type, run.Ns[i]);
+    for (int N : run.finer_Ns) at_N.emplace_back(run, type, N);  // (the last ones)
     long block_evaluations = 0;
     std::vector<BoundaryFunction> counted;
     for (const TestFunctionAt& g : at_N)
@@ -371,14 +377,14 @@ struct Outcome {
   std::string failures;  // the curves that ended in a failure, named
 };
 
-Outcome compute_boundary(const Config& config, const BoundaryRun& run, const Invocation& inv) {
+Outcome compute_boundary(const BoundaryRun& run, const Invocation& inv) {
   Outcome out;
   using Clock = std::chrono::steady_clock;
   const auto since = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   const Clock::time_point search_start = Clock::now();
-  out.stable_below = follow_starts(config, run, out.curves, out.types, [&](const Start& start) {
+  out.stable_below = follow_starts(run, out.curves, out.types, [&](const Start& start) {
     const Clock::time_point trace_start = Clock::now();
-    const TestFunctionAt finest(config, run, start.type, run.Ns.back());
+    const TestFunctionAt finest(run, start.type, run.Ns.back());
     // At the curve's points g itself, but for a grazing curve (the multipliers there too)
     const BoundaryFunction at_points = [&finest](double x, double y) { return finest.at_point(x, y); };
     const bool grazing = start.type == BifurcationType::grazing;
@@ -393,7 +399,7 @@ Outcome compute_boundary(const Config& config, const BoundaryRun& run, const Inv
   for (const BoundaryCurve& c : out.curves) points += static_cast<long>(c.points.size());
   Progress progress(inv.err, "boundary", points, inv.quiet);
   for (size_t i = 0; i < out.curves.size(); ++i) {
-    out.studies.push_back(study_points(config, run, out.types[i], out.curves[i], progress, out.study_evaluations));
+    out.studies.push_back(study_points(run, out.types[i], out.curves[i], progress, out.study_evaluations));
     out.evaluations += out.curves[i].evaluations;
     if (out.curves[i].end == BoundaryEnd::failure)
       out.failures += (out.failures.empty() ? "" : "; ") + std::string("curve ") + std::to_string(i + 1) + " " +
@@ -531,7 +537,7 @@ int command_boundary(Config& config, const Invocation& inv) {
   const BoundaryRun run = read_boundary_run(config);
   if (const std::string note = autonomous_fixed_point_note(run.problem); !note.empty() && !inv.quiet)
     inv.err << "delayspec boundary: note: " << note << "\n";
-  const Outcome out = compute_boundary(config, run, inv);
+  const Outcome out = compute_boundary(run, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   const json j = boundary_json(run, out, seconds);
   if (inv.out_dir) {

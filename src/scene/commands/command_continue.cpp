@@ -44,51 +44,13 @@ namespace {
 
 using nlohmann::json;
 
-// One level N with the continued key at p: the scene the family of models reads (analyses_with_key
-// copies it), its problem, and the options' discretisation taken from it.
-struct Level {
-  Config config;
-  Problem problem;
-};
-Level level_at(const Config& config, const std::string& key, double p, int N, ContinuationOptions& options,
-               Progress& progress) {
-  Level level{config, {}};
-  level.config.set("N", std::to_string(N), "continue_Ns");
-  level.config.set(key, format_number(p), "continue");
-  level.problem = read_problem(level.config, 100);
-  options.N = N;
-  options.periods_per_map = level.problem.orbit_period;
-  options.step_options = step_options(level.problem);
-  options.on_point = [&progress](const ContinuationPoint&) { progress.add(); };
-  return level;
-}
-
-// The branch at one N: the start orbit at `from`, then continue_orbit; with period_guess the
-// orbit of unknown period found as `floquet` finds it, then continue_autonomous_orbit.
-ContinuationResult branch_at(const Config& config, const ContinueSettings& settings,
-                             const OrbitSettings& orbit_settings, const std::optional<double>& period_guess,
-                             ContinuationOptions options, int N, Progress& progress) {
-  const Level level = level_at(config, settings.key, options.from, N, options, progress);
-  const AnalysesAt at = analyses_with_key(level.config, settings.key);
-  if (period_guess)
-    return level.problem.analyses->continue_autonomous_orbit(
-        at, autonomous_orbit_options(level.problem, N, *period_guess, orbit_settings), options);
-  return level.problem.analyses->continue_orbit(at, orbit_settings, options);
-}
-
-// The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
-ContinuationResult switched_at(const Config& config, const ContinueSettings& settings, ContinuationOptions options,
-                               int N, const Bifurcation& pd, Progress& progress) {
-  const Level level = level_at(config, settings.key, pd.parameter, N, options, progress);
-  return level.problem.analyses->continue_period_doubled(analyses_with_key(level.config, settings.key), pd, options);
-}
-
 // What the command reads and checks before any work; the keys are read in this order (--help lists them so).
 struct ContinueRun {
   ContinueSettings settings;
   OrbitSettings orbit_settings;
   ContinuationOptions options;
   Problem problem;         // at continue_from
+  int index = -1;          // the continued key's parameter in problem.family
   std::vector<int> Ns;     // continue_Ns, or the one level N
   bool switching = false;  // the model switches in the state (its extrapolation order)
   std::optional<double> period_guess;  // an autonomous orbit of unknown period (issue 60 item 5)
@@ -103,11 +65,10 @@ ContinueRun read_continue_run(Config& config) {
   run.options.floquet = read_floquet_options(config);
   run.options.newton.tolerance = run.orbit_settings.newton.tolerance;       // the corrector's relative residual
   run.options.start_iterations = run.orbit_settings.newton.max_iterations;  // the first point's Newton
-  // The continued key takes the start value; reading the problem with it validates it and marks
-  // it as used (a key no model reads is then reported as unknown).
-  config.set(run.settings.key, format_number(run.options.from), "continue_from");
-  run.problem = read_problem(config, 100);
-  run.period_guess = read_period_guess(config, run.problem);
+  const Problem scene = read_problem(config, 100);
+  run.period_guess = read_period_guess(config, scene);
+  run.problem = starting_problem(scene, config, {{"continue_key", run.settings.key, run.options.from, "continue_from"}});
+  run.index = family_parameter(run.problem, "continue_key", run.settings.key);
   config.check_all_used();
   if (run.period_guess && run.settings.switch_period_doubling)
     throw BadInput("`continue_switch = true` with `period_guess`: the period-2 branch of an orbit of unknown period "
@@ -115,6 +76,38 @@ ContinueRun read_continue_run(Config& config) {
   run.Ns = run.settings.Ns.empty() ? std::vector<int>{run.problem.N} : run.settings.Ns;
   run.switching = run.problem.analyses->switches_in_state();
   return run;
+}
+
+// One level N with the continued parameter at p (the model's family: no scene read), and the
+// options' discretisation taken from it.
+Problem level_at(const ContinueRun& run, double p, int N, ContinuationOptions& options, Progress& progress) {
+  std::string rejected;
+  const std::optional<Problem> level =
+      problem_at(run.problem, ProblemFamily::with(run.problem.parameter_values, run.index, p), N, rejected);
+  if (!level) throw BadInput(rejected);
+  options.N = N;
+  options.periods_per_map = level->orbit_period;
+  options.step_options = step_options(*level);
+  options.on_point = [&progress](const ContinuationPoint&) { progress.add(); };
+  return *level;
+}
+
+// The branch at one N: the start orbit at `from`, then continue_orbit; with period_guess the
+// orbit of unknown period found as `floquet` finds it, then continue_autonomous_orbit.
+ContinuationResult branch_at(const ContinueRun& run, ContinuationOptions options, int N, Progress& progress) {
+  const Problem level = level_at(run, options.from, N, options, progress);
+  const AnalysesAt at = analyses_along(level, run.index);
+  if (run.period_guess)
+    return level.analyses->continue_autonomous_orbit(
+        at, autonomous_orbit_options(level, N, *run.period_guess, run.orbit_settings), options);
+  return level.analyses->continue_orbit(at, run.orbit_settings, options);
+}
+
+// The period-2 branch from the period doubling `pd` of the branch at N (continue_switch).
+ContinuationResult switched_at(const ContinueRun& run, ContinuationOptions options, int N, const Bifurcation& pd,
+                               Progress& progress) {
+  const Problem level = level_at(run, pd.parameter, N, options, progress);
+  return level.analyses->continue_period_doubled(analyses_along(level, run.index), pd, options);
 }
 
 // The computed branches: one per N, the period-2 branches of the finest one, the extrapolated
@@ -131,12 +124,12 @@ struct ContinueOutcome {
 
 // Computes the branch at every N, extrapolates its bifurcations, and (continue_switch) the
 // period-2 branches from the finest branch's period doublings.
-ContinueOutcome compute_continue(const Config& config, const ContinueRun& run, const Invocation& inv) {
+ContinueOutcome compute_continue(const ContinueRun& run, const Invocation& inv) {
   const ContinuationOptions& options = run.options;
   ContinueOutcome out;
   Progress progress(inv.err, "continue", 0, inv.quiet);
   for (int N : run.Ns)
-    out.levels.push_back(branch_at(config, run.settings, run.orbit_settings, run.period_guess, options, N, progress));
+    out.levels.push_back(branch_at(run, options, N, progress));
   std::vector<std::vector<Bifurcation>> by_N;
   for (const auto& r : out.levels) by_N.push_back(r.bifurcations);
   // the floor of the bars: the locations' tolerance (its default filled in), or the refined one
@@ -151,7 +144,7 @@ ContinueOutcome compute_continue(const Config& config, const ContinueRun& run, c
   if (run.settings.switch_period_doubling)
     for (const Bifurcation& b : out.branch().bifurcations)
       if (b.type == BifurcationType::period_doubling) {
-        out.switched.push_back(switched_at(config, run.settings, options, run.Ns.back(), b, progress));
+        out.switched.push_back(switched_at(run, options, run.Ns.back(), b, progress));
         out.switched_from.push_back(b.parameter);
       }
   progress.finish();
@@ -291,7 +284,7 @@ int command_continue(Config& config, const Invocation& inv) {
   if (const std::string note = autonomous_fixed_point_note(run.problem);
       !note.empty() && !run.period_guess && !inv.quiet)
     inv.err << "delayspec continue: note: " << note << "\n";
-  const ContinueOutcome out = compute_continue(config, run, inv);
+  const ContinueOutcome out = compute_continue(run, inv);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const json j = continue_json(run, out, seconds);
   if (inv.out_dir) write_continue_files(inv, config, run, out, j, seconds);

@@ -250,6 +250,7 @@ struct EquilibriaRun {
   ContinueSettings settings;
   bool from_hopf = false;  // continue_switch: the orbits born at Hopf points
   Problem problem;         // at continue_from
+  int index = -1;          // the continued key's parameter in problem.family
   EquilibriumSettings eq;
   ContinuationOptions orbit_options;  // the orbit branches': the range with its defaults, nev, orbit_tolerance
   std::vector<int> Ns;                // continue_Ns, or the one level N
@@ -264,7 +265,6 @@ EquilibriaRun read_equilibria_run(Config& config) {
                    "equilibrium's bifurcations are located on the exact characteristic function, with no "
                    "discretisation error to extrapolate (continue_Ns gives the error bars of the orbit branches "
                    "born at its Hopf points)");
-  config.set(run.settings.key, format_number(run.settings.options.from), "continue_from");
   run.problem = read_problem(config, 100, ModelNeed::autonomous);
   run.eq = read_equilibrium_settings(config, run.problem);
   run.orbit_options = run.settings.options;
@@ -274,6 +274,9 @@ EquilibriaRun read_equilibria_run(Config& config) {
     run.orbit_options.newton.tolerance = read_orbit_settings(config).newton.tolerance;
     run.orbit_options.step_options = step_options(run.problem);
   }
+  run.problem = starting_problem(run.problem, config,
+                                 {{"continue_key", run.settings.key, run.settings.options.from, "continue_from"}});
+  run.index = family_parameter(run.problem, "continue_key", run.settings.key);
   config.check_all_used();
   require_autonomous(run.problem);
   if (run.from_hopf && run.problem.analyses->is_linear())
@@ -320,7 +323,7 @@ int continue_equilibria(Config& config, const Invocation& inv) {
   o.nroots = run.eq.options.nroots;
   Progress progress(inv.err, "continue", 0, inv.quiet);
   o.on_point = [&progress] { progress.add(); };
-  const AnalysesAt at = analyses_with_key(config, key);
+  const AnalysesAt at = analyses_along(run.problem, run.index);
   const EquilibriumOptions& eq = run.eq.options;
   const EquilibriumFamily family{
       [&at](const Eigen::VectorXd& y, double p) { return at(p)->at_constant_history(y); },

@@ -6,6 +6,7 @@
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include <toml++/toml.h>
 
@@ -280,6 +281,104 @@ double positive_value(const std::string& item, double value) {
   return value;
 }
 
+// The items of the delays in messages, each in backquotes.
+std::vector<std::string> delay_items(const EquationNames& names) {
+  std::vector<std::string> items;
+  for (size_t k = 0; k < names.delays.size(); ++k)  // (append: GCC 12 warns falsely on "`" + string, -Wrestrict)
+    items.push_back(std::string("`").append(delay_item(names, k)).append("`"));
+  return items;
+}
+
+// The period, delays and constant history at some parameters, each checked and named.
+struct EquationConstants {
+  double period;
+  std::vector<double> delays, history;
+};
+
+// From `constants` (period, delays, history: GiNaC's values, or the compiled model's); ratio:
+// tau_over_T (NaN: the delays are the table's).
+EquationConstants equation_constants(const EquationNames& names, double ratio, const std::vector<double>& constants) {
+  const size_t n = names.delays.size();
+  EquationConstants c;
+  c.period = positive_value("equations.period", constants[0]);
+  if (!std::isnan(ratio)) {
+    require_positive("tau_over_T", ratio);
+    c.delays = {ratio * c.period};
+  } else {
+    for (size_t k = 0; k < n; ++k) positive_value(delay_item(names, k), constants[1 + k]);
+    c.delays.assign(constants.begin() + 1, constants.begin() + 1 + static_cast<long>(n));
+  }
+  c.history.assign(constants.begin() + 1 + static_cast<long>(n), constants.end());
+  for (size_t i = 0; i < c.history.size(); ++i)
+    if (!std::isfinite(c.history[i]))
+      throw BadInput("`equations.history." + names.state[i] + "` evaluates to " + format_number(c.history[i]) +
+                     " at these parameters: must be finite");
+  return c;
+}
+
+// The compiled model as a family (problem_family.hpp): its parameters, and tau_over_T for a
+// model of one delay (NaN in the base values when the scene does not give it: the table's delay).
+// A new value costs the constants' evaluation and the analyses' construction, never a compile.
+class EquationFamily final : public ProblemFamily {
+ public:
+  EquationFamily(const EquationPlugin& plugin, std::string table_text, EquationNames names, std::vector<double> p,
+                 double ratio)
+      : plugin_(plugin), table_text_(std::move(table_text)), names_(std::move(names)) {
+    parameter_names_ = names_.parameters;
+    base_values_ = std::move(p);
+    if (names_.delays.size() == 1) {
+      parameter_names_.push_back("tau_over_T");
+      base_values_.push_back(ratio);
+    }
+  }
+  const std::vector<std::string>& parameter_names() const override { return parameter_names_; }
+  const std::vector<double>& base_values() const override { return base_values_; }
+
+  // The compiled model's constants at `values`; BadInput naming the item that is not valid.
+  EquationConstants constants(const std::vector<double>& values) const {
+    const size_t n = names_.delays.size();
+    std::vector<double> c(1 + n + names_.state.size());
+    c[0] = plugin_.period(values.data());
+    plugin_.delays(values.data(), c.data() + 1);
+    plugin_.history(values.data(), c.data() + 1 + n);
+    return equation_constants(names_, ratio(values), c);
+  }
+
+
+ protected:
+  FamilyMember make(const std::vector<double>& values) const override {
+    if (values.size() != base_values_.size())
+      throw std::invalid_argument("EquationFamily::make: " + std::to_string(values.size()) + " values for " +
+                                  std::to_string(base_values_.size()) + " parameters");
+    try {
+      for (size_t k = 0; k < names_.parameters.size(); ++k) require_finite(names_.parameters[k].c_str(), values[k]);
+      const EquationConstants c = constants(values);
+      std::unique_ptr<const ModelAnalyses> analyses(
+          plugin_.analyses(values.data(), c.delays.data(), c.period, c.history.data()));
+      // Null only from a model of a prebuilt shape whose libdelayspec_prebuilt lacks that shape: a
+      // library left from a build with another list (prebuilt_shapes.hpp) under the same revision.
+      if (!analyses)
+        throw BadInput("equations: libdelayspec_prebuilt beside the library does not hold the shape of the model " +
+                       plugin_.object.string() + " (left from another build?): rebuild it (cmake --build BUILD_DIR "
+                       "--target delayspec_prebuilt)");
+      const std::vector<double> p(values.begin(), values.begin() + static_cast<long>(names_.parameters.size()));
+      return {std::make_shared<const ExplainedAnalyses>(std::move(analyses), table_text_, names_, p), ""};
+    } catch (const BadInput& e) {
+      return {nullptr, e.what()};
+    }
+  }
+
+ private:
+  double ratio(const std::vector<double>& values) const {
+    return names_.delays.size() == 1 ? values.back() : NAN;
+  }
+  const EquationPlugin& plugin_;  // (compiled() and found() keep every plugin for the process)
+  std::string table_text_;
+  EquationNames names_;
+  std::vector<std::string> parameter_names_;
+  std::vector<double> base_values_;
+};
+
 }  // namespace
 
 std::vector<std::string> engine_keys(const KeyIndex& index) {
@@ -314,65 +413,29 @@ EquationModel read_equation_model(Config& config,
     require_finite(names.parameters[k].c_str(), p[k]);
   }
   const size_t n = names.delays.size();
-  const bool delay_from_ratio = config.has("tau_over_T");
-  if (delay_from_ratio) {
-    require_positive("tau_over_T", config.get_double("tau_over_T", 1));
+  double ratio = NAN;  // tau_over_T, when given: the one delay in periods
+  if (config.has("tau_over_T")) {
+    ratio = config.get_double("tau_over_T", 1);
+    require_positive("tau_over_T", ratio);
     if (n > 1)
       throw BadInput("`tau_over_T`: sets the one delay of a model; this model has " + std::to_string(n) +
                      " (equations.delays): set the parameters its delays depend on instead");
   }
-  // The period, delays and history at these parameters, from `constants` (period, delays,
-  // history: GiNaC's values, or the compiled model's), each checked and named.
-  const auto period_from = [&](const std::vector<double>& constants) {
-    return positive_value("equations.period", constants[0]);
-  };
-  const auto delays_from = [&](const std::vector<double>& constants) {
-    if (delay_from_ratio) return std::vector<double>{config.get_double("tau_over_T", 1) * period_from(constants)};
-    for (size_t k = 0; k < n; ++k) positive_value(delay_item(names, k), constants[1 + k]);
-    return std::vector<double>(constants.begin() + 1, constants.begin() + 1 + static_cast<long>(n));
-  };
-  const auto history_from = [&](const std::vector<double>& constants) {
-    const std::vector<double> history(constants.begin() + 1 + static_cast<long>(n), constants.end());
-    for (size_t i = 0; i < history.size(); ++i)
-      if (!std::isfinite(history[i]))
-        throw BadInput("`equations.history." + names.state[i] + "` evaluates to " + format_number(history[i]) +
-                       " at these parameters: must be finite");
-    return history;
-  };
-  std::vector<std::string> delay_items;
-  for (size_t k = 0; k < n; ++k)  // (append: GCC 12 warns falsely on "`" + string, -Wrestrict)
-    delay_items.push_back(std::string("`").append(delay_item(names, k)).append("`"));
   if (!was_compiled) {
     // Everything that can be checked without the compiled model is checked before the compile
     // (seconds): the constant expressions, and the grid they give with N.
-    const std::vector<double> exact = constants_at(*src, p);
-    history_from(exact);
-    check_grid(delays_from(exact), delay_items, period_from(exact));
+    const EquationConstants exact = equation_constants(names, ratio, constants_at(*src, p));
+    check_grid(exact.delays, delay_items(names), exact.period);
     // equilibrium of a forced model compiled for 13 s before refusing it (issue 61 item 4)
     if (check_autonomy) check_autonomy(src->shape.autonomous);
     loaded = LoadedEquations{&compiled(*src, text, cache_dir), names};
   }
-  const EquationPlugin& plugin = *loaded->plugin;
-  std::vector<double> constants(1 + n + names.state.size());
-  constants[0] = plugin.period(p.data());
-  plugin.delays(p.data(), constants.data() + 1);
-  plugin.history(p.data(), constants.data() + 1 + n);
-  const double period = period_from(constants);
-  const std::vector<double> taus = delays_from(constants);
-  const std::vector<double> history = history_from(constants);
-  if (was_compiled) check_grid(taus, delay_items, period);
-  EquationModel model;
-  model.state = names.state;
-  model.parameters = names.parameters;
-  std::unique_ptr<const ModelAnalyses> analyses(plugin.analyses(p.data(), taus.data(), period, history.data()));
-  // Null only from a model of a prebuilt shape whose libdelayspec_prebuilt lacks that shape: a
-  // library left from a build with another list (prebuilt_shapes.hpp) under the same revision.
-  if (!analyses)
-    throw BadInput("equations: libdelayspec_prebuilt beside the library does not hold the shape of the model " +
-                   plugin.object.string() + " (left from another build?): rebuild it (cmake --build BUILD_DIR "
-                   "--target delayspec_prebuilt)");
-  model.analyses = std::make_shared<const ExplainedAnalyses>(std::move(analyses), text, names, p);
-  return model;
+  auto family = std::make_shared<const EquationFamily>(*loaded->plugin, text, names, p, ratio);
+  if (was_compiled) {
+    const EquationConstants constants = family->constants(family->base_values());
+    check_grid(constants.delays, delay_items(names), constants.period);
+  }
+  return {names.state, names.parameters, std::move(family)};
 }
 
 }  // namespace delayspec::cli

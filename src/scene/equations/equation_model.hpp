@@ -13,14 +13,16 @@
 #include <vector>
 
 #include "scene/keys/config.hpp"
-#include "delayspec/model_analyses.hpp"
+#include "delayspec/problem_family.hpp"
 
 namespace delayspec::cli {
 
 struct EquationModel {
   std::vector<std::string> state;       // the state's names (output columns)
   std::vector<std::string> parameters;  // the parameters' names (keys)
-  std::shared_ptr<const ModelAnalyses> analyses;
+  // The compiled model at any parameter values (problem_family.hpp): the parameters, and
+  // tau_over_T for a model of one delay; its base values are the scene's.
+  std::shared_ptr<const ProblemFamily> family;
 };
 
 // Reads the [equations] table (kept whole by Config as the key `equations`), the parameter keys,

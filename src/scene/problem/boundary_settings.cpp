@@ -4,7 +4,6 @@
 #include <utility>
 
 #include "delayspec/errors.hpp"
-#include "scene/problem/continue_settings.hpp"
 
 namespace delayspec::cli {
 
@@ -14,8 +13,6 @@ BoundarySettings read_boundary_settings(Config& config) {
     if (!config.has(key)) throw BadInput(std::string("missing key `") + key + "` (a model parameter, e.g. depth)");
   s.x_key = config.get_string("boundary_x", "");
   s.y_key = config.get_string("boundary_y", "");
-  require_parameter_key("boundary_x", s.x_key);
-  require_parameter_key("boundary_y", s.y_key);
   if (s.x_key == s.y_key)
     throw BadInput("`boundary_x = boundary_y = " + s.x_key + "`: two different model keys are needed");
   BoundaryOptions& o = s.options;

@@ -15,7 +15,8 @@ struct BoundarySettings {
   int scan_points = 0;  // boundary_starts = scan: the x values searched; 0: the first start only
 };
 
-// BadInput naming the key: boundary_x or boundary_y missing, equal, or not a model parameter;
+// BadInput naming the key: boundary_x or boundary_y missing or equal (whether each is a model
+// parameter is the problem's: read_problem_at, family_parameter);
 // an empty range; a step <= 0 or step_min > step_max; a chord error or tolerance <= 0.
 BoundarySettings read_boundary_settings(Config& config);
 

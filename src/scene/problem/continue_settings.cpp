@@ -8,22 +8,11 @@
 
 namespace delayspec::cli {
 
-void require_parameter_key(const std::string& item, const std::string& key) {
-  // Keys that are not a parameter of the model's equations: the discretisation, the model's name,
-  // the commands' own keys.
-  for (const char* reserved : {"model", "N", "orbit_period", "events", "jacobian", "contact_substeps", "grid", "nev",
-                               "solver", "ncv", "tol", "seed", "orbit", "x0", "v0", "pitch_angles"})
-    if (key == reserved) throw BadInput("`" + item + " = " + key + "`: not a model parameter that can be continued");
-  for (const char* prefix : {"continue_", "boundary_"})
-    if (key.rfind(prefix, 0) == 0) throw BadInput("`" + item + " = " + key + "`: not a model parameter");
-}
-
 ContinueSettings read_continue_settings(Config& config) {
   ContinueSettings s;
   if (!config.has("continue_key"))
     throw BadInput("missing key `continue_key` (the model parameter to continue, e.g. k)");
   s.key = config.get_string("continue_key", "");
-  require_parameter_key("continue_key", s.key);
   ContinuationOptions& o = s.options;
   o.from = config.require_double("continue_from");
   o.to = config.require_double("continue_to");
@@ -75,16 +64,6 @@ ContinueSettings read_continue_settings(Config& config) {
              : solver == "lu"   ? ContinuationSolver::lu
                                 : ContinuationSolver::automatic;
   return s;
-}
-
-AnalysesAt analyses_with_key(const Config& base, const std::string& key) {
-  // One scene, the key replaced in place at each call, not a copy of the scene's keys per
-  // parameter value (the continuation calls this at every corrector step): a family serves one
-  // thread (the library's continuation runs on one).
-  return [at = base, &key](double p) mutable {
-    at.set(key, format_number(p), "continue");
-    return read_problem(at, 100).analyses;
-  };
 }
 
 }  // namespace delayspec::cli

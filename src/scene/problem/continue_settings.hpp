@@ -17,20 +17,11 @@ struct ContinueSettings {
   bool switch_period_doubling = false;  // continue_switch: the period-2 branch at each period doubling
 };
 
-// BadInput unless `key` (the value of the key `item`) can be a model parameter: not the
-// discretisation's, the model's name or a command's own key.
-void require_parameter_key(const std::string& item, const std::string& key);
-
 // Reads continue_key, continue_from, continue_to (required), continue_step, continue_step_min,
 // continue_step_max, continue_max_points, continue_tolerance, continue_Ns, continue_switch, continue_solver. BadInput naming the key:
-// a missing required key, a key that is not a model parameter (N, model, events, ...), an empty
-// range, a non-positive step or tolerance, step_min > step_max, Ns not increasing or out of range.
-// The Floquet and discretisation options are the caller's (read_floquet_options, read_problem).
+// a missing required key, an empty range, a non-positive step or tolerance, step_min > step_max, Ns not increasing or out of range.
+// The Floquet and discretisation options are the caller's (read_floquet_options, read_problem), and
+// whether the key is a parameter of the model the problem's (read_problem_at, family_parameter).
 ContinueSettings read_continue_settings(Config& config);
-
-// The model's analyses with `key` set to p: the scene `base` read again with that value (the
-// same validation as any scene value; an equation model keeps its compiled code, new constants).
-// Keeps a copy of `base` (the scene as it is now) and a reference to `key`; one thread at a time.
-AnalysesAt analyses_with_key(const Config& base, const std::string& key);
 
 }  // namespace delayspec::cli

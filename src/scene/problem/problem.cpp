@@ -3,94 +3,12 @@
 #include <climits>
 
 #include "delayspec/errors.hpp"
-#include "delayspec/memory_budget.hpp"
 #include "delayspec/grid.hpp"
 #include "scene/equations/equation_model.hpp"
+#include "scene/problem/builtin_family.hpp"
 #include "scene/problem/models_module_loader.hpp"
 
 namespace delayspec::cli {
-
-namespace {
-
-ImpactModel read_impact(Config& c) {
-  ImpactParameters p;
-  p.zeta = c.get_double("zeta", p.zeta);
-  p.e = c.get_double("e", p.e);
-  p.a = c.get_double("a", p.a);
-  p.beta = c.get_double("beta", p.beta);
-  p.omega = c.get_double("omega", p.omega);
-  p.k = c.get_double("k", p.k);
-  p.x0 = c.get_double("x0", p.x0);
-  p.v0 = c.get_double("v0", p.v0);
-  if (c.has("tau") && c.has("tau_over_T")) throw BadInput("`tau` and `tau_over_T` are both given: give one of them");
-  if (c.has("tau")) {
-    p.tau = c.get_double("tau", 0);
-    require_positive("tau", p.tau);
-  } else {
-    p.tau_over_T = c.get_double("tau_over_T", p.tau_over_T);
-    require_positive("tau_over_T", p.tau_over_T);
-  }
-  return ImpactModel(p);
-}
-
-LinearModel read_linear(Config& c) {
-  LinearParameters p;
-  p.a = c.get_double("a", p.a);
-  p.b = c.get_double("b", p.b);
-  p.tau = c.get_double("tau", p.tau);
-  p.period = c.get_double("period", p.tau);
-  return LinearModel(p);
-}
-
-MathieuModel read_mathieu(Config& c) {
-  MathieuParameters p;
-  p.kappa = c.get_double("kappa", p.kappa);
-  p.delta = c.get_double("delta", p.delta);
-  p.eps = c.get_double("eps", p.eps);
-  p.b = c.get_double("b", p.b);
-  return MathieuModel(p);
-}
-
-MackeyGlassModel read_mackey_glass(Config& c) {
-  MackeyGlassParameters p;
-  p.beta = c.get_double("beta", p.beta);
-  p.gamma = c.get_double("gamma", p.gamma);
-  p.n = c.get_double("n", p.n);
-  p.tau = c.get_double("tau", p.tau);
-  p.period = c.get_double("period", p.tau);
-  p.x0 = c.get_double("x0", p.x0);
-  return MackeyGlassModel(p);
-}
-
-// Equal pitch unless `pitch_angles` gives unequal spacings (VariablePitchMillingModel); angles all
-// equal are the equal-pitch tool, the same model as without them.
-AnyModel read_milling(Config& c) {
-  MillingParameters p;
-  p.spindle_rpm = c.get_double("spindle_rpm", p.spindle_rpm);
-  p.depth = c.get_double("depth", p.depth);
-  p.radial_immersion = c.get_double("radial_immersion", p.radial_immersion);
-  // The model names the allowed range (1..kMaxTeeth) in its own message; the wide range here
-  // only keeps the cast safe.
-  p.teeth = static_cast<int>(c.get_int_in_range("teeth", p.teeth, 1, MillingModel::kMaxTeeth));
-  // `equal` (what --help prints as the default) is accepted as a value too: the equal pitch.
-  if (c.get_string("pitch_angles", "equal") != "equal") p.pitch_angles = c.get_double_list("pitch_angles", "equal");
-  p.Kt = c.get_double("Kt", p.Kt);
-  p.Kn = c.get_double("Kn", p.Kn);
-  p.omega_n = c.get_double("omega_n", p.omega_n);
-  p.zeta = c.get_double("zeta", p.zeta);
-  p.mass = c.get_double("mass", p.mass);
-  p.direction = c.get_choice("milling", "down", {"down", "up"}) == "up" ? MillingDirection::up : MillingDirection::down;
-  p.x0 = c.get_double("x0", p.x0);
-  p.v0 = c.get_double("v0", p.v0);
-  if (p.pitch_angles.empty()) return MillingModel(p);
-  if (!c.has("teeth")) p.teeth = static_cast<int>(std::min<size_t>(p.pitch_angles.size(), MillingModel::kMaxTeeth + 1));
-  const VariablePitchMillingModel variable(p);  // (checks the angles against the teeth)
-  if (variable.distinct_pitches() > 1) return variable;
-  p.pitch_angles.clear();
-  return MillingModel(p);
-}
-
-}  // namespace
 
 StepOptions step_options(const Problem& problem) {
   StepOptions options;
@@ -135,11 +53,11 @@ const std::vector<BuiltinModel>& builtin_models() {
   // The default first. Forced: a periodic forcing sets the map's period (orbit_period counts its
   // periods); linear and mackey-glass are autonomous, their map's period is the key `period`.
   static const std::vector<BuiltinModel> table = {
-      {"impact", [](Config& c) -> AnyModel { return read_impact(c); }, true, {"x", "v"}},
-      {"linear", [](Config& c) -> AnyModel { return read_linear(c); }, false, {"x"}},
-      {"mathieu", [](Config& c) -> AnyModel { return read_mathieu(c); }, true, {"x", "v"}},
-      {"mackey-glass", [](Config& c) -> AnyModel { return read_mackey_glass(c); }, false, {"x"}},
-      {"milling", read_milling, true, {"x", "v"}},
+      {"impact", read_impact_family, true, {"x", "v"}},
+      {"linear", read_linear_family, false, {"x"}},
+      {"mathieu", read_mathieu_family, true, {"x", "v"}},
+      {"mackey-glass", read_mackey_glass_family, false, {"x"}},
+      {"milling", read_milling_family, true, {"x", "v"}},
   };
   return table;
 }
@@ -185,8 +103,9 @@ Problem read_problem(Config& config, int default_N, ModelNeed need) {
   for (const auto& model : builtin_models())
     if (model.name == problem.model_name) builtin = &model;
   if (builtin) {
-    problem.model = builtin->read(config);
-    problem.analyses = builtin_model_analyses(*problem.model);
+    const std::shared_ptr<const BuiltinFamily> family = builtin->read(config);
+    problem.model = family->model_at(family->base_values());
+    problem.family = family;
     problem.state_names = builtin->state_names;
     problem.forced = builtin->forced;
   } else {
@@ -199,7 +118,7 @@ Problem read_problem(Config& config, int default_N, ModelNeed need) {
         [&](bool autonomous) {
           if (need == ModelNeed::autonomous) require_autonomous_model(autonomous, "equations", false);
         });
-    problem.analyses = std::move(equations.analyses);
+    problem.family = std::move(equations.family);
     problem.state_names = std::move(equations.state);
   }
   // N up to 1e9 (the history alone is then 16 GB at d = 2); orbit_period and contact_substeps
@@ -220,10 +139,58 @@ Problem read_problem(Config& config, int default_N, ModelNeed need) {
   // BadInput now when N does not fit the delay/period ratio, or when two histories (the state and
   // the vector a step map is applied to: the least any analysis holds) exceed the memory
   // (memory_budget.hpp; each analysis bounds its own larger arrays before allocating them).
-  const long n = problem.grid().dimension(problem.state_dimension());
-  require_memory(2 * 8.0 * static_cast<double>(n), "`N = " + std::to_string(problem.N) + "`",
-                 "two histories of d (N + 1) = " + std::to_string(n) + " doubles");
+  problem.parameter_values = problem.family->base_values();
+  const FamilyMember member = problem.family->at(problem.parameter_values, problem.map_settings());
+  if (!member) throw BadInput(member.rejected);
+  problem.analyses = member.analyses;
   return problem;
+}
+
+std::optional<Problem> problem_at(const Problem& base, const std::vector<double>& values, int N,
+                                  std::string& rejected) {
+  Problem problem = base;
+  problem.N = N;
+  problem.parameter_values = values;
+  const FamilyMember member = problem.family->at(values, problem.map_settings());
+  if (!member) {
+    rejected = member.rejected;
+    return std::nullopt;
+  }
+  problem.analyses = member.analyses;
+  // The built-in model itself (bench's classic discretisations) at these values too.
+  if (problem.model) problem.model = dynamic_cast<const BuiltinFamily&>(*problem.family).model_at(values);
+  return problem;
+}
+
+int family_parameter(const Problem& problem, const std::string& item, const std::string& key) {
+  const int index = problem.family->index_of(key);
+  if (index >= 0) return index;
+  std::string names;
+  for (const std::string& name : problem.family->parameter_names()) names += (names.empty() ? "" : ", ") + name;
+  throw BadInput("`" + item + " = " + key + "`: not a model parameter of model " + problem.model_name +
+                 " (its parameters: " + names + ")");
+}
+
+Problem starting_problem(const Problem& problem, Config& config, const std::vector<ParameterSetting>& settings) {
+  std::vector<double> values = problem.parameter_values;
+  std::string keys;
+  for (const ParameterSetting& s : settings) {
+    values = ProblemFamily::with(values, family_parameter(problem, s.item, s.key), s.value);
+    keys += (keys.empty() ? "`" : ", `") + s.origin + " = " + format_number(s.value) + "`";
+  }
+  std::string rejected;
+  std::optional<Problem> at = problem_at(problem, values, problem.N, rejected);
+  if (!at) throw BadInput(keys + ": " + rejected);
+  // Given, as far as the output's metadata says: the run starts there.
+  for (const ParameterSetting& s : settings) {
+    config.set(s.key, format_number(s.value), s.origin);
+    config.mark_used(s.key);
+  }
+  return *at;
+}
+
+AnalysesAt analyses_along(const Problem& problem, int index) {
+  return delayspec::analyses_along(problem.family, problem.parameter_values, index, problem.map_settings());
 }
 
 }  // namespace delayspec::cli

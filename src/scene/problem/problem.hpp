@@ -16,13 +16,20 @@
 #include "modules/models/any_model.hpp"
 #include "delayspec/grid.hpp"
 #include "delayspec/model_analyses.hpp"
+#include "delayspec/problem_family.hpp"
 
 namespace delayspec::cli {
+
+class BuiltinFamily;
 
 struct Problem {
   std::string model_name;
   std::optional<AnyModel> model;                  // the built-in model; empty for model = equations
   std::shared_ptr<const ModelAnalyses> analyses;  // every model
+  // The model at other parameter values (problem_family.hpp), and this problem's values: what
+  // continue and boundary vary, set as doubles, never by the scene's keys again.
+  std::shared_ptr<const ProblemFamily> family;
+  std::vector<double> parameter_values;
   std::vector<std::string> state_names;           // the state's components: "x", "v" (output columns)
   // Whether a periodic forcing sets the map's period (orbit_period counts forcing periods); an
   // equation model's period is its own, so it may take several.
@@ -53,7 +60,7 @@ StepOptions step_options(const Problem& problem);
 // keys make the model, and the traits the scene layer needs beside its analyses.
 struct BuiltinModel {
   std::string name;
-  AnyModel (*read)(Config& config);
+  std::shared_ptr<const BuiltinFamily> (*read)(Config& config);  // builtin_family.hpp
   bool forced;                           // Problem::forced
   std::vector<std::string> state_names;  // Problem::state_names
 };
@@ -80,6 +87,33 @@ enum class ModelNeed { any, autonomous };
 // Reads `model` and its parameters, N, orbit_period, events, jacobian, contact_substeps, grid.
 // default_N is used when the key N is absent.
 Problem read_problem(Config& config, int default_N = 100, ModelNeed need = ModelNeed::any);
+
+// The same problem at other parameter values (its family's, in their order) and resolution N:
+// nothing, with the model's reason in `rejected`, when the model refuses them or the grid of N
+// cannot be made at them. The discretisation options are base's.
+std::optional<Problem> problem_at(const Problem& base, const std::vector<double>& values, int N,
+                                  std::string& rejected);
+
+// The index of model parameter `key` in the problem's family; BadInput naming `item = key` and
+// the model's parameters when it has none of that name (N, model, a command's own key, ...).
+int family_parameter(const Problem& problem, const std::string& item, const std::string& key);
+
+// The problem where a continuation or a boundary starts: `problem` (the scene's, read_problem)
+// with each setting's key, a model parameter (family_parameter names `item` when it is not), set
+// to its value through the family. The values are recorded in `config` as given from `origin`
+// (the output's metadata). BadInput naming the origins when the model refuses the values. Called
+// after the command has read its other keys (with the scene's problem, whose values they do not
+// depend on), so that --help lists them all whatever the placeholder keys.
+struct ParameterSetting {
+  std::string item, key;  // "continue_key", "b"
+  double value;
+  std::string origin;  // "continue_from"
+};
+Problem starting_problem(const Problem& problem, Config& config, const std::vector<ParameterSetting>& settings);
+
+// The problem along its parameter `index`, at its own N and other values (continuation's family
+// of models, problem_family.hpp's analyses_along).
+AnalysesAt analyses_along(const Problem& problem, int index);
 
 // For the commands that follow the fixed point of the stroboscopic map (continue, chart,
 // boundary): on an autonomous model, which has no forcing period, what that fixed point is and
