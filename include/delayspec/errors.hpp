@@ -59,6 +59,9 @@ std::string format_number(double value);
 // Formats a double with `significant_digits` digits (printf's %g): a tolerance in a message
 // (3), a coordinate in a plot script (10). The one home of number formatting with format_number.
 std::string format_number(double value, int significant_digits);
+// A printf format with up to four doubles (%g, %.3g, %.0f for a count): a note's sentence with its
+// numbers, of any length (sized by a first call; a fixed buffer once cut the longest note short).
+std::string format_text(const char* format, double a, double b = 0, double c = 0, double d = 0);
 // "a + bi" / "a - bi" with format_number's parts: a complex number in a message.
 std::string format_complex(std::complex<double> value);
 

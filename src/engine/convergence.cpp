@@ -75,12 +75,6 @@ std::string failures_text(const std::vector<int>& Ns, const std::vector<LevelRes
   return text;
 }
 
-std::string fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-  char buf[240];
-  std::snprintf(buf, sizeof buf, format, a, b, c, d);
-  return buf;
-}
-
 // Settledness of a list of pair orders (design 1.5: pre-asymptotic behaviour must be said).
 void judge(OrderReport& r, const std::vector<double>& log_x, const std::vector<double>& log_y, double spread_limit) {
   const size_t n = r.pair_orders.size();
@@ -597,17 +591,17 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
       study.target_met = true;
       study.stopped_by = "target";
       study.stop_note =
-          fmt("target %.3g met at N = %.0f: largest relative error estimate %.3g", o.target, o.Ns.back(), worst);
+          format_text("target %.3g met at N = %.0f: largest relative error estimate %.3g", o.target, o.Ns.back(), worst);
       return study;
     }
     study.target_met = false;
     const std::string unmet =
-        (std::isfinite(worst) ? fmt("largest relative error estimate %.3g", worst) : std::string("no error estimate")) +
-        fmt(" > target %.3g", o.target);
+        (std::isfinite(worst) ? format_text("largest relative error estimate %.3g", worst) : std::string("no error estimate")) +
+        format_text(" > target %.3g", o.target);
     const int last = o.Ns.back();
     if (last > o.max_N / 2) {
       study.stopped_by = "converge_max_N";
-      study.stop_note = fmt("converge_max_N = %.0f reached (the next N would be %.0f): ", o.max_N, 2.0 * last) + unmet;
+      study.stop_note = format_text("converge_max_N = %.0f reached (the next N would be %.0f): ", o.max_N, 2.0 * last) + unmet;
       return study;
     }
     // The next level's cost: the last one's times the growth of the last doubling (at least 2).
@@ -618,7 +612,7 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
     if (spent + predicted > o.max_seconds) {
       study.stopped_by = "converge_max_seconds";
       study.stop_note =
-          fmt("converge_max_seconds = %.3g: the next level (N = %.0f) would take about %.3g s after %.3g s "
+          format_text("converge_max_seconds = %.3g: the next level (N = %.0f) would take about %.3g s after %.3g s "
               "spent: ",
               o.max_seconds, 2.0 * last, predicted, spent) +
           unmet;

@@ -1,5 +1,6 @@
 #include "delayspec/errors.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -59,6 +60,14 @@ std::string format_number(double value, int significant_digits) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*g", significant_digits, value);
   return buffer;
+}
+
+std::string format_text(const char* format, double a, double b, double c, double d) {
+  const int n = std::max(std::snprintf(nullptr, 0, format, a, b, c, d), 0);
+  std::string out(static_cast<size_t>(n) + 1, '\0');
+  std::snprintf(out.data(), out.size(), format, a, b, c, d);
+  out.resize(static_cast<size_t>(n));
+  return out;
 }
 
 NonFiniteStep::NonFiniteStep(const std::string& what, std::vector<ModelPoint> points)

@@ -121,15 +121,6 @@ Eigen::VectorXd column_weights(const std::vector<double>& h, int last, int j, co
   return A.transpose().colPivHouseholderQr().solve(Eigen::VectorXd::Unit(j + 1, 0));
 }
 
-std::string fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-  // Sized by a first call: a fixed buffer cut the longest note short.
-  const int n = std::snprintf(nullptr, 0, format, a, b, c, d);
-  std::string out(static_cast<size_t>(std::max(n, 0)) + 1, '\0');
-  std::snprintf(out.data(), out.size(), format, a, b, c, d);
-  out.resize(static_cast<size_t>(std::max(n, 0)));
-  return out;
-}
-
 }  // namespace
 
 // d2 / d1 for three levels h0 > h1 > h2 of a sequence whose error is exactly C h^p:
@@ -250,11 +241,11 @@ Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::ve
     for (int i = std::max(J, L - 4) + 1; i <= L - 1; ++i)  // the entries the column checks looked at
       spread = std::max(spread, std::abs(entry(i, J) - entry(i - 1, J)) * std::pow(h[L - 1] / h[i], q));
     e.error_estimate = std::max(spread, roundoff);
-    e.note = fmt("column %.0f (%.0f levels) shows order %.3g over its last entries, expected %.3g, ", J + 1.0, J + 1.0,
+    e.note = format_text("column %.0f (%.0f levels) shows order %.3g over its last entries, expected %.3g, ", J + 1.0, J + 1.0,
                  e.column_orders[J], tab.remaining_order(J)) +
-             fmt("while column %.0f shows its order %.3g: ", J + 0.0, q) +
+             format_text("while column %.0f shows its order %.3g: ", J + 0.0, q) +
              (J + 1 <= top ? "higher columns not used; " : "") +
-             fmt("the order-%.3g term's coefficient wanders from level to level (events moving across the grid): "
+             format_text("the order-%.3g term's coefficient wanders from level to level (events moving across the grid): "
                  "error from the spread of column %.0f's last entries, each scaled to the finest step like h^%.3g",
                  q, J + 1.0, q);
     return e;
@@ -278,19 +269,19 @@ Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::ve
     } else {
       e.error_estimate = std::max({d_last, d_prev, hidden.spread, roundoff});
     }
-    e.note = fmt("column 1 (1 level, no extrapolation) shows order %.3g over its last entries, expected %.3g: ",
+    e.note = format_text("column 1 (1 level, no extrapolation) shows order %.3g over its last entries, expected %.3g: ",
                  e.column_orders[0], q) +
              (top >= 1 ? "higher columns not used; " : "") +
              (plateau[0] ? "its differences fall far faster than that order allows (a plateau, the value moves in "
                            "jumps): no error estimate"
               : std::isinf(e.error_estimate) && !hidden.never_seen ? "its differences grow: no error estimate"
               : hidden.never_seen
-                  ? fmt("no level shows the order-%.3g term and %.0f level(s) are too few to rule it out (it can "
+                  ? format_text("no level shows the order-%.3g term and %.0f level(s) are too few to rule it out (it can "
                         "hide behind a switch that sits near the same place in its step at every level): no error "
                         "estimate (more levels, coarser or finer, or events = on)",
                         q, static_cast<double>(h.size()))
               : hidden.spread > std::max(d_last, d_prev)
-                  ? fmt("the order-%.3g term showed at coarser levels and may be hidden at these: error from the "
+                  ? format_text("the order-%.3g term showed at coarser levels and may be hidden at these: error from the "
                         "largest difference of the column, each scaled to the finest step like h^%.3g",
                         q, q)
                   : "error from that column's last differences");
@@ -298,18 +289,18 @@ Extrapolation richardson_extrapolate(const std::vector<double>& h, const std::ve
   }
   if (J == 0) {  // column 0 unchecked (fewer than three levels) or the only one
     e.error_estimate = std::numeric_limits<double>::infinity();
-    e.note = L < 3 ? fmt("%.0f level(s): the order cannot be checked (three levels needed): no extrapolation, no error "
+    e.note = L < 3 ? format_text("%.0f level(s): the order cannot be checked (three levels needed): no extrapolation, no error "
                          "estimate",
                          L)
                    : "one column only: no extrapolation, no error estimate";
     return e;
   }
   e.error_estimate = std::max(std::abs(entry(L - 1, J) - entry(L - 1, J - 1)), roundoff);
-  e.note = !options.check_orders ? fmt("%.0f levels (orders not checked)", J + 1.0)
-           : J < top             ? fmt("%.0f levels: every column below shows its expected order; column %.0f has too "
+  e.note = !options.check_orders ? format_text("%.0f levels (orders not checked)", J + 1.0)
+           : J < top             ? format_text("%.0f levels: every column below shows its expected order; column %.0f has too "
                                                    "few entries to check, so it is not built upon (more N would allow more levels)",
                                        J + 1.0, J + 1.0)
-                                 : fmt("%.0f levels: every column below shows its expected order", J + 1.0);
+                                 : format_text("%.0f levels: every column below shows its expected order", J + 1.0);
   return e;
 }
 

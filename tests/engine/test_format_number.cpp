@@ -78,4 +78,13 @@ TEST(FormatNumber, IsTheShortestPrintfSpellingThatReadsBack) {
   for (double x : values) ASSERT_EQ(delayspec::format_number(x), shortest_printf_spelling(x)) << x;
 }
 
+TEST(FormatText, ANoteOfAnyLengthKeepsItsLastWords) {
+  // The notes of convergence and richardson are sentences with numbers; a fixed 240-byte buffer
+  // once cut the longest short. 600 characters of text and the numbers at its end come out whole.
+  const std::string long_text(600, 'x');
+  const std::string format = long_text + " %.3g and %.0f levels";
+  EXPECT_EQ(delayspec::format_text(format.c_str(), 0.125, 6), long_text + " 0.125 and 6 levels");
+  EXPECT_EQ(delayspec::format_text("%g %g %g %g", 1, 2, 3, 4), "1 2 3 4");
+}
+
 }  // namespace

@@ -337,7 +337,7 @@ std::vector<BadTable> bad_tables() {
     for (int k = 0; k < 300; ++k) product += "*(x + " + std::to_string(k + 1) + "*x_tau)";
     add("derivatives too large", scalar_table(product), {"`equations.rhs[1]`", "its derivatives have more than"});
     toml::table many;
-    for (int k = 0; k < 129; ++k) many.insert("d" + std::to_string(k), "1");
+    for (int k = 0; k < 129; ++k) many.insert(std::string("d").append(std::to_string(k)), "1");  // (GCC 12 -Wrestrict)
     toml::table with_many = impact_without("delay");
     with_many.insert_or_assign("delays", many);
     add("too many delays", with_many, {"`equations.delays`", "129 delays, at most 128"});

@@ -83,8 +83,9 @@ void expect_setters_are_the_keys(const std::string& text, const std::vector<std:
       keys_outcome = std::string("refused: ") + e.what();
     }
     EXPECT_EQ(family_outcome, keys_outcome) << base.model_name << ": " << name << " = " << value;
-    if (by_family)
+    if (by_family) {
       EXPECT_NE(family_outcome, fingerprint(base)) << base.model_name << ": " << name << " changes nothing";
+    }
   }
 }
 
