@@ -15,7 +15,7 @@
 #include "delayspec/lyapunov.hpp"
 #include "delayspec/model_linear.hpp"
 #include "delayspec/stroboscopic_map.hpp"
-#include "scene/points/parallel_points.hpp"
+#include "delayspec/parallel_points.hpp"
 
 using namespace delayspec;
 
@@ -92,7 +92,7 @@ TEST(Cancellation, ParallelPointsWorkersRunUnderTheCallersCheck) {
   bool all_saw_it = true;
   {
     const CancellationScope scope(&check);
-    cli::parallel_points(64, 4, [&](long) {
+    parallel_points(64, 4, [&](long) {
       std::lock_guard<std::mutex> lock(mutex);
       threads.insert(std::this_thread::get_id());
       all_saw_it = all_saw_it && current_cancellation_check() == &check;
@@ -107,7 +107,7 @@ TEST(Cancellation, ParallelPointsRethrowsCancelledOnTheCallingThread) {
   AfterQuestions check(0);  // requests at once
   const CancellationScope scope(&check);
   std::atomic<long> finished{0};
-  EXPECT_THROW(cli::parallel_points(100, 3,
+  EXPECT_THROW(parallel_points(100, 3,
                                     [&](long) {
                                       throw_if_cancelled();
                                       ++finished;

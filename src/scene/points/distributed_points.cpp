@@ -7,7 +7,7 @@
 #include <functional>
 #include <string>
 
-#include "scene/points/parallel_points.hpp"
+#include "delayspec/parallel_points.hpp"
 #include "scene/points/ranks.hpp"
 
 #ifdef DELAYSPEC_MPI

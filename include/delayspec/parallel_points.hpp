@@ -13,7 +13,7 @@
 
 #include "delayspec/cancellation.hpp"
 
-namespace delayspec::cli {
+namespace delayspec {
 
 template <class Work>
 void parallel_points(long count, int threads, Work&& work) {
@@ -41,4 +41,4 @@ void parallel_points(long count, int threads, Work&& work) {
   if (failure) std::rethrow_exception(failure);
 }
 
-}  // namespace delayspec::cli
+}  // namespace delayspec
