@@ -13,6 +13,7 @@
 #include "delayspec/builtin_analyses.hpp"
 #include "delayspec/continuation.hpp"
 #include "delayspec/errors.hpp"
+#include "delayspec/family_equilibria.hpp"
 #include "delayspec/problem_family.hpp"
 
 using namespace delayspec;
@@ -171,4 +172,67 @@ TEST(ProblemFamily, ABoundaryThroughTheFamilyCoversTheExactCurveWithItsBars) {
   RecordProperty("worst_finest", format_number(worst_finest));
   RecordProperty("worst_extrapolated", format_number(worst_extrapolated));
   RecordProperty("worst_bar", format_number(worst_bar));
+}
+
+namespace {
+
+// Mackey-Glass x' = beta x_tau / (1 + x_tau^n) - gamma x over tau (the map's period tau), the
+// other parameters those of the scene mackey_glass_hopf.toml.
+class MackeyGlassTauFamily final : public ProblemFamily {
+ public:
+  const std::vector<std::string>& parameter_names() const override { return names_; }
+  const std::vector<double>& base_values() const override { return base_; }
+
+ protected:
+  FamilyMember make(const std::vector<double>& v) const override {
+    try {
+      return {builtin_analyses(MackeyGlassModel({0.2, 0.1, 10, v[0], v[0], 1.1})), ""};
+    } catch (const BadInput& e) {
+      return {nullptr, e.what()};
+    }
+  }
+
+ private:
+  std::vector<std::string> names_ = {"tau"};
+  std::vector<double> base_ = {3};
+};
+
+}  // namespace
+
+TEST(ProblemFamily, EquilibriaAlongAFamilyFindTheExactHopfPoint) {
+  // continue_equilibrium on equilibria_along(a family), public headers only. At x* = 1 the
+  // linearisation is lambda = -0.1 - 0.4 exp(-lambda tau): roots +-i omega with omega^2 = 0.4^2 -
+  // 0.1^2 = 0.15 where cos(omega tau) = -1/4, the first at tau = arccos(-1/4) / sqrt(0.15). The
+  // location is on the exact characteristic function (no discretisation error), to the
+  // continuation's tolerance 1e-12 |to - from| = 3e-12, and the orbit branch born there
+  // (orbits_from_hopf_points at N = 100, 200) leaves it with the period 2 pi / omega.
+  const auto family = std::make_shared<const MackeyGlassTauFamily>();
+  MapSettings map;
+  map.N = 100;
+  const AnalysesAt along = analyses_along(family, family->base_values(), 0, map);
+  EquilibriumBranchOptions o;
+  o.from = 3;
+  o.to = 6;
+  o.tolerance = 1e-12 * (o.to - o.from);
+  const EquilibriumOptions eq;
+  const EquilibriumBranch branch = continue_equilibrium(equilibria_along(along, eq), Eigen::VectorXd::Constant(1, 1.1), o);
+  ASSERT_TRUE(branch.failure.empty()) << branch.failure;
+  ASSERT_EQ(branch.bifurcations.size(), 1u);
+  const EquilibriumBifurcation& hopf = branch.bifurcations[0];
+  EXPECT_EQ(hopf.type, EquilibriumBifurcationType::hopf);
+  const double exact = std::acos(-0.25) / std::sqrt(0.15);
+  EXPECT_NEAR(hopf.parameter, exact, 1e-11);
+  EXPECT_NEAR(hopf.omega, std::sqrt(0.15), 1e-10);
+
+  ContinuationOptions orbit;
+  orbit.from = hopf.parameter;
+  orbit.to = 6;
+  orbit.max_points = 8;
+  const std::vector<HopfOrbitBranch> orbits = orbits_from_hopf_points(branch, along, {100, 200}, orbit);
+  ASSERT_EQ(orbits.size(), 1u);
+  ASSERT_EQ(orbits[0].levels.size(), 2u);
+  EXPECT_EQ(orbits[0].hopf, &hopf);
+  ASSERT_GE(orbits[0].finest().points.size(), 2u) << orbits[0].finest().failure;
+  // the first point leaves the Hopf point with its period, to the discretisation's O(h^2)
+  EXPECT_NEAR(orbits[0].finest().points.front().period, 2 * std::numbers::pi / std::sqrt(0.15), 1e-2);
 }

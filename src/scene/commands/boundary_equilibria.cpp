@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "delayspec/equilibrium_boundary.hpp"
+#include "delayspec/family_equilibria.hpp"
 #include "delayspec/errors.hpp"
 #include "scene/output/metadata.hpp"
 #include "scene/output/output.hpp"
@@ -48,32 +49,6 @@ EquilibriaBoundaryRun read_run(Config& config) {
   require_autonomous(run.problem);
   return run;
 }
-
-// The model at (x, y) from the problem's family, made once per pair (Newton asks for the same
-// pair several times in a row). BadInput with the model's reason where it refuses the pair.
-class ModelAtPair {
- public:
-  explicit ModelAtPair(const EquilibriaBoundaryRun& run)
-      : problem_(run.problem), values_(run.problem.parameter_values), x_index_(run.x_index), y_index_(run.y_index) {}
-  std::shared_ptr<const ModelAnalyses> operator()(double x, double y) {
-    if (!analyses_ || x != x_ || y != y_) {
-      values_[static_cast<size_t>(x_index_)] = x;
-      values_[static_cast<size_t>(y_index_)] = y;
-      const FamilyMember member = problem_.family->at(values_, problem_.map_settings());
-      if (!member) throw BadInput(member.rejected);
-      analyses_ = member.analyses;
-      x_ = x, y_ = y;
-    }
-    return analyses_;
-  }
-
- private:
-  const Problem& problem_;
-  std::vector<double> values_;
-  int x_index_, y_index_;
-  std::shared_ptr<const ModelAnalyses> analyses_;
-  double x_ = 0, y_ = 0;
-};
 
 std::vector<double> state_values(const Eigen::VectorXd& y) { return {y.data(), y.data() + y.size()}; }
 
@@ -233,18 +208,9 @@ void print_fold_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const
 int boundary_equilibria(Config& config, const Invocation& inv) {
   const auto start = std::chrono::steady_clock::now();
   const EquilibriaBoundaryRun run = read_run(config);
-  auto at = std::make_shared<ModelAtPair>(run);
   const EquilibriumOptions& eq = run.eq.options;
-  const EquilibriumFamily2 family{
-      [at](const Eigen::VectorXd& s, double x, double y) { return (*at)(x, y)->at_constant_history(s); },
-      [at, &eq](const Eigen::VectorXd& guess, double x, double y, int nroots) {
-        EquilibriumOptions with = eq;
-        with.nroots = nroots;
-        return (*at)(x, y)->equilibrium(guess, with);
-      },
-      [at](const Eigen::VectorXd& s, const Eigen::VectorXd& w, double x, double y) {
-        return (*at)(x, y)->jacobian_at(s, w);
-      }};
+  const EquilibriumFamily2 family = equilibria_over(run.problem.family, run.problem.parameter_values, run.x_index,
+                                                    run.y_index, run.problem.map_settings(), eq);
   HopfCurveOptions o;
   o.boundary = run.settings.options;
   o.equilibrium = eq;

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "delayspec/equilibrium_branch.hpp"
+#include "delayspec/family_equilibria.hpp"
 #include "delayspec/errors.hpp"
 #include "scene/output/branch_output.hpp"
 #include "scene/output/metadata.hpp"
@@ -116,41 +117,10 @@ std::string equilibrium_bifurcations_csv(const std::string& header, const Equili
   return rows.str();
 }
 
-// continue_switch: the branch of orbits born at each Hopf point of the equilibria, at every N of
-// continue_Ns (or N), its bifurcations extrapolated to N -> infinity as an orbit branch's.
-struct HopfBranch {
-  const EquilibriumBifurcation* hopf = nullptr;
-  std::vector<ContinuationResult> levels;  // by N; the reported branch is the last
-  std::vector<BifurcationEstimate> estimates;
-  const ContinuationResult& finest() const { return levels.back(); }
-};
-
-std::vector<HopfBranch> hopf_branches(const EquilibriumBranch& equilibria, const AnalysesAt& at,
-                                      const std::vector<int>& Ns, const ContinuationOptions& options,
-                                      Progress& progress) {
-  std::vector<HopfBranch> out;
-  for (const EquilibriumBifurcation& b : equilibria.bifurcations) {
-    if (b.type != EquilibriumBifurcationType::hopf) continue;
-    HopfBranch branch;
-    branch.hopf = &b;
-    std::vector<std::vector<Bifurcation>> by_N;
-    for (int N : Ns) {
-      ContinuationOptions o = options;
-      o.N = N;
-      o.on_point = [&progress](const ContinuationPoint&) { progress.add(); };
-      branch.levels.push_back(at(b.parameter)->continue_from_hopf(at, b, o));
-      by_N.push_back(branch.levels.back().bifurcations);
-    }
-    branch.estimates = extrapolate_bifurcations(Ns, by_N, options.tolerance);
-    out.push_back(std::move(branch));
-  }
-  return out;
-}
-
 // Every Hopf branch's failures on one line (empty: none).
-std::string hopf_failures(const std::vector<HopfBranch>& branches, const std::vector<int>& Ns, const std::string& key) {
+std::string hopf_failures(const std::vector<HopfOrbitBranch>& branches, const std::vector<int>& Ns, const std::string& key) {
   std::string failures;
-  for (const HopfBranch& b : branches)
+  for (const HopfOrbitBranch& b : branches)
     for (size_t i = 0; i < b.levels.size(); ++i)
       if (!b.levels[i].failure.empty())
         failures += (failures.empty() ? "" : "; ") + std::string("orbits from the Hopf point at ") + key + " = " +
@@ -158,9 +128,9 @@ std::string hopf_failures(const std::vector<HopfBranch>& branches, const std::ve
   return failures;
 }
 
-json hopf_branches_json(const std::vector<HopfBranch>& branches, const std::vector<int>& Ns) {
+json hopf_branches_json(const std::vector<HopfOrbitBranch>& branches, const std::vector<int>& Ns) {
   json list = json::array();
-  for (const HopfBranch& b : branches) {
+  for (const HopfOrbitBranch& b : branches) {
     json bj;
     bj["from_parameter"] = b.hopf->parameter;
     bj["omega"] = b.hopf->omega;
@@ -176,10 +146,10 @@ json hopf_branches_json(const std::vector<HopfBranch>& branches, const std::vect
   return list;
 }
 
-void print_hopf_branches(std::ostream& os, const std::string& key, const std::vector<HopfBranch>& branches,
+void print_hopf_branches(std::ostream& os, const std::string& key, const std::vector<HopfOrbitBranch>& branches,
                          const std::vector<int>& Ns) {
   char line[256];
-  for (const HopfBranch& b : branches) {
+  for (const HopfOrbitBranch& b : branches) {
     const ContinuationResult& r = b.finest();
     os << "orbits from the Hopf point at " << key << " = " << format_number(b.hopf->parameter) << " (N = " << Ns.back()
        << "): " << r.points.size() << " points, ended at `" << to_string(r.end) << "`\n";
@@ -290,7 +260,7 @@ EquilibriaRun read_equilibria_run(Config& config) {
 // --out DIR: equilibria.csv, equilibrium_bifurcations.csv, hopf_branch_K.csv and
 // hopf_bifurcations_K.csv, continue.json, marked incomplete after a failure.
 void write_equilibria_files(const Invocation& inv, const Config& config, const EquilibriaRun& run,
-                            const EquilibriumBranch& branch, const std::vector<HopfBranch>& orbits,
+                            const EquilibriumBranch& branch, const std::vector<HopfOrbitBranch>& orbits,
                             const std::string& failures, const json& j, double seconds) {
   const std::filesystem::path dir(*inv.out_dir);
   OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
@@ -324,23 +294,11 @@ int continue_equilibria(Config& config, const Invocation& inv) {
   Progress progress(inv.err, "continue", 0, inv.quiet);
   o.on_point = [&progress] { progress.add(); };
   const AnalysesAt at = analyses_along(run.problem, run.index);
-  const EquilibriumOptions& eq = run.eq.options;
-  const EquilibriumFamily family{
-      [&at](const Eigen::VectorXd& y, double p) { return at(p)->at_constant_history(y); },
-      [&at, &eq](const Eigen::VectorXd& guess, double p, int nroots) {
-        EquilibriumOptions with = eq;
-        with.nroots = nroots;
-        return at(p)->equilibrium(guess, with);
-      },
-      // a normal form asks for some 700 Jacobians at one p: the model is read once for them
-      [&at, last = std::make_shared<std::pair<double, std::shared_ptr<const ModelAnalyses>>>()](
-          const Eigen::VectorXd& y, const Eigen::VectorXd& delayed, double p) {
-        if (!last->second || last->first != p) *last = {p, at(p)};
-        return last->second->jacobian_at(y, delayed);
-      }};
-  const EquilibriumBranch branch = continue_equilibrium(family, run.eq.guess, o);
-  const std::vector<HopfBranch> orbits =
-      run.from_hopf ? hopf_branches(branch, at, run.Ns, run.orbit_options, progress) : std::vector<HopfBranch>{};
+  const EquilibriumBranch branch = continue_equilibrium(equilibria_along(at, run.eq.options), run.eq.guess, o);
+  ContinuationOptions orbit_options = run.orbit_options;
+  orbit_options.on_point = [&progress](const ContinuationPoint&) { progress.add(); };
+  const std::vector<HopfOrbitBranch> orbits =
+      run.from_hopf ? orbits_from_hopf_points(branch, at, run.Ns, orbit_options) : std::vector<HopfOrbitBranch>{};
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string failures = branch.failure;
