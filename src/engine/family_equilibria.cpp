@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "delayspec/error_expansion.hpp"
 #include "delayspec/errors.hpp"
 
 namespace delayspec {
@@ -88,7 +89,8 @@ std::vector<HopfOrbitBranch> orbits_from_hopf_points(const EquilibriumBranch& eq
       branch.levels.push_back(at(b.parameter)->continue_from_hopf(at, b, o));
       by_N.push_back(branch.levels.back().bifurcations);
     }
-    branch.estimates = extrapolate_bifurcations(Ns, by_N, options.tolerance);
+    branch.estimates =
+        extrapolate_bifurcations(Ns, by_N, options.tolerance, error_expansion(*at(b.parameter), options.step_options));
     out.push_back(std::move(branch));
   }
   return out;

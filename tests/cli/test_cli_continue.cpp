@@ -130,6 +130,35 @@ TEST(ContinueCli, NeimarkSackerBarIsTightAtTheDefaultTolerance) {
   for (const auto& p : two["points"]) EXPECT_EQ(p["verdict"], "undecided");
 }
 
+// The error expansion has one home (error_expansion.hpp) for every analysis. Milling at a/D = 0.05
+// stepped with events = off on a uniform grid (the tooth's entry and exit inside steps): the
+// period-doubling depth carries a wandering h^2 term. continue assumed h^2, h^4, ... there (its
+// own copy of the rule looked at switches in the state only) and printed 0.0040630 +- 1.4e-5 over
+// N = 100, 200, 400, 2.8e-5 from the depth 0.00409071 (events on, N = 800, 1600, 3200: +- 8.3e-8):
+// a bar that did not cover. Now, as floquet's error bars: no estimate, and why; with the switches
+// on nodes (the aligned grid) the order-1 expansion gives one that covers.
+TEST(ContinueCli, MillingWithEventsOffHasFloquetsErrorExpansion) {
+  const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/milling_point.toml";
+  const double reference = 0.0040907106;  // events on, N = 800 .. 3200: +- 8.3e-8
+  for (const char* grid : {"uniform", "aligned"}) {
+    const CliResult r = run({"continue", scene, "--set", "radial_immersion=0.05", "--set", "continue_key=depth", "--set",
+                             "continue_from=1e-4", "--set", "continue_to=2e-2", "--set", "nev=4", "--set", "events=off",
+                             "--set", std::string("grid=") + grid, "--set", "continue_Ns=100,200,400", "--json"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["bifurcations"].size(), 1u) << grid;
+    const auto& b = j["bifurcations"][0];
+    EXPECT_EQ(b["type"], "period-doubling");
+    if (std::string(grid) == "uniform") {
+      EXPECT_TRUE(b["error_estimate"].is_null()) << b;
+      EXPECT_NE(b["note"].get<std::string>().find("no error estimate"), std::string::npos) << b;
+    } else {
+      ASSERT_FALSE(b["error_estimate"].is_null()) << b;
+      EXPECT_LE(std::abs(b["extrapolated"].get<double>() - reference), b["error_estimate"].get<double>()) << b;
+    }
+  }
+}
+
 // Issue 32, item 4: on the PWSDDE period-2 branch a second contact region appears at k = 0.1767
 // on an orbit already in contact (`floquet data/scenes/pwsdde-period2.toml --set N=800`: 1
 // contact at k = 0.1767, 2 at 0.1768), which the sign of max H does not see: continue reported only

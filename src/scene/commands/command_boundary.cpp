@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "delayspec/boundary_diagram.hpp"
+#include "delayspec/error_expansion.hpp"
 #include "delayspec/richardson.hpp"
 #include "scene/commands/boundary_equilibria.hpp"
 #include "scene/commands/commands.hpp"
@@ -121,8 +122,7 @@ BoundaryDiagram compute_boundary(const BoundaryRun& run, const Invocation& inv) 
   o.threads = run.threads;
   o.orbit = run.orbit_settings;
   o.floquet = run.floquet;
-  if (run.problem.analyses->switches_in_state() && run.problem.events == EventMode::off)
-    o.richardson.order = o.richardson.order_step = 1;  // design.md 1.5
+  o.richardson = error_expansion(*run.problem.analyses, o.map.step);
   std::optional<Progress> progress;
   o.on_studies = [&](long points) { progress.emplace(inv.err, "boundary", points, inv.quiet); };
   o.on_point_studied = [&] { progress->add(); };

@@ -31,6 +31,7 @@
 #include "scene/problem/continue_settings.hpp"
 #include "delayspec/branch_verdicts.hpp"
 #include "delayspec/continuation.hpp"
+#include "delayspec/error_expansion.hpp"
 #include "scene/problem/floquet_settings.hpp"
 #include "scene/output/metadata.hpp"
 #include "scene/problem/orbit_settings.hpp"
@@ -52,7 +53,6 @@ struct ContinueRun {
   Problem problem;         // at continue_from
   int index = -1;          // the continued key's parameter in problem.family
   std::vector<int> Ns;     // continue_Ns, or the one level N
-  bool switching = false;  // the model switches in the state (its extrapolation order)
   std::optional<double> period_guess;  // an autonomous orbit of unknown period (issue 60 item 5)
 };
 
@@ -74,7 +74,6 @@ ContinueRun read_continue_run(Config& config) {
     throw BadInput("`continue_switch = true` with `period_guess`: the period-2 branch of an orbit of unknown period "
                    "is not followed yet (its period doublings are located and extrapolated)");
   run.Ns = run.settings.Ns.empty() ? std::vector<int>{run.problem.N} : run.settings.Ns;
-  run.switching = run.problem.analyses->switches_in_state();
   return run;
 }
 
@@ -135,10 +134,8 @@ ContinueOutcome compute_continue(const ContinueRun& run, const Invocation& inv) 
   // the floor of the bars: the locations' tolerance (its default filled in), or the refined one
   const ContinuationOptions checked = continuation_detail::checked_options(options);
   const double tolerance = checked.refine_tolerance > 0 ? checked.refine_tolerance : checked.tolerance;
-  RichardsonOptions richardson;
-  if (run.switching && run.problem.events == EventMode::off)
-    richardson.order = richardson.order_step = 1;  // design.md 1.5
-  out.estimates = extrapolate_bifurcations(run.Ns, by_N, tolerance, richardson);
+  out.estimates = extrapolate_bifurcations(run.Ns, by_N, tolerance,
+                                           error_expansion(*run.problem.analyses, step_options(run.problem)));
   out.verdicts = branch_verdicts(out.branch().points, out.estimates, run.Ns, by_N);
   // continue_switch: the period-2 branch of every period doubling on the finest branch.
   if (run.settings.switch_period_doubling)

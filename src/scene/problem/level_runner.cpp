@@ -1,5 +1,7 @@
 #include "scene/problem/level_runner.hpp"
 
+#include "delayspec/error_expansion.hpp"
+
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -138,12 +140,7 @@ LevelResult level_result(const FloquetResult& result, long n, long K) {
 }
 
 RichardsonOptions error_expansion(const Problem& problem) {
-  RichardsonOptions options;
-  const bool first_order = problem.switching() && problem.events == EventMode::off;
-  options.order = first_order ? 1 : 2;
-  options.order_step = first_order ? 1 : 2;
-  options.leading_term_may_hide = first_order;
-  return options;
+  return delayspec::error_expansion(*problem.analyses, step_options(problem));
 }
 
 LevelResult StudyLevels::run(int N, int count, const Eigen::VectorXd* guess, int from_N) {

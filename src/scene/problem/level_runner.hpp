@@ -67,9 +67,8 @@ void with_monodromy(const Problem& problem, EventMode events, const OrbitSetting
 // solve of a monodromy of dimension n over K steps.
 LevelResult level_result(const FloquetResult& result, long n, long K);
 
-// The Richardson expansion of the problem's discretisation error: h^2, h^4, ... (the trapezoid,
-// smooth or with events located), or h, h^2, ... for a switching model with events = off (a
-// step across the switching surface is first order, design 1.5).
+// The Richardson expansion of the problem's discretisation error (delayspec/error_expansion.hpp,
+// the rule's one home).
 RichardsonOptions error_expansion(const Problem& problem);
 
 // A level of a study: orbit, monodromy, multipliers and their accuracy (convergence.hpp). The
