@@ -23,6 +23,7 @@
 #include "delayspec/floquet.hpp"
 #include "delayspec/lambert_w.hpp"
 #include "scene/equations/equation_plugin.hpp"
+#include "equation_scenes.hpp"
 #include "scene/problem/problem.hpp"
 #include "characteristic_roots.hpp"
 
@@ -42,15 +43,7 @@ rhs_switched = ["v", "a*omega^2*sin(omega*t) + k*(v_tau - v) - 2*zeta*v - x - be
 history = { x = 0.0, v = 0.0 }
 )scene";
 
-const char* kMackeyGlassScene = R"scene(model = "equations"
-[equations]
-state = ["x"]
-parameters = { beta = 0.2, gamma = 0.1, n = 10, tau = 8 }
-period = "tau"
-delay = "tau"
-rhs = ["beta*x_tau/(1 + x_tau^n) - gamma*x"]
-history = { x = 0.5 }
-)scene";
+const char* kMackeyGlassScene = delayspec::testing::kMackeyGlassEquationsScene;
 
 const char* kLinearScene = R"scene(model = "equations"
 [equations]

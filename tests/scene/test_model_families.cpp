@@ -13,6 +13,7 @@
 #include "delayspec/errors.hpp"
 #include "scene/keys/config.hpp"
 #include "scene/problem/problem.hpp"
+#include "equation_scenes.hpp"
 
 using delayspec::BadInput;
 using delayspec::format_number;
@@ -20,16 +21,6 @@ using delayspec::cli::Config;
 using delayspec::cli::Problem;
 
 namespace {
-
-const char* kMackeyGlassEquations = R"scene(model = "equations"
-[equations]
-state = ["x"]
-parameters = { beta = 0.2, gamma = 0.1, n = 10, tau = 8 }
-period = "tau"
-delay = "tau"
-rhs = ["beta*x_tau/(1 + x_tau^n) - gamma*x"]
-history = { x = 0.5 }
-)scene";
 
 Config scene(const std::string& text, const std::vector<std::pair<std::string, std::string>>& sets) {
   Config config = Config::from_scene_text(text, "test.toml");
@@ -101,8 +92,9 @@ TEST(ModelFamilies, EverySetterIsItsKey) {
   expect_setters_are_the_keys("model = \"milling\"\nradial_immersion = 0.3\ndepth = 2e-4\n", {});
   expect_setters_are_the_keys("model = \"milling\"\nradial_immersion = 0.3\ndepth = 2e-4\npitch_angles = [80, 100, 80, 100]\n",
                               {});
-  expect_setters_are_the_keys(kMackeyGlassEquations, {});                            // the delay from the table
-  expect_setters_are_the_keys(kMackeyGlassEquations, {{"tau_over_T", "0.5"}});       // the delay in periods
+  using delayspec::testing::kMackeyGlassEquationsScene;
+  expect_setters_are_the_keys(kMackeyGlassEquationsScene, {});                       // the delay from the table
+  expect_setters_are_the_keys(kMackeyGlassEquationsScene, {{"tau_over_T", "0.5"}});  // the delay in periods
 }
 
 TEST(ModelFamilies, NotAParameterIsNamedWithTheModelsParameters) {

@@ -28,6 +28,7 @@
 #include "scene/problem/boundary_settings.hpp"
 #include "scene/problem/continue_settings.hpp"
 #include "scene/problem/floquet_settings.hpp"
+#include "scene/problem/level_runner.hpp"
 #include "scene/problem/orbit_settings.hpp"
 #include "scene/problem/parameter_grid.hpp"
 #include "scene/problem/problem.hpp"
@@ -65,12 +66,7 @@ BoundaryRun read_boundary_run(Config& config) {
   for (BifurcationType t : {BifurcationType::neimark_sacker, BifurcationType::period_doubling, BifurcationType::fold,
                             BifurcationType::grazing})
     if (type == to_string(t)) run.type = t;
-  for (long N : config.get_int_list("boundary_Ns", {})) {
-    if (N < 1 || N > 10'000'000) throw BadInput("`boundary_Ns`: N = " + std::to_string(N) + " must be between 1 and 1e7");
-    if (!run.Ns.empty() && N <= run.Ns.back())
-      throw BadInput("`boundary_Ns`: must be increasing (" + std::to_string(run.Ns.back()) + ", " + std::to_string(N) + ")");
-    run.Ns.push_back(static_cast<int>(N));
-  }
+  run.Ns = read_levels(config, "boundary_Ns");
   const bool refine = config.get_choice("boundary_refine", "on", {"on", "off"}) == "on";
   run.threads = read_threads(config);
   run.orbit_settings = read_orbit_settings(config);

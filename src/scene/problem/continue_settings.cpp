@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "delayspec/errors.hpp"
+#include "scene/problem/level_runner.hpp"
 #include "scene/problem/parameter_grid.hpp"
 #include "scene/problem/problem.hpp"
 
@@ -39,16 +40,7 @@ ContinueSettings read_continue_settings(Config& config) {
   if (!(o.tolerance >= 0) || !std::isfinite(o.tolerance))
     throw BadInput("`continue_tolerance = " + format_number(o.tolerance) +
                    "`: must be > 0 (or 0 for 1e-10 |to - from|)");
-  if (config.has("continue_Ns")) {
-    for (long N : config.get_int_list("continue_Ns", {})) {
-      if (N < 1 || N > 10'000'000)
-        throw BadInput("`continue_Ns`: N = " + std::to_string(N) + " must be between 1 and 1e7");
-      if (!s.Ns.empty() && N <= s.Ns.back())
-        throw BadInput("`continue_Ns`: must be increasing (" + std::to_string(s.Ns.back()) + ", " + std::to_string(N) +
-                       ")");
-      s.Ns.push_back(static_cast<int>(N));
-    }
-  }
+  s.Ns = read_levels(config, "continue_Ns");
   // With error bars the locations are extrapolated, and a location known only to the library's
   // default 1e-10 |to - from| puts a floor under every bar (about twice the tolerance: the
   // Richardson weights) far above the extrapolation's own error: on x' = -x + b x(t - tau) over

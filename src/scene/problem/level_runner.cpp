@@ -73,6 +73,19 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
   return Ns;
 }
 
+std::vector<int> read_levels(Config& config, const std::string& key) {
+  std::vector<int> Ns;
+  if (!config.has(key)) return Ns;
+  for (long N : config.get_int_list(key, {})) {
+    if (N < 1 || N > 10'000'000)
+      throw BadInput("`" + key + "`: N = " + std::to_string(N) + " must be between 1 and 1e7");
+    if (!Ns.empty() && N <= Ns.back())
+      throw BadInput("`" + key + "`: must be increasing (" + std::to_string(Ns.back()) + ", " + std::to_string(N) + ")");
+    Ns.push_back(static_cast<int>(N));
+  }
+  return Ns;
+}
+
 std::vector<std::string> read_word_list(Config& config, const std::string& key, const std::string& fallback,
                                         const std::vector<std::string>& allowed) {
   const std::string text = config.get_string(key, fallback);

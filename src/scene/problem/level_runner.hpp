@@ -32,6 +32,10 @@ void use_first_level_as_N(Config& config);
 // problem (make_grid names N when the delay/period ratio needs a multiple).
 std::vector<int> read_N_list(Config& config, const Problem& problem, int default_min, int default_max);
 
+// An increasing list of levels N for error bars (continue_Ns, boundary_Ns): each N in 1 .. 1e7,
+// strictly increasing (BadInput naming the key); empty when the key is not given.
+std::vector<int> read_levels(Config& config, const std::string& key);
+
 // A comma-separated list of words, each one of `allowed` (BadInput naming the key and the word).
 std::vector<std::string> read_word_list(Config& config, const std::string& key, const std::string& fallback,
                                         const std::vector<std::string>& allowed);
