@@ -107,13 +107,18 @@ enum class BoundaryEnd { to, from, y_range, codim2, max_points, failure };
 // "to", "from", "y_range", "codim2", "max_points", "failure".
 std::string to_string(BoundaryEnd end);
 
-// Where a curve changes character.
+// Where a curve changes character: a Neimark-Sacker curve whose pair reaches 1 (angle 0) or -1
+// (angle pi), or a grazing curve meeting a stability curve.
+enum class Codim2Kind { resonance_1_1, resonance_1_2, grazing_meets };
+
 struct Codim2Point {
-  // "1:1 resonance" (angle 0), "1:2 resonance" (angle pi), "grazing meets TYPE" (TYPE the
-  // stability curve's: fold, period-doubling, neimark-sacker)
-  std::string kind;
-  double x = 0, y = 0, angle = 0;  // angle: the critical multiplier's |arg| there
+  Codim2Kind kind = Codim2Kind::resonance_1_1;
+  BifurcationType met = BifurcationType::fold;  // grazing_meets: the stability curve's type
+  double x = 0, y = 0, angle = 0;               // angle: the critical multiplier's |arg| there
 };
+// "1:1 resonance", "1:2 resonance", "grazing meets TYPE" (TYPE the stability curve's: fold,
+// period-doubling, neimark-sacker): the JSON's and the text's words.
+std::string to_string(const Codim2Point& point);
 
 struct BoundaryCurve {
   std::vector<BoundaryPoint> points;

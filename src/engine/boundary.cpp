@@ -24,6 +24,15 @@ std::string to_string(BoundaryEnd end) {
   return "?";
 }
 
+std::string to_string(const Codim2Point& point) {
+  switch (point.kind) {
+    case Codim2Kind::resonance_1_1: return "1:1 resonance";
+    case Codim2Kind::resonance_1_2: return "1:2 resonance";
+    case Codim2Kind::grazing_meets: return "grazing meets " + to_string(point.met);
+  }
+  return "?";
+}
+
 BoundarySample boundary_sample(BifurcationType type, const std::vector<std::complex<double>>& multipliers,
                                double max_H) {
   BoundarySample s;
@@ -224,7 +233,7 @@ std::optional<Codim2Point> passed_resonance(const std::array<Vec2, 3>& X, const 
   const int k = vertex <= s[1] ? 0 : 1;  // the segment holding it
   const double w = (vertex - s[k]) / (s[k + 1] - s[k]);
   Codim2Point q;
-  q.kind = at_pi ? "1:2 resonance" : "1:1 resonance";
+  q.kind = at_pi ? Codim2Kind::resonance_1_2 : Codim2Kind::resonance_1_1;
   q.x = X[k][0] + w * (X[k + 1][0] - X[k][0]);  // (scaled; the caller maps to x, y)
   q.y = X[k][1] + w * (X[k + 1][1] - X[k][1]);
   q.angle = edge;
@@ -407,7 +416,8 @@ std::optional<Codim2Point> met_other_curve(const ScaledCurve& scaled, const Curv
   const std::optional<CurveState> at = sign_change_between(scaled, a, b, tolerance, &BoundarySample::other, closed);
   if (!at) return std::nullopt;
   Codim2Point q;
-  q.kind = "grazing meets " + to_string(at->sample.other_type);
+  q.kind = Codim2Kind::grazing_meets;
+  q.met = at->sample.other_type;
   q.x = scaled.x(at->X);
   q.y = scaled.y(at->X);
   q.angle = at->sample.other_angle;
@@ -497,11 +507,14 @@ BoundaryCurve trace_boundary(const BoundaryFunction& g, double y_start, const Bo
     if (const std::optional<CurveState>& at = resonance) {
       add_point(*at);
       const bool one_to_one = at->sample.other_type == BifurcationType::fold;
-      const Codim2Point q{one_to_one ? "1:1 resonance" : "1:2 resonance", scaled.x(at->X), scaled.y(at->X),
-                          at->sample.angle};
+      Codim2Point q;
+      q.kind = one_to_one ? Codim2Kind::resonance_1_1 : Codim2Kind::resonance_1_2;
+      q.x = scaled.x(at->X);
+      q.y = scaled.y(at->X);
+      q.angle = at->sample.angle;
       curve.codim2.push_back(q);
       curve.end = BoundaryEnd::codim2;
-      curve.note = std::string("a second multiplier reached ") + (one_to_one ? "+1" : "-1") + ": " + q.kind +
+      curve.note = std::string("a second multiplier reached ") + (one_to_one ? "+1" : "-1") + ": " + to_string(q) +
                    " at x = " + format_number(q.x) + ", y = " + format_number(q.y);
       return curve;
     }

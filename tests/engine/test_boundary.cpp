@@ -74,7 +74,9 @@ TEST(Boundary, WhereTheCurveMeetsACurveOfTheOtherKindIsLocatedAndPassed) {
   EXPECT_EQ(c.end, BoundaryEnd::from) << c.note;  // passed, not an end
   ASSERT_EQ(c.codim2.size(), 1u);
   const Codim2Point& q = c.codim2[0];
-  EXPECT_EQ(q.kind, "grazing meets period-doubling");
+  EXPECT_EQ(q.kind, Codim2Kind::grazing_meets);
+  EXPECT_EQ(q.met, BifurcationType::period_doubling);
+  EXPECT_EQ(to_string(q), "grazing meets period-doubling");
   // The bracket along the chord is closed to the tolerance, 1e-10 of the ranges (<= 2.4e-10),
   // on points each on the circle to |g| <= ~1e-9 (above): v to 1e-9, u = sqrt(1 - v^2) to 2e-9.
   EXPECT_NEAR(q.y, 0.6, 1e-9);
@@ -180,7 +182,8 @@ TEST(Boundary, APeriodDoublingCurveEndsAtThe12ResonanceWhereASecondMultiplierRea
   const BoundaryCurve c = trace_boundary(g, -0.8, o);
   EXPECT_EQ(c.end, BoundaryEnd::codim2) << c.note;
   ASSERT_EQ(c.codim2.size(), 1u);
-  EXPECT_EQ(c.codim2[0].kind, "1:2 resonance");
+  EXPECT_EQ(c.codim2[0].kind, Codim2Kind::resonance_1_2);
+  EXPECT_EQ(to_string(c.codim2[0]), "1:2 resonance");
   EXPECT_NEAR(c.codim2[0].y, 0.6, 1e-9);
   EXPECT_NEAR(c.codim2[0].x, 0.8, 2e-9);
   EXPECT_EQ(c.points.back().x, c.codim2[0].x);

@@ -165,7 +165,7 @@ json boundary_json(const BoundaryRun& run, const BoundaryDiagram& out, double se
     }
     c["codim2"] = json::array();
     for (const Codim2Point& q : curve.codim2)
-      c["codim2"].push_back({{"kind", q.kind}, {"x", q.x}, {"y", q.y}, {"angle", q.angle}});
+      c["codim2"].push_back({{"kind", to_string(q)}, {"x", q.x}, {"y", q.y}, {"angle", q.angle}});
     j["curves"].push_back(c);
   }
   // Where the orbit is stable, when the search found it stable at y_from everywhere: below the
@@ -235,7 +235,7 @@ void print_boundary(std::ostream& os, const BoundaryRun& run, const BoundaryDiag
     // (located on the finest N's curve only: the coarser levels' curves are not followed, so
     // nothing says how far it is from N -> infinity)
     for (const Codim2Point& q : curve.codim2)
-      os << "  codim 2: " << q.kind << " at " << run.x_key << " = " << format_number(q.x) << ", " << run.y_key
+      os << "  codim 2: " << to_string(q) << " at " << run.x_key << " = " << format_number(q.x) << ", " << run.y_key
          << " = " << format_number(q.y) << " (at N = " << run.Ns.back() << ", no error estimate)\n";
   }
   os << "time: " << seconds << " s: the starts' search " << format_number(out.search_seconds, 2) << " s, tracing "
