@@ -182,6 +182,10 @@ struct RichardsonReport {
   int levels_used = 0;  // the column the extrapolated value comes from (+1)
 };
 
+// What ended a study: its list of levels (no target), the target met, the largest N allowed, the
+// time allowed, a level that failed.
+enum class StudyStop { levels, target, max_N, max_seconds, failure };
+
 struct ConvergenceStudy {
   std::vector<ConvergenceRow> rows;                    // every level, failed ones included, by N
   ReferenceKind reference = ReferenceKind::automatic;  // the one used (never automatic)
@@ -192,11 +196,10 @@ struct ConvergenceStudy {
   std::vector<ExtrapolatedMultiplier> extrapolated;    // per track (empty with one level)
   RichardsonReport richardson;                         // of track 0
   double seconds = 0;                                  // sum over the levels
-  // The target (options.target > 0): met or not, and what ended the study: "target",
-  // "converge_max_N", "converge_max_seconds", "failure"; "Ns" without a target. stop_note says it
-  // in words with the numbers.
+  // The target (options.target > 0): met or not, and what ended the study (levels: the list of
+  // Ns without a target). stop_note says it in words with the numbers.
   std::optional<bool> target_met;
-  std::string stopped_by = "Ns";
+  StudyStop stopped_by = StudyStop::levels;
   std::string stop_note;
 };
 

@@ -589,7 +589,7 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
     const double worst = worst_relative_estimate(study);
     if (worst <= o.target) {
       study.target_met = true;
-      study.stopped_by = "target";
+      study.stopped_by = StudyStop::target;
       study.stop_note =
           format_text("target %.3g met at N = %.0f: largest relative error estimate %.3g", o.target, o.Ns.back(), worst);
       return study;
@@ -600,7 +600,7 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
         format_text(" > target %.3g", o.target);
     const int last = o.Ns.back();
     if (last > o.max_N / 2) {
-      study.stopped_by = "converge_max_N";
+      study.stopped_by = StudyStop::max_N;
       study.stop_note = format_text("converge_max_N = %.0f reached (the next N would be %.0f): ", o.max_N, 2.0 * last) + unmet;
       return study;
     }
@@ -610,7 +610,7 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
     const double growth = t_prev > 0 ? std::max(2.0, t_last / t_prev) : 2.0;
     const double predicted = t_last * growth, spent = total_seconds();
     if (spent + predicted > o.max_seconds) {
-      study.stopped_by = "converge_max_seconds";
+      study.stopped_by = StudyStop::max_seconds;
       study.stop_note =
           format_text("converge_max_seconds = %.3g: the next level (N = %.0f) would take about %.3g s after %.3g s "
               "spent: ",
@@ -629,7 +629,7 @@ ConvergenceStudy run_convergence_study(const LevelFunction& level, const Converg
     if (!levels.back().failure.empty()) {
       const double now = worst_relative_estimate(study);
       study.target_met = now <= o.target;
-      study.stopped_by = "failure";
+      study.stopped_by = StudyStop::failure;
       study.stop_note = "level N = " + std::to_string(N) + " failed (" + levels.back().failure + ")";
       return study;
     }

@@ -626,7 +626,7 @@ TEST(Target, KeepsDoublingUntilTheEstimateMeetsIt) {
   const ConvergenceStudy s = run_convergence_study(failing_levels({}), o);
   ASSERT_TRUE(s.target_met.has_value());
   EXPECT_TRUE(*s.target_met) << s.stop_note;
-  EXPECT_EQ(s.stopped_by, "target");
+  EXPECT_EQ(s.stopped_by, StudyStop::target);
   EXPECT_GT(s.rows.size(), 3u);
   EXPECT_EQ(s.rows.back().N, 10 << (s.rows.size() - 1));  // doubling
   const Multipliers truth{0.8, 0.3};
@@ -639,7 +639,7 @@ TEST(Target, KeepsDoublingUntilTheEstimateMeetsIt) {
   const ConvergenceStudy plain = run_convergence_study(failing_levels({}), o);
   EXPECT_EQ(plain.rows.size(), 3u);
   EXPECT_FALSE(plain.target_met.has_value());
-  EXPECT_EQ(plain.stopped_by, "Ns");
+  EXPECT_EQ(plain.stopped_by, StudyStop::levels);
 }
 
 TEST(Target, StopsAtTheLimitsAndSaysWhich) {
@@ -650,7 +650,7 @@ TEST(Target, StopsAtTheLimitsAndSaysWhich) {
   o.target = 1e-14;  // below what these levels can claim (their own round-off floor)
   o.max_N = 160;
   const ConvergenceStudy n = run_convergence_study(failing_levels({}), o);
-  EXPECT_EQ(n.stopped_by, "converge_max_N");
+  EXPECT_EQ(n.stopped_by, StudyStop::max_N);
   EXPECT_FALSE(*n.target_met);
   EXPECT_EQ(n.rows.back().N, 160);
   EXPECT_NE(n.stop_note.find("converge_max_N = 160"), std::string::npos) << n.stop_note;
@@ -658,14 +658,14 @@ TEST(Target, StopsAtTheLimitsAndSaysWhich) {
   o.max_N = 51200;
   o.max_seconds = 0.1;
   const ConvergenceStudy t = run_convergence_study(failing_levels({}), o);
-  EXPECT_EQ(t.stopped_by, "converge_max_seconds");
+  EXPECT_EQ(t.stopped_by, StudyStop::max_seconds);
   EXPECT_FALSE(*t.target_met);
   EXPECT_EQ(t.rows.back().N, 40);
   EXPECT_NE(t.stop_note.find("N = 80"), std::string::npos) << t.stop_note;
   // a new level that fails (and cannot be retried) ends the study
   o.max_seconds = 600;
   const ConvergenceStudy f = run_convergence_study(failing_levels({80}), o);
-  EXPECT_EQ(f.stopped_by, "failure");
+  EXPECT_EQ(f.stopped_by, StudyStop::failure);
   EXPECT_EQ(f.rows.back().N, 80);
   EXPECT_FALSE(f.rows.back().failure.empty());
   // bad limits

@@ -38,6 +38,19 @@ namespace delayspec::cli {
 
 namespace {
 
+// What ended a study, in the keys' words (the JSON's stopped_by): the list `Ns`, the target, the
+// key that bounded it, a failure.
+std::string stop_key(StudyStop stop) {
+  switch (stop) {
+    case StudyStop::levels: return "Ns";
+    case StudyStop::target: return "target";
+    case StudyStop::max_N: return "converge_max_N";
+    case StudyStop::max_seconds: return "converge_max_seconds";
+    case StudyStop::failure: return "failure";
+  }
+  return "?";
+}
+
 // A failure message on one line (for a CSV comment).
 std::string one_line(std::string text) {
   std::replace(text.begin(), text.end(), '\n', ' ');
@@ -117,7 +130,7 @@ nlohmann::json study_json(const ConvergenceStudy& s, const std::string& events, 
   j["richardson"] = cols;
   j["seconds"] = s.seconds;
   j["target_met"] = s.target_met ? nlohmann::json(*s.target_met) : nlohmann::json(nullptr);
-  j["stopped_by"] = s.stopped_by;
+  j["stopped_by"] = stop_key(s.stopped_by);
   if (!s.stop_note.empty()) j["stop_note"] = s.stop_note;
   return j;
 }
@@ -420,7 +433,7 @@ nlohmann::json converge_json(const ConvergeSettings& s, const std::vector<Conver
     for (size_t v = 0; v < studies.size(); ++v)
       if (studies[v].target_met && !*studies[v].target_met)
         missed += (missed.empty() ? "" : "; ") + std::string("events = ") + s.events[v] + ": not met (" +
-                  studies[v].stopped_by + ")";
+                  stop_key(studies[v].stopped_by) + ")";
     if (!missed.empty()) {
       j["target_met"] = false;
       j["target_note"] = missed;
