@@ -364,7 +364,12 @@ void end_where_it_stops(BoundaryCurve& curve, const ScaledCurve& scaled, const C
   if (std::isfinite(angle) && (angle < 0.05 || angle > std::numbers::pi - 0.05) &&
       (pair || last.sample.second_gap < 0.05)) {
     const bool one_to_one = angle < 0.05;
-    curve.codim2.push_back({one_to_one ? "1:1 resonance" : "1:2 resonance", x, y, angle});
+    Codim2Point q;
+    q.kind = one_to_one ? Codim2Kind::resonance_1_1 : Codim2Kind::resonance_1_2;
+    q.x = x;
+    q.y = y;
+    q.angle = angle;
+    curve.codim2.push_back(q);
     curve.end = BoundaryEnd::codim2;
     curve.note = std::string("the critical pair reached the real axis (angle ") + format_number(angle, 3) + "): " +
                  (one_to_one ? "1:1" : "1:2") + " resonance at x = " + format_number(x) + ", y = " + format_number(y);
