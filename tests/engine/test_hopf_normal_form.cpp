@@ -212,8 +212,7 @@ EquilibriumFamily2 linear_in_a_b() {
 TEST(HopfCurves, LinearHopfCurveIsTheClosedForm) {
   HopfCurveOptions o;
   o.boundary.x_from = -1, o.boundary.x_to = 0.9, o.boundary.y_from = -0.5, o.boundary.y_to = -3;
-  const HopfCurves r = hopf_curves(linear_in_a_b(),
-                                   Eigen::VectorXd(), o);
+  const HopfCurves r = hopf_curves(linear_in_a_b(), Eigen::VectorXd(), o);
   ASSERT_EQ(r.curves.size(), 1u);
   const HopfCurve& c = r.curves[0];
   EXPECT_EQ(c.end, BoundaryEnd::to) << c.note;
@@ -237,8 +236,7 @@ TEST(HopfCurves, LinearHopfCurveIsTheClosedForm) {
 TEST(HopfCurves, AHopfCurveEndsAtItsBogdanovTakensPoint) {
   HopfCurveOptions o;
   o.boundary.x_from = -1, o.boundary.x_to = 1.2, o.boundary.y_from = -0.5, o.boundary.y_to = -3;
-  const HopfCurves r = hopf_curves(linear_in_a_b(),
-                                   Eigen::VectorXd(), o);
+  const HopfCurves r = hopf_curves(linear_in_a_b(), Eigen::VectorXd(), o);
   ASSERT_EQ(r.curves.size(), 1u);
   const HopfCurve& c = r.curves[0];
   EXPECT_EQ(c.end, BoundaryEnd::codim2) << c.note;

@@ -18,7 +18,6 @@
 
 #include "delayspec/boundary_diagram.hpp"
 #include "delayspec/error_expansion.hpp"
-#include "delayspec/richardson.hpp"
 #include "scene/commands/boundary_equilibria.hpp"
 #include "scene/commands/commands.hpp"
 #include "scene/output/metadata.hpp"
@@ -26,7 +25,6 @@
 #include "scene/output/output_directory.hpp"
 #include "scene/output/progress.hpp"
 #include "scene/problem/boundary_settings.hpp"
-#include "scene/problem/continue_settings.hpp"
 #include "scene/problem/floquet_settings.hpp"
 #include "scene/problem/level_runner.hpp"
 #include "scene/problem/orbit_settings.hpp"

@@ -16,7 +16,7 @@ struct BoundarySettings {
 };
 
 // BadInput naming the key: boundary_x or boundary_y missing or equal (whether each is a model
-// parameter is the problem's: read_problem_at, family_parameter);
+// parameter is the problem's: starting_problem, family_parameter);
 // an empty range; a step <= 0 or step_min > step_max; a chord error or tolerance <= 0.
 BoundarySettings read_boundary_settings(Config& config);
 

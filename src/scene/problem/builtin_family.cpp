@@ -65,6 +65,15 @@ std::shared_ptr<const BuiltinFamily> checked_family(const Parameters& p,
   return family;
 }
 
+// The key `period`, or NaN when the scene does not give it: then the delay's at every value of
+// the family (with_period), not the scene's tau fixed. (Read either way: --help shows tau's value
+// as its default.)
+double period_or_nan(Config& c, double tau) {
+  const bool given = c.has("period");
+  const double period = c.get_double("period", tau);
+  return given ? period : NAN;
+}
+
 // A period not given (NaN) is the delay's: the map samples once per delay.
 template <class Parameters>
 Parameters with_period(Parameters p) {
@@ -114,9 +123,7 @@ std::shared_ptr<const BuiltinFamily> read_linear_family(Config& c) {
   p.a = c.get_double("a", p.a);
   p.b = c.get_double("b", p.b);
   p.tau = c.get_double("tau", p.tau);
-  const bool period_given = c.has("period");
-  const double period = c.get_double("period", p.tau);
-  p.period = period_given ? period : NAN;  // (not given: tau's, at every value of the family)
+  p.period = period_or_nan(c, p.tau);
   return checked_family<P>(p, {{"a", &P::a}, {"b", &P::b}, {"tau", &P::tau}, {"period", &P::period}},
                            [](P q) -> AnyModel { return LinearModel(with_period(q)); });
 }
@@ -139,9 +146,7 @@ std::shared_ptr<const BuiltinFamily> read_mackey_glass_family(Config& c) {
   p.gamma = c.get_double("gamma", p.gamma);
   p.n = c.get_double("n", p.n);
   p.tau = c.get_double("tau", p.tau);
-  const bool period_given = c.has("period");
-  const double period = c.get_double("period", p.tau);
-  p.period = period_given ? period : NAN;  // (not given: tau's, at every value of the family)
+  p.period = period_or_nan(c, p.tau);
   p.x0 = c.get_double("x0", p.x0);
   return checked_family<P>(
       p, {{"beta", &P::beta}, {"gamma", &P::gamma}, {"n", &P::n}, {"tau", &P::tau}, {"period", &P::period}},

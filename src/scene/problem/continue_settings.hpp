@@ -21,7 +21,7 @@ struct ContinueSettings {
 // continue_step_max, continue_max_points, continue_tolerance, continue_Ns, continue_switch, continue_solver. BadInput naming the key:
 // a missing required key, an empty range, a non-positive step or tolerance, step_min > step_max, Ns not increasing or out of range.
 // The Floquet and discretisation options are the caller's (read_floquet_options, read_problem), and
-// whether the key is a parameter of the model the problem's (read_problem_at, family_parameter).
+// whether the key is a parameter of the model the problem's (starting_problem, family_parameter).
 ContinueSettings read_continue_settings(Config& config);
 
 }  // namespace delayspec::cli
