@@ -125,16 +125,15 @@ void compute_chart_point(const Config& config, const ChartSettings& s, ChartPoin
   const Problem p = read_problem(point, 40);
   const FloquetOptions options = read_floquet_options(point, 1);
   try {
-    const LinearisedOrbit at_orbit = p.analyses->linearised_orbit(p.map_settings(), s.orbit_settings);
-    const FloquetResult result = floquet_multipliers(*at_orbit.monodromy, options);
-    pts.radius[i] = std::abs(result.multipliers.at(0));
-    pts.angle[i] = std::abs(std::arg(result.multipliers.at(0)));
-    if (s.with_error_bars) {
-      double seconds = 0;
-      const ErrorBars bars = floquet_error_bars(p, s.orbit_settings, options,
-                                                level_result(result, p.dimension(), p.grid().K), {}, seconds);
-      pts.verdict[i] = to_string(bars.verdict);
-      pts.bar[i] = bars.bars.at(0).error_estimate;
+    // The solve and its error bars (resolution_study.hpp; no retry from the point's orbit, which
+    // is not kept: a chart has many points)
+    const FloquetAtResolution at =
+        resolution_study(p, s.orbit_settings, options).floquet(s.with_error_bars, /*retry_from_N=*/false);
+    pts.radius[i] = std::abs(at.result.multipliers.at(0));
+    pts.angle[i] = std::abs(std::arg(at.result.multipliers.at(0)));
+    if (at.bars) {
+      pts.verdict[i] = to_string(at.bars->verdict);
+      pts.bar[i] = at.bars->bars.at(0).error_estimate;
     }
   } catch (const NumericalFailure& e) {
     pts.failure[i] = e.what();  // e.g. no periodic orbit at this point: reported, not fatal

@@ -98,7 +98,7 @@ ContinuationResult branch_at(const ContinueRun& run, ContinuationOptions options
   const AnalysesAt at = analyses_along(level, run.index);
   if (run.period_guess)
     return level.analyses->continue_autonomous_orbit(
-        at, autonomous_orbit_options(level, N, *run.period_guess, run.orbit_settings), options);
+        at, autonomous_orbit_options(run.orbit_settings, step_options(level), N, *run.period_guess), options);
   return level.analyses->continue_orbit(at, run.orbit_settings, options);
 }
 

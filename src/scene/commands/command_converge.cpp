@@ -10,7 +10,7 @@
 //
 // A level whose orbit cannot be found (simulation does not settle: e.g. an orbit that is
 // spuriously unstable at a coarse N) is retried with Newton from the orbit of the nearest level
-// that succeeded, prolonged to its N (level_runner.hpp); a level that still fails is a row with
+// that succeeded, prolonged to its N (delayspec/resolution_study.hpp); a level that still fails is a row with
 // its reason (`failure`), not the end of the study (convergence.hpp).
 #include <algorithm>
 #include <chrono>
@@ -349,8 +349,8 @@ std::vector<ConvergenceStudy> run_studies(const ConvergeSettings& s, const Invoc
             try {
               FloquetOptions solver = s.solver_options;
               solver.nev = count;
-              AutonomousFloquetLevel level =
-                  autonomous_level(with_events, N, *s.period_guess, s.orbit_settings, solver);
+              AutonomousFloquetLevel level = autonomous_level(*with_events.analyses, step_options(with_events), N,
+                                                              *s.period_guess, s.orbit_settings, solver);
               period.add(N, level.orbit);
               r = std::move(level.others);
             } catch (const NumericalFailure& e) {
@@ -364,7 +364,7 @@ std::vector<ConvergenceStudy> run_studies(const ConvergeSettings& s, const Invoc
       period.extrapolate(options.richardson);
       continue;
     }
-    StudyLevels levels(s.problem, with_events.events, s.orbit_settings, s.solver_options, &progress);
+    ResolutionStudy levels = resolution_study(with_events, s.orbit_settings, s.solver_options, &progress);
     studies.push_back(
         run_convergence_study([&](int N, int count) { return levels.level(N, count); }, options,
                               [&](int N, int count, int from_N) { return levels.retry(N, count, from_N); }));

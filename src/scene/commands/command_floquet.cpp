@@ -20,7 +20,8 @@ namespace {
 int floquet_of_unknown_period(const Problem& problem, const OrbitSettings& orbit_settings,
                               const FloquetOptions& options, bool with_error_bars, double period_guess,
                               const Invocation& inv, std::chrono::steady_clock::time_point start) {
-  const AutonomousFloquet r = autonomous_floquet(problem, period_guess, orbit_settings, options, with_error_bars);
+  const AutonomousFloquet r = autonomous_floquet(*problem.analyses, step_options(problem), problem.N, period_guess,
+                                                 orbit_settings, options, with_error_bars);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (inv.json) {
     nlohmann::json json;
@@ -57,37 +58,20 @@ int command_floquet(Config& config, const Invocation& inv) {
   const long n = problem.dimension();
   validate_floquet_options(options, n);  // before the orbit: fail fast
 
-  nlohmann::json json;
-  FloquetResult result;
-  PeriodicOrbit orbit;
-  ContactSummary contacts;
-  HistoryGrid grid;  // the orbit's (aligned with its contacts where it could be: contact_aligned_orbit.hpp)
-  nlohmann::json alignment;
-  double orbit_seconds = 0;  // finding the orbit and its linearisation (the step maps)
-  LevelResult at_N;  // the solve's multipliers with their accuracy
-  std::optional<ErrorBars> bars;
-  double error_bar_seconds = 0;
-  {
-    const auto orbit_start = std::chrono::steady_clock::now();
-    OrbitRequest request;
-    request.sequence = with_error_bars;  // the orbit at N: where a coarser level's Newton may start
-    LinearisedOrbit at_orbit = problem.analyses->linearised_orbit(problem.map_settings(), orbit_settings, request);
-    orbit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - orbit_start).count();
-    orbit = std::move(at_orbit.orbit);
-    contacts = at_orbit.contacts;
-    grid = at_orbit.grid;
-    alignment = contact_alignment_json(at_orbit);
-    result = floquet_multipliers(*at_orbit.monodromy, options);
-    // Each multiplier's accuracy (multiplier_accuracy): the ones below it are not printed as values.
-    at_N = level_result(result, n, problem.grid().K);
-    if (with_error_bars)
-      bars = floquet_error_bars(problem, orbit_settings, options, at_N, std::move(at_orbit.sequence),
-                                error_bar_seconds);
-  }
+  // The solve at N and its error bars (delayspec/resolution_study.hpp): two coarser solves, about
+  // 1.3x the single one, retried from the orbit at N where a coarse orbit fails.
+  FloquetAtResolution at = resolution_study(problem, orbit_settings, options).floquet(with_error_bars);
+  const FloquetResult& result = at.result;
+  const PeriodicOrbit& orbit = at.at_orbit.orbit;
+  const ContactSummary& contacts = at.at_orbit.contacts;
+  const HistoryGrid& grid = at.at_orbit.grid;  // the orbit's (aligned with its contacts where it could be)
+  const LevelResult& at_N = at.at_N;
+  const std::optional<ErrorBars>& bars = at.bars;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::vector<double>& accuracy = at_N.accuracy;
 
   if (inv.json) {
+    nlohmann::json json;
     json["model"] = problem.model_name;
     json["N"] = problem.N;
     json["dimension"] = n;
@@ -97,10 +81,10 @@ int command_floquet(Config& config, const Invocation& inv) {
     if (bars) {
       add_error_bars_json(json["multipliers"], *bars);
       json["verdict"] = to_string(bars->verdict);
-      json["error_bars"] = error_bars_json(*bars, error_bar_seconds);
+      json["error_bars"] = error_bars_json(*bars, at.error_bar_seconds);
     }
     json["seconds"] = seconds;
-    json["orbit_seconds"] = orbit_seconds;
+    json["orbit_seconds"] = at.orbit_seconds;
     json["eigensolver_seconds"] = result.seconds;
     json["operator_applications"] = result.operator_applications;
     json["converged"] = result.converged;
@@ -116,7 +100,8 @@ int command_floquet(Config& config, const Invocation& inv) {
     json["steps_per_map"] = problem.grid().K;
     json["events"] = to_string(problem.events);
     json["grid"] = grid_json(grid);
-    if (!alignment.is_null()) json["grid"]["contacts"] = alignment;
+    if (const nlohmann::json alignment = contact_alignment_json(at.at_orbit); !alignment.is_null())
+      json["grid"]["contacts"] = alignment;
     json["jacobian"] = to_string(problem.jacobian);
     json["orbit_residual"] = orbit.residual;
     json["orbit_periods"] = orbit.maps;

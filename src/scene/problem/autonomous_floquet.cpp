@@ -1,12 +1,10 @@
 #include "scene/problem/autonomous_floquet.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 
 #include "delayspec/errors.hpp"
 #include "scene/output/output.hpp"
-#include "scene/problem/level_runner.hpp"
 
 namespace delayspec::cli {
 
@@ -17,61 +15,6 @@ std::optional<double> read_period_guess(Config& config, const Problem& problem) 
     throw BadInput("`period_guess` with `model = " + problem.model_name +
                    "`: a forced model's orbit has the forcing's period; `period_guess` is for autonomous models");
   return guess;
-}
-
-AutonomousOrbitOptions autonomous_orbit_options(const Problem& problem, int N, double period_guess,
-                                                const OrbitSettings& orbit) {
-  AutonomousOrbitOptions o;
-  o.period_guess = period_guess;
-  o.N = N;
-  o.guess_periods = static_cast<int>(orbit.guess_periods);
-  o.newton = orbit.newton;
-  o.step = step_options(problem);
-  o.coarse_N = orbit.coarse_N;
-  // newton: sparse LU on the whole period; auto and shooting: nested shooting (sparse LU alone
-  // below refinement coarse_N, where it has one level)
-  if (orbit.method == OrbitMethod::simulate)
-    throw BadInput("`orbit = simulate` with `period_guess`: an orbit of unknown period is solved for with its "
-                   "period (orbit = newton, shooting or auto)");
-  o.method = orbit.method == OrbitMethod::newton ? AutonomousOrbitMethod::newton : AutonomousOrbitMethod::shooting;
-  return o;
-}
-
-AutonomousFloquetLevel autonomous_level(const Problem& problem, int N, double period_guess,
-                                        const OrbitSettings& orbit, const FloquetOptions& solver) {
-  AutonomousLinearisedOrbit at = problem.analyses->autonomous_orbit(autonomous_orbit_options(problem, N, period_guess, orbit));
-  AutonomousFloquetLevel level;
-  level.N = N;
-  level.orbit = std::move(at.orbit);
-  FloquetOptions fo = solver;
-  fo.nev = static_cast<int>(std::min<long>(solver.nev + 1, at.monodromy->rows()));
-  level.result = floquet_multipliers(*at.monodromy, fo);
-  const LevelResult all = level_result(level.result, at.monodromy->rows(), level.orbit.grid.K);
-  const size_t trivial = trivial_multiplier_index(all.multipliers);
-  level.trivial = all.multipliers.at(trivial);
-  for (size_t i = 0; i < all.multipliers.size(); ++i)
-    if (i != trivial) {
-      level.others.multipliers.push_back(all.multipliers[i]);
-      level.others.accuracy.push_back(all.accuracy[i]);
-    }
-  return level;
-}
-
-void PeriodStudy::add(int N, const AutonomousOrbit& orbit) {
-  Ns.push_back(N);
-  Ks.push_back(orbit.grid.K);
-  periods.push_back(orbit.period);
-}
-
-void PeriodStudy::extrapolate(const RichardsonOptions& expansion) {
-  if (periods.size() < 2) return;
-  std::vector<double> h;
-  std::vector<std::complex<double>> values;
-  for (size_t i = 0; i < periods.size(); ++i) {
-    h.push_back(1.0 / Ks[i]);
-    values.emplace_back(periods[i]);
-  }
-  extrapolated = richardson_extrapolate(h, values, expansion);
 }
 
 nlohmann::json period_study_json(const PeriodStudy& study) {
@@ -85,37 +28,6 @@ nlohmann::json period_study_json(const PeriodStudy& study) {
     p["note"] = study.extrapolated->note;
   }
   return p;
-}
-
-AutonomousFloquet autonomous_floquet(const Problem& problem, double period_guess, const OrbitSettings& orbit,
-                                     const FloquetOptions& solver, bool with_error_bars) {
-  AutonomousFloquet out;
-  out.at_N = autonomous_level(problem, problem.N, period_guess, orbit, solver);
-  if (!with_error_bars) return out;
-  const auto start = std::chrono::steady_clock::now();
-  // The coarser levels, each from the period found at N (the guess closest to their orbit).
-  // (quartering: error_bars.hpp says why an autonomous orbit's levels are not halved yet)
-  std::vector<int> Ns = coarser_levels(problem.N, [](int N) { return N >= 8; }, 4, LevelSpacing::quartering);
-  std::vector<LevelResult> levels;
-  for (int N : Ns) {
-    LevelResult r;
-    try {
-      AutonomousFloquetLevel level =
-          autonomous_level(problem, N, out.at_N.orbit.period, orbit, solver);
-      out.period.add(N, level.orbit);
-      r = std::move(level.others);
-    } catch (const NumericalFailure& e) {
-      r.failure = e.what();
-    }
-    levels.push_back(std::move(r));
-  }
-  Ns.push_back(problem.N);
-  levels.push_back(out.at_N.others);
-  out.period.add(problem.N, out.at_N.orbit);
-  out.bars = error_bars(Ns, levels, error_expansion(problem));
-  out.period.extrapolate(error_expansion(problem));
-  out.error_bar_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
 }
 
 void add_autonomous_floquet_json(nlohmann::json& j, const AutonomousFloquet& r, double period_guess) {

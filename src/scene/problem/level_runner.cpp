@@ -141,100 +141,15 @@ ExactReference exact_reference(const Problem& problem, int count) {
   return r;
 }
 
-LevelResult level_result(const FloquetResult& result, long n, long K) {
-  LevelResult r;
-  r.multipliers = result.multipliers;
-  r.operator_applications = result.operator_applications;
-  const double radius = result.multipliers.empty() ? 0.0 : std::abs(result.multipliers.front());
-  for (size_t k = 0; k < result.multipliers.size(); ++k)
-    r.accuracy.push_back(multiplier_accuracy(result.multipliers[k],
-                                             k < result.residuals.size() ? result.residuals[k] : NAN, n, K, radius));
-  return r;
-}
-
 RichardsonOptions error_expansion(const Problem& problem) {
   return delayspec::error_expansion(*problem.analyses, step_options(problem));
 }
 
-LevelResult StudyLevels::run(int N, int count, const Eigen::VectorXd* guess, int from_N) {
-  LevelResult r;
-  const auto start = std::chrono::steady_clock::now();
-  bool orbit_found = false;
-  Eigen::VectorXd sequence;
-  Problem level = problem_;
-  level.N = N;
-  const long K = level.grid().K;
-  try {
-    with_monodromy(problem_, events_, orbit_, N,
-                   [&](const LinearOperator& op, const LinearisedOrbit& at_orbit, double) {
-                     sequence = at_orbit.sequence;
-                     orbit_found = true;
-                     FloquetOptions fo = solver_;
-                     fo.nev = static_cast<int>(std::min<long>(count, op.rows()));
-                     r = level_result(floquet_multipliers(op, fo), op.rows(), K);
-                   },
-                   {guess, true});
-    if (sequence.size() > 0) sequences_[N] = std::move(sequence);
-    if (guess) r.note = "orbit by Newton from the orbit of N = " + std::to_string(from_N) + ", after: " + failed_.at(N);
-  } catch (const NumericalFailure& e) {
-    r = {};
-    r.failure = e.what();
-    if (!orbit_found) orbit_failed_.insert(N);
-    failed_[N] = r.failure;
-  }
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (progress_) progress_->add();
-  return r;
-}
-
-ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
-                             const LevelResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds) {
-  const auto start = std::chrono::steady_clock::now();
-  constexpr int kExtra = 2;  // candidates beyond nev for the matching (convergence.hpp)
-  FloquetOptions coarse = solver;
-  coarse.ncv = 0;  // the automatic subspace: a user's ncv may exceed a coarse level's dimension
-  coarse.nev = solver.nev + kExtra;
-  // A valid grid on which the solver's options hold, with more than the candidates (a proper
-  // sub-spectrum).
-  auto valid = [&](int N) {
-    if (!valid_grid(problem, N)) return false;
-    Problem at = problem;
-    at.N = N;
-    const long n = at.dimension();
-    FloquetOptions checked = coarse;
-    checked.nev = static_cast<int>(std::min<long>(coarse.nev, n));
-    try {
-      validate_floquet_options(checked, n);
-    } catch (const BadInput&) {
-      return false;
-    }
-    return n > coarse.nev;
-  };
-  std::vector<int> Ns = coarser_levels(problem.N, valid);
-  StudyLevels levels(problem, problem.events, orbit, coarse);
-  std::vector<LevelResult> results;
-  for (int N : Ns) results.push_back(levels.level(N, coarse.nev));
-  if (orbit_at_N.size() > 0) {
-    levels.keep_orbit(problem.N, std::move(orbit_at_N));
-    for (size_t i = 0; i < Ns.size(); ++i)
-      if (!results[i].failure.empty())
-        if (std::optional<LevelResult> again = levels.retry(Ns[i], coarse.nev, problem.N)) {
-          const std::string first = results[i].failure;
-          results[i] = std::move(*again);
-          if (!results[i].failure.empty()) results[i].failure = first + "; retried: " + results[i].failure;
-        }
-  }
-  Ns.push_back(problem.N);
-  results.push_back(at_N);
-  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  ErrorBars bars = error_bars(Ns, results, error_expansion(problem));
-  // A coarse level that cannot be had is said, not dropped silently (issue 61 item 9).
-  if (Ns.size() < 3)
-    bars.note += (bars.note.empty() ? "" : "; ") + std::to_string(Ns.size() - 1) +
-                 " coarse level(s) of the two wanted: below N = " + std::to_string(problem.N) +
-                 ", a level needs a grid the delays fit and more than nev + 2 = " +
-                 std::to_string(coarse.nev) + " multipliers (its dimension d (N + 1))";
-  return bars;
+ResolutionStudy resolution_study(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
+                                 Progress* progress) {
+  std::function<void()> on_level;
+  if (progress) on_level = [progress] { progress->add(); };
+  return ResolutionStudy(problem.analyses, problem.map_settings(), orbit, solver, std::move(on_level));
 }
 
 }  // namespace delayspec::cli

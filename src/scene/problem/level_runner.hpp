@@ -1,11 +1,10 @@
 #pragma once
 // Shared by the commands that solve at several resolutions (converge, bench, floquet's error
-// bars): the problem at another resolution N, its periodic orbit and monodromy, a level of a
-// study, and the key lists they read (Ns / N_min..N_max).
+// bars, chart): the key lists they read (Ns / N_min..N_max, continue_Ns, ...), the exact
+// references, the problem at another resolution N with its orbit and monodromy (bench), and the
+// problem's resolution study (the engine's, delayspec/resolution_study.hpp).
 #include <chrono>
-#include <map>
 #include <optional>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -14,6 +13,7 @@
 #include "delayspec/error_bars.hpp"
 #include "delayspec/floquet.hpp"
 #include "delayspec/periodic_orbit.hpp"
+#include "delayspec/resolution_study.hpp"
 #include "scene/problem/orbit_settings.hpp"
 #include "scene/problem/problem.hpp"
 #include "scene/output/progress.hpp"
@@ -67,53 +67,13 @@ void with_monodromy(const Problem& problem, EventMode events, const OrbitSetting
   fn(static_cast<const LinearOperator&>(*at_orbit.monodromy), at_orbit, setup);
 }
 
-// A level's multipliers with their accuracy (multiplier_accuracy, convergence.hpp), from one
-// solve of a monodromy of dimension n over K steps.
-LevelResult level_result(const FloquetResult& result, long n, long K);
-
 // The Richardson expansion of the problem's discretisation error (delayspec/error_expansion.hpp,
 // the rule's one home).
 RichardsonOptions error_expansion(const Problem& problem);
 
-// A level of a study: orbit, monodromy, multipliers and their accuracy (convergence.hpp). The
-// orbits of the levels that succeeded are kept (states of one map, a few MB at most) so that a
-// level whose orbit failed can be retried with Newton from its nearest neighbour's.
-class StudyLevels {
- public:
-  StudyLevels(const Problem& problem, EventMode events, const OrbitSettings& orbit, const FloquetOptions& solver,
-              Progress* progress = nullptr)
-      : problem_(problem), events_(events), orbit_(orbit), solver_(solver), progress_(progress) {}
-
-  LevelResult level(int N, int count) { return run(N, count, nullptr); }
-
-  // Only a level whose orbit failed is worth a second try; any other failure stands.
-  std::optional<LevelResult> retry(int N, int count, int from_N) {
-    if (!orbit_failed_.count(N) || !sequences_.count(from_N)) return std::nullopt;
-    return run(N, count, &sequences_.at(from_N), from_N);
-  }
-
-  // A level computed elsewhere (the solve at N itself): its orbit, for the retries of the others.
-  void keep_orbit(int N, Eigen::VectorXd sequence) { sequences_[N] = std::move(sequence); }
-
- private:
-  LevelResult run(int N, int count, const Eigen::VectorXd* guess, int from_N = 0);
-
-  const Problem& problem_;
-  EventMode events_;
-  const OrbitSettings& orbit_;
-  const FloquetOptions& solver_;
-  Progress* progress_;
-  std::map<int, Eigen::VectorXd> sequences_;  // N -> orbit states of one map, levels that succeeded
-  std::set<int> orbit_failed_;                // N whose orbit (not the eigen-solve) failed
-  std::map<int, std::string> failed_;         // N -> why it failed
-};
-
-// floquet's error bars (delayspec/error_bars.hpp) for the multipliers `at_N` of the problem at
-// its N (level_result of its solve): the coarser levels (N/4 and N/2, valid grids on which the solver's options hold), each
-// solved as a study level with nev + 2 candidates (a level whose orbit failed is retried by Newton
-// from `orbit_at_N`, the orbit's states at N, when given), then analysed. `seconds` receives what
-// the coarser levels cost.
-ErrorBars floquet_error_bars(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
-                             const LevelResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds);
+// The problem's resolution study (delayspec/resolution_study.hpp): its model and steps, its N the
+// study's resolution of record. on_level: after every level (a progress counter).
+ResolutionStudy resolution_study(const Problem& problem, const OrbitSettings& orbit, const FloquetOptions& solver,
+                                 Progress* progress = nullptr);
 
 }  // namespace delayspec::cli
