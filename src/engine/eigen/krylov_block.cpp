@@ -93,10 +93,135 @@ Eigenpairs rayleigh_quotient_eigenpairs(Eigen::MatrixXd h) {
   return e;
 }
 
+// The Krylov-Schur factorisation M V(:, 0:p) = V(:, 0:p + b) H(0:p + b, 0:p) of one operator, and
+// what grows it (expand), reads it (rayleigh_ritz, ritz_pairs) and shrinks it (restart): the basis,
+// the projection and the last Rayleigh quotient's eigenpairs are this object's, no caller reaches
+// into them (Spectra's KrylovSchur / ARPACK's reverse communication keep theirs so too).
 class BlockKrylovSchur {
  public:
-  BlockKrylovSchur(long n, int b, int m) : n_(n), b_(b), m_(m), V_(n, m + b), H_(Eigen::MatrixXd::Zero(m + b, m)) {}
+  // The wanted values of the last Rayleigh-Ritz step, largest modulus first (a pair split by nev
+  // counted whole), with their residual estimates.
+  struct RitzStep {
+    std::vector<std::complex<double>> values;
+    std::vector<double> estimates;
+    int converged = 0;  // of them, those whose estimate <= tol max(|theta|, eps^(2/3))
+    bool all_converged() const { return converged == static_cast<int>(values.size()); }
+  };
 
+  // A basis of m + b columns for an operator of dimension n, b vectors per product.
+  BlockKrylovSchur(const LinearOperator& op, int b, int m)
+      : op_(op), n_(op.rows()), b_(b), m_(m), V_(n_, m + b), H_(Eigen::MatrixXd::Zero(m + b, m)) {}
+
+  // The first block: `start` and b - 1 more vectors from the same generator, orthonormalised.
+  void start(const Eigen::VectorXd& start) {
+    Eigen::MatrixXd W(n_, b_), c, R;
+    W.col(0) = start;
+    for (int i = 1; i < b_; ++i) W.col(i) = start_vector(n_, 0xb10cULL + static_cast<std::uint64_t>(i));
+    orthonormalise(0, W, c, R);
+    V_.leftCols(b_) = W;
+    j_ = b_;
+  }
+
+  // Expands while a whole block fits: M V(:, j-b:j) -> a new block, until m columns are multiplied.
+  void expand() {
+    if (b_ == 1) expand_single(j_, m_);
+    Eigen::MatrixXd X, Y, c, R;
+    while (j_ + b_ <= m_ + b_) {
+      X = V_.middleCols(j_ - b_, b_);
+      op_.apply_block(X, Y);
+      orthonormalise(j_, Y, c, R);
+      H_.block(0, j_ - b_, j_, b_) = c;
+      H_.block(j_, j_ - b_, b_, b_) = R;
+      V_.middleCols(j_, b_) = Y;
+      j_ += b_;
+    }
+  }
+
+  // Rayleigh-Ritz on H_p = H(0:p, 0:p): its eigenpairs (kept for ritz_pairs and restart) and the
+  // residual estimates |H(p:p+b, 0:p) y| (|y| = 1) of the nev largest in modulus.
+  RitzStep rayleigh_ritz(int nev, double tolerance) {
+    p_ = j_ - b_;
+    Hp_ = H_.topLeftCorner(p_, p_);
+    coupling_ = H_.block(p_, 0, b_, p_);
+    ritz_ = rayleigh_quotient_eigenpairs(Hp_);
+    const Eigen::VectorXcd& theta = ritz_.values;
+    const Eigen::MatrixXcd& Yc = ritz_.vectors;  // unit columns
+    order_.resize(p_);
+    for (long i = 0; i < p_; ++i) order_[i] = i;
+    std::stable_sort(order_.begin(), order_.end(),
+                     [&](long a, long c2) { return std::abs(theta[a]) > std::abs(theta[c2]); });
+    // A pair split by nev counts whole.
+    int wanted = nev;
+    if (wanted < p_ && theta[order_[wanted - 1]].imag() != 0 &&
+        theta[order_[wanted]] == std::conj(theta[order_[wanted - 1]]))
+      ++wanted;
+    const double eps23 = std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);
+    RitzStep step;
+    for (int i = 0; i < wanted; ++i) {
+      const long col = order_[i];
+      const double est = (coupling_.cast<std::complex<double>>() * Yc.col(col)).norm();
+      step.values.push_back(theta[col]);
+      step.estimates.push_back(est);
+      step.converged += est <= tolerance * std::max(std::abs(theta[col]), eps23);
+    }
+    return step;
+  }
+
+  // The pairs of the last Rayleigh-Ritz step's wanted values, vectors in the basis.
+  RitzPairs ritz_pairs(const RitzStep& step) const {
+    std::vector<std::complex<double>> wanted_theta;
+    std::vector<Eigen::VectorXcd> wanted_y;
+    for (size_t i = 0; i < step.values.size(); ++i) {
+      wanted_theta.push_back(ritz_.values[order_[i]]);
+      wanted_y.push_back(ritz_.vectors.col(order_[i]));
+    }
+    return ritz_pairs_in_basis(wanted_theta, wanted_y, V_.leftCols(p_));
+  }
+
+  // Restart (Krylov-Schur, Stewart 2001) after a Rayleigh-Ritz step: ordered real Schur form of
+  // H_p with the `keep` largest moduli first (dgees selects by modulus; ties, the exact zeros of a
+  // rank-deficient monodromy or round-off-level values of a strongly unstable one, can select more
+  // than fit: then a larger threshold, down to nev values), V(:, 0:k) <- V Z_k, H_k <- T_k, the
+  // coupling row block <- H(p:p+b, 0:p) Z_k; the last block stays the one not yet multiplied.
+  void restart(int nev, int keep) {
+    const long p = p_;
+    const Eigen::VectorXcd& theta = ritz_.values;
+    Eigen::MatrixXd T, Z(p, p);
+    const int ip = static_cast<int>(p);
+    int sdim = 0, info = 0;
+    Eigen::VectorXd wr(p), wi(p);
+    std::vector<int> bwork(p);
+    std::vector<double> work;
+    const auto dgees = detail::lapack().dgees;
+    bool restarted = false;
+    for (int q = keep - 1; q >= nev - 1 && !restarted; --q) {
+      select_threshold = std::abs(theta[order_[q]]) * (1 - 1e-12);
+      if (!(select_threshold > 0)) continue;
+      T = Hp_;
+      int lwork = -1;
+      double query = 0;
+      dgees("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, &query, &lwork,
+            bwork.data(), &info);
+      lwork = static_cast<int>(query);
+      work.assign(static_cast<size_t>(std::max(1, lwork)), 0.0);
+      dgees("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, work.data(), &lwork,
+            bwork.data(), &info);
+      restarted = info == 0 && sdim >= nev && sdim + b_ <= m_;
+    }
+    if (!restarted)
+      throw NumericalFailure("Krylov (block): no restart keeps between nev = " + std::to_string(nev) + " and " +
+                             std::to_string(m_ - b_) + " Ritz values (dgees info " + std::to_string(info) + ", " +
+                             std::to_string(sdim) + " selected); try another solver");
+    rotate_basis(p, Z, sdim);                      // V(:, 0:sdim) <- V Z_k
+    V_.middleCols(sdim, b_) = V_.middleCols(p, b_);  // disjoint: sdim + b <= m = p
+    H_.setZero();
+    H_.topLeftCorner(sdim, sdim) = T.topLeftCorner(sdim, sdim);
+    H_.block(sdim, 0, b_, sdim) = coupling_ * Z.leftCols(sdim);
+    source_norm_ = 1;
+    j_ = sdim + b_;
+  }
+
+ private:
   // Orthonormalises W (n x b) against V(:, 0:j) and within itself: W_in = V(:, 0:j) c + W R.
   void orthonormalise(long j, Eigen::MatrixXd& W, Eigen::MatrixXd& c, Eigen::MatrixXd& R) {
     const Eigen::VectorXd norm_in = W.colwise().norm().transpose();
@@ -175,12 +300,12 @@ class BlockKrylovSchur {
   // Rounding: s = O(eps) |u| after the first projection, so the delayed second one corrects H' by
   // O(eps) and c loses O(eps |s| / r) <= O(eps) |M| as long as r > 1e-12 |M q_prev| (below that the
   // direction is lost and replaced, as in column_qr).
-  void expand_single(const LinearOperator& op, long& j, long m) {
+  void expand_single(long& j, long m) {
     Eigen::VectorXd w(n_), s, t, hs;
     while (j <= m) {
       const long q_cols = j - 1;
       double* u = V_.col(j - 1).data();
-      op.perform_op(u, w.data());
+      op_.perform_op(u, w.data());
       s.resize(q_cols);
       t.resize(q_cols);
       basis_coefficients(V_.data(), n_, q_cols, u, w.data(), s.data(), t.data(), threads_);
@@ -257,9 +382,17 @@ class BlockKrylovSchur {
     }
   }
 
+  const LinearOperator& op_;
   long n_;
   int b_, m_;
   Eigen::MatrixXd V_, H_;
+  long j_ = 0;  // basis columns; the last b not yet multiplied
+  // The last Rayleigh-Ritz step: its size p, H_p, the coupling rows H(p:p+b, 0:p), the eigenpairs
+  // and their order by modulus.
+  long p_ = 0;
+  Eigen::MatrixXd Hp_, coupling_;
+  Eigenpairs ritz_;
+  std::vector<long> order_;
   std::uint64_t seed_ = 0;
   int threads_ = gram_schmidt_threads(n_);
   double source_norm_ = 1;  // |M q| of the vector the current u was projected from (|start| at first)
@@ -275,116 +408,26 @@ RitzPairs block_ritz_pairs(const LinearOperator& op, const Settings& s, const Ei
   const int b = static_cast<int>(std::max<long>(1, std::min<long>(s.block_size, (n - nev) / 3)));
   const int m = static_cast<int>(std::min<long>(std::max(s.ncv, nev + 2 * b + 2), n - b));
   const int keep = std::max(nev, std::min((nev + m) / 2, m - b - 1));
-  BlockKrylovSchur k(n, b, m);
-  Eigen::MatrixXd& V = k.V_;
-  Eigen::MatrixXd& H = k.H_;
-
-  // Start block: the common start vector and b - 1 more from the same generator.
-  Eigen::MatrixXd W(n, b), c, R, X, Y;
-  W.col(0) = start;
-  for (int i = 1; i < b; ++i) W.col(i) = start_vector(n, 0xb10cULL + static_cast<std::uint64_t>(i));
-  k.orthonormalise(0, W, c, R);
-  V.leftCols(b) = W;
-  long j = b;  // basis columns; the last b not yet multiplied
-
-  RitzPairs pairs;
-  const double eps23 = std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);
+  BlockKrylovSchur krylov(op, b, m);
+  krylov.start(start);
   for (int iteration = 1;; ++iteration) {
-    // Expand while a whole block fits: M V(:, j-b:j) -> new block.
-    if (b == 1) k.expand_single(op, j, m);
-    while (j + b <= m + b) {
-      X = V.middleCols(j - b, b);
-      op.apply_block(X, Y);
-      k.orthonormalise(j, Y, c, R);
-      H.block(0, j - b, j, b) = c;
-      H.block(j, j - b, b, b) = R;
-      V.middleCols(j, b) = Y;
-      j += b;
-    }
-    const long p = j - b;  // Rayleigh quotient size
-    const Eigen::MatrixXd Hp = H.topLeftCorner(p, p);
-    const Eigen::MatrixXd coupling = H.block(p, 0, b, p);
-    const Eigenpairs es = rayleigh_quotient_eigenpairs(Hp);
-    const Eigen::VectorXcd& theta = es.values;
-    const Eigen::MatrixXcd& Yc = es.vectors;  // unit columns
-    std::vector<long> order(p);
-    for (long i = 0; i < p; ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](long a, long c2) { return std::abs(theta[a]) > std::abs(theta[c2]); });
-    // A pair split by nev counts whole.
-    int wanted = nev;
-    if (wanted < p && theta[order[wanted - 1]].imag() != 0 &&
-        theta[order[wanted]] == std::conj(theta[order[wanted - 1]]))
-      ++wanted;
-    std::vector<std::complex<double>> values;
-    std::vector<double> estimates;
-    int converged = 0;
-    bool all = true;
-    for (int i = 0; i < wanted; ++i) {
-      const long col = order[i];
-      const double est = (coupling.cast<std::complex<double>>() * Yc.col(col)).norm();
-      values.push_back(theta[col]);
-      estimates.push_back(est);
-      const bool ok = est <= s.tolerance * std::max(std::abs(theta[col]), eps23);
-      converged += ok;
-      all = all && ok;
-    }
-    if (all) {
-      std::vector<std::complex<double>> wanted_theta;
-      std::vector<Eigen::VectorXcd> wanted_y;
-      for (int i = 0; i < wanted; ++i) {
-        wanted_theta.push_back(theta[order[i]]);
-        wanted_y.push_back(Yc.col(order[i]));
-      }
-      pairs = ritz_pairs_in_basis(wanted_theta, wanted_y, V.leftCols(p));
-      pairs.converged = converged;
+    krylov.expand();
+    const BlockKrylovSchur::RitzStep step = krylov.rayleigh_ritz(nev, s.tolerance);
+    if (step.all_converged()) {
+      RitzPairs pairs = krylov.ritz_pairs(step);
+      pairs.converged = step.converged;
       pairs.iterations = iteration;
       return pairs;
     }
     if (iteration >= s.max_iterations)
       throw NumericalFailure(
-          "Krylov (block) did not converge: " + std::to_string(converged) + " of nev = " + std::to_string(nev) +
+          "Krylov (block) did not converge: " + std::to_string(step.converged) + " of nev = " + std::to_string(nev) +
           " Ritz values converged after " + std::to_string(iteration) +
           " iterations (max_iterations = " + std::to_string(s.max_iterations) + " = 1 + max_restarts, basis " +
           std::to_string(m) + ", block " + std::to_string(b) + "), largest relative residual estimate " +
-          format_number(largest_relative_estimate(values, estimates, nev)) + " > tol " + format_number(s.tolerance, 3));
-
-    // Restart: ordered real Schur form, the `keep` largest moduli first. dgees selects by modulus;
-    // ties (exact zeros of a rank-deficient monodromy, round-off-level values of a strongly
-    // unstable one) can select more than fit: then a larger threshold, down to nev values.
-    Eigen::MatrixXd T, Z(p, p);
-    const int ip = static_cast<int>(p);
-    int sdim = 0, info = 0;
-    Eigen::VectorXd wr(p), wi(p);
-    std::vector<int> bwork(p);
-    std::vector<double> work;
-    const auto dgees = detail::lapack().dgees;
-    bool restarted = false;
-    for (int q = keep - 1; q >= nev - 1 && !restarted; --q) {
-      select_threshold = std::abs(theta[order[q]]) * (1 - 1e-12);
-      if (!(select_threshold > 0)) continue;
-      T = Hp;
-      int lwork = -1;
-      double query = 0;
-      dgees("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, &query, &lwork,
-            bwork.data(), &info);
-      lwork = static_cast<int>(query);
-      work.assign(static_cast<size_t>(std::max(1, lwork)), 0.0);
-      dgees("V", "S", select_large, &ip, T.data(), &ip, &sdim, wr.data(), wi.data(), Z.data(), &ip, work.data(), &lwork,
-            bwork.data(), &info);
-      restarted = info == 0 && sdim >= nev && sdim + b <= m;
-    }
-    if (!restarted)
-      throw NumericalFailure("Krylov (block): no restart keeps between nev = " + std::to_string(nev) + " and " +
-                             std::to_string(m - b) + " Ritz values (dgees info " + std::to_string(info) + ", " +
-                             std::to_string(sdim) + " selected); try another solver");
-    k.rotate_basis(p, Z, sdim);                  // V(:, 0:sdim) <- V Z_k
-    V.middleCols(sdim, b) = V.middleCols(p, b);  // disjoint: sdim + b <= m = p
-    H.setZero();
-    H.topLeftCorner(sdim, sdim) = T.topLeftCorner(sdim, sdim);
-    H.block(sdim, 0, b, sdim) = coupling * Z.leftCols(sdim);
-    k.source_norm_ = 1;
-    j = sdim + b;
+          format_number(largest_relative_estimate(step.values, step.estimates, nev)) + " > tol " +
+          format_number(s.tolerance, 3));
+    krylov.restart(nev, keep);
   }
 }
 
