@@ -116,8 +116,7 @@ double multiplier_accuracy(std::complex<double> mu, double relative_residual, lo
 inline bool multiplier_resolved(std::complex<double> mu, double accuracy) { return std::abs(mu) > accuracy; }
 
 enum class ReferenceKind { exact, extrapolated, finest, automatic };
-// "exact", "extrapolated", "finest", "auto"; BadInput otherwise.
-ReferenceKind parse_reference_kind(const std::string& name);
+// "exact", "extrapolated", "finest", "auto".
 std::string to_string(ReferenceKind kind);
 
 struct ConvergenceOptions {

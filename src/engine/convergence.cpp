@@ -191,14 +191,6 @@ std::vector<int> hungarian(const std::vector<std::vector<double>>& cost, int n, 
 
 }  // namespace
 
-ReferenceKind parse_reference_kind(const std::string& name) {
-  if (name == "exact") return ReferenceKind::exact;
-  if (name == "extrapolated") return ReferenceKind::extrapolated;
-  if (name == "finest") return ReferenceKind::finest;
-  if (name == "auto") return ReferenceKind::automatic;
-  throw BadInput("`reference = " + name + "`: must be one of exact, extrapolated, finest, auto");
-}
-
 std::string to_string(ReferenceKind kind) {
   switch (kind) {
     case ReferenceKind::exact: return "exact";

@@ -388,6 +388,32 @@ TEST(OutputDirectory, ResumeSkipsALineCutShortByAKill) {
   fs::remove_all(dir);
 }
 
+// A chart point's record is untrusted input like any results file: a verdict word that is no
+// verdict (edited by hand, or written by another program) is not taken into the table; the point
+// is computed again and the table is the uninterrupted run's.
+TEST(OutputDirectory, ResumeComputesAgainAChartPointWhoseVerdictIsNoVerdict) {
+  const std::vector<std::string> args = {"chart", "--quiet", "--set", "model=mathieu", "--set", "N=10", "--set",
+                                         "solver=dense", "--set", "chart_x_points=3", "--set", "chart_y_points=2"};
+  const fs::path dir = fresh_dir("outdir_bad_verdict");
+  ASSERT_EQ(run(with(args, {"--out", dir.string()})).status, 0);
+  const std::string complete = without_metadata(read_text(dir / "chart.csv"));
+  fs::remove(dir / "complete.json");
+  fs::remove(dir / "chart.csv");
+  const std::vector<fs::path> logs = point_logs(dir / "chart_points");
+  ASSERT_EQ(logs.size(), 1u);
+  std::string log = read_text(logs[0]);
+  const std::string word = "\"verdict\":\"undecided\"";
+  const size_t at = log.find(word);
+  ASSERT_NE(at, std::string::npos) << log;
+  log.replace(at, word.size(), "\"verdict\":\"bogus\"");
+  std::ofstream(logs[0], std::ios::trunc) << log;
+  const CliResult resumed = run(with(args, {"--out", dir.string(), "--resume", "--json"}));
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_FALSE(contains(resumed.out, "bogus")) << resumed.out;
+  EXPECT_EQ(without_metadata(read_text(dir / "chart.csv")), complete);
+  fs::remove_all(dir);
+}
+
 // The settings --resume compares are the effective ones: a scene or --set stating keys at their
 // default values (in any spelling of the number) resumes a sweep made without them.
 TEST(OutputDirectory, ResumeAcceptsExplicitDefaults) {

@@ -36,7 +36,7 @@ struct EquilibriaBoundaryRun {
 EquilibriaBoundaryRun read_run(Config& config) {
   EquilibriaBoundaryRun run;
   run.settings = read_boundary_settings(config);
-  run.folds = config.get_choice("boundary_type", "hopf", {"hopf", "fold"}) == "fold";
+  run.folds = config.get_enum("boundary_type", false, {{"hopf", false}, {"fold", true}});
   const BoundaryOptions& o = run.settings.options;
   run.problem = read_problem(config, 100, ModelNeed::autonomous);
   run.eq = read_equilibrium_settings(config, run.problem);

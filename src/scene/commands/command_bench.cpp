@@ -117,8 +117,7 @@ BenchSettings read_bench_settings(Config& config) {
       read_word_list(config, "solvers", "spectra,arpack,dense-lapack",
                      {"spectra", "arpack", "block", "dense", "dense-lapack", "dense-eigen", "sdm0", "fdm1"});
   s.base = read_floquet_options(config, 10);
-  s.reference_kind =
-      parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
+  s.reference_kind = read_reference_kind(config);
   s.repeats = config.get_int_in_range("repeats", s.repeats, 1, 1000);
   s.classic_max_N = config.get_int_in_range("classic_max_N", s.classic_max_N, 2, 1'000'000);
   s.limit_mb = config.get_double("dense_memory_limit_mb", 2048);

@@ -65,7 +65,7 @@ BoundaryRun read_boundary_run(Config& config) {
                             BifurcationType::grazing})
     if (type == to_string(t)) run.type = t;
   run.Ns = read_levels(config, "boundary_Ns");
-  const bool refine = config.get_choice("boundary_refine", "on", {"on", "off"}) == "on";
+  const bool refine = config.get_switch("boundary_refine", true);
   run.threads = read_threads(config);
   run.orbit_settings = read_orbit_settings(config);
   run.floquet = read_floquet_options(config);

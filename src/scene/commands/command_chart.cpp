@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -63,7 +64,7 @@ ChartSettings read_chart_settings(Config& config) {
   read_floquet_options(config, 1);
   // Each point's |mu_1| with its error bar and verdict (floquet's rule: error_bars.hpp), as floquet
   // gives them: a chart says which cells it cannot vouch for (undecided, drawn so).
-  s.with_error_bars = config.get_choice("error_bars", "on", {"on", "off"}) == "on";
+  s.with_error_bars = config.get_switch("error_bars", true);
   require_model_parameter(config, "chart_x", s.x.name, s.problem.model_name);
   require_model_parameter(config, "chart_y", s.y.name, s.problem.model_name);
   config.check_all_used();
@@ -78,13 +79,20 @@ struct ChartPoints {
         angle(static_cast<size_t>(count), NAN),
         failure(static_cast<size_t>(count)),
         bar(static_cast<size_t>(count), NAN),
-        verdict(static_cast<size_t>(count)) {}
+        verdict(static_cast<size_t>(count), StabilityVerdict::undecided) {}
   std::vector<double> radius;
   std::vector<double> angle;  // |arg mu_1|
   std::vector<std::string> failure;
   std::vector<double> bar;  // error_estimate of |mu_1| (inf: none)
-  std::vector<std::string> verdict;
+  std::vector<StabilityVerdict> verdict;  // with error bars (error_bars.hpp)
 };
+
+// The verdict a record's word names; none for any other word (a record is untrusted input).
+std::optional<StabilityVerdict> verdict_named(const std::string& word) {
+  for (StabilityVerdict v : {StabilityVerdict::stable, StabilityVerdict::unstable, StabilityVerdict::undecided})
+    if (to_string(v) == word) return v;
+  return std::nullopt;
+}
 
 // A point's record: its row of the result, its line in --out DIR's log (point_files.hpp), and its
 // message to the lead under mpirun (distributed_points.hpp).
@@ -95,7 +103,7 @@ nlohmann::json chart_record(const ChartSettings& s, const ChartPoints& pts, long
   else row["failure"] = pts.failure[i];
   if (s.with_error_bars && pts.failure[i].empty()) {
     row["error_estimate"] = number_or_null(pts.bar[i]);
-    row["verdict"] = pts.verdict[i];
+    row["verdict"] = to_string(pts.verdict[i]);
   }
   return row;
 }
@@ -110,8 +118,12 @@ bool take_chart_record(const ChartSettings& s, ChartPoints& pts, long i, const n
     pts.angle[i] = row["angle"].is_number() ? row["angle"].get<double>() : NAN;
   }
   if (s.with_error_bars && !row.contains("failure")) {
-    if (!row.contains("verdict")) return false;  // a record of a run without error bars: recompute
-    pts.verdict[i] = row.at("verdict").get<std::string>();
+    // a record of a run without error bars, or a word that is no verdict: recompute
+    const std::optional<StabilityVerdict> verdict =
+        row.contains("verdict") && row.at("verdict").is_string() ? verdict_named(row["verdict"].get<std::string>())
+                                                                 : std::nullopt;
+    if (!verdict) return false;
+    pts.verdict[i] = *verdict;
     pts.bar[i] = row.at("error_estimate").is_number() ? row["error_estimate"].get<double>() : INFINITY;
   }
   return true;
@@ -132,7 +144,7 @@ void compute_chart_point(const Config& config, const ChartSettings& s, ChartPoin
     pts.radius[i] = std::abs(at.result.multipliers.at(0));
     pts.angle[i] = std::abs(std::arg(at.result.multipliers.at(0)));
     if (at.bars) {
-      pts.verdict[i] = to_string(at.bars->verdict);
+      pts.verdict[i] = at.bars->verdict;
       pts.bar[i] = at.bars->bars.at(0).error_estimate;
     }
   } catch (const NumericalFailure& e) {
@@ -155,7 +167,7 @@ ChartTally tally_chart(const ChartSettings& s, const ChartPoints& pts) {
     row.erase("index");
     if (!pts.failure[i].empty()) ++t.failed;
     else if (!s.with_error_bars) t.stable += pts.radius[i] < 1;
-    else t.stable += pts.verdict[i] == "stable", t.undecided += pts.verdict[i] == "undecided";
+    else t.stable += pts.verdict[i] == StabilityVerdict::stable, t.undecided += pts.verdict[i] == StabilityVerdict::undecided;
     t.rows.push_back(row);
   }
   return t;
@@ -178,7 +190,7 @@ void write_chart_csv(const Invocation& inv, const Config& config, const ChartSet
     // undecided: 1 where the circle is within the bar, 0 where a verdict was reached (nan: failed)
     if (s.with_error_bars)
       csv.stream() << "," << (ok && std::isfinite(pts.bar[i]) ? pts.bar[i] : NAN) << ","  // nan: no bar
-                   << (ok ? (pts.verdict[i] == "undecided" ? "1" : "0") : "nan");
+                   << (ok ? (pts.verdict[i] == StabilityVerdict::undecided ? "1" : "0") : "nan");
     csv.stream() << "," << (ok ? pts.angle[i] : NAN) << "\n";
   }
   csv.commit();

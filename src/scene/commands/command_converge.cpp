@@ -281,8 +281,7 @@ ConvergeSettings read_converge_settings(Config& config) {
   s.solver_options = read_floquet_options(config, 2);  // nev, solver, ncv, tol, ...
   base.nev = s.solver_options.nev;
   base.extra = std::max(2, base.nev / 2);
-  base.reference =
-      parse_reference_kind(config.get_choice("reference", "auto", {"exact", "extrapolated", "finest", "auto"}));
+  base.reference = read_reference_kind(config);
   s.order_given = config.has("extrapolation_order");
   s.step_given = config.has("extrapolation_order_step");
   s.x_order = config.get_double("extrapolation_order", 2);

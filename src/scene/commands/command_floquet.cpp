@@ -49,7 +49,7 @@ int command_floquet(Config& config, const Invocation& inv) {
   const OrbitSettings orbit_settings = read_orbit_settings(config);
   const FloquetOptions options = read_floquet_options(config);
   // The error bars (error_bars.hpp): two coarser solves, about 1.3x the single one.
-  const bool with_error_bars = config.get_choice("error_bars", "on", {"on", "off"}) == "on";
+  const bool with_error_bars = config.get_switch("error_bars", true);
   // An autonomous model's orbit of unknown period (autonomous_floquet.hpp)
   const std::optional<double> period_guess = read_period_guess(config, problem);
   config.check_all_used();

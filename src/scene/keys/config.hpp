@@ -15,6 +15,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <toml++/toml.h>
@@ -56,6 +57,25 @@ class Config {
   std::string get_string(const std::string& key, const std::string& fallback);
   // A value that must be one of `allowed`.
   std::string get_choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed);
+  // A value that names one of `choices` (the key's words, in the order messages and --help list
+  // them), as the enum it stands for; the fallback's word is the default. BadInput as get_choice.
+  template <class E>
+  E get_enum(const std::string& key, E fallback, const std::vector<std::pair<std::string, E>>& choices) {
+    std::string fallback_word;
+    std::vector<std::string> words;
+    for (const auto& [word, value] : choices) {
+      words.push_back(word);
+      if (value == fallback && fallback_word.empty()) fallback_word = word;
+    }
+    const std::string word = get_choice(key, fallback_word, words);
+    for (const auto& [w, value] : choices)
+      if (w == word) return value;
+    return fallback;  // (not reached: get_choice accepted one of the words)
+  }
+  // An on/off key (error_bars, ...): true for "on".
+  bool get_switch(const std::string& key, bool fallback) {
+    return get_enum<bool>(key, fallback, {{"on", true}, {"off", false}});
+  }
   std::vector<long> get_int_list(const std::string& key, const std::vector<long>& fallback);
   // A list of finite numbers ("1, 2.5" or a TOML array); empty when the key is absent
   // (fallback_text: what is used then, for --help).

@@ -22,7 +22,7 @@ BoundarySettings read_boundary_settings(Config& config) {
   o.y_to = config.require_double("boundary_y_to");
   if (o.x_from == o.x_to) throw BadInput("`boundary_x_from = boundary_x_to = " + format_number(o.x_from) + "`: an empty range");
   if (o.y_from == o.y_to) throw BadInput("`boundary_y_from = boundary_y_to = " + format_number(o.y_from) + "`: an empty range");
-  const bool scan = config.get_choice("boundary_starts", "first", {"first", "scan"}) == "scan";
+  const bool scan = config.get_enum("boundary_starts", false, {{"first", false}, {"scan", true}});
   const int scan_points = static_cast<int>(config.get_int_in_range("boundary_scan_points", 20, 2, 100000));
   if (scan) s.scan_points = scan_points;
   o.step = config.get_double("boundary_step", 0.02);

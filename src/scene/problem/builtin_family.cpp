@@ -171,7 +171,7 @@ std::shared_ptr<const BuiltinFamily> read_milling_family(Config& c) {
   p.omega_n = c.get_double("omega_n", p.omega_n);
   p.zeta = c.get_double("zeta", p.zeta);
   p.mass = c.get_double("mass", p.mass);
-  p.direction = c.get_choice("milling", "down", {"down", "up"}) == "up" ? MillingDirection::up : MillingDirection::down;
+  p.direction = c.get_enum("milling", MillingDirection::down, {{"down", MillingDirection::down}, {"up", MillingDirection::up}});
   p.x0 = c.get_double("x0", p.x0);
   p.v0 = c.get_double("v0", p.v0);
   if (!p.pitch_angles.empty()) {

@@ -50,7 +50,7 @@ ContinueSettings read_continue_settings(Config& config) {
   // grazing, where the corrector may fail on one side, it stops), and the bracket it reaches is
   // carried into the bar (extrapolate_bifurcations). A tolerance the user gives is kept as given.
   if (o.tolerance == 0 && s.Ns.size() >= 2) o.refine_tolerance = 1e-13 * range;
-  s.switch_period_doubling = config.get_choice("continue_switch", "false", {"false", "true"}) == "true";
+  s.switch_period_doubling = config.get_enum("continue_switch", false, {{"false", false}, {"true", true}});
   const std::string solver = config.get_choice("continue_solver", "auto", {"auto", "krylov", "lu"});
   o.solver = solver == "krylov" ? ContinuationSolver::krylov
              : solver == "lu"   ? ContinuationSolver::lu

@@ -73,6 +73,13 @@ std::vector<int> read_N_list(Config& config, const Problem& problem, int default
   return Ns;
 }
 
+ReferenceKind read_reference_kind(Config& config) {
+  std::vector<std::pair<std::string, ReferenceKind>> kinds;
+  for (ReferenceKind k : {ReferenceKind::exact, ReferenceKind::extrapolated, ReferenceKind::finest, ReferenceKind::automatic})
+    kinds.emplace_back(to_string(k), k);
+  return config.get_enum("reference", ReferenceKind::automatic, kinds);
+}
+
 std::vector<int> read_levels(Config& config, const std::string& key) {
   std::vector<int> Ns;
   if (!config.has(key)) return Ns;

@@ -32,6 +32,9 @@ void use_first_level_as_N(Config& config);
 // problem (make_grid names N when the delay/period ratio needs a multiple).
 std::vector<int> read_N_list(Config& config, const Problem& problem, int default_min, int default_max);
 
+// The key `reference` (exact, extrapolated, finest, auto): what converge and bench score against.
+ReferenceKind read_reference_kind(Config& config);
+
 // An increasing list of levels N for error bars (continue_Ns, boundary_Ns): each N in 1 .. 1e7,
 // strictly increasing (BadInput naming the key); empty when the key is not given.
 std::vector<int> read_levels(Config& config, const std::string& key);

@@ -4,10 +4,10 @@ namespace delayspec::cli {
 
 OrbitSettings read_orbit_settings(Config& config) {
   OrbitSettings s;
-  const std::string method =
-      config.get_choice("orbit", to_string(s.method), {"auto", "shooting", "simulate", "newton"});
+  std::vector<std::pair<std::string, OrbitMethod>> methods;
   for (OrbitMethod m : {OrbitMethod::automatic, OrbitMethod::shooting, OrbitMethod::simulate, OrbitMethod::newton})
-    if (to_string(m) == method) s.method = m;
+    methods.emplace_back(to_string(m), m);
+  s.method = config.get_enum("orbit", s.method, methods);
   s.simulation.tolerance = config.get_double("orbit_tolerance", s.simulation.tolerance);
   require_positive("orbit_tolerance", s.simulation.tolerance);
   s.newton.tolerance = s.simulation.tolerance;

@@ -129,13 +129,12 @@ Problem read_problem(Config& config, int default_N, ModelNeed need) {
     throw BadInput("`orbit_period = " + std::to_string(problem.orbit_period) +
                    "`: only for forced models (impact, mathieu, milling); for linear and mackey-glass set `period`");
   problem.events = parse_event_mode(config.get_choice("events", "on", event_mode_names()));
-  problem.jacobian = config.get_choice("jacobian", "consistent", {"consistent", "frozen"}) == "frozen"
-                         ? JacobianMode::frozen
-                         : JacobianMode::consistent;
+  problem.jacobian = config.get_enum("jacobian", JacobianMode::consistent,
+                                     {{"consistent", JacobianMode::consistent}, {"frozen", JacobianMode::frozen}});
   problem.contact_substeps =
       static_cast<int>(config.get_int_in_range("contact_substeps", problem.contact_substeps, 1, 1000));
-  const bool uniform = config.get_choice("grid", "aligned", {"aligned", "uniform"}) == "uniform";
-  problem.grid_layout = uniform ? GridLayout::uniform : GridLayout::aligned;
+  problem.grid_layout =
+      config.get_enum("grid", GridLayout::aligned, {{"aligned", GridLayout::aligned}, {"uniform", GridLayout::uniform}});
   // BadInput now when N does not fit the delay/period ratio, or when two histories (the state and
   // the vector a step map is applied to: the least any analysis holds) exceed the memory
   // (memory_budget.hpp; each analysis bounds its own larger arrays before allocating them).
