@@ -328,6 +328,28 @@ TEST_F(ModelCache, TheCompilerDiesWithTheProgramAndWithinItsTimeLimit) {
     EXPECT_FALSE(contains(e.path().filename().string(), ".so")) << e.path();
 }
 
+// SIGKILL, which delayspec cannot catch (issue 61 item 4: `kill -9` during a compile left cc1plus
+// running to completion): the compiler's whole group still dies with it, the driver's children too.
+TEST_F(ModelCache, TheCompilerDiesWithTheProgramKilledBySigkill) {
+  const fs::path started = dir_ / "started";
+  const fs::path slow =
+      script(dir_ / "slow-cc", "touch " + started.string() + "\n(sleep 3; touch " + marker_.string() + ") &\nwait\n");
+  const fs::path scene = dir_ / "scene.toml";
+  write(scene, std::string("model = \"equations\"\n") + kEquations);
+  const std::vector<std::string> args = {"floquet", scene.string(), "--set", "model_cache=" + (dir_ / "cache").string(),
+                                         "--set", "N=20"};
+  const pid_t pid = start_program(args, {"DELAYSPEC_CXX=" + slow.string()}, dir_ / "err");
+  for (int i = 0; i < 600 && !fs::exists(started); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(fs::exists(started)) << "the compiler did not start within 30 s: " << read_text(dir_ / "err");
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // its child is running
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+  std::this_thread::sleep_for(std::chrono::milliseconds(3500));
+  EXPECT_FALSE(fs::exists(marker_)) << "the compiler's child outlived delayspec killed by SIGKILL";
+}
+
 TEST_F(ModelCache, AStaleTemporaryIsRemovedUnderTheLock) {
   const fs::path scene = dir_ / "scene.toml";
   write(scene, std::string("model = \"equations\"\n") + kEquations);

@@ -1,7 +1,8 @@
 #include "scene/equations/child_process.hpp"
 
+#include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -72,6 +73,34 @@ std::atomic<pid_t>* register_group(pid_t group) {
   return nullptr;
 }
 
+// The child's life after fork, never returning; async-signal-safe calls only (the parent may have
+// other threads). It starts the program as its own child, in its group, and waits for whichever
+// comes first: the program's end (its exit status, or its signal, passed on as this process's) or
+// the end of `alive`, the pipe whose write end only delayspec holds: delayspec is gone, however it
+// died (SIGKILL included, which it cannot catch), and the whole group goes with it (cc1plus, as
+// and ld are the driver's children: PR_SET_PDEATHSIG on the driver alone left them running).
+[[noreturn]] void supervise(char* const* args, int alive) {
+  const pid_t program = ::fork();
+  if (program < 0) ::_exit(127);
+  if (program == 0) {
+    ::execve(args[0], args, environ);
+    ::_exit(127);
+  }
+  for (;;) {
+    int status = 0;
+    if (::waitpid(program, &status, WNOHANG) == program) {
+      if (WIFEXITED(status)) ::_exit(WEXITSTATUS(status));
+      struct sigaction defaults {};
+      defaults.sa_handler = SIG_DFL;
+      ::sigaction(WTERMSIG(status), &defaults, nullptr);
+      ::kill(::getpid(), WTERMSIG(status));
+      ::_exit(128 + WTERMSIG(status));
+    }
+    pollfd end{alive, POLLIN, 0};
+    if (::poll(&end, 1, 10) > 0) ::kill(0, SIGKILL);  // EOF (or an error): delayspec is gone
+  }
+}
+
 }  // namespace
 
 ChildOutcome run_child(const std::vector<std::string>& argv, int output_fd, double time_limit_seconds) {
@@ -79,27 +108,40 @@ ChildOutcome run_child(const std::vector<std::string>& argv, int output_fd, doub
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   const pid_t parent = ::getpid();
+  // alive: read by the child's supervisor, written by nobody; it ends when this process does.
+  int alive[2];
+  if (::pipe2(alive, O_CLOEXEC) != 0) return {};
   install_handlers();
   // Between fork and exec the child calls async-signal-safe functions only (this process may
   // have other threads).
   const pid_t pid = ::fork();
   if (pid == 0) {
     ::setpgid(0, 0);
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (::getppid() != parent) ::_exit(127);  // the parent died before prctl
+    ::close(alive[1]);
+    if (::getppid() != parent) ::_exit(127);  // the parent died before the child could watch it
     // Our handler is not the child's (exec resets it anyway; this closes the window before exec);
     // an ignored signal stays ignored, as exec keeps it.
     struct sigaction defaults {};
     defaults.sa_handler = SIG_DFL;
     for (size_t k = 0; k < kStopSignals.size(); ++k)
       if (previous[k].sa_handler != SIG_IGN) ::sigaction(kStopSignals[k], &defaults, nullptr);
+    const int watch = ::fcntl(alive[0], F_DUPFD_CLOEXEC, 3);  // above 0..2, whichever of them was closed
+    if (watch < 0) ::_exit(127);
     ::dup2(output_fd, STDOUT_FILENO);
     ::dup2(output_fd, STDERR_FILENO);
-    ::execve(args[0], args.data(), environ);
-    ::_exit(127);
+    // Only `alive` stays open beyond them (as descriptor 3): a write end of another child's pipe,
+    // inherited from a fork of another thread, would keep that child's supervisor from its end.
+    if (watch != 3) {
+      ::dup2(watch, 3);
+      ::fcntl(3, F_SETFD, FD_CLOEXEC);
+    }
+    ::close_range(4, ~0U, 0);
+    supervise(args.data(), 3);
   }
+  ::close(alive[0]);
   ChildOutcome outcome;
   if (pid < 0) {
+    ::close(alive[1]);
     restore_handlers();
     return outcome;
   }
@@ -124,6 +166,7 @@ ChildOutcome run_child(const std::vector<std::string>& argv, int output_fd, doub
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  ::close(alive[1]);
   if (slot) slot->store(0);
   restore_handlers();
   if (outcome.end == ChildOutcome::End::timed_out) return outcome;

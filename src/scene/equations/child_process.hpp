@@ -7,7 +7,9 @@
 //   kills the group, then re-raises the signal with the handler that was there before, so the
 //   program still dies of it and Python still sees its KeyboardInterrupt);
 // - when the time limit passes;
-// - and the driver, when delayspec dies of SIGKILL (PR_SET_PDEATHSIG), which nothing can catch.
+// - and when delayspec dies of anything else, SIGKILL included, which nothing can catch: the child
+//   is a small supervisor that runs the program in the group and kills the group when the pipe
+//   only delayspec writes to ends (child_process.cpp, supervise).
 #include <string>
 #include <vector>
 
