@@ -131,7 +131,10 @@ void equilibrium_state(const std::function<ConstantHistory(const Eigen::VectorXd
   r.state = y;
 }
 
-CharacteristicRoot refined_root(const ConstantHistory& h, std::complex<double> l, const EquilibriumOptions& o) {
+namespace {
+
+// Newton on c from l (refined_root's iteration).
+CharacteristicRoot newton_on_c(const ConstantHistory& h, std::complex<double> l, const EquilibriumOptions& o) {
   CharacteristicRoot root;
   root.discretised = l;
   for (root.iterations = 1;; ++root.iterations) {
@@ -148,6 +151,28 @@ CharacteristicRoot refined_root(const ConstantHistory& h, std::complex<double> l
   root.residual = h.residual(l);
   root.error_bound = std::max(root.last_step, 4 * std::numeric_limits<double>::epsilon() * (1 + std::abs(l)));
   return root;
+}
+
+}  // namespace
+
+CharacteristicRoot refined_root(const ConstantHistory& h, std::complex<double> l, const EquilibriumOptions& o) {
+  try {
+    return newton_on_c(h, l, o);
+  } catch (const NumericalFailure&) {
+    // c has real coefficients, so Newton from a real start never leaves the real axis. Near a
+    // double real root the discretisation may give two real roots where the exact ones are a
+    // complex pair of small imaginary part (x' = 1.5 x - 1.648722 x(t - 1): 0.5000003 +- 9.4e-4 i,
+    // the N = 100 roots real); Newton then wanders on the axis. Once more from just above it (the
+    // conjugate comes with the root, refine_multipliers); the first failure stands otherwise.
+    if (l.imag() != 0) throw;
+    try {
+      CharacteristicRoot root = newton_on_c(h, {l.real(), 1e-3 * (1 + std::abs(l))}, o);
+      root.discretised = l;
+      return root;
+    } catch (const NumericalFailure&) {
+    }
+    throw;
+  }
 }
 
 namespace {

@@ -369,6 +369,26 @@ TEST(Equilibrium, AnExactlySingularDeltaIsAConvergedRoot) {
   }));
 }
 
+// Near a double real root the N = 100 discretisation gives two real roots where the exact ones are
+// a complex pair: x' = 1.5 x - 1.648722 x(t - 1) (the double root 1/2 at b = -e^{1/2} =
+// -1.64872127...), exact pair 0.50000029489509261 +- 0.00094057707055736 i (mpmath, 40 digits).
+// Newton from the real start stayed on the axis: "did not converge", exit 3. Now the pair, to its
+// bound (the bound's floor is rounding: the root is ill-conditioned only at the double root itself).
+TEST(Equilibrium, AComplexPairTheDiscretisationSplitIntoTwoRealRootsIsFound) {
+  const LinearModel model({.a = 1.5, .b = -1.648722, .tau = 1, .period = 1});
+  EquilibriumOptions o;
+  o.nroots = 2;
+  const EquilibriumResult r = find_equilibrium(model, Vec<1>(0.0), o);
+  ASSERT_EQ(r.roots.size(), 2u);
+  const cd exact(0.50000029489509261, 0.00094057707055736);
+  for (const CharacteristicRoot& root : r.roots) {
+    const cd e = root.value.imag() > 0 ? exact : std::conj(exact);
+    EXPECT_LE(std::abs(root.value - e), std::max(root.error_bound, 1e-15)) << root.value;
+    EXPECT_LE(std::abs(root.value - e), 1e-12) << root.value;
+  }
+  EXPECT_EQ(r.unstable, 2);
+}
+
 // Issue 61's reproducers: from the default steps (range / 50, growing to range / 10), each Hopf
 // point of the closed form is found once, as a Hopf point, and nothing else. Before: kappa = 0.1
 // ended in "did not converge (last step -nan)"; kappa = 0.3 printed a branch point at P = -0.1279
