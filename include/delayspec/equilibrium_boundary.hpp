@@ -117,15 +117,38 @@ HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& 
 // the y range is corrected onto the edge (the crossed coordinate fixed) and ends the curve there;
 // max_points; a step below step_min (failure, named). Starts: the folds of the branch of
 // equilibria in y at x_from (and scan lines), each not already on a curve, traced both ways.
+//
+// Bogdanov-Takens points on a fold curve (issue 60 item 3): where the fold's zero root is double,
+// c(lambda) = det Delta(lambda) has c'(0) = 0 too. With q and p the null vectors of J and J^T from
+// the bordered systems above (so normalised smoothly along the curve: c^T q = 1, b^T p = 1), the
+// test function
+//
+//   bt = p^T Delta'(0) q,   Delta'(0) = I + sum_i tau_i B_i,
+//
+// vanishes exactly there (p^T Delta'(0) q is c'(0) up to a nonzero factor where the zero root is
+// simple in J's kernel). A sign change of bt between two curve points is located by Illinois
+// along the chord, each trial corrected onto the curve in the hyperplane normal to the chord
+// (Newton on the extended system); the bound is the final bracket in the plane's units plus the
+// corrector's tolerance over the ranges (as for the Hopf curves' codim-2 points). Cusp points
+// (the fold's quadratic coefficient zero) need the second derivatives of f and are not detected.
 struct FoldCurvePoint {
   double x = 0, y = 0;
   Eigen::VectorXd state;
+};
+
+struct BogdanovTakensPoint {
+  double x = 0, y = 0;
+  double bound = 0;  // on its distance from the exact point, in the plane's units (max over x and y)
+  Eigen::VectorXd state;
+  int evaluations = 0;
 };
 
 struct FoldCurve {
   std::vector<FoldCurvePoint> points;
   BoundaryEnd end = BoundaryEnd::max_points;
   std::string note;
+  std::vector<BogdanovTakensPoint> bogdanov_takens;  // in order along the curve
+  std::vector<std::string> notes;                    // a sign change that could not be located: where and why
 };
 
 struct FoldCurves {

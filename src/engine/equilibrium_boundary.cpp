@@ -369,6 +369,23 @@ class FoldSystem {
     return out;
   }
 
+  // The Bogdanov-Takens test p^T Delta'(0) q at z (equilibrium_boundary.hpp), q and p the first d
+  // entries of the bordered solves [J b; c^T 0] (q, g) = (0, 1) and its transpose's.
+  double bogdanov_takens_test(const Eigen::VectorXd& z) const {
+    const ConstantHistory h = family_.at(z.head(d_), x(z), y(z));
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d_ + 1, d_ + 1);
+    M.topLeftCorner(d_, d_) = h.jacobian();
+    M.topRightCorner(d_, 1) = left_;
+    M.bottomLeftCorner(1, d_) = right_.transpose();
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(d_ + 1);
+    rhs[d_] = 1;
+    const Eigen::VectorXd q = M.fullPivLu().solve(rhs).head(d_);
+    const Eigen::VectorXd p = M.transpose().fullPivLu().solve(rhs).head(d_);
+    Eigen::MatrixXcd derivative;
+    h.delta(0.0, &derivative);
+    return p.dot(derivative.real() * q);
+  }
+
   // dF/dz by central differences, relative step 1e-7
   Eigen::MatrixXd jacobian(const Eigen::VectorXd& z) const {
     Eigen::MatrixXd D(d_ + 1, d_ + 2);
@@ -414,6 +431,53 @@ class FoldSystem {
   long d_;
   Eigen::VectorXd left_, right_;
 };
+
+// The Bogdanov-Takens points of a traced fold curve (equilibrium_boundary.hpp): each sign change of
+// the test between consecutive points located by Illinois along the chord.
+void bogdanov_takens_points(FoldSystem& sys, const BoundaryOptions& o, FoldCurve& curve) {
+  const long d = sys.d();
+  const double sx = std::abs(o.x_to - o.x_from), sy = std::abs(o.y_to - o.y_from);
+  std::vector<double> test;
+  for (const FoldCurvePoint& p : curve.points) test.push_back(sys.bogdanov_takens_test(sys.z_of(p.state, p.x, p.y)));
+  for (size_t i = 0; i + 1 < curve.points.size(); ++i) {
+    if (!(test[i] * test[i + 1] < 0)) continue;  // (a NaN too: nothing to locate)
+    const FoldCurvePoint &a = curve.points[i], &b = curve.points[i + 1];
+    const Eigen::VectorXd za = sys.z_of(a.state, a.x, a.y), zb = sys.z_of(b.state, b.x, b.y);
+    const Eigen::VectorXd row = (zb - za).normalized();
+    BogdanovTakensPoint out;
+    Eigen::VectorXd at = za;
+    double lo = 0, hi = 1;
+    bool located = true;
+    detail::IllinoisValues illinois{test[i], test[i + 1]};
+    for (int k = 0; k < 60 && std::max((hi - lo) * std::abs(b.x - a.x) / sx, (hi - lo) * std::abs(b.y - a.y) / sy) >
+                                  o.tolerance;
+         ++k) {
+      const double t = std::clamp(illinois.root(lo, hi), lo + 0.01 * (hi - lo), hi - 0.01 * (hi - lo));
+      const Eigen::VectorXd trial = za + t * (zb - za);
+      int iterations = 0;
+      const std::optional<Eigen::VectorXd> on_curve = sys.correct(trial, row, row.dot(trial), iterations);
+      const double v = on_curve ? sys.bogdanov_takens_test(*on_curve) : NAN;
+      if (!std::isfinite(v)) {
+        curve.notes.push_back("a Bogdanov-Takens point between (" + format_number(a.x) + ", " + format_number(a.y) +
+                              ") and (" + format_number(b.x) + ", " + format_number(b.y) +
+                              "): not located (no point of the curve at t = " + format_number(t) + " along the chord)");
+        located = false;
+        break;
+      }
+      at = *on_curve;
+      ++out.evaluations;
+      if (v == 0) {
+        lo = hi = t;
+        break;
+      }
+      (illinois.replace(v) < 0 ? lo : hi) = t;
+    }
+    if (!located) continue;
+    out.x = sys.x(at), out.y = sys.y(at), out.state = at.head(d);
+    out.bound = (hi - lo) * std::max(std::abs(b.x - a.x), std::abs(b.y - a.y)) + o.tolerance * std::max(sx, sy);
+    curve.bogdanov_takens.push_back(std::move(out));
+  }
+}
 
 // One way from z0 along +-t0: the points after z0, the end and its note.
 FoldCurve trace_fold_one_way(FoldSystem& sys, const BoundaryOptions& o, const Eigen::VectorXd& z0,
@@ -501,6 +565,7 @@ FoldCurves fold_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& 
       const FoldCurve& worse = !ok_back ? back : forward;
       curve.end = worse.end;
       curve.note = worse.note;
+      bogdanov_takens_points(sys, b, curve);
       BoundaryCurve as_boundary;
       for (const FoldCurvePoint& p : curve.points) as_boundary.points.push_back({p.x, p.y, NAN, 0});
       traced.push_back(std::move(as_boundary));

@@ -380,5 +380,53 @@ TEST(FoldCurves, TheCuspsTwoFoldCurvesAreTheClosedForm) {
   EXPECT_LT(r.curves[0].points.back().y * r.curves[1].points.back().y, 0);
 }
 
+// x' = p - x^2 + q (x(t - 2) - x): equilibria x = +-sqrt p, J = A + B = -2 x, so the equilibria fold
+// at x = 0 on the line p = 0 for every q; there Delta(lambda) = lambda + q - q e^{-2 lambda}, whose
+// Delta'(0) = 1 + 2 q vanishes at q = -1/2: the zero root is double, the Bogdanov-Takens point
+// (q, p) = (-1/2, 0). The fold curve traced in q from 0.5 to -1.5 carries exactly that one point,
+// within its bound, and the bound is the location's tolerance (1e-10 of the ranges), not more.
+// (It starts at q = 0.5, where c has a single real root for every x: from q = -1.5 the branch of
+// equilibria in p meets two real roots merging into a complex pair at p = 0.05 and ends there.)
+struct TakensModel {
+  static constexpr int d = 1;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double p = 1, q = 0.5;
+  double tau() const { return 2; }
+  double period() const { return 2; }
+  Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const {
+    return Vec<1>(p - y[0] * y[0] + q * (w[0] - y[0]));
+  }
+  Mat<1> A(int, double, const Vec<1>& y, const Vec<1>&) const { return Mat<1>::Constant(-2 * y[0] - q); }
+  Mat<1> B(int, double, const Vec<1>&, const Vec<1>&) const { return Mat<1>::Constant(q); }
+  Vec<1> initial_state() const { return Vec<1>(1); }
+};
+
+TEST(FoldCurves, ABogdanovTakensPointIsLocatedOnItsFoldCurve) {
+  HopfCurveOptions o;
+  o.boundary.x_from = 0.5, o.boundary.x_to = -1.5, o.boundary.y_from = 1, o.boundary.y_to = -1;
+  const FoldCurves r =
+      fold_curves(family_in_two<TakensModel>([](double q, double p) { return TakensModel{p, q}; }), Vec<1>(1), o);
+  ASSERT_EQ(r.curves.size(), 1u) << (r.notes.empty() ? "" : r.notes[0]);
+  const FoldCurve& c = r.curves[0];
+  EXPECT_EQ(c.end, BoundaryEnd::to) << c.note;
+  for (const FoldCurvePoint& p : c.points) EXPECT_NEAR(p.y, 0, 1e-9);
+  ASSERT_EQ(c.bogdanov_takens.size(), 1u) << (c.notes.empty() ? "" : c.notes[0]);
+  const BogdanovTakensPoint& bt = c.bogdanov_takens[0];
+  EXPECT_LE(std::abs(bt.x + 0.5), bt.bound) << bt.x + 0.5;
+  EXPECT_LE(bt.bound, 1e-8);
+  EXPECT_NEAR(bt.y, 0, 1e-9);
+  EXPECT_NEAR(bt.state[0], 0, 1e-6);  // x = sqrt p: the equilibrium's error is the root of p's
+}
+
+// The cusp's fold curves (above) have no Bogdanov-Takens point: Delta'(0) = 1 + c = 1.5 everywhere.
+TEST(FoldCurves, NoBogdanovTakensPointWhereTheZeroRootStaysSimple) {
+  HopfCurveOptions o;
+  o.boundary.x_from = 0.5, o.boundary.x_to = 2, o.boundary.y_from = -2, o.boundary.y_to = 2;
+  const FoldCurves r = fold_curves(family_in_two<CuspModel>([](double q, double p) { return CuspModel{p, q, 0.5}; }),
+                                   Vec<1>(-1.4), o);
+  ASSERT_EQ(r.curves.size(), 2u);
+  for (const FoldCurve& c : r.curves) EXPECT_TRUE(c.bogdanov_takens.empty());
+}
+
 }  // namespace
 }  // namespace delayspec

@@ -97,9 +97,16 @@ json curve_json(const char* type, BoundaryEnd end, const std::string& note, cons
 json fold_curves_json(const EquilibriaBoundaryRun& run, const FoldCurves& r, double seconds) {
   json j = run_json(run);
   for (const FoldCurve& c : r.curves) {
-    json cj = curve_json("fold", c.end, c.note, {});
+    json cj = curve_json("fold", c.end, c.note, c.notes);
     for (const FoldCurvePoint& p : c.points)
       cj["points"].push_back({{"x", p.x}, {"y", p.y}, {"equilibrium", state_values(p.state)}});
+    for (const BogdanovTakensPoint& b : c.bogdanov_takens)
+      cj["codim2"].push_back({{"kind", "bogdanov_takens"},
+                              {"x", b.x},
+                              {"y", b.y},
+                              {"bound", b.bound},
+                              {"equilibrium", state_values(b.state)},
+                              {"evaluations", b.evaluations}});
     j["curves"].push_back(cj);
   }
   j["notes"] = r.notes;
@@ -198,6 +205,10 @@ void print_fold_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const
     if (!c.points.empty())
       os << "    from (" << format_number(c.points.front().x) << ", " << format_number(c.points.front().y) << ") to ("
          << format_number(c.points.back().x) << ", " << format_number(c.points.back().y) << ")\n";
+    for (const BogdanovTakensPoint& b : c.bogdanov_takens)
+      os << "    Bogdanov-Takens point (a double zero root) at " << run.settings.x_key << " = " << format_number(b.x)
+         << ", " << run.settings.y_key << " = " << format_number(b.y) << " +- " << format_number(b.bound, 2) << "\n";
+    for (const std::string& n : c.notes) os << "    note: " << n << "\n";
   }
   for (const std::string& n : r.notes) os << "note: " << n << "\n";
   os << "time: " << seconds << " s\n";
