@@ -166,12 +166,20 @@ SegmentCrossings crossing_roots(const Tracer& tracer, const OnBranch& a, const E
       return out;
     }
     const size_t j = static_cast<size_t>(it - ra.roots.begin());
+    const bool right_a = it->value.real() > 0, right_b = root.value.real() > 0;
+    // Two real roots at b onto one complex root at a, neither crossing: the pair of a and its
+    // conjugate, which split into two real roots between the points (or merged, followed the other
+    // way): no crossing, and the count check below still holds the segment to account.
+    if (used[j] == 1 && it->value.imag() > tol * (1 + std::abs(it->value)) && root.value.imag() == 0 &&
+        right_a == right_b) {
+      ++used[j];
+      continue;
+    }
     if (used[j]++) {
       out.why = "two roots followed back to p = " + format_number(a.p()) + " landed on the same root " +
                 format_complex(it->value);
       return out;
     }
-    const bool right_a = it->value.real() > 0, right_b = root.value.real() > 0;
     if (right_a != right_b) {
       out.crossings.push_back({it->value, root.value});
       change += (right_b ? 1 : -1) * weight(root);

@@ -301,6 +301,41 @@ TEST(EquilibriumBranch, FoldIsPassedAndLocated) {
   EXPECT_EQ(branch.points.back().equilibrium.unstable, 1);
 }
 
+// x' = p - x^2 + q (x(t - 2) - x) at q = -1.5, down the upper branch x = sqrt(p) from p = 1: near
+// p = 0.05 two real roots of c right of the axis (Delta(lambda) = lambda + 2 x + q - q e^{-2 lambda})
+// merge into a complex pair, never crossing the axis. Following the pair back onto the two real
+// roots took them for "two roots landed on the same root" and ended the branch there (found while
+// testing Bogdanov-Takens points); the branch now passes it and reaches its fold at p = 0.
+struct MergingRootsModel {
+  static constexpr int d = 1;
+  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
+  double p = 1, q = -1.5;
+  double tau() const { return 2; }
+  double period() const { return 2; }
+  Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const { return Vec<1>(p - y[0] * y[0] + q * (w[0] - y[0])); }
+  Mat<1> A(int, double, const Vec<1>& y, const Vec<1>&) const { return Mat<1>::Constant(-2 * y[0] - q); }
+  Mat<1> B(int, double, const Vec<1>&, const Vec<1>&) const { return Mat<1>::Constant(q); }
+  Vec<1> initial_state() const { return Vec<1>(1); }
+};
+
+TEST(EquilibriumBranch, TwoRealRootsMergingIntoAPairOffTheAxisAreNoCrossing) {
+  const EquilibriumFamily family = family_of<MergingRootsModel>([](double p) { return MergingRootsModel{p, -1.5}; });
+  EquilibriumBranchOptions o;
+  o.from = 1, o.to = -1;
+  const EquilibriumBranch branch = continue_equilibrium(family, Vec<1>(1.0), o);
+  EXPECT_EQ(branch.end, BranchEnd::from) << branch.failure;
+  // the merge happened on the way: the rightmost root real at some point, complex at another, right of the axis
+  bool real_right = false, pair_right = false;
+  for (const EquilibriumPoint& pt : branch.points) {
+    const CharacteristicRoot& r = pt.equilibrium.roots.front();
+    if (pt.equilibrium.state[0] > 0 && r.value.real() > 0) (r.value.imag() == 0 ? real_right : pair_right) = true;
+  }
+  EXPECT_TRUE(real_right && pair_right);
+  ASSERT_EQ(branch.bifurcations.size(), 1u);
+  EXPECT_EQ(branch.bifurcations[0].type, EquilibriumBifurcationType::fold);
+  EXPECT_NEAR(branch.bifurcations[0].parameter, 0, 2e-10);  // the tolerance, 1e-10 |to - from|
+}
+
 // The Lang-Kobayashi laser with delayed optical feedback in real form (issue 61's reproducer),
 // E = Ex + i Ey, C = 0:
 //
