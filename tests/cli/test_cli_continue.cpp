@@ -380,6 +380,22 @@ TEST(ContinueCli, StartsAtTheEndOfAKeysRange) {
   EXPECT_NEAR(from_zero, from_inside, 1e-12 * from_inside);
 }
 
+// x' = a x + 0.5 x(t - 1) for a in [1e20, 1e21] and up to 1e308: the exact leading multiplier is
+// e^a (no bifurcation: a real root > 0 throughout), while the step cannot resolve h a beyond
+// 4 / eps (the trapezoid's factor rounds to -1) and every computed multiplier is 1 to rounding.
+// Five "folds" at 1e20 .. 1e21 and four near 1e308 were printed at exit 0 (issue 61 item 9): a
+// multiplier within rounding of the circle is not counted outside, so none is.
+TEST(ContinueCli, MultipliersOnTheCircleToRoundingAreNoBifurcation) {
+  for (const auto& [from, to] : {std::pair{"1e20", "1e21"}, std::pair{"-1", "1e308"}}) {
+    const CliResult r = run({"continue", "--json", "--set", "model=linear", "--set", "b=0.5", "--set",
+                             "continue_key=a", "--set", std::string("continue_from=") + from, "--set",
+                             std::string("continue_to=") + to});
+    ASSERT_EQ(r.status, 0) << from << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(j.at("bifurcations").empty()) << from << ": " << j.at("bifurcations").dump();
+  }
+}
+
 }  // namespace
 
 // Issue 60 item 5: `continue` with period_guess follows the orbit of unknown period from where
