@@ -80,6 +80,10 @@ std::string ResultTable::metadata_text(const std::string& key, const std::string
   return it == metadata.end() ? fallback : it->second;
 }
 
+std::string ResultTable::model_label(const std::string& fallback) const {
+  return metadata_text("model_label", metadata_text("model", fallback));
+}
+
 size_t ResultTable::data_rows() const {
   size_t n = 0;
   for (const auto& row : rows) n += !row.empty();

@@ -156,7 +156,9 @@ BasinTally tally_basin(const BasinSettings& s, const BasinPoints& pts) {
 void write_basin_csv(const Invocation& inv, const Config& config, const BasinSettings& s, const BasinPoints& pts,
                      const nlohmann::json& json, double seconds) {
   OutputFile csv(inv, std::filesystem::path(*inv.out_dir) / "basin.csv");
-  csv.stream() << metadata_comment_lines(make_metadata("basin", inv.scene, config, json, seconds));
+  OutputMetadata metadata = make_metadata("basin", inv.scene, config, json, seconds);
+  name_model(metadata, s.problem.model_name, s.problem.state_names);
+  csv.stream() << metadata_comment_lines(metadata);
   csv.stream() << s.x.name << "," << s.y.name << ",period,max_section_x\n";
   csv.stream().precision(12);
   for (long i = 0; i < s.count; ++i) {

@@ -54,6 +54,7 @@ struct ContinueRun {
   int index = -1;          // the continued key's parameter in problem.family
   std::vector<int> Ns;     // continue_Ns, or the one level N
   std::optional<double> period_guess;  // an autonomous orbit of unknown period (issue 60 item 5)
+  size_t component = 0;                // plot_component: the state component the table shows
 };
 
 // Reads the keys and the problem at the start value, and rejects what continue cannot take.
@@ -67,6 +68,7 @@ ContinueRun read_continue_run(Config& config) {
   run.options.start_iterations = run.orbit_settings.newton.max_iterations;  // the first point's Newton
   const Problem scene = read_problem(config, 100);
   run.period_guess = read_period_guess(config, scene);
+  run.component = read_plot_component(config, scene);
   run.problem = starting_problem(scene, config, {{"continue_key", run.settings.key, run.options.from, "continue_from"}});
   run.index = family_parameter(run.problem, "continue_key", run.settings.key);
   config.check_all_used();
@@ -183,6 +185,7 @@ json continue_json(const ContinueRun& run, const ContinueOutcome& out, double se
   const ContinuationResult& branch = out.branch();
   json j;
   j["model"] = run.problem.model_name;
+  j["state_names"] = run.problem.state_names;  // the measures' components, in order
   j["continue_key"] = run.settings.key;
   j["N"] = run.Ns.back();
   j["Ns"] = run.Ns;
@@ -217,6 +220,7 @@ void write_continue_files(const Invocation& inv, const Config& config, const Con
   const std::filesystem::path dir(*inv.out_dir);
   OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
   metadata.parameters.erase(run.settings.key);  // per row (plot labels the x axis with continue_key)
+  name_model(metadata, run.problem.model_name, run.problem.state_names);
   std::string header = metadata_comment_lines(metadata);
   if (!out.failures.empty()) header += "# INCOMPLETE: the branch ended in a failure: " + out.failures + "\n";
   write_output(inv, dir / "branch.csv",
@@ -228,18 +232,21 @@ void write_continue_files(const Invocation& inv, const Config& config, const Con
 }
 
 // The text report: the branch's points, the bifurcations, the time.
-void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutcome& out, double seconds) {
+void print_continue(std::ostream& os, const Invocation& inv, const ContinueRun& run, const ContinueOutcome& out,
+                    double seconds) {
   const ContinuationResult& branch = out.branch();
   const std::string& key = run.settings.key;
   char line[256];
-  os << "delayspec continue: model " << run.problem.model_name << ", " << key << " from "
+  os << "delayspec continue: model " << model_label(run.problem.model_name, run.problem.state_names, inv.scene)
+     << ", " << key << " from "
      << format_number(run.options.from) << " to " << format_number(run.options.to) << ", N = ";
   for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
   os << "\nbranch (N = " << run.Ns.back() << "): " << branch.points.size() << " points, ended at `"
      << to_string(branch.end) << "`\n";
   // an orbit of unknown period: its period too (the multipliers are the others than the trivial one)
   const bool with_period = run.period_guess.has_value();
-  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s%s  %s\n", key.c_str(), "|mu_1|", "unstable", "max y1",
+  const std::string max = "max " + run.problem.state_names.at(run.component);
+  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s%s  %s\n", key.c_str(), "|mu_1|", "unstable", max.c_str(),
                 with_period ? "            period" : "", "verdict");
   os << line;
   for (size_t i = 0; i < branch.points.size(); ++i) {
@@ -247,7 +254,8 @@ void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutc
     char period[32] = "";
     if (with_period) std::snprintf(period, sizeof period, "  %16.10g", p.period);
     std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g%s  %s\n", p.parameter,
-                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0], period,
+                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable,
+                  p.measures.max.at(run.component), period,
                   to_string(out.verdicts.verdicts.at(i)).c_str());
     os << line;
   }
@@ -294,7 +302,7 @@ int command_continue(Config& config, const Invocation& inv) {
     inv.out << j.dump(2) << "\n";
     return 0;
   }
-  print_continue(inv.out, run, out, seconds);
+  print_continue(inv.out, inv, run, out, seconds);
   return 0;
 }
 

@@ -240,6 +240,8 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"plot_gnuplot", "plot: the gnuplot program"},
       {"plot_width", "plot: PNG width in pixels, 100..10000"},
       {"plot_height", "plot: PNG height in pixels, 100..10000"},
+      {"plot_component", "continue, plot: the state component a branch's table and figures show, a state name or "
+                         "1-based index (default the first; plot: the one continue was given)"},
       {"analyses", "run: the analyses (command names) to run, in order (default: the command reading every key)"},
       {"title", "run: a title for the manifest"},
   };

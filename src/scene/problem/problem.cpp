@@ -5,6 +5,7 @@
 #include "delayspec/errors.hpp"
 #include "delayspec/grid.hpp"
 #include "scene/equations/equation_model.hpp"
+#include "scene/output/metadata.hpp"
 #include "scene/problem/builtin_family.hpp"
 #include "scene/problem/models_module_loader.hpp"
 
@@ -94,6 +95,10 @@ void require_autonomous_model(bool autonomous, const std::string& model_name, bo
     throw BadInput("`model = " + model_name + "` is not autonomous: " +
                    (builtin ? "its forcing depends on t" : "its right-hand side depends on t, or it switches") +
                    "; equilibria are for models with no forcing (linear, mackey-glass, or equations without t)");
+}
+
+size_t read_plot_component(Config& config, const Problem& problem) {
+  return state_component("plot_component", config.get_string("plot_component", "1"), problem.state_names);
 }
 
 Problem read_problem(Config& config, int default_N, ModelNeed need) {
