@@ -429,8 +429,13 @@ void plot_bifurcation(FigureRenderer& renderer, const fs::path& dir) {
     if (!row.empty()) rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + "\n";
   std::ostringstream gp;
   gp << gnuplot_datablock("section", rows);
-  gp << figure_title(t.metadata_text("title", ""), "Bifurcation diagram: x on the Poincare section against " + label);
-  gp << "set xlabel " << gnuplot_label(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
+  // the column x is the first state component: named as the model names it where the file says
+  const std::vector<std::string> names = t.state_names();
+  const std::string x = enhanced_text(names.empty() ? "x" : names.front());
+  gp << figure_title(t.metadata_text("title", ""),
+                     "Bifurcation diagram: " + x + " on the Poincare section against " + enhanced_text(label));
+  gp << "set xlabel " << gnuplot_label(label) << "\nset ylabel " << gnuplot_string(x + "(t_0 + jT)")
+     << "\nset grid\nset key off\n";
   gp << "plot $section using 1:2 with points pt 7 ps 0.3 lc rgb '#000000'\n";
   renderer.figure("bifurcation", gp.str());
 }

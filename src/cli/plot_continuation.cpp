@@ -116,9 +116,7 @@ void branch_figure(FigureRenderer& renderer, const ResultTable& t, const BranchF
 // The names of a branch file's d state components: its `# state_names` line (continue writes
 // the model's names there), else y1, ..., yd (a file written before it did).
 std::vector<std::string> state_names(const ResultTable& t, size_t d) {
-  std::vector<std::string> names;
-  std::stringstream line(t.metadata_text("state_names", ""));
-  for (std::string name; std::getline(line, name, ',');) names.push_back(name);
+  std::vector<std::string> names = t.state_names();
   if (names.size() == d) return names;
   names.clear();
   for (size_t c = 0; c < d; ++c) names.push_back("y" + std::to_string(c + 1));

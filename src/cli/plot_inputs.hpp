@@ -45,6 +45,8 @@ struct ResultTable {
   // The model as titles name it: the `# model_label` line (an [equations] model by its scene),
   // else the key `model`, else `fallback`.
   std::string model_label(const std::string& fallback) const;
+  // The state's names of the `# state_names = x,v` line (the model's, in order), empty without one.
+  std::vector<std::string> state_names() const;
   // The number of non-empty rows.
   size_t data_rows() const;
 

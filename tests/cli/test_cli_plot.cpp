@@ -758,3 +758,61 @@ TEST(PlotCli, PhasePortraitDrawsTheImpactBoundaryOnlyForTheImpactModel) {
     fs::remove_all(dir);
   }
 }
+
+// Issue 61 item 8: sweep's section.csv (x: the first state component) is drawn with the model's
+// name for it, recorded in the file's metadata.
+TEST(PlotCli, BifurcationDiagramNamesTheFirstState) {
+  const fs::path dir = fresh_plot_dir("names_sweep");
+  const fs::path scene = fresh_plot_dir("names_sweep_scene") / "forced_uw.toml";
+  std::ofstream(scene) << R"toml(model = "equations"
+[equations]
+state = ["u", "w"]
+parameters = { b = 0.1, c = 1.0 }
+period = "2*pi"
+delay = "1"
+rhs = ["w", "-u - c*w - 0.1*u^3 + b*u_tau + cos(t)"]
+history = { u = 0, w = 0 }
+)toml";
+  const CliResult s = run({"sweep", scene.string(), "--out", dir.string(), "--quiet", "--set",
+                           std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE, "--set", "sweep_key=b", "--set",
+                           "sweep_from=0.1", "--set", "sweep_to=0.2", "--set", "sweep_points=2", "--set", "N=10",
+                           "--set", "periods=5", "--set", "transient=0", "--set", "section_points=2"});
+  ASSERT_EQ(s.status, 0) << s.err;
+  const std::string csv = read_text(dir / "section.csv");
+  EXPECT_TRUE(delayspec::testing::contains(csv, "\n# state_names = u,w\n")) << csv;
+  EXPECT_TRUE(delayspec::testing::contains(csv, "\nparameter,x\n")) << csv;  // the documented header stays
+  ASSERT_EQ(run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"}).status, 0);
+  const std::string gp = read_text(dir / "plots" / "bifurcation.gp");
+  EXPECT_TRUE(delayspec::testing::contains(gp, "set ylabel 'u(t_0 + jT)'")) << gp;
+  EXPECT_TRUE(delayspec::testing::contains(gp, "Bifurcation diagram: u on the Poincare section against b")) << gp;
+  fs::remove_all(dir);
+  fs::remove_all(scene.parent_path());
+}
+
+// Issue 61 item 8: the table of the orbits born at a Hopf point says what its amplitude is,
+// (max - min)/2 of the component, and prints that of the JSON's measures.
+TEST(PlotCli, HopfBranchTableSaysItsAmplitudeIsHalfTheRange) {
+  const std::vector<std::string> args = {"continue", "--set", "model=mackey-glass", "--set",
+                                         "continue_object=equilibrium", "--set", "continue_key=tau", "--set",
+                                         "continue_from=3", "--set", "continue_to=5", "--set",
+                                         "equilibrium_guess=1.1", "--set", "continue_switch=true", "--set", "N=50"};
+  const CliResult text = run(args);
+  ASSERT_EQ(text.status, 0) << text.err;
+  std::vector<std::string> json_args = args;
+  json_args.push_back("--json");
+  const CliResult json = run(json_args);
+  ASSERT_EQ(json.status, 0) << json.err;
+  const auto point = nlohmann::json::parse(json.out)["hopf_branches"][0]["points"][1];
+  const double amplitude =
+      (point["measures"]["max"][0].get<double>() - point["measures"]["min"][0].get<double>()) / 2;
+  const size_t header = text.out.find("(max - min)/2 of x\n");
+  ASSERT_NE(header, std::string::npos) << text.out;
+  EXPECT_FALSE(delayspec::testing::contains(text.out, "y1")) << text.out;
+  // the second row after the header: its last column
+  std::istringstream rows(text.out.substr(text.out.find('\n', header) + 1));
+  std::string row;
+  std::getline(rows, row);
+  std::getline(rows, row);
+  const double printed = std::stod(row.substr(row.find_last_of(' ') + 1));
+  EXPECT_NEAR(printed, amplitude, 1e-7 * amplitude) << row;
+}
