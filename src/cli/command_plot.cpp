@@ -77,6 +77,14 @@ std::string json_scene_title(const JsonField& j) {
   return parameters ? parameters->text_or("title", "") : "";
 }
 
+// The model as titles name it: the metadata's model_label (an [equations] model by its scene),
+// else the result's `model`.
+std::string json_model_label(const JsonField& j) {
+  const auto metadata = j.find("metadata");
+  const std::string label = metadata ? metadata->text_or("model_label", "") : "";
+  return label.empty() ? j.text_or("model", "?") : label;
+}
+
 // floquet.json: multipliers [{re, im, ...}] -> the complex plane with the unit circle.
 void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   std::string rows;
@@ -93,7 +101,7 @@ void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   const double N = j.number_or("N", NAN);
   std::ostringstream gp;
   gp << gnuplot_datablock("mu", rows);
-  gp << figure_title(json_scene_title(j), "Floquet multipliers: model " + j.text_or("model", "?") + ", N = " +
+  gp << figure_title(json_scene_title(j), "Floquet multipliers: model " + enhanced_text(json_model_label(j)) + ", N = " +
                                              (std::isnan(N) ? std::string("?") : gnuplot_number(N)) + ", solver " +
                                              j.text_or("solver", "?"));
   gp << "set size ratio -1\nset grid\nset xlabel 'Re {/Symbol m}'\nset ylabel 'Im {/Symbol m}'\n";

@@ -694,8 +694,18 @@ history = { x = 0, v = 0 }
   ASSERT_EQ(run(with(branch, {"--set", "plot_component=v", "--out", chosen.string(), "--quiet"})).status, 0);
   ASSERT_EQ(run(with({"plot", chosen.string()}, size)).status, 0);
   EXPECT_TRUE(delayspec::testing::contains(read_text(chosen / "plots" / "branch.gp"), "'max v over the orbit'"));
+  // floquet through run: its figure's title names the model by the scene too
+  const fs::path ran = fresh_dir("plot_names_run");
+  ASSERT_EQ(run({"run", scene.string(), "--set", cache, "--set", "analyses=floquet", "--set", "N=40", "--out",
+                 ran.string(), "--quiet"})
+                .status,
+            0);
+  ASSERT_EQ(run(with({"plot", ran.string()}, size)).status, 0);
+  EXPECT_TRUE(delayspec::testing::contains(read_text(ran / "plots" / "multipliers.gp"),
+                                           "Floquet multipliers: model forced\\_pair, N = 40"));
   fs::remove_all(dir);
   fs::remove_all(chosen);
+  fs::remove_all(ran);
   fs::remove_all(scene.parent_path());
 }
 

@@ -220,7 +220,6 @@ void write_continue_files(const Invocation& inv, const Config& config, const Con
   const std::filesystem::path dir(*inv.out_dir);
   OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
   metadata.parameters.erase(run.settings.key);  // per row (plot labels the x axis with continue_key)
-  name_model(metadata, run.problem.model_name, run.problem.state_names);
   std::string header = metadata_comment_lines(metadata);
   if (!out.failures.empty()) header += "# INCOMPLETE: the branch ended in a failure: " + out.failures + "\n";
   write_output(inv, dir / "branch.csv",

@@ -25,6 +25,7 @@ int floquet_of_unknown_period(const Problem& problem, const OrbitSettings& orbit
   if (inv.json) {
     nlohmann::json json;
     json["model"] = problem.model_name;
+    json["state_names"] = problem.state_names;
     json["N"] = problem.N;
     json["dimension"] = r.at_N.orbit.history.size();
     json["solver"] = to_string(r.at_N.result.solver);
@@ -89,6 +90,7 @@ int command_floquet(Config& config, const Invocation& inv) {
 
   if (inv.json) {
     json["model"] = problem.model_name;
+    json["state_names"] = problem.state_names;
     json["N"] = problem.N;
     json["dimension"] = n;
     json["solver"] = to_string(result.solver);

@@ -271,7 +271,6 @@ void write_equilibria_files(const Invocation& inv, const Config& config, const E
   const std::filesystem::path dir(*inv.out_dir);
   OutputMetadata metadata = make_metadata("continue", inv.scene, config, j, seconds);
   metadata.parameters.erase(run.settings.key);  // per row
-  name_model(metadata, run.problem.model_name, run.problem.state_names);
   std::string header = metadata_comment_lines(metadata);
   if (!failures.empty()) header += "# INCOMPLETE: a branch ended in a failure: " + failures + "\n";
   write_output(inv, dir / "equilibria.csv", points_csv(header, run.problem, branch));

@@ -32,6 +32,15 @@ OutputMetadata make_metadata(const std::string& command, const std::optional<std
     auto it = m.parameters.find(key);
     return it != m.parameters.end() ? it->second : fallback;
   };
+  // A result that names its model and state (floquet, continue) names them in its files too, even
+  // when `run` writes them from its JSON alone.
+  if (result.is_object() && result.contains("model") && result["model"].is_string() &&
+      result.contains("state_names") && result["state_names"].is_array()) {
+    std::vector<std::string> names;
+    for (const auto& name : result["state_names"])
+      if (name.is_string()) names.push_back(name.get<std::string>());
+    name_model(m, result["model"].get<std::string>(), names);
+  }
   m.events = text("events", "on");
   m.jacobian = text("jacobian", "consistent");
   if (result.is_object() && result.contains("N") && result["N"].is_number_integer()) {
