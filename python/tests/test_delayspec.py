@@ -356,6 +356,14 @@ def test_the_orbits_born_at_a_hopf_point_come_as_arrays():
     assert b.from_period == r["hopf_branches"][0]["period"]  # 2 pi / omega at the Hopf point
     with pytest.raises(IndexError, match="1 branch"):
         r.hopf_branch(1)
+    # the orbits' size by the model's name of the state, (max - min)/2 as the table prints it
+    assert r.state_names == ["x"]
+    maxima = np.array([p["measures"]["max"][0] for p in points])
+    minima = np.array([p["measures"]["min"][0] for p in points])
+    np.testing.assert_array_equal(b.maximum("x"), maxima)
+    np.testing.assert_array_equal(b.amplitude("x"), (maxima - minima) / 2)
+    with pytest.raises(ValueError, match="state `y1`: not a state component of the model .state_names: x"):
+        b.amplitude("y1")
 
 
 def test_hopf_points_carry_their_criticality():
