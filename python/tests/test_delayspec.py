@@ -50,6 +50,20 @@ def test_floquet_reports_error_estimates_and_a_verdict():
     np.testing.assert_array_equal(off.multipliers, r.multipliers)
 
 
+def test_floquet_gives_the_orbit_as_a_time_series_by_state_name():
+    """Issue 61 item 8: the orbit over one map, t and each state component by its name, as arrays
+    (the CLI test checks the numbers against a long simulation: tests/cli/test_cli_floquet.cpp)."""
+    keys = dict(N=40, nev=2, error_bars="off", orbit_series="on")
+    r = delayspec.floquet(DEFAULT, **keys)
+    same_as_cli(r, "floquet", DEFAULT, **keys)
+    series = r.orbit_series
+    assert sorted(series) == ["t", "v", "x"] and r.state_names == ["x", "v"]
+    assert series["t"].dtype == np.float64 and series["x"].shape == (r.steps_per_map,)
+    # the grid's node times over one forcing period (aligned with the orbit's contacts: not uniform)
+    t = series["t"]
+    assert t[0] == 0 and np.all(np.diff(t) > 0) and t[-1] < 2 * np.pi / 0.802
+
+
 def test_floquet_without_scene_equals_cli_json():
     r = delayspec.floquet(N=20, k=0.1, orbit="newton")
     same_as_cli(r, "floquet", N=20, k=0.1, orbit="newton")

@@ -173,7 +173,7 @@ void write_basin_csv(const Invocation& inv, const Config& config, const BasinSet
 // The text summary: the grid, the points by period, the failed ones, the time.
 void print_basin(std::ostream& out, const BasinSettings& s, const BasinTally& t, double seconds) {
   const ParameterAxis &x = s.x, &y = s.y;
-  out << "delayspec basin: model " << s.problem.model_name << ", N = " << s.problem.N << ", " << x.name << " in ["
+  out << "delayspec basin: model " << s.problem.model_label << ", N = " << s.problem.N << ", " << x.name << " in ["
       << x.min << ", " << x.max << "] x " << y.name << " in [" << y.min << ", " << y.max << "], " << s.count
       << " points, transient " << s.transient << " periods\n";
   for (const auto& [period, n] : t.counts)

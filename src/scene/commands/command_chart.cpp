@@ -190,7 +190,7 @@ void write_chart_csv(const Invocation& inv, const Config& config, const ChartSet
 // The text summary: the grid, the stable (and undecided, failed) points, the time.
 void print_chart(const Invocation& inv, const ChartSettings& s, const ChartTally& t, double seconds) {
   const ParameterAxis &x = s.x, &y = s.y;
-  inv.out << "delayspec chart: model " << s.problem.model_name << ", N = " << s.problem.N << ", " << x.name << " in ["
+  inv.out << "delayspec chart: model " << s.problem.model_label << ", N = " << s.problem.N << ", " << x.name << " in ["
           << x.min << ", " << x.max << "] x " << y.name << " in [" << y.min << ", " << y.max << "], " << s.count
           << " points on " << s.threads << " threads\n";
   if (s.with_error_bars)

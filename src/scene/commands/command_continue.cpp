@@ -231,12 +231,11 @@ void write_continue_files(const Invocation& inv, const Config& config, const Con
 }
 
 // The text report: the branch's points, the bifurcations, the time.
-void print_continue(std::ostream& os, const Invocation& inv, const ContinueRun& run, const ContinueOutcome& out,
-                    double seconds) {
+void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutcome& out, double seconds) {
   const ContinuationResult& branch = out.branch();
   const std::string& key = run.settings.key;
   char line[256];
-  os << "delayspec continue: model " << model_label(run.problem.model_name, run.problem.state_names, inv.scene)
+  os << "delayspec continue: model " << run.problem.model_label
      << ", " << key << " from "
      << format_number(run.options.from) << " to " << format_number(run.options.to) << ", N = ";
   for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
@@ -301,7 +300,7 @@ int command_continue(Config& config, const Invocation& inv) {
     inv.out << j.dump(2) << "\n";
     return 0;
   }
-  print_continue(inv.out, inv, run, out, seconds);
+  print_continue(inv.out, run, out, seconds);
   return 0;
 }
 

@@ -222,7 +222,7 @@ int command_sweep(Config& config, const Invocation& inv) {
   if (inv.json) {
     inv.out << summary.dump(1) << "\n";
   } else {
-    inv.out << "delayspec sweep: model " << s.first.model_name << ", " << s.key << " from " << s.from << " to " << s.to
+    inv.out << "delayspec sweep: model " << s.first.model_label << ", " << s.key << " from " << s.from << " to " << s.to
             << " (" << s.count << " points, " << thread_count << " threads), N = " << s.first.N << ", transient "
             << options.transient << ", periods " << options.periods << "\n";
     inv.out << tables.exponents_csv;

@@ -188,11 +188,11 @@ std::string criticality_line(const HopfNormalForm& n) {
   return line;
 }
 
-// The table shows the state component `component` of each equilibrium; `model` names the model.
-void print_branch(std::ostream& os, const Problem& problem, const std::string& model, size_t component,
+// The table shows the state component `component` of each equilibrium.
+void print_branch(std::ostream& os, const Problem& problem, size_t component,
                   const std::string& key, const EquilibriumBranchOptions& o, const EquilibriumBranch& b,
                   double seconds) {
-  os << "delayspec continue: model " << model << ", equilibria in " << key << " from "
+  os << "delayspec continue: model " << problem.model_label << ", equilibria in " << key << " from "
      << format_number(o.from) << " to " << format_number(o.to) << "\nbranch: " << b.points.size()
      << " points, ended at `" << to_string(b.end) << "`\n";
   char line[256];
@@ -323,8 +323,7 @@ int continue_equilibria(Config& config, const Invocation& inv) {
     inv.out << j.dump(2) << "\n";
   } else {
     const std::string& name = run.problem.state_names.at(run.component);
-    print_branch(inv.out, run.problem, model_label(run.problem.model_name, run.problem.state_names, inv.scene),
-                 run.component, key, o, branch, seconds);
+    print_branch(inv.out, run.problem, run.component, key, o, branch, seconds);
     print_hopf_branches(inv.out, key, orbits, run.Ns, run.component, name);
   }
   return 0;

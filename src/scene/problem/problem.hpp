@@ -23,7 +23,8 @@ namespace delayspec::cli {
 class BuiltinFamily;
 
 struct Problem {
-  std::string model_name;
+  std::string model_name;   // the key `model`: a built-in model's name, or "equations"
+  std::string model_label;  // how outputs name it (metadata.hpp's model_label: the scene file's stem)
   std::optional<AnyModel> model;                  // the built-in model; empty for model = equations
   std::shared_ptr<const ModelAnalyses> analyses;  // every model
   // The model at other parameter values (problem_family.hpp), and this problem's values: what
