@@ -125,11 +125,13 @@ Problem read_problem(Config& config, int default_N, ModelNeed need) {
         });
     problem.family = std::move(equations.family);
     problem.state_names = std::move(equations.state);
+    // named by the scene file that holds the [equations] table (read above; a Python dict has no
+    // file name)
+    const std::string& origin = config.origin("equations");
+    problem.model_label = model_label(problem.model_name, problem.state_names,
+                                      origin.ends_with(".toml") ? std::optional(origin) : std::nullopt);
   }
-  // named by the scene file that holds the [equations] table (not a Python dict: no file name)
-  const std::string origin = config.has("equations") ? config.origin("equations") : "";
-  problem.model_label = model_label(problem.model_name, problem.state_names,
-                                    origin.size() > 5 && origin.ends_with(".toml") ? std::optional(origin) : std::nullopt);
+  if (builtin) problem.model_label = problem.model_name;
   // N up to 1e9 (the history alone is then 16 GB at d = 2); orbit_period and contact_substeps
   // multiply the work per step or per period, 1000 is far beyond any use.
   problem.N = static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000));
