@@ -157,7 +157,7 @@ void write_basin_csv(const Invocation& inv, const Config& config, const BasinSet
                      const nlohmann::json& json, double seconds) {
   OutputFile csv(inv, std::filesystem::path(*inv.out_dir) / "basin.csv");
   OutputMetadata metadata = make_metadata("basin", inv.scene, config, json, seconds);
-  name_model(metadata, s.problem.model_name, s.problem.state_names);
+  name_model(metadata, s.problem.model_label, s.problem.state_names);
   csv.stream() << metadata_comment_lines(metadata);
   csv.stream() << s.x.name << "," << s.y.name << ",period,max_section_x\n";
   csv.stream().precision(12);

@@ -167,7 +167,7 @@ void write_chart_csv(const Invocation& inv, const Config& config, const ChartSet
                      const nlohmann::json& json, double seconds) {
   OutputFile csv(inv, std::filesystem::path(*inv.out_dir) / "chart.csv");
   OutputMetadata metadata = make_metadata("chart", inv.scene, config, json, seconds);
-  name_model(metadata, s.problem.model_name, s.problem.state_names);
+  name_model(metadata, s.problem.model_label, s.problem.state_names);
   csv.stream() << metadata_comment_lines(metadata);
   csv.stream() << s.x.name << "," << s.y.name << ",spectral_radius"
                << (s.with_error_bars ? ",error_estimate,undecided" : "") << ",angle\n";

@@ -212,7 +212,7 @@ int command_sweep(Config& config, const Invocation& inv) {
     // with it); the swept key's own value is per row, so it is not a metadata line.
     OutputMetadata metadata = make_metadata("sweep", inv.scene, config, summary, seconds);
     metadata.parameters.erase(s.key);
-    name_model(metadata, s.first.model_name, s.first.state_names);  // section.csv's x: the first
+    name_model(metadata, s.first.model_label, s.first.state_names);  // section.csv's x: the first
     const std::string header = metadata_comment_lines(metadata);
     write_output(inv, dir / "exponents.csv", header + tables.exponents_csv);
     write_output(inv, dir / "section.csv", header + tables.section_csv);

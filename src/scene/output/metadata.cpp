@@ -39,7 +39,7 @@ OutputMetadata make_metadata(const std::string& command, const std::optional<std
     std::vector<std::string> names;
     for (const auto& name : result["state_names"])
       if (name.is_string()) names.push_back(name.get<std::string>());
-    name_model(m, result["model"].get<std::string>(), names);
+    name_model(m, model_label(result["model"].get<std::string>(), names, scene), names);
   }
   m.events = text("events", "on");
   m.jacobian = text("jacobian", "consistent");
@@ -115,8 +115,8 @@ std::string model_label(const std::string& model, const std::vector<std::string>
   return "equations in " + names;
 }
 
-void name_model(OutputMetadata& m, const std::string& model, const std::vector<std::string>& state_names) {
-  m.model_label = model_label(model, state_names, m.scene);
+void name_model(OutputMetadata& m, const std::string& label, const std::vector<std::string>& state_names) {
+  m.model_label = label;
   m.state_names = state_names;
 }
 

@@ -52,8 +52,10 @@ struct OutputMetadata {
 // else by its state ("equations in x, y") (issue 61 item 8).
 std::string model_label(const std::string& model, const std::vector<std::string>& state_names,
                         const std::optional<std::string>& scene);
-// Fills metadata.model_label (from metadata.scene) and metadata.state_names.
-void name_model(OutputMetadata& metadata, const std::string& model, const std::vector<std::string>& state_names);
+// Fills metadata.model_label and metadata.state_names: a command passes its Problem's
+// (problem.hpp: model_label of the scene file holding the [equations] table); make_metadata
+// names a result that carries `model` and `state_names` by model_label(model, names, scene).
+void name_model(OutputMetadata& metadata, const std::string& label, const std::vector<std::string>& state_names);
 
 // The state component `value` names, 0-based: a state name or its 1-based index among `names`
 // (the key plot_component); BadInput naming `key`, the value and the names otherwise.
