@@ -101,9 +101,9 @@ void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   const double N = j.number_or("N", NAN);
   std::ostringstream gp;
   gp << gnuplot_datablock("mu", rows);
-  gp << figure_title(json_scene_title(j), "Floquet multipliers: model " + enhanced_text(json_model_label(j)) + ", N = " +
-                                             (std::isnan(N) ? std::string("?") : gnuplot_number(N)) + ", solver " +
-                                             j.text_or("solver", "?"));
+  gp << figure_title(json_scene_title(j), "Floquet multipliers: model " + enhanced_text(json_model_label(j)) +
+                                              ", N = " + (std::isnan(N) ? std::string("?") : gnuplot_number(N)) +
+                                              ", solver " + j.text_or("solver", "?"));
   gp << "set size ratio -1\nset grid\nset xlabel 'Re {/Symbol m}'\nset ylabel 'Im {/Symbol m}'\n";
   gp << "set xrange [" << gnuplot_number(-r) << ":" << gnuplot_number(r) << "]\nset yrange [" << gnuplot_number(-r)
      << ":" << gnuplot_number(r) << "]\n";
@@ -509,7 +509,8 @@ void plot_phase(FigureRenderer& renderer, const fs::path& dir) {
   if (trajectory.metadata_text("model", "impact") == "impact") {
     const std::string e = gnuplot_number(impact_boundary(dir, trajectory));
     gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#1f77b4' lw 2 front\n";
-    boundary_plot = ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title " + gnuplot_string("impact boundary x = e = " + e);
+    boundary_plot =
+        ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title " + gnuplot_string("impact boundary x = e = " + e);
   }
   gp << "plot $trajectory using 1:2 with lines lc rgb '#999999' title 'trajectory'" << section_plot << boundary_plot
      << "\n";

@@ -91,11 +91,11 @@ void branch_figure(FigureRenderer& renderer, const ResultTable& t, const BranchF
      << gnuplot_datablock("marks", f.marks.empty() ? "nan nan\n" : f.marks)
      << gnuplot_datablock("undecided", open.empty() ? "nan nan\n" : open);
   const std::string styles = !solid.empty() && !dashed.empty() ? "stable solid, unstable dashed"
-                             : !solid.empty()                 ? "stable throughout"
-                                                              : "unstable throughout";
-  gp << figure_title(t.metadata_text("title", ""),
-                     f.title + " (" + styles +
-                         (none_decided ? "; at this N: no N -> infinity verdict without continue_Ns)" : ")"));
+                             : !solid.empty()                  ? "stable throughout"
+                                                               : "unstable throughout";
+  gp << figure_title(
+      t.metadata_text("title", ""),
+      f.title + " (" + styles + (none_decided ? "; at this N: no N -> infinity verdict without continue_Ns)" : ")"));
   gp << "set xlabel " << gnuplot_label(f.key) << "\nset ylabel " << gnuplot_string(f.ylabel)
      << "\nset grid\nset key top left\n"
      << f.labels;
@@ -162,9 +162,11 @@ void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path&
     int index = 0;
     for (const JsonField& b : bifurcations->elements()) {
       const double p = b.at("parameter").number();
-      const std::vector<JsonField> max = b.at("measures").at("max").elements();
-      if (max.size() != d) b.at("measures").at("max").fail("has " + std::to_string(max.size()) + " entries, not " +
-                                                           std::to_string(d) + " (the CSV's max_y columns)");
+      const JsonField max_field = b.at("measures").at("max");
+      const std::vector<JsonField> max = max_field.elements();
+      if (max.size() != d)
+        max_field.fail("has " + std::to_string(max.size()) + " entries, not " + std::to_string(d) +
+                       " (the CSV's max_y columns)");
       const double y = max[c].number();
       const std::string type = b.at("type").text();
       if (type != "fold" && type != "period-doubling" && type != "neimark-sacker" && type != "grazing")
@@ -180,8 +182,8 @@ void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path&
   }
   const std::string title = branch_title(t, what, key);
   branch_figure(renderer, t,
-                {name, title, key, "max " + enhanced_text(names[c]) + " over the orbit", marks_y, labels_y, "", "", max_y,
-                 stable, undecided});
+                {name, title, key, "max " + enhanced_text(names[c]) + " over the orbit", marks_y, labels_y, "", "",
+                 max_y, stable, undecided});
   if (mu1 >= 0)
     branch_figure(renderer, t,
                   {name + "_mu1", title, key, "|{/Symbol m}_1|", marks_mu, labels_mu, "1", "|{/Symbol m}| = 1", mu1,
@@ -226,10 +228,11 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir,
     int index = 0;
     for (const JsonField& b : j.at("bifurcations").elements()) {
       const double p = b.at("parameter").number();
-      const std::vector<JsonField> state = b.at("equilibrium").elements();
+      const JsonField state_field = b.at("equilibrium");
+      const std::vector<JsonField> state = state_field.elements();
       if (state.size() != names.size())
-        b.at("equilibrium").fail("has " + std::to_string(state.size()) + " entries, not " +
-                                 std::to_string(names.size()) + " (the CSV's state columns)");
+        state_field.fail("has " + std::to_string(state.size()) + " entries, not " + std::to_string(names.size()) +
+                         " (the CSV's state columns)");
       const double at = state[c].number();
       const std::string type = b.at("type").text();
       if (type != "fold" && type != "hopf" && type != "branch_point") b.at("type").fail("unknown bifurcation type");

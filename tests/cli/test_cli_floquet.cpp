@@ -161,8 +161,8 @@ history = { x = 0, v = 0 }
   EXPECT_NEAR(last[1].get<double>(), s["x"][0].get<double>(), 1e-10);
   EXPECT_NEAR(last[2].get<double>(), s["v"][0].get<double>(), 1e-10);
   // the text prints it too; without the key, neither does
-  const CliResult text = run({"floquet", scene, "--set", cache, "--set", "N=40", "--set", "orbit_series=on", "--set",
-                              "error_bars=off"});
+  const CliResult text =
+      run({"floquet", scene, "--set", cache, "--set", "N=40", "--set", "orbit_series=on", "--set", "error_bars=off"});
   ASSERT_EQ(text.status, 0) << text.err;
   EXPECT_NE(text.out.find("orbit series (" + std::to_string(K) + " samples over one map):\n"), std::string::npos)
       << text.out;

@@ -390,8 +390,8 @@ nlohmann::json bench_json(const BenchSettings& s, const std::vector<BenchRow>& r
 void print_bench(std::ostream& out, const BenchSettings& s, const std::vector<BenchRow>& rows,
                  const BenchReference& reference) {
   char line[300];
-  out << "delayspec bench: model " << s.problem.model_label << ", nev " << s.base.nev << ", reference " << reference.used
-      << (reference.used == "exact" ? " (" + s.exact_source + ")" : "")
+  out << "delayspec bench: model " << s.problem.model_label << ", nev " << s.base.nev << ", reference "
+      << reference.used << (reference.used == "exact" ? " (" + s.exact_source + ")" : "")
       << (reference.note.empty() ? "" : " (" + reference.note + ")") << "\n";
   std::snprintf(line, sizeof line, "  %6s  %7s  %-12s  %10s  %10s  %9s  %10s  %10s  %6s  %10s\n", "N", "n", "solver",
                 "seconds", "peak MB", "op.appl", "error", "max error", "digits", "vs dense");

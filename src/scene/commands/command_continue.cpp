@@ -235,8 +235,7 @@ void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutc
   const ContinuationResult& branch = out.branch();
   const std::string& key = run.settings.key;
   char line[256];
-  os << "delayspec continue: model " << run.problem.model_label
-     << ", " << key << " from "
+  os << "delayspec continue: model " << run.problem.model_label << ", " << key << " from "
      << format_number(run.options.from) << " to " << format_number(run.options.to) << ", N = ";
   for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
   os << "\nbranch (N = " << run.Ns.back() << "): " << branch.points.size() << " points, ended at `"
@@ -253,8 +252,7 @@ void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutc
     if (with_period) std::snprintf(period, sizeof period, "  %16.10g", p.period);
     std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g%s  %s\n", p.parameter,
                   p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable,
-                  p.measures.max.at(run.component), period,
-                  to_string(out.verdicts.verdicts.at(i)).c_str());
+                  p.measures.max.at(run.component), period, to_string(out.verdicts.verdicts.at(i)).c_str());
     os << line;
   }
   os << "verdicts: " << out.verdicts.note << "\n";

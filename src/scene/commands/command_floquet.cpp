@@ -31,7 +31,8 @@ nlohmann::json orbit_series_json(const Problem& problem, const Eigen::VectorXd& 
     std::vector<double> y(static_cast<size_t>(K));
     // a linear model's orbit is the zero orbit, which it does not store (LinearisedOrbit::sequence)
     for (long l = 0; l < K; ++l)
-      y[static_cast<size_t>(l)] = sequence.size() == 0 ? 0.0 : sequence[l * static_cast<long>(d) + static_cast<long>(c)];
+      y[static_cast<size_t>(l)] =
+          sequence.size() == 0 ? 0.0 : sequence[l * static_cast<long>(d) + static_cast<long>(c)];
     j[problem.state_names[c]] = y;
   }
   return j;
@@ -61,8 +62,7 @@ void print_orbit_series(std::ostream& os, const Problem& problem, const nlohmann
 
 int floquet_of_unknown_period(const Problem& problem, const OrbitSettings& orbit_settings,
                               const FloquetOptions& options, bool with_error_bars, bool with_series,
-                              double period_guess, const Invocation& inv,
-                              std::chrono::steady_clock::time_point start) {
+                              double period_guess, const Invocation& inv, std::chrono::steady_clock::time_point start) {
   const AutonomousFloquet r = autonomous_floquet(problem, period_guess, orbit_settings, options, with_error_bars);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   nlohmann::json series;  // orbit_series = on: u_l at t = l T / K (the scaled problem's uniform grid)
@@ -107,8 +107,8 @@ int command_floquet(Config& config, const Invocation& inv) {
   const std::optional<double> period_guess = read_period_guess(config, problem);
   config.check_all_used();
   if (period_guess)
-    return floquet_of_unknown_period(problem, orbit_settings, options, with_error_bars, with_series, *period_guess,
-                                     inv, start);
+    return floquet_of_unknown_period(problem, orbit_settings, options, with_error_bars, with_series, *period_guess, inv,
+                                     start);
   const long n = problem.dimension();
   validate_floquet_options(options, n);  // before the orbit: fail fast
 

@@ -189,9 +189,8 @@ std::string criticality_line(const HopfNormalForm& n) {
 }
 
 // The table shows the state component `component` of each equilibrium.
-void print_branch(std::ostream& os, const Problem& problem, size_t component,
-                  const std::string& key, const EquilibriumBranchOptions& o, const EquilibriumBranch& b,
-                  double seconds) {
+void print_branch(std::ostream& os, const Problem& problem, size_t component, const std::string& key,
+                  const EquilibriumBranchOptions& o, const EquilibriumBranch& b, double seconds) {
   os << "delayspec continue: model " << problem.model_label << ", equilibria in " << key << " from "
      << format_number(o.from) << " to " << format_number(o.to) << "\nbranch: " << b.points.size()
      << " points, ended at `" << to_string(b.end) << "`\n";
@@ -201,9 +200,9 @@ void print_branch(std::ostream& os, const Problem& problem, size_t component,
   os << line;
   for (const EquilibriumPoint& p : b.points) {
     const auto& r = p.equilibrium;
-    std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %+16.9e  %16.9e  %8d\n", p.parameter, r.state[static_cast<long>(component)],
-                  r.roots.empty() ? NAN : r.roots[0].value.real(), r.roots.empty() ? NAN : r.roots[0].value.imag(),
-                  r.unstable);
+    std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %+16.9e  %16.9e  %8d\n", p.parameter,
+                  r.state[static_cast<long>(component)], r.roots.empty() ? NAN : r.roots[0].value.real(),
+                  r.roots.empty() ? NAN : r.roots[0].value.imag(), r.unstable);
     os << line;
   }
   os << "bifurcations: " << b.bifurcations.size() << " (located on the exact characteristic function)\n";

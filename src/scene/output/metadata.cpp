@@ -34,8 +34,8 @@ OutputMetadata make_metadata(const std::string& command, const std::optional<std
   };
   // A result that names its model and state (floquet, continue) names them in its files too, even
   // when `run` writes them from its JSON alone.
-  if (result.is_object() && result.contains("model") && result["model"].is_string() &&
-      result.contains("state_names") && result["state_names"].is_array()) {
+  if (result.is_object() && result.contains("model") && result["model"].is_string() && result.contains("state_names") &&
+      result["state_names"].is_array()) {
     std::vector<std::string> names;
     for (const auto& name : result["state_names"])
       if (name.is_string()) names.push_back(name.get<std::string>());
