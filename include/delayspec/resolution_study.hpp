@@ -81,9 +81,10 @@ class ResolutionStudy {
   ErrorBars error_bars(const LevelResult& at_N, Eigen::VectorXd orbit_at_N, double& seconds);
 
   // The solve at map().N with the solver's options, and with_error_bars its bars (above, with the
-  // retries from the orbit at N when retry_from_N). NumericalFailure when the orbit or the solve
-  // at N fails.
-  FloquetAtResolution floquet(bool with_error_bars, bool retry_from_N = true);
+  // retries from the orbit at N when retry_from_N); keep_sequence: the orbit's states of one map
+  // stay in at_orbit.sequence (nonlinear models). NumericalFailure when the orbit or the solve at
+  // N fails.
+  FloquetAtResolution floquet(bool with_error_bars, bool retry_from_N = true, bool keep_sequence = false);
 
  private:
   LevelResult run(int N, int count, const Eigen::VectorXd* guess, int from_N = 0);

@@ -263,9 +263,34 @@ class GridResult(Result):
 class ContinueResult(SweepResult):
     """`continue`: per-point fields stacked over the branch's points (`parameter`, `multipliers`:
     points x nev complex128, `verdict`: "stable", "unstable" or "undecided" for N -> infinity, ...),
-    and the CLI's fields (`bifurcations`, `Ns`, `verdicts_note`, ...; see docs/continuation.md).
+    and the CLI's fields (`bifurcations`, `Ns`, `verdicts_note`, `state_names`, ...; see
+    docs/continuation.md). `maximum(state)`, `minimum(state)` and `amplitude(state)` ((max - min)/2)
+    give an orbit branch's measures of the state component named `state` (the model's name, e.g. "x").
     With `continue_switch` on a branch of equilibria, `hopf_branch(i)` is the branch of orbits born
     at its i-th Hopf point, as a ContinueResult of its own (`parameter`, `period`, ... stacked)."""
+
+    def _measure(self, field, state):
+        """The orbits' measure `field` ("max" or "min") of state component `state`, per point."""
+        names = list(self._data.get("state_names") or [])
+        if state not in names:
+            raise ValueError(f"state `{state}`: not a state component of the model (state_names: "
+                             f"{', '.join(names) or 'none in this result'})")
+        i = names.index(state)
+        return np.array([np.nan if p.get("measures") is None or p["measures"][field][i] is None
+                         else p["measures"][field][i] for p in self._data.get("points", [])], dtype=np.float64)
+
+    def maximum(self, state):
+        """The max over each point's orbit of the state component named `state` (one of
+        `state_names`: the model's names, e.g. "x", "v"), float64 per point."""
+        return self._measure("max", state)
+
+    def minimum(self, state):
+        """The min over each point's orbit of the state component named `state`, per point."""
+        return self._measure("min", state)
+
+    def amplitude(self, state):
+        """(max - min)/2 over each point's orbit of the state component named `state`, per point."""
+        return (self._measure("max", state) - self._measure("min", state)) / 2
 
     def hopf_branch(self, index=0):
         """The branch of orbits born at the index-th Hopf point (`hopf_branches[index]` of the
@@ -280,6 +305,7 @@ class ContinueResult(SweepResult):
         # beside `from_parameter`, so that `period` is the points' (stacked)
         if "period" in branch:
             branch["from_period"] = branch.pop("period")
+        branch.setdefault("state_names", self._data.get("state_names"))  # for maximum(state), ...
         return ContinueResult(self.command, branch, {}, self.status)
 
 

@@ -50,6 +50,20 @@ def test_floquet_reports_error_estimates_and_a_verdict():
     np.testing.assert_array_equal(off.multipliers, r.multipliers)
 
 
+def test_floquet_gives_the_orbit_as_a_time_series_by_state_name():
+    """Issue 61 item 8: the orbit over one map, t and each state component by its name, as arrays
+    (the CLI test checks the numbers against a long simulation: tests/cli/test_cli_floquet.cpp)."""
+    keys = dict(N=40, nev=2, error_bars="off", orbit_series="on")
+    r = delayspec.floquet(DEFAULT, **keys)
+    same_as_cli(r, "floquet", DEFAULT, **keys)
+    series = r.orbit_series
+    assert sorted(series) == ["t", "v", "x"] and r.state_names == ["x", "v"]
+    assert series["t"].dtype == np.float64 and series["x"].shape == (r.steps_per_map,)
+    # the grid's node times over one forcing period (aligned with the orbit's contacts: not uniform)
+    t = series["t"]
+    assert t[0] == 0 and np.all(np.diff(t) > 0) and t[-1] < 2 * np.pi / 0.802
+
+
 def test_floquet_without_scene_equals_cli_json():
     r = delayspec.floquet(N=20, k=0.1, orbit="newton")
     same_as_cli(r, "floquet", N=20, k=0.1, orbit="newton")
@@ -356,6 +370,14 @@ def test_the_orbits_born_at_a_hopf_point_come_as_arrays():
     assert b.from_period == r["hopf_branches"][0]["period"]  # 2 pi / omega at the Hopf point
     with pytest.raises(IndexError, match="1 branch"):
         r.hopf_branch(1)
+    # the orbits' size by the model's name of the state, (max - min)/2 as the table prints it
+    assert r.state_names == ["x"]
+    maxima = np.array([p["measures"]["max"][0] for p in points])
+    minima = np.array([p["measures"]["min"][0] for p in points])
+    np.testing.assert_array_equal(b.maximum("x"), maxima)
+    np.testing.assert_array_equal(b.amplitude("x"), (maxima - minima) / 2)
+    with pytest.raises(ValueError, match="state `y1`: not a state component of the model .state_names: x"):
+        b.amplitude("y1")
 
 
 def test_hopf_points_carry_their_criticality():

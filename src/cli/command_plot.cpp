@@ -18,7 +18,8 @@
 //   trajectory.csv, poincare.csv (simulate) -> phase: portrait with Poincare points and x = e
 //   impacts.csv (simulate)    -> impacts: cumulative impact count against time
 //   branch.csv, continue.json (continue) -> branch, branch_mu1 (plot_continuation.hpp)
-// Keys: plot_gnuplot (the program, default "gnuplot"), plot_width, plot_height (pixels of the PNG).
+// Keys: plot_gnuplot (the program, default "gnuplot"), plot_width, plot_height (pixels of the PNG),
+// plot_component (the state component of the branch figures).
 //
 // The inputs are read strictly (plot_inputs.hpp): a file of the wrong shape is bad input (exit 2)
 // naming the file and the line or field; values reach the scripts only as numbers we print or as
@@ -76,6 +77,14 @@ std::string json_scene_title(const JsonField& j) {
   return parameters ? parameters->text_or("title", "") : "";
 }
 
+// The model as titles name it: the metadata's model_label (an [equations] model by its scene),
+// else the result's `model`.
+std::string json_model_label(const JsonField& j) {
+  const auto metadata = j.find("metadata");
+  const std::string label = metadata ? metadata->text_or("model_label", "") : "";
+  return label.empty() ? j.text_or("model", "?") : label;
+}
+
 // floquet.json: multipliers [{re, im, ...}] -> the complex plane with the unit circle.
 void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   std::string rows;
@@ -92,9 +101,9 @@ void plot_multipliers(FigureRenderer& renderer, const JsonField& j) {
   const double N = j.number_or("N", NAN);
   std::ostringstream gp;
   gp << gnuplot_datablock("mu", rows);
-  gp << figure_title(json_scene_title(j), "Floquet multipliers: model " + j.text_or("model", "?") + ", N = " +
-                                             (std::isnan(N) ? std::string("?") : gnuplot_number(N)) + ", solver " +
-                                             j.text_or("solver", "?"));
+  gp << figure_title(json_scene_title(j), "Floquet multipliers: model " + enhanced_text(json_model_label(j)) +
+                                              ", N = " + (std::isnan(N) ? std::string("?") : gnuplot_number(N)) +
+                                              ", solver " + j.text_or("solver", "?"));
   gp << "set size ratio -1\nset grid\nset xlabel 'Re {/Symbol m}'\nset ylabel 'Im {/Symbol m}'\n";
   gp << "set xrange [" << gnuplot_number(-r) << ":" << gnuplot_number(r) << "]\nset yrange [" << gnuplot_number(-r)
      << ":" << gnuplot_number(r) << "]\n";
@@ -183,7 +192,7 @@ void plot_chart(FigureRenderer& renderer, const fs::path& file) {
   }
   gp << "unset contour\nset surface\n";
   gp << figure_title(t.metadata_text("title", ""), "Spectral radius |{/Symbol m}_1|, model " +
-                                                       t.metadata_text("model", "?") + ", N = " + title_N(t) +
+                                                       enhanced_text(t.model_label("?")) + ", N = " + title_N(t) +
                                                        (typed ? "" : " (white line: |{/Symbol m}_1| = 1)"));
   gp << "set xlabel " << key_axis_label(t.columns[0]) << "\nset ylabel " << key_axis_label(t.columns[1]) << "\n";
   gp << "set cblabel '|{/Symbol m}_1| (clipped at 2)'\nset cbrange [0:2]\n"
@@ -235,7 +244,7 @@ void plot_basin(FigureRenderer& renderer, const fs::path& file) {
   }
   std::ostringstream gp;
   gp << gnuplot_datablock("basin", rows);
-  gp << figure_title(t.metadata_text("title", ""), "Basins of attraction, model " + t.metadata_text("model", "?") +
+  gp << figure_title(t.metadata_text("title", ""), "Basins of attraction, model " + enhanced_text(t.model_label("?")) +
                                                        ", k = " + gnuplot_number(t.metadata_number("k", 0)) +
                                                        ", N = " + title_N(t));
   gp << "set xlabel " << key_axis_label(t.columns[0]) << "\nset ylabel " << key_axis_label(t.columns[1]) << "\n";
@@ -428,8 +437,13 @@ void plot_bifurcation(FigureRenderer& renderer, const fs::path& dir) {
     if (!row.empty()) rows += gnuplot_number(row[0]) + " " + gnuplot_number(row[1]) + "\n";
   std::ostringstream gp;
   gp << gnuplot_datablock("section", rows);
-  gp << figure_title(t.metadata_text("title", ""), "Bifurcation diagram: x on the Poincare section against " + label);
-  gp << "set xlabel " << gnuplot_label(label) << "\nset ylabel 'x(t_0 + jT)'\nset grid\nset key off\n";
+  // the column x is the first state component: named as the model names it where the file says
+  const std::vector<std::string> names = t.state_names();
+  const std::string x = enhanced_text(names.empty() ? "x" : names.front());
+  gp << figure_title(t.metadata_text("title", ""),
+                     "Bifurcation diagram: " + x + " on the Poincare section against " + enhanced_text(label));
+  gp << "set xlabel " << gnuplot_label(label) << "\nset ylabel " << gnuplot_string(x + "(t_0 + jT)")
+     << "\nset grid\nset key off\n";
   gp << "plot $section using 1:2 with points pt 7 ps 0.3 lc rgb '#000000'\n";
   renderer.figure("bifurcation", gp.str());
 }
@@ -486,13 +500,19 @@ void plot_phase(FigureRenderer& renderer, const fs::path& dir) {
       section_plot = ", \\\n     $section using 1:2 with points pt 7 ps 0.8 lc rgb '#000000' title 'Poincare points'";
     }
   }
-  const std::string e = gnuplot_number(impact_boundary(dir, trajectory));
   gp << figure_title(trajectory.metadata_text("title", ""),
                      std::string("Phase portrait") + (thin ? " (trajectory thinned for drawing)" : ""));
   gp << "set xlabel 'x'\nset ylabel 'v = dx/dt'\nset grid\nset key outside bottom center horizontal\n";
-  gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#1f77b4' lw 2 front\n";
-  gp << "plot $trajectory using 1:2 with lines lc rgb '#999999' title 'trajectory'" << section_plot
-     << ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title " << gnuplot_string("impact boundary x = e = " + e)
+  // The impact boundary only for the impact model (the default): mathieu and milling have x, v too,
+  // and no boundary to draw or list in the legend.
+  std::string boundary_plot;
+  if (trajectory.metadata_text("model", "impact") == "impact") {
+    const std::string e = gnuplot_number(impact_boundary(dir, trajectory));
+    gp << "set arrow from " << e << ", graph 0 to " << e << ", graph 1 nohead lc rgb '#1f77b4' lw 2 front\n";
+    boundary_plot =
+        ", \\\n     NaN with lines lc rgb '#1f77b4' lw 2 title " + gnuplot_string("impact boundary x = e = " + e);
+  }
+  gp << "plot $trajectory using 1:2 with lines lc rgb '#999999' title 'trajectory'" << section_plot << boundary_plot
      << "\n";
   renderer.figure("phase", gp.str());
 }
@@ -519,6 +539,8 @@ int command_plot(Config& config, const Invocation& inv) {
   settings.width = static_cast<int>(config.get_int_in_range("plot_width", settings.width, 100, 10000));
   settings.height = static_cast<int>(config.get_int_in_range("plot_height", settings.height, 100, 10000));
   if (settings.program.empty()) throw BadInput("`plot_gnuplot = `: empty (the gnuplot program to run)");
+  // checked against the branch file's state names when a branch is drawn (plot_continuation.hpp)
+  const std::string component = config.get_string("plot_component", "");
   config.check_all_used();
   // The directory: `delayspec plot DIR` (the positional argument) or --out DIR.
   std::string dir_text = inv.scene.value_or(inv.out_dir.value_or(""));
@@ -542,8 +564,8 @@ int command_plot(Config& config, const Invocation& inv) {
   if (present(dir, "section.csv")) plot_bifurcation(renderer, dir);
   if (present(dir, "trajectory.csv")) plot_phase(renderer, dir);
   if (present(dir, "impacts.csv")) plot_impacts(renderer, dir);
-  if (present(dir, "branch.csv")) plot_continuation(renderer, dir);
-  if (present(dir, "equilibria.csv")) plot_equilibria(renderer, dir);
+  if (present(dir, "branch.csv")) plot_continuation(renderer, dir, component);
+  if (present(dir, "equilibria.csv")) plot_equilibria(renderer, dir, component);
   if (present(dir, "boundary.csv")) plot_boundary(renderer, dir);
   if (present(dir, "hopf_curves.csv") || present(dir, "fold_curves.csv")) plot_hopf_curves(renderer, dir);
   if (present(dir, "converge.json")) {

@@ -33,14 +33,16 @@ std::string gnuplot_string(const std::string& text) {
   return out + "'";
 }
 
-std::string gnuplot_label(const std::string& text) {
+std::string enhanced_text(const std::string& text) {
   std::string escaped;
   for (const char c : text) {
     if (std::string_view("_^{}@&~").find(c) != std::string_view::npos) escaped += '\\';
     escaped += c;
   }
-  return gnuplot_string(escaped);
+  return escaped;
 }
+
+std::string gnuplot_label(const std::string& text) { return gnuplot_string(enhanced_text(text)); }
 
 std::string figure_title(const std::string& scene_title, const std::string& description) {
   if (scene_title.empty()) return "set title " + gnuplot_string(description) + "\n";

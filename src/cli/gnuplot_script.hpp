@@ -27,6 +27,9 @@ std::string gnuplot_string(const std::string& text);
 // The same for text drawn in enhanced mode (axis labels from key names): enhanced-text controls
 // (_ ^ { } @ & ~) are escaped, so that `spindle_rpm` is not drawn as spindle with subscript r.
 std::string gnuplot_label(const std::string& text);
+// The escaping of gnuplot_label alone, for a name inside a string that has enhanced-text markup
+// of its own (then quoted with gnuplot_string): "max u_v" must not subscript the v.
+std::string enhanced_text(const std::string& text);
 
 // A figure's title: the scene's own title (a run's `title`, from the result file's metadata) on
 // top and `description` (enhanced text, what is drawn) in smaller type below it; the description

@@ -138,7 +138,10 @@ void plot_hopf_curves(FigureRenderer& renderer, const std::filesystem::path& dir
   std::ostringstream gp;
   for (const auto& [kind, block] : by_kind) gp << gnuplot_datablock(kind, block);
   gp << gnuplot_datablock("marks", marks.empty() ? "nan nan\n" : marks);
-  gp << figure_title("", "Curves of the equilibrium's bifurcations");
+  // the scene's title above, as on every figure (boundary.json's metadata.parameters)
+  const auto metadata = root.find("metadata");
+  const auto parameters = metadata ? metadata->find("parameters") : std::nullopt;
+  gp << figure_title(parameters ? parameters->text_or("title", "") : "", "Curves of the equilibrium's bifurcations");
   gp << "set xlabel " << key_axis_label(root.at("boundary_x").text()) << "\nset ylabel "
      << key_axis_label(root.at("boundary_y").text())
      << "\nset grid\nset key outside bottom center horizontal\nset style textbox opaque noborder\n" << labels;

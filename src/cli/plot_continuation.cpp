@@ -9,6 +9,7 @@
 
 #include "delayspec/errors.hpp"
 #include "cli/plot_inputs.hpp"
+#include "scene/output/metadata.hpp"
 
 namespace delayspec::cli {
 
@@ -89,28 +90,56 @@ void branch_figure(FigureRenderer& renderer, const ResultTable& t, const BranchF
      << gnuplot_datablock("unstable", dashed.empty() ? "nan nan\n" : dashed)
      << gnuplot_datablock("marks", f.marks.empty() ? "nan nan\n" : f.marks)
      << gnuplot_datablock("undecided", open.empty() ? "nan nan\n" : open);
-  gp << figure_title(t.metadata_text("title", ""),
-                     f.title + " (stable solid, unstable dashed" +
-                         (none_decided ? "; at this N: no N -> infinity verdict without continue_Ns)" : ")"));
+  const std::string styles = !solid.empty() && !dashed.empty() ? "stable solid, unstable dashed"
+                             : !solid.empty()                  ? "stable throughout"
+                                                               : "unstable throughout";
+  gp << figure_title(
+      t.metadata_text("title", ""),
+      f.title + " (" + styles + (none_decided ? "; at this N: no N -> infinity verdict without continue_Ns)" : ")"));
   gp << "set xlabel " << gnuplot_label(f.key) << "\nset ylabel " << gnuplot_string(f.ylabel)
      << "\nset grid\nset key top left\n"
      << f.labels;
-  gp << "plot $stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable', \\\n"
-     << "     $unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable'"
-     << (f.marks.empty() ? "" : ", \\\n     $marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'")
-     << (open.empty() ? ""
-                      : ", \\\n     $undecided using 1:2 with points pt 6 ps 1.2 lc rgb '#7f7f7f' title "
-                        "'undecided as N -> infinity'")
-     << (f.reference.empty() ? "" : ", \\\n     " + f.reference + " with lines lc rgb '#2ca02c' title '" +
-                                        f.reference_title + "'")
-     << "\n";
+  // A legend entry only for what is drawn: a branch stable throughout has no dashed stretch.
+  std::string plot = "plot ";
+  const auto add = [&](const std::string& item) { plot += (plot == "plot " ? "" : ", \\\n     ") + item; };
+  if (!solid.empty()) add("$stable using 1:2 with lines lw 2 dt 1 lc rgb '#000000' title 'stable'");
+  if (!dashed.empty()) add("$unstable using 1:2 with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable'");
+  if (!f.marks.empty()) add("$marks using 1:2 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'bifurcations'");
+  if (!open.empty())
+    add("$undecided using 1:2 with points pt 6 ps 1.2 lc rgb '#7f7f7f' title 'undecided as N -> infinity'");
+  if (!f.reference.empty())
+    add(f.reference + " with lines lc rgb '#2ca02c' title " + gnuplot_string(f.reference_title));
+  gp << plot << "\n";
   renderer.figure(f.name, gp.str());
 }
 
-// The figures of one branch of orbits: `name` (max y1 over the orbit) and `name`_mu1 (|mu_1|)
-// from its CSV, the bifurcations (`bifurcations`: continue.json's list for it, or null) marked.
+// The names of a branch file's d state components: its `# state_names` line (continue writes
+// the model's names there), else y1, ..., yd (a file written before it did).
+std::vector<std::string> state_names(const ResultTable& t, size_t d) {
+  std::vector<std::string> names = t.state_names();
+  if (names.size() == d) return names;
+  names.clear();
+  for (size_t c = 0; c < d; ++c) names.push_back("y" + std::to_string(c + 1));
+  return names;
+}
+
+// The component a branch's figures show (0-based): plot's plot_component (`component`), else the
+// one continue was given (the file records it), else the first.
+size_t shown_component(const ResultTable& t, const std::string& component, const std::vector<std::string>& names) {
+  return state_component("plot_component", component.empty() ? t.metadata_text("plot_component", "1") : component,
+                         names);
+}
+
+// A figure's title: `what` of the model (as the files name it) against `key`.
+std::string branch_title(const ResultTable& t, const std::string& what, const std::string& key) {
+  return what + " of " + enhanced_text(t.model_label("?")) + " against " + enhanced_text(key);
+}
+
+// The figures of one branch of orbits: `name` (the max over the orbit of the component chosen
+// by plot_component, `component`) and `name`_mu1 (|mu_1|) from its CSV, the bifurcations
+// (`bifurcations`: continue.json's list for it, or null) marked.
 void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path& csv, const JsonField* bifurcations,
-                          const std::string& name, const std::string& what) {
+                          const std::string& name, const std::string& what, const std::string& component) {
   // max_H and contact_time are nan for models without switching; the multiplier columns for points
   // with fewer multipliers than nev.
   ResultTable t = read_result_table(csv, [](const std::string& c) {
@@ -118,10 +147,14 @@ void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path&
   });
   t.require_header({"parameter", "stable", "unstable", "abs_mu1", "max_y1"});
   t.require_rows();
-  const int stable = t.column("stable"), mu1 = t.column("abs_mu1"), max_y1 = t.column("max_y1");
+  size_t d = 0;  // the columns max_y1 .. max_yd (docs/formats.md)
+  while (t.column("max_y" + std::to_string(d + 1)) >= 0) ++d;
+  const std::vector<std::string> names = state_names(t, d);
+  const size_t c = shown_component(t, component, names);
+  const int stable = t.column("stable"), mu1 = t.column("abs_mu1"), max_y = t.column("max_y" + std::to_string(c + 1));
   const int undecided = t.column("undecided");  // -1: no verdicts (one level, or a Hopf branch)
   const std::string key = t.metadata_text("continue_key", "parameter");
-  // The bifurcations: parameter, max y1 at the point, |mu| (1 on the circle; grazing: none).
+  // The bifurcations: parameter, the component's max at the point, |mu| (1 on the circle; grazing: none).
   std::string marks_y, marks_mu, labels_y, labels_mu;
   double x0, x1;
   parameter_range(t, x0, x1);
@@ -129,11 +162,16 @@ void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path&
     int index = 0;
     for (const JsonField& b : bifurcations->elements()) {
       const double p = b.at("parameter").number();
-      const double y = b.at("measures").at("max").elements().at(0).number();
+      const JsonField max_field = b.at("measures").at("max");
+      const std::vector<JsonField> max = max_field.elements();
+      if (max.size() != d)
+        max_field.fail("has " + std::to_string(max.size()) + " entries, not " + std::to_string(d) +
+                       " (the CSV's max_y columns)");
+      const double y = max[c].number();
       const std::string type = b.at("type").text();
       if (type != "fold" && type != "period-doubling" && type != "neimark-sacker" && type != "grazing")
         b.at("type").fail("unknown bifurcation type");
-      if (type != "grazing") insert_bifurcation_row(t, p, max_y1, y, mu1, 1);
+      if (type != "grazing") insert_bifurcation_row(t, p, max_y, y, mu1, 1);
       marks_y += gnuplot_number(p) + " " + gnuplot_number(y) + "\n";
       labels_y += bifurcation_label(++index, type, p, y, x0, x1);
       if (type != "grazing") {
@@ -142,9 +180,10 @@ void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path&
       }
     }
   }
-  const std::string title = what + " of " + t.metadata_text("model", "?") + " against " + key;
+  const std::string title = branch_title(t, what, key);
   branch_figure(renderer, t,
-                {name, title, key, "max y_1 over the orbit", marks_y, labels_y, "", "", max_y1, stable, undecided});
+                {name, title, key, "max " + enhanced_text(names[c]) + " over the orbit", marks_y, labels_y, "", "",
+                 max_y, stable, undecided});
   if (mu1 >= 0)
     branch_figure(renderer, t,
                   {name + "_mu1", title, key, "|{/Symbol m}_1|", marks_mu, labels_mu, "1", "|{/Symbol m}| = 1", mu1,
@@ -153,27 +192,32 @@ void orbit_branch_figures(FigureRenderer& renderer, const std::filesystem::path&
 
 }  // namespace
 
-void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& dir) {
+void plot_continuation(FigureRenderer& renderer, const std::filesystem::path& dir, const std::string& component) {
   if (!std::filesystem::exists(dir / "continue.json")) {
-    orbit_branch_figures(renderer, dir / "branch.csv", nullptr, "branch", "Branch");
+    orbit_branch_figures(renderer, dir / "branch.csv", nullptr, "branch", "Branch", component);
     return;
   }
   const nlohmann::json doc = read_json_file(dir / "continue.json");
   const JsonField j(doc, "continue.json", "");
   const JsonField bifurcations = j.at("bifurcations");
-  orbit_branch_figures(renderer, dir / "branch.csv", &bifurcations, "branch", "Branch");
+  orbit_branch_figures(renderer, dir / "branch.csv", &bifurcations, "branch", "Branch", component);
 }
 
-void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir) {
+void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir, const std::string& component) {
   // the root columns are nan where a point has fewer roots than nroots
   ResultTable t = read_result_table(dir / "equilibria.csv", [](const std::string& c) {
     return c.rfind("lambda", 0) == 0;
   });
   t.require_header({"parameter", "stable", "unstable"});
   t.require_rows();
-  // the first state component: the column after parameter, stable, unstable (docs/formats.md)
-  const int stable = t.column("stable"), y1 = 3, re1 = t.require_column("lambda1_re", "the roots lambda1_re, lambda1_im, ...");
-  const std::string key = t.metadata_text("continue_key", "parameter"), y1_name = t.columns.at(3);
+  // the state components: the columns after parameter, stable, unstable, named by the model
+  // (docs/formats.md), up to the roots'
+  const int stable = t.column("stable"), re1 = t.require_column("lambda1_re", "the roots lambda1_re, lambda1_im, ...");
+  if (re1 < 4) throw BadInput("`" + t.path.string() + "`: no state column before `lambda1_re`");
+  const std::vector<std::string> names(t.columns.begin() + 3, t.columns.begin() + re1);
+  const size_t c = shown_component(t, component, names);
+  const int y = 3 + static_cast<int>(c);
+  const std::string key = t.metadata_text("continue_key", "parameter");
   // The bifurcations of continue.json: marked at their state and on Re lambda = 0.
   std::string marks_y, marks_re, labels_y, labels_re;
   double x0, x1;
@@ -184,20 +228,26 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir)
     int index = 0;
     for (const JsonField& b : j.at("bifurcations").elements()) {
       const double p = b.at("parameter").number();
-      const double y = b.at("equilibrium").elements().at(0).number();
+      const JsonField state_field = b.at("equilibrium");
+      const std::vector<JsonField> state = state_field.elements();
+      if (state.size() != names.size())
+        state_field.fail("has " + std::to_string(state.size()) + " entries, not " + std::to_string(names.size()) +
+                         " (the CSV's state columns)");
+      const double at = state[c].number();
       const std::string type = b.at("type").text();
       if (type != "fold" && type != "hopf" && type != "branch_point") b.at("type").fail("unknown bifurcation type");
-      insert_bifurcation_row(t, p, y1, y, re1, 0);
+      insert_bifurcation_row(t, p, y, at, re1, 0);
       ++index;
-      marks_y += gnuplot_number(p) + " " + gnuplot_number(y) + "\n";
+      marks_y += gnuplot_number(p) + " " + gnuplot_number(at) + "\n";
       marks_re += gnuplot_number(p) + " 0\n";
-      labels_y += bifurcation_label(index, type, p, y, x0, x1);
+      labels_y += bifurcation_label(index, type, p, at, x0, x1);
       labels_re += bifurcation_label(index, type, p, 0, x0, x1);
     }
   }
-  const std::string title = "Equilibria of " + t.metadata_text("model", "?") + " against " + key;
+  const std::string title = branch_title(t, "Equilibria", key);
   branch_figure(renderer, t,
-                {"equilibria", title, key, y1_name + " at the equilibrium", marks_y, labels_y, "", "", y1, stable});
+                {"equilibria", title, key, enhanced_text(names[c]) + " at the equilibrium", marks_y, labels_y, "", "",
+                 y, stable});
   branch_figure(renderer, t,
                 {"equilibria_re_lambda", title, key, "Re {/Symbol l}_1 (rightmost root)", marks_re, labels_re, "0",
                  "Re {/Symbol l} = 0", re1, stable});
@@ -215,7 +265,7 @@ void plot_equilibria(FigureRenderer& renderer, const std::filesystem::path& dir)
     const std::optional<JsonField> bifurcations =
         has_json ? std::optional<JsonField>(branches[static_cast<size_t>(k - 1)].at("bifurcations")) : std::nullopt;
     orbit_branch_figures(renderer, dir / (name + ".csv"), bifurcations ? &*bifurcations : nullptr, name,
-                         "Orbits from a Hopf point");
+                         "Orbits from a Hopf point", component);
   }
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 
 #include "delayspec/errors.hpp"
 
@@ -78,6 +79,17 @@ double ResultTable::metadata_number(const std::string& key, double fallback) con
 std::string ResultTable::metadata_text(const std::string& key, const std::string& fallback) const {
   const auto it = metadata.find(key);
   return it == metadata.end() ? fallback : it->second;
+}
+
+std::string ResultTable::model_label(const std::string& fallback) const {
+  return metadata_text("model_label", metadata_text("model", fallback));
+}
+
+std::vector<std::string> ResultTable::state_names() const {
+  std::vector<std::string> names;
+  std::stringstream line(metadata_text("state_names", ""));
+  for (std::string name; std::getline(line, name, ',');) names.push_back(name);
+  return names;
 }
 
 size_t ResultTable::data_rows() const {

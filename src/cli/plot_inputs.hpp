@@ -42,6 +42,11 @@ struct ResultTable {
   double metadata_number(const std::string& key, double fallback) const;
   // A metadata value as text (unchecked: quote it with gnuplot_string()).
   std::string metadata_text(const std::string& key, const std::string& fallback) const;
+  // The model as titles name it: the `# model_label` line (an [equations] model by its scene),
+  // else the key `model`, else `fallback`.
+  std::string model_label(const std::string& fallback) const;
+  // The state's names of the `# state_names = x,v` line (the model's, in order), empty without one.
+  std::vector<std::string> state_names() const;
   // The number of non-empty rows.
   size_t data_rows() const;
 

@@ -136,18 +136,22 @@ ErrorBars ResolutionStudy::error_bars(const LevelResult& at_N, Eigen::VectorXd o
   return bars;
 }
 
-FloquetAtResolution ResolutionStudy::floquet(bool with_error_bars, bool retry_from_N) {
+FloquetAtResolution ResolutionStudy::floquet(bool with_error_bars, bool retry_from_N, bool keep_sequence) {
   FloquetAtResolution out;
   const auto start = std::chrono::steady_clock::now();
   OrbitRequest request;
-  request.sequence = with_error_bars && retry_from_N;  // where a coarser level's Newton may start
+  request.sequence = (with_error_bars && retry_from_N) || keep_sequence;  // where a coarser level's Newton may start
   out.at_orbit = analyses_->linearised_orbit(map_, orbit_, request);
   out.orbit_seconds = seconds_since(start);
   out.result = floquet_multipliers(*out.at_orbit.monodromy, solver_);
   out.at_orbit.monodromy.reset();  // its step maps: memory the coarser levels can use
   // Each multiplier's accuracy (multiplier_accuracy): the ones below it are not printed as values.
   out.at_N = level_result(out.result, dimension(map_.N), analyses_->grid(map_).K);
-  if (with_error_bars) out.bars = error_bars(out.at_N, std::move(out.at_orbit.sequence), out.error_bar_seconds);
+  if (with_error_bars) {
+    Eigen::VectorXd from;  // the orbit at N, where a coarse level whose orbit failed is retried from
+    if (retry_from_N) from = keep_sequence ? out.at_orbit.sequence : std::move(out.at_orbit.sequence);
+    out.bars = error_bars(out.at_N, std::move(from), out.error_bar_seconds);
+  }
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <complex>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <tuple>
@@ -292,7 +293,7 @@ TEST(EquilibriumCli, TheFirstLyapunovCoefficientPredictsTheOrbitsAmplitude) {
 TEST(EquilibriumCli, BoundaryOfAnEquilibriumFollowsItsHopfCurveToTheGeneralisedHopfPoint) {
   const std::string scene = std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/wright_generalised_hopf.toml";
   const std::string dir = delayspec::testing::fresh_dir("boundary_equilibria").string();
-  const CliResult r = run({"boundary", scene, "--json", "--out", dir, "--set",
+  const CliResult r = run({"boundary", scene, "--json", "--out", dir, "--set", "title=Wright with a cubic", "--set",
                            std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE});
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -313,6 +314,10 @@ TEST(EquilibriumCli, BoundaryOfAnEquilibriumFollowsItsHopfCurveToTheGeneralisedH
   const CliResult plot = run({"plot", dir});
   ASSERT_EQ(plot.status, 0) << plot.err;
   EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(dir) / "plots/hopf_curves.png"));
+  // the scene's title on the figure, as on every other (issue 61 item 8)
+  std::ifstream gp(std::filesystem::path(dir) / "plots/hopf_curves.gp");
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  EXPECT_NE(script.find("'Wright with a cubic'"), std::string::npos) << script;
 
   const CliResult forced = run({"boundary", "--set", "model=impact", "--set", "boundary_object=equilibrium", "--set",
                                 "boundary_x=k", "--set", "boundary_y=e", "--set", "boundary_x_from=0.1", "--set",

@@ -2,10 +2,14 @@
 // (CLI contract: exit 2 and a message naming the key and the value).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "cli_test_support.hpp"
+#include "delayspec/errors.hpp"
 #include "delayspec_test_paths.hpp"
 
 namespace {
@@ -114,4 +118,72 @@ TEST(FloquetCli, DefaultSceneRuns) {
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   EXPECT_LT(j["multipliers"][0]["abs"].get<double>(), 1.0);  // the period-1 orbit is stable
+}
+
+// Issue 61 item 8: orbit_series = on gives the orbit over one map as a time series, by the
+// model's state names. Checked against what does not come from the orbit search: a long
+// simulation of the same discrete map (the stable orbit's Poincare point after 100 periods), the
+// grid's step (t), v = dx/dt (central differences, O(h^2)), and for the Pyragas orbit of unknown
+// period its closed form, a circle (the equation is rotation invariant, so the discrete orbit is
+// one too; its radius^2 -> -lam = 0.005 as N grows, within 5% at N = 40).
+TEST(FloquetCli, OrbitSeriesIsTheOrbitOverOneMapByStateName) {
+  const std::filesystem::path dir = delayspec::testing::fresh_dir("floquet_orbit_series");
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "forced_pair.toml").string();
+  std::ofstream(scene) << R"toml(model = "equations"
+[equations]
+state = ["x", "v"]
+parameters = { b = 0.1, c = 1.0 }
+period = "2*pi"
+delay = "1"
+rhs = ["v", "-x - c*v - 0.1*x^3 + b*x_tau + cos(t)"]
+history = { x = 0, v = 0 }
+)toml";
+  const std::string cache = std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE;
+  const CliResult f = run({"floquet", scene, "--json", "--set", cache, "--set", "N=40", "--set", "orbit_series=on",
+                           "--set", "error_bars=off"});
+  ASSERT_EQ(f.status, 0) << f.err;
+  const auto j = nlohmann::json::parse(f.out);
+  const auto& s = j["orbit_series"];
+  const size_t K = j["steps_per_map"].get<size_t>();
+  const double h = j["h"].get<double>();
+  ASSERT_EQ(s["t"].size(), K);
+  ASSERT_EQ(s["x"].size(), K);
+  ASSERT_EQ(s["v"].size(), K);
+  for (size_t l = 0; l < K; ++l) EXPECT_NEAR(s["t"][l].get<double>(), l * h, 1e-12);
+  for (size_t l = 1; l + 1 < K; ++l)
+    EXPECT_NEAR((s["x"][l + 1].get<double>() - s["x"][l - 1].get<double>()) / (2 * h), s["v"][l].get<double>(), 1e-3)
+        << l;
+  const CliResult sim = run({"simulate", scene, "--json", "--set", cache, "--set", "N=40", "--set",
+                             "t_end=" + delayspec::format_number(200 * std::acos(-1.0))});
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const auto last = nlohmann::json::parse(sim.out)["poincare"].back();
+  EXPECT_NEAR(last[1].get<double>(), s["x"][0].get<double>(), 1e-10);
+  EXPECT_NEAR(last[2].get<double>(), s["v"][0].get<double>(), 1e-10);
+  // the text prints it too; without the key, neither does
+  const CliResult text =
+      run({"floquet", scene, "--set", cache, "--set", "N=40", "--set", "orbit_series=on", "--set", "error_bars=off"});
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("orbit series (" + std::to_string(K) + " samples over one map):\n"), std::string::npos)
+      << text.out;
+  const CliResult plain = run({"floquet", scene, "--json", "--set", cache, "--set", "N=40", "--set", "error_bars=off"});
+  EXPECT_FALSE(nlohmann::json::parse(plain.out).contains("orbit_series"));
+  const CliResult bad = run({"floquet", scene, "--set", cache, "--set", "orbit_series=yes"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("`orbit_series = yes`"), std::string::npos) << bad.err;
+
+  const CliResult pyragas =
+      run({"floquet", std::string(DELAYSPEC_SOURCE_DIR) + "/data/scenes/pyragas_oscillator.toml", "--json", "--set",
+           cache, "--set", "N=40", "--set", "orbit_series=on", "--set", "error_bars=off"});
+  ASSERT_EQ(pyragas.status, 0) << pyragas.err;
+  const auto p = nlohmann::json::parse(pyragas.out);
+  const auto& o = p["orbit_series"];
+  const size_t n = o["t"].size();
+  ASSERT_GT(n, 10u);
+  EXPECT_NEAR(o["t"][n - 1].get<double>(), (n - 1.0) / n * p["period"].get<double>(), 1e-12);
+  for (size_t l = 0; l < n; ++l) {
+    const double r2 = std::pow(o["x"][l].get<double>(), 2) + std::pow(o["y"][l].get<double>(), 2);
+    EXPECT_NEAR(r2, 0.005, 2.5e-4) << l;
+  }
+  std::filesystem::remove_all(dir);
 }

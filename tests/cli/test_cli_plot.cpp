@@ -4,6 +4,7 @@
 #include <unistd.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <complex>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 
 #include "cli_test_support.hpp"
 #include "delayspec/continuation.hpp"
+#include "delayspec_test_paths.hpp"
 #include "mathieu_ode.hpp"
 #include "png_image.hpp"
 
@@ -564,4 +566,297 @@ TEST(PlotCli, ChartLobesAreTypedByTheMultiplierThatLeavesTheCircle) {
   EXPECT_EQ(delayspec::testing::contains(gp, "Neimark-Sacker"),
             unstable_types.count(delayspec::BifurcationType::neimark_sacker) == 1)
       << gp;  // a legend entry only for the lobes there are
+}
+
+namespace {
+
+// The (x, y) rows of datablock `name` in a figure's script.
+std::vector<std::pair<double, double>> datablock_rows(const std::string& gp, const std::string& name) {
+  std::vector<std::pair<double, double>> rows;
+  const size_t start = gp.find("$" + name + " << EOD\n");
+  if (start == std::string::npos) return rows;
+  std::istringstream in(gp.substr(start, gp.find("\nEOD\n", start) - start));
+  std::string line;
+  std::getline(in, line);  // the datablock's first line
+  for (double x, y; std::getline(in, line);)
+    if (std::istringstream(line) >> x >> y) rows.emplace_back(x, y);
+  return rows;
+}
+
+// The rows of a CSV written by a command (comment lines skipped), each split at its commas; the
+// header first.
+std::vector<std::vector<std::string>> csv_cells(const fs::path& file) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    rows.emplace_back();
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) rows.back().push_back(cell);
+  }
+  return rows;
+}
+
+// The values of column `name` of those rows.
+std::vector<double> csv_column(const std::vector<std::vector<std::string>>& rows, const std::string& name) {
+  std::vector<double> values;
+  const auto it = std::find(rows.at(0).begin(), rows.at(0).end(), name);
+  if (it == rows.at(0).end()) ADD_FAILURE() << "no column " << name;
+  else
+    for (size_t i = 1; i < rows.size(); ++i) values.push_back(std::stod(rows[i].at(it - rows[0].begin())));
+  return values;
+}
+
+}  // namespace
+
+// Issue 61 item 8: an [equations] model's state names and its scene reach the tables, the files'
+// metadata and the figures (not y1, "max y_1" or "equations"); the documented columns max_y1.. stay;
+// plot_component chooses the component shown (a name or a 1-based index; others exit 2 naming
+// the key and value); a branch stable throughout has no `unstable` legend entry.
+TEST(PlotCli, BranchFiguresNameTheStateAndShowTheChosenComponent) {
+  const fs::path dir = fresh_plot_dir("names");
+  const fs::path scene = fresh_plot_dir("names_scene") / "forced_pair.toml";
+  // a damped, forced, weakly nonlinear oscillator: one stable orbit for every b of the range
+  std::ofstream(scene) << R"toml(model = "equations"
+[equations]
+state = ["x", "v"]
+parameters = { b = 0.1, c = 1.0 }
+period = "2*pi"
+delay = "1"
+rhs = ["v", "-x - c*v - 0.1*x^3 + b*x_tau + cos(t)"]
+history = { x = 0, v = 0 }
+)toml";
+  const std::string cache = std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE;
+  const std::vector<std::string> branch = {"continue", scene.string(),    "--set", cache,
+                                           "--set",    "continue_key=b",  "--set", "continue_from=0.1",
+                                           "--set",    "continue_to=0.2", "--set", "N=40"};
+  auto with = [](std::vector<std::string> args, const std::vector<std::string>& extra) {
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  };
+  const CliResult c = run(with(branch, {"--out", dir.string(), "--quiet"}));
+  ASSERT_EQ(c.status, 0) << c.err;
+  const std::string csv = read_text(dir / "branch.csv");
+  EXPECT_TRUE(delayspec::testing::contains(csv, "\n# state_names = x,v\n")) << csv;
+  EXPECT_TRUE(delayspec::testing::contains(csv, "\n# model_label = forced_pair\n")) << csv;
+  const auto rows = csv_cells(dir / "branch.csv");
+  // the documented columns (docs/formats.md) are kept
+  ASSERT_GE(rows.at(0).size(), 8u);
+  EXPECT_EQ(
+      std::vector<std::string>(rows[0].begin(), rows[0].begin() + 8),
+      (std::vector<std::string>{"parameter", "stable", "unstable", "abs_mu1", "max_y1", "max_y2", "min_y1", "min_y2"}));
+  const auto json = nlohmann::json::parse(read_text(dir / "continue.json"));
+  EXPECT_EQ(json["state_names"], (nlohmann::json{"x", "v"}));
+  for (double s : csv_column(rows, "stable")) ASSERT_EQ(s, 1);  // stable throughout: no dashed curve to list
+
+  const std::vector<std::string> size = {"--set", "plot_width=200", "--set", "plot_height=150"};
+  ASSERT_EQ(run(with({"plot", dir.string()}, size)).status, 0);
+  const std::string first = read_text(dir / "plots" / "branch.gp");
+  EXPECT_TRUE(delayspec::testing::contains(first, "set ylabel 'max x over the orbit'")) << first;
+  // the title names the scene (its underscore escaped for gnuplot's enhanced text), not "equations"
+  EXPECT_TRUE(delayspec::testing::contains(first, "Branch of forced\\_pair against b")) << first;
+  EXPECT_FALSE(delayspec::testing::contains(first, "equations")) << first;
+  EXPECT_FALSE(delayspec::testing::contains(first, "'unstable'")) << first;
+  EXPECT_TRUE(delayspec::testing::contains(first, "title 'stable'")) << first;
+
+  // plot_component = v, or its index 2: the figure shows max_y2, the CSV's second component
+  const std::vector<double> p = csv_column(rows, "parameter"), max_v = csv_column(rows, "max_y2");
+  ASSERT_NE(max_v, csv_column(rows, "max_y1"));
+  std::string by_name;
+  for (const char* component : {"v", "2"}) {
+    ASSERT_EQ(run(with({"plot", dir.string(), "--set", std::string("plot_component=") + component}, size)).status, 0);
+    const std::string gp = read_text(dir / "plots" / "branch.gp");
+    EXPECT_TRUE(delayspec::testing::contains(gp, "set ylabel 'max v over the orbit'")) << gp;
+    const auto drawn = datablock_rows(gp, "stable");
+    ASSERT_EQ(drawn.size(), p.size()) << gp;
+    for (size_t i = 0; i < p.size(); ++i) {
+      EXPECT_NEAR(drawn[i].first, p[i], 1e-9 * (1 + std::abs(p[i])));
+      EXPECT_NEAR(drawn[i].second, max_v[i], 1e-9 * (1 + std::abs(max_v[i])));
+    }
+    if (by_name.empty()) by_name = gp;
+    else EXPECT_EQ(gp, by_name);
+  }
+  for (const char* bad : {"w", "0", "3", "y1", "1.0"}) {
+    const CliResult r = run(with({"plot", dir.string(), "--set", std::string("plot_component=") + bad}, size));
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    EXPECT_TRUE(delayspec::testing::contains(r.err, std::string("`plot_component = ") + bad + "`")) << r.err;
+  }
+
+  // continue's table names the component and the model; the choice is recorded for plot
+  const CliResult text = run(with(branch, {"--set", "plot_component=v"}));
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_TRUE(delayspec::testing::contains(text.out, "model forced_pair,")) << text.out;
+  EXPECT_TRUE(delayspec::testing::contains(text.out, "max v")) << text.out;
+  EXPECT_FALSE(delayspec::testing::contains(text.out, "y1")) << text.out;
+  const CliResult bad = run(with(branch, {"--set", "plot_component=3"}));
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_TRUE(delayspec::testing::contains(bad.err, "`plot_component = 3`")) << bad.err;
+  const fs::path chosen = fresh_plot_dir("names_chosen");
+  ASSERT_EQ(run(with(branch, {"--set", "plot_component=v", "--out", chosen.string(), "--quiet"})).status, 0);
+  ASSERT_EQ(run(with({"plot", chosen.string()}, size)).status, 0);
+  EXPECT_TRUE(delayspec::testing::contains(read_text(chosen / "plots" / "branch.gp"), "'max v over the orbit'"));
+  // floquet through run: its figure's title names the model by the scene too
+  const fs::path ran = fresh_dir("plot_names_run");
+  ASSERT_EQ(run({"run", scene.string(), "--set", cache, "--set", "analyses=floquet", "--set", "N=40", "--out",
+                 ran.string(), "--quiet"})
+                .status,
+            0);
+  ASSERT_EQ(run(with({"plot", ran.string()}, size)).status, 0);
+  EXPECT_TRUE(delayspec::testing::contains(read_text(ran / "plots" / "multipliers.gp"),
+                                           "Floquet multipliers: model forced\\_pair, N = 40"));
+  fs::remove_all(dir);
+  fs::remove_all(chosen);
+  fs::remove_all(ran);
+  fs::remove_all(scene.parent_path());
+}
+
+// Issue 61 item 8: the equilibria figure shows the chosen component by its name (z = 0.5 at
+// every equilibrium), and its legend lists a curve only where the CSV has points for it.
+TEST(PlotCli, EquilibriaFigureShowsTheChosenComponent) {
+  const fs::path dir = fresh_plot_dir("names_equilibria");
+  const fs::path scene = dir.string() + "-cusp.toml";
+  std::ofstream(scene) << R"toml(model = "equations"
+equilibrium_guess = [-1.4, 0]
+[equations]
+state = ["x", "z"]
+parameters = { p = -2, q = 0.5, c = 0.5 }
+period = "1"
+delay = "1"
+rhs = ["p + q*x - x^3 + c*(x_tau - x)", "0.5 - z"]
+history = { x = -1.4, z = 0.5 }
+)toml";
+  const std::string cache = std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE;
+  const CliResult c =
+      run({"continue", scene.string(), "--set", cache, "--set", "continue_object=equilibrium", "--set",
+           "continue_key=q", "--set", "continue_from=0.5", "--set", "continue_to=4", "--out", dir.string(), "--quiet"});
+  ASSERT_EQ(c.status, 0) << c.err;
+  const auto rows = csv_cells(dir / "equilibria.csv");
+  const std::vector<double> z = csv_column(rows, "z");
+  ASSERT_EQ(run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"}).status, 0);
+  EXPECT_TRUE(delayspec::testing::contains(read_text(dir / "plots" / "equilibria.gp"), "'x at the equilibrium'"));
+  ASSERT_EQ(
+      run({"plot", dir.string(), "--set", "plot_component=z", "--set", "plot_width=200", "--set", "plot_height=150"})
+          .status,
+      0);
+  const std::string gp = read_text(dir / "plots" / "equilibria.gp");
+  EXPECT_TRUE(delayspec::testing::contains(gp, "set ylabel 'z at the equilibrium'")) << gp;
+  std::vector<std::pair<double, double>> drawn = datablock_rows(gp, "stable");
+  const auto unstable = datablock_rows(gp, "unstable");
+  drawn.insert(drawn.end(), unstable.begin(), unstable.end());
+  for (const auto& [p, y] : drawn) EXPECT_NEAR(y, 0.5, 1e-9) << p;  // z = 0.5 at every equilibrium
+  EXPECT_FALSE(z.empty());
+  // the legend lists each curve the CSV has points for
+  const std::vector<double> stable = csv_column(rows, "stable");
+  EXPECT_EQ(delayspec::testing::contains(gp, "title 'unstable'"), std::count(stable.begin(), stable.end(), 0.0) > 0)
+      << gp;
+  EXPECT_EQ(delayspec::testing::contains(gp, "title 'stable'"), std::count(stable.begin(), stable.end(), 1.0) > 0)
+      << gp;
+  fs::remove_all(dir);
+  fs::remove(scene);
+}
+
+// Issue 61 item 8: the phase portrait of a model without an impact (mathieu has x, v too) has no
+// impact boundary, drawn or in the legend; the impact model's has it.
+TEST(PlotCli, PhasePortraitDrawsTheImpactBoundaryOnlyForTheImpactModel) {
+  for (const std::string model : {"mathieu", "impact"}) {
+    const fs::path dir = fresh_plot_dir("phase_" + model);
+    ASSERT_EQ(run({"simulate", "--set", "model=" + model, "--set", "N=20", "--set", "t_end=20", "--out", dir.string(),
+                   "--quiet"})
+                  .status,
+              0);
+    ASSERT_EQ(run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"}).status, 0);
+    const std::string gp = read_text(dir / "plots" / "phase.gp");
+    EXPECT_EQ(delayspec::testing::contains(gp, "impact boundary"), model == "impact") << gp;
+    EXPECT_EQ(delayspec::testing::contains(gp, "set arrow"), model == "impact") << gp;
+    fs::remove_all(dir);
+  }
+}
+
+// Issue 61 item 8: sweep's section.csv (x: the first state component) is drawn with the model's
+// name for it, recorded in the file's metadata.
+TEST(PlotCli, BifurcationDiagramNamesTheFirstState) {
+  const fs::path dir = fresh_plot_dir("names_sweep");
+  const fs::path scene = fresh_plot_dir("names_sweep_scene") / "forced_uw.toml";
+  std::ofstream(scene) << R"toml(model = "equations"
+[equations]
+state = ["u", "w"]
+parameters = { b = 0.1, c = 1.0 }
+period = "2*pi"
+delay = "1"
+rhs = ["w", "-u - c*w - 0.1*u^3 + b*u_tau + cos(t)"]
+history = { u = 0, w = 0 }
+)toml";
+  const CliResult s = run({"sweep",
+                           scene.string(),
+                           "--out",
+                           dir.string(),
+                           "--quiet",
+                           "--set",
+                           std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE,
+                           "--set",
+                           "sweep_key=b",
+                           "--set",
+                           "sweep_from=0.1",
+                           "--set",
+                           "sweep_to=0.2",
+                           "--set",
+                           "sweep_points=2",
+                           "--set",
+                           "N=10",
+                           "--set",
+                           "periods=5",
+                           "--set",
+                           "transient=0",
+                           "--set",
+                           "section_points=2"});
+  ASSERT_EQ(s.status, 0) << s.err;
+  const std::string csv = read_text(dir / "section.csv");
+  EXPECT_TRUE(delayspec::testing::contains(csv, "\n# state_names = u,w\n")) << csv;
+  EXPECT_TRUE(delayspec::testing::contains(csv, "\nparameter,x\n")) << csv;  // the documented header stays
+  ASSERT_EQ(run({"plot", dir.string(), "--set", "plot_width=200", "--set", "plot_height=150"}).status, 0);
+  const std::string gp = read_text(dir / "plots" / "bifurcation.gp");
+  EXPECT_TRUE(delayspec::testing::contains(gp, "set ylabel 'u(t_0 + jT)'")) << gp;
+  EXPECT_TRUE(delayspec::testing::contains(gp, "Bifurcation diagram: u on the Poincare section against b")) << gp;
+  fs::remove_all(dir);
+  fs::remove_all(scene.parent_path());
+}
+
+// Issue 61 item 8: the table of the orbits born at a Hopf point says what its amplitude is,
+// (max - min)/2 of the component, and prints that of the JSON's measures.
+TEST(PlotCli, HopfBranchTableSaysItsAmplitudeIsHalfTheRange) {
+  const std::vector<std::string> args = {"continue",
+                                         "--set",
+                                         "model=mackey-glass",
+                                         "--set",
+                                         "continue_object=equilibrium",
+                                         "--set",
+                                         "continue_key=tau",
+                                         "--set",
+                                         "continue_from=3",
+                                         "--set",
+                                         "continue_to=5",
+                                         "--set",
+                                         "equilibrium_guess=1.1",
+                                         "--set",
+                                         "continue_switch=true",
+                                         "--set",
+                                         "N=50"};
+  const CliResult text = run(args);
+  ASSERT_EQ(text.status, 0) << text.err;
+  std::vector<std::string> json_args = args;
+  json_args.push_back("--json");
+  const CliResult json = run(json_args);
+  ASSERT_EQ(json.status, 0) << json.err;
+  const auto point = nlohmann::json::parse(json.out)["hopf_branches"][0]["points"][1];
+  const double amplitude = (point["measures"]["max"][0].get<double>() - point["measures"]["min"][0].get<double>()) / 2;
+  const size_t header = text.out.find("(max - min)/2 of x\n");
+  ASSERT_NE(header, std::string::npos) << text.out;
+  EXPECT_FALSE(delayspec::testing::contains(text.out, "y1")) << text.out;
+  // the second row after the header: its last column
+  std::istringstream rows(text.out.substr(text.out.find('\n', header) + 1));
+  std::string row;
+  std::getline(rows, row);
+  std::getline(rows, row);
+  const double printed = std::stod(row.substr(row.find_last_of(' ') + 1));
+  EXPECT_NEAR(printed, amplitude, 1e-7 * amplitude) << row;
 }

@@ -163,7 +163,7 @@ std::string curves_csv(const std::string& header, const HopfCurves& r) {
 void print_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const HopfCurves& r, double seconds) {
   const std::string &x = run.settings.x_key, &y = run.settings.y_key;
   const BoundaryOptions& o = run.settings.options;
-  os << "delayspec boundary: model " << run.problem.model_name << ", Hopf curves of the equilibrium in (" << x << ", "
+  os << "delayspec boundary: model " << run.problem.model_label << ", Hopf curves of the equilibrium in (" << x << ", "
      << y << ") over [" << format_number(o.x_from) << ", " << format_number(o.x_to) << "] x ["
      << format_number(o.y_from) << ", " << format_number(o.y_to)
      << "], on the exact characteristic function\ncurves: " << r.curves.size() << "\n";
@@ -194,7 +194,7 @@ void print_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const Hopf
 
 void print_fold_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const FoldCurves& r, double seconds) {
   const BoundaryOptions& o = run.settings.options;
-  os << "delayspec boundary: model " << run.problem.model_name << ", fold curves of the equilibrium in ("
+  os << "delayspec boundary: model " << run.problem.model_label << ", fold curves of the equilibrium in ("
      << run.settings.x_key << ", " << run.settings.y_key << ") over [" << format_number(o.x_from) << ", "
      << format_number(o.x_to) << "] x [" << format_number(o.y_from) << ", " << format_number(o.y_to)
      << "], on the extended system (f = 0, J singular)\ncurves: " << r.curves.size() << "\n";

@@ -156,7 +156,9 @@ BasinTally tally_basin(const BasinSettings& s, const BasinPoints& pts) {
 void write_basin_csv(const Invocation& inv, const Config& config, const BasinSettings& s, const BasinPoints& pts,
                      const nlohmann::json& json, double seconds) {
   OutputFile csv(inv, std::filesystem::path(*inv.out_dir) / "basin.csv");
-  csv.stream() << metadata_comment_lines(make_metadata("basin", inv.scene, config, json, seconds));
+  OutputMetadata metadata = make_metadata("basin", inv.scene, config, json, seconds);
+  name_model(metadata, s.problem.model_label, s.problem.state_names);
+  csv.stream() << metadata_comment_lines(metadata);
   csv.stream() << s.x.name << "," << s.y.name << ",period,max_section_x\n";
   csv.stream().precision(12);
   for (long i = 0; i < s.count; ++i) {
@@ -171,7 +173,7 @@ void write_basin_csv(const Invocation& inv, const Config& config, const BasinSet
 // The text summary: the grid, the points by period, the failed ones, the time.
 void print_basin(std::ostream& out, const BasinSettings& s, const BasinTally& t, double seconds) {
   const ParameterAxis &x = s.x, &y = s.y;
-  out << "delayspec basin: model " << s.problem.model_name << ", N = " << s.problem.N << ", " << x.name << " in ["
+  out << "delayspec basin: model " << s.problem.model_label << ", N = " << s.problem.N << ", " << x.name << " in ["
       << x.min << ", " << x.max << "] x " << y.name << " in [" << y.min << ", " << y.max << "], " << s.count
       << " points, transient " << s.transient << " periods\n";
   for (const auto& [period, n] : t.counts)

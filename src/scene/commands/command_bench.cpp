@@ -338,7 +338,7 @@ void write_bench_csv(const Invocation& inv, const std::filesystem::path& path, c
                      const BenchSettings& s, const std::vector<BenchRow>& rows, const BenchReference& reference) {
   OutputFile csv(inv, path);
   csv.stream() << metadata_header;
-  csv.stream() << "# delayspec bench: model " << s.problem.model_name << ", nev " << s.base.nev << ", reference "
+  csv.stream() << "# delayspec bench: model " << s.problem.model_label << ", nev " << s.base.nev << ", reference "
                << reference.used << "\nN,n,solver,status,seconds,setup_seconds,peak_bytes,operator_applications,"
                << "error,max_error,correct_digits,deviation_from_dense,abs_mu1,abs_error,seconds_slowest\n";
   csv.stream().precision(10);
@@ -389,8 +389,8 @@ nlohmann::json bench_json(const BenchSettings& s, const std::vector<BenchRow>& r
 void print_bench(std::ostream& out, const BenchSettings& s, const std::vector<BenchRow>& rows,
                  const BenchReference& reference) {
   char line[300];
-  out << "delayspec bench: model " << s.problem.model_name << ", nev " << s.base.nev << ", reference " << reference.used
-      << (reference.used == "exact" ? " (" + s.exact_source + ")" : "")
+  out << "delayspec bench: model " << s.problem.model_label << ", nev " << s.base.nev << ", reference "
+      << reference.used << (reference.used == "exact" ? " (" + s.exact_source + ")" : "")
       << (reference.note.empty() ? "" : " (" + reference.note + ")") << "\n";
   std::snprintf(line, sizeof line, "  %6s  %7s  %-12s  %10s  %10s  %9s  %10s  %10s  %6s  %10s\n", "N", "n", "solver",
                 "seconds", "peak MB", "op.appl", "error", "max error", "digits", "vs dense");

@@ -203,7 +203,7 @@ std::string boundary_csv(const std::string& header, const BoundaryRun& run, cons
 
 void print_boundary(std::ostream& os, const BoundaryRun& run, const BoundaryDiagram& out, double seconds) {
   char line[256];
-  os << "delayspec boundary: model " << run.problem.model_name << ", " << out.curves.size() << " curve"
+  os << "delayspec boundary: model " << run.problem.model_label << ", " << out.curves.size() << " curve"
      << (out.curves.size() == 1 ? "" : "s") << " in (" << run.x_key << ", " << run.y_key << "), N = ";
   for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
   os << "\n";

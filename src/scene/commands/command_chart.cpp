@@ -177,7 +177,9 @@ ChartTally tally_chart(const ChartSettings& s, const ChartPoints& pts) {
 void write_chart_csv(const Invocation& inv, const Config& config, const ChartSettings& s, const ChartPoints& pts,
                      const nlohmann::json& json, double seconds) {
   OutputFile csv(inv, std::filesystem::path(*inv.out_dir) / "chart.csv");
-  csv.stream() << metadata_comment_lines(make_metadata("chart", inv.scene, config, json, seconds));
+  OutputMetadata metadata = make_metadata("chart", inv.scene, config, json, seconds);
+  name_model(metadata, s.problem.model_label, s.problem.state_names);
+  csv.stream() << metadata_comment_lines(metadata);
   csv.stream() << s.x.name << "," << s.y.name << ",spectral_radius"
                << (s.with_error_bars ? ",error_estimate,undecided" : "") << ",angle\n";
   csv.stream().precision(12);
@@ -199,7 +201,7 @@ void write_chart_csv(const Invocation& inv, const Config& config, const ChartSet
 // The text summary: the grid, the stable (and undecided, failed) points, the time.
 void print_chart(const Invocation& inv, const ChartSettings& s, const ChartTally& t, double seconds) {
   const ParameterAxis &x = s.x, &y = s.y;
-  inv.out << "delayspec chart: model " << s.problem.model_name << ", N = " << s.problem.N << ", " << x.name << " in ["
+  inv.out << "delayspec chart: model " << s.problem.model_label << ", N = " << s.problem.N << ", " << x.name << " in ["
           << x.min << ", " << x.max << "] x " << y.name << " in [" << y.min << ", " << y.max << "], " << s.count
           << " points on " << s.threads << " threads\n";
   if (s.with_error_bars)

@@ -54,6 +54,7 @@ struct ContinueRun {
   int index = -1;          // the continued key's parameter in problem.family
   std::vector<int> Ns;     // continue_Ns, or the one level N
   std::optional<double> period_guess;  // an autonomous orbit of unknown period (issue 60 item 5)
+  size_t component = 0;                // plot_component: the state component the table shows
 };
 
 // Reads the keys and the problem at the start value, and rejects what continue cannot take.
@@ -67,6 +68,7 @@ ContinueRun read_continue_run(Config& config) {
   run.options.start_iterations = run.orbit_settings.newton.max_iterations;  // the first point's Newton
   const Problem scene = read_problem(config, 100);
   run.period_guess = read_period_guess(config, scene);
+  run.component = read_plot_component(config, scene);
   run.problem = starting_problem(scene, config, {{"continue_key", run.settings.key, run.options.from, "continue_from"}});
   run.index = family_parameter(run.problem, "continue_key", run.settings.key);
   config.check_all_used();
@@ -183,6 +185,7 @@ json continue_json(const ContinueRun& run, const ContinueOutcome& out, double se
   const ContinuationResult& branch = out.branch();
   json j;
   j["model"] = run.problem.model_name;
+  j["state_names"] = run.problem.state_names;  // the measures' components, in order
   j["continue_key"] = run.settings.key;
   j["N"] = run.Ns.back();
   j["Ns"] = run.Ns;
@@ -232,14 +235,15 @@ void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutc
   const ContinuationResult& branch = out.branch();
   const std::string& key = run.settings.key;
   char line[256];
-  os << "delayspec continue: model " << run.problem.model_name << ", " << key << " from "
+  os << "delayspec continue: model " << run.problem.model_label << ", " << key << " from "
      << format_number(run.options.from) << " to " << format_number(run.options.to) << ", N = ";
   for (size_t i = 0; i < run.Ns.size(); ++i) os << (i ? "," : "") << run.Ns[i];
   os << "\nbranch (N = " << run.Ns.back() << "): " << branch.points.size() << " points, ended at `"
      << to_string(branch.end) << "`\n";
   // an orbit of unknown period: its period too (the multipliers are the others than the trivial one)
   const bool with_period = run.period_guess.has_value();
-  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s%s  %s\n", key.c_str(), "|mu_1|", "unstable", "max y1",
+  const std::string max = "max " + run.problem.state_names.at(run.component);
+  std::snprintf(line, sizeof line, "  %16s  %12s  %8s  %14s%s  %s\n", key.c_str(), "|mu_1|", "unstable", max.c_str(),
                 with_period ? "            period" : "", "verdict");
   os << line;
   for (size_t i = 0; i < branch.points.size(); ++i) {
@@ -247,8 +251,8 @@ void print_continue(std::ostream& os, const ContinueRun& run, const ContinueOutc
     char period[32] = "";
     if (with_period) std::snprintf(period, sizeof period, "  %16.10g", p.period);
     std::snprintf(line, sizeof line, "  %16.10g  %12.8f  %8d  %14.8g%s  %s\n", p.parameter,
-                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable, p.measures.max[0], period,
-                  to_string(out.verdicts.verdicts.at(i)).c_str());
+                  p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable,
+                  p.measures.max.at(run.component), period, to_string(out.verdicts.verdicts.at(i)).c_str());
     os << line;
   }
   os << "verdicts: " << out.verdicts.note << "\n";

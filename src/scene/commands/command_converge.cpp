@@ -379,7 +379,7 @@ void write_converge_files(const Invocation& inv, const Config& config, const Con
   const std::string header =
       metadata_comment_lines(make_metadata("converge", inv.scene, config, nlohmann::json::object(), seconds));
   OutputFile rows(inv, dir / "converge.csv");
-  rows.stream() << header << "# delayspec converge: model " << s.problem.model_name << ", solver "
+  rows.stream() << header << "# delayspec converge: model " << s.problem.model_label << ", solver "
                 << to_string(s.solver_options.solver) << "\n";
   for (size_t v = 0; v < studies.size(); ++v)  // failed levels have no multipliers: named here
     for (const auto& r : studies[v].rows)
@@ -482,7 +482,7 @@ int command_converge(Config& config, const Invocation& inv) {
     inv.out << converge_json(s, studies, period).dump(2) << "\n";
     return 0;
   }
-  inv.out << "delayspec converge: model " << s.problem.model_name << ", solver " << to_string(s.solver_options.solver)
+  inv.out << "delayspec converge: model " << s.problem.model_label << ", solver " << to_string(s.solver_options.solver)
           << ", nev " << s.base.nev << ", N = ";
   for (size_t i = 0; i < s.base.Ns.size(); ++i) inv.out << (i ? "," : "") << s.base.Ns[i];
   inv.out << "\n";

@@ -33,7 +33,7 @@ nlohmann::json equilibrium_json(const Problem& problem, const EquilibriumResult&
 }
 
 void print_equilibrium(std::ostream& out, const Problem& problem, const EquilibriumResult& r) {
-  out << "delayspec equilibrium: model " << problem.model_name << ", N = " << problem.N
+  out << "delayspec equilibrium: model " << problem.model_label << ", N = " << problem.N
       << " steps per the longest delay (the starting roots)\n";
   out << "equilibrium:";
   for (long i = 0; i < r.state.size(); ++i)

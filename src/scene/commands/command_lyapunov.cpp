@@ -46,7 +46,7 @@ int command_lyapunov(Config& config, const Invocation& inv) {
     j["jacobian"] = to_string(problem.jacobian);
     inv.out << j.dump(2) << "\n";
   } else {
-    inv.out << "delayspec lyapunov: model " << problem.model_name << ", " << problem.grid().describe() << ", n = " << n
+    inv.out << "delayspec lyapunov: model " << problem.model_label << ", " << problem.grid().describe() << ", n = " << n
             << "\n";
     inv.out << r.per_period.size() << " leading Lyapunov exponents after a transient of " << r.transient
             << " periods, averaged over " << r.periods << " periods (period = " << r.map_time

@@ -143,7 +143,7 @@ int command_simulate(Config& config, const Invocation& inv) {
     json["seconds"] = seconds;
     json["files"] = files;
   } else {
-    text << "delayspec simulate: model " << problem.model_name << ", " << grid.describe() << ", events "
+    text << "delayspec simulate: model " << problem.model_label << ", " << grid.describe() << ", events "
          << to_string(problem.events) << "\n";
     text << "window [" << options.t_start << ", " << options.t_end << "], " << rec.steps << " steps";
     if (control_on_at > 0)

@@ -212,6 +212,7 @@ int command_sweep(Config& config, const Invocation& inv) {
     // with it); the swept key's own value is per row, so it is not a metadata line.
     OutputMetadata metadata = make_metadata("sweep", inv.scene, config, summary, seconds);
     metadata.parameters.erase(s.key);
+    name_model(metadata, s.first.model_label, s.first.state_names);  // section.csv's x: the first
     const std::string header = metadata_comment_lines(metadata);
     write_output(inv, dir / "exponents.csv", header + tables.exponents_csv);
     write_output(inv, dir / "section.csv", header + tables.section_csv);
@@ -221,7 +222,7 @@ int command_sweep(Config& config, const Invocation& inv) {
   if (inv.json) {
     inv.out << summary.dump(1) << "\n";
   } else {
-    inv.out << "delayspec sweep: model " << s.first.model_name << ", " << s.key << " from " << s.from << " to " << s.to
+    inv.out << "delayspec sweep: model " << s.first.model_label << ", " << s.key << " from " << s.from << " to " << s.to
             << " (" << s.count << " points, " << thread_count << " threads), N = " << s.first.N << ", transient "
             << options.transient << ", periods " << options.periods << "\n";
     inv.out << tables.exponents_csv;

@@ -146,20 +146,22 @@ json hopf_branches_json(const std::vector<HopfOrbitBranch>& branches, const std:
   return list;
 }
 
+// The orbits' size in the table: the amplitude (max - min)/2 of the state component `name`.
 void print_hopf_branches(std::ostream& os, const std::string& key, const std::vector<HopfOrbitBranch>& branches,
-                         const std::vector<int>& Ns) {
+                         const std::vector<int>& Ns, size_t component, const std::string& name) {
   char line[256];
   for (const HopfOrbitBranch& b : branches) {
     const ContinuationResult& r = b.finest();
     os << "orbits from the Hopf point at " << key << " = " << format_number(b.hopf->parameter) << " (N = " << Ns.back()
        << "): " << r.points.size() << " points, ended at `" << to_string(r.end) << "`\n";
-    std::snprintf(line, sizeof line, "  %16s  %16s  %12s  %8s  %14s\n", key.c_str(), "period", "|mu_1|", "unstable",
-                  "amplitude y1");
+    const std::string amplitude = "(max - min)/2 of " + name;
+    std::snprintf(line, sizeof line, "  %16s  %16s  %12s  %8s  %20s\n", key.c_str(), "period", "|mu_1|", "unstable",
+                  amplitude.c_str());
     os << line;
     for (const ContinuationPoint& p : r.points) {
-      std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %12.8f  %8d  %14.8g\n", p.parameter, p.period,
+      std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %12.8f  %8d  %20.8g\n", p.parameter, p.period,
                     p.multipliers.empty() ? NAN : std::abs(p.multipliers[0]), p.unstable,
-                    (p.measures.max[0] - p.measures.min[0]) / 2);
+                    (p.measures.max.at(component) - p.measures.min.at(component)) / 2);
       os << line;
     }
     os << "  bifurcations: " << b.estimates.size() << "\n";
@@ -186,20 +188,21 @@ std::string criticality_line(const HopfNormalForm& n) {
   return line;
 }
 
-void print_branch(std::ostream& os, const Problem& problem, const std::string& key, const EquilibriumBranchOptions& o,
-                  const EquilibriumBranch& b, double seconds) {
-  os << "delayspec continue: model " << problem.model_name << ", equilibria in " << key << " from "
+// The table shows the state component `component` of each equilibrium.
+void print_branch(std::ostream& os, const Problem& problem, size_t component, const std::string& key,
+                  const EquilibriumBranchOptions& o, const EquilibriumBranch& b, double seconds) {
+  os << "delayspec continue: model " << problem.model_label << ", equilibria in " << key << " from "
      << format_number(o.from) << " to " << format_number(o.to) << "\nbranch: " << b.points.size()
      << " points, ended at `" << to_string(b.end) << "`\n";
   char line[256];
   std::snprintf(line, sizeof line, "  %16s  %16s  %16s  %16s  %8s\n", key.c_str(),
-                (problem.state_names.front()).c_str(), "Re lambda_1", "Im lambda_1", "unstable");
+                problem.state_names.at(component).c_str(), "Re lambda_1", "Im lambda_1", "unstable");
   os << line;
   for (const EquilibriumPoint& p : b.points) {
     const auto& r = p.equilibrium;
-    std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %+16.9e  %16.9e  %8d\n", p.parameter, r.state[0],
-                  r.roots.empty() ? NAN : r.roots[0].value.real(), r.roots.empty() ? NAN : r.roots[0].value.imag(),
-                  r.unstable);
+    std::snprintf(line, sizeof line, "  %16.10g  %16.10g  %+16.9e  %16.9e  %8d\n", p.parameter,
+                  r.state[static_cast<long>(component)], r.roots.empty() ? NAN : r.roots[0].value.real(),
+                  r.roots.empty() ? NAN : r.roots[0].value.imag(), r.unstable);
     os << line;
   }
   os << "bifurcations: " << b.bifurcations.size() << " (located on the exact characteristic function)\n";
@@ -224,6 +227,7 @@ struct EquilibriaRun {
   EquilibriumSettings eq;
   ContinuationOptions orbit_options;  // the orbit branches': the range with its defaults, nev, orbit_tolerance
   std::vector<int> Ns;                // continue_Ns, or the one level N
+  size_t component = 0;               // plot_component: the state component the tables show
 };
 
 EquilibriaRun read_equilibria_run(Config& config) {
@@ -237,6 +241,7 @@ EquilibriaRun read_equilibria_run(Config& config) {
                    "born at its Hopf points)");
   run.problem = read_problem(config, 100, ModelNeed::autonomous);
   run.eq = read_equilibrium_settings(config, run.problem);
+  run.component = read_plot_component(config, run.problem);
   run.orbit_options = run.settings.options;
   static_cast<BranchRange&>(run.orbit_options) = checked_range(run.settings.options);
   if (run.from_hopf) {
@@ -316,8 +321,9 @@ int continue_equilibria(Config& config, const Invocation& inv) {
   if (inv.json) {
     inv.out << j.dump(2) << "\n";
   } else {
-    print_branch(inv.out, run.problem, key, o, branch, seconds);
-    print_hopf_branches(inv.out, key, orbits, run.Ns);
+    const std::string& name = run.problem.state_names.at(run.component);
+    print_branch(inv.out, run.problem, run.component, key, o, branch, seconds);
+    print_hopf_branches(inv.out, key, orbits, run.Ns, run.component, name);
   }
   return 0;
 }

@@ -129,6 +129,8 @@ const std::map<std::string, std::string>& problem_and_analysis_meanings() {
       {"nroots", "equilibrium: rightmost characteristic roots wanted, 1..1000"},
       {"equilibrium_guess", "equilibrium: where Newton starts, one number per state component (default: the initial history)"},
       {"equilibrium_tolerance", "equilibrium: Newton's relative step at which the state and each root count as converged, (0, 1e-3]"},
+      {"orbit_series", "floquet: on: the orbit as a time series over one map (t and each state component at the "
+                       "grid's K nodes) in the text and the JSON (orbit_series); off"},
       {"error_bars",
        "on: each multiplier's distance to the N -> infinity value, from solves at N/4 and N/2 (about 1.75x the "
        "time), and a verdict stable / unstable / undecided; off: the solve at N alone"},
@@ -240,6 +242,8 @@ const std::map<std::string, std::string>& grid_and_continuation_meanings() {
       {"plot_gnuplot", "plot: the gnuplot program"},
       {"plot_width", "plot: PNG width in pixels, 100..10000"},
       {"plot_height", "plot: PNG height in pixels, 100..10000"},
+      {"plot_component", "continue, plot: the state component a branch's table and figures show, a state name or "
+                         "1-based index (default the first; plot: the one continue was given)"},
       {"analyses", "run: the analyses (command names) to run, in order (default: the command reading every key)"},
       {"title", "run: a title for the manifest"},
   };

@@ -21,6 +21,7 @@
 //     ...
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -39,7 +40,26 @@ struct OutputMetadata {
   std::string events;
   std::string jacobian;
   double wall_seconds = 0;
+  // How the files name the model and its state components (name_model): "model_label" and
+  // "state_names" in JSON, `# model_label = ...` and `# state_names = x,v` in CSV (plot's titles
+  // and axis labels); empty: not said (a command without one model).
+  std::string model_label;
+  std::vector<std::string> state_names;
 };
+
+// How outputs name a model: the built-in model's name (the key `model`); an [equations] model,
+// whose key value "equations" names no model, by its scene file's stem ("pyragas_oscillator"),
+// else by its state ("equations in x, y") (issue 61 item 8).
+std::string model_label(const std::string& model, const std::vector<std::string>& state_names,
+                        const std::optional<std::string>& scene);
+// Fills metadata.model_label and metadata.state_names: a command passes its Problem's
+// (problem.hpp: model_label of the scene file holding the [equations] table); make_metadata
+// names a result that carries `model` and `state_names` by model_label(model, names, scene).
+void name_model(OutputMetadata& metadata, const std::string& label, const std::vector<std::string>& state_names);
+
+// The state component `value` names, 0-based: a state name or its 1-based index among `names`
+// (the key plot_component); BadInput naming `key`, the value and the names otherwise.
+size_t state_component(const std::string& key, const std::string& value, const std::vector<std::string>& names);
 
 // Fills the metadata of `command` run with `config`, taking N/events/jacobian from `result`
 // when present.

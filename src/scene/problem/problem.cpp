@@ -5,6 +5,7 @@
 #include "delayspec/errors.hpp"
 #include "delayspec/grid.hpp"
 #include "scene/equations/equation_model.hpp"
+#include "scene/output/metadata.hpp"
 #include "scene/problem/builtin_family.hpp"
 #include "scene/problem/models_module_loader.hpp"
 
@@ -96,6 +97,10 @@ void require_autonomous_model(bool autonomous, const std::string& model_name, bo
                    "; equilibria are for models with no forcing (linear, mackey-glass, or equations without t)");
 }
 
+size_t read_plot_component(Config& config, const Problem& problem) {
+  return state_component("plot_component", config.get_string("plot_component", "1"), problem.state_names);
+}
+
 Problem read_problem(Config& config, int default_N, ModelNeed need) {
   Problem problem;
   problem.model_name = config.get_choice("model", model_names().front(), model_choices());
@@ -120,7 +125,13 @@ Problem read_problem(Config& config, int default_N, ModelNeed need) {
         });
     problem.family = std::move(equations.family);
     problem.state_names = std::move(equations.state);
+    // named by the scene file that holds the [equations] table (read above; a Python dict has no
+    // file name)
+    const std::string& origin = config.origin("equations");
+    problem.model_label = model_label(problem.model_name, problem.state_names,
+                                      origin.ends_with(".toml") ? std::optional(origin) : std::nullopt);
   }
+  if (builtin) problem.model_label = problem.model_name;
   // N up to 1e9 (the history alone is then 16 GB at d = 2); orbit_period and contact_substeps
   // multiply the work per step or per period, 1000 is far beyond any use.
   problem.N = static_cast<int>(config.get_int_in_range("N", default_N, 1, 1'000'000'000));

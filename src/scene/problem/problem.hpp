@@ -23,7 +23,8 @@ namespace delayspec::cli {
 class BuiltinFamily;
 
 struct Problem {
-  std::string model_name;
+  std::string model_name;   // the key `model`: a built-in model's name, or "equations"
+  std::string model_label;  // how outputs name it (metadata.hpp's model_label: the scene file's stem)
   std::optional<AnyModel> model;                  // the built-in model; empty for model = equations
   std::shared_ptr<const ModelAnalyses> analyses;  // every model
   // The model at other parameter values (problem_family.hpp), and this problem's values: what
@@ -119,6 +120,11 @@ AnalysesAt analyses_along(const Problem& problem, int index);
 // boundary): on an autonomous model, which has no forcing period, what that fixed point is and
 // where the orbits and equilibria are followed instead; empty for a forced model (issue 61 item 7).
 std::string autonomous_fixed_point_note(const Problem& problem);
+
+// The key plot_component: the state component (0-based) that a branch's figures and tables show,
+// a state name or a 1-based index, default the first (issue 61 item 8). continue reads it (its
+// table; the files record it for plot) and plot (which may override it).
+size_t read_plot_component(Config& config, const Problem& problem);
 
 // BadInput unless the model is autonomous (equilibria need a model with no forcing). builtin:
 // the model is one of the built-in ones (its forcing, else the equations' t or switch, named).
