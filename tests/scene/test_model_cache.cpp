@@ -502,4 +502,35 @@ TEST_F(ModelCache, AnotherEntrysObjectAndRecordAreNotLoadedAsThisOne) {
   EXPECT_EQ(leading(scene_b), b_values);
 }
 
+// Issue 61 item 4: a table's record (tx-HASH.table: the object's name, the table's text, the
+// names and defaults) does not decide the parameters' defaults: they are read from the table text
+// that is compared with the scene's. Editing the record's defaults line (a = -1 -> a = 5: an
+// unstable model) changed the multipliers of the next run; now they are the first run's.
+TEST_F(ModelCache, ATableRecordsDefaultsLineDoesNotChangeTheModel) {
+  const fs::path cache = dir_ / "cache";
+  const fs::path scene = dir_ / "a.toml";
+  write(scene, std::string("model = \"equations\"\n") + kEquations);
+  auto leading = [&] {
+    const fs::path out = dir_ / "out.json";
+    const std::string command = std::string(DELAYSPEC_CLI_PATH) + " floquet " + scene.string() +
+                                " --json --set model_cache=" + cache.string() + " --set N=20 --set nev=1 > " +
+                                out.string() + " 2>/dev/null";
+    EXPECT_EQ(std::system(command.c_str()), 0) << read_text(out);
+    const nlohmann::json j = nlohmann::json::parse(read_text(out), nullptr, false);
+    return j.is_object() && j.contains("multipliers") ? j.at("multipliers").dump() : read_text(out);
+  };
+  const std::string first = leading();
+  fs::path record;
+  for (const auto& e : fs::directory_iterator(cache))
+    if (e.path().extension() == ".table") record = e.path();
+  ASSERT_FALSE(record.empty());
+  std::string text = read_text(record);
+  const size_t at = text.find("\ndefaults -1 ");
+  ASSERT_NE(at, std::string::npos) << text;
+  text.replace(at, std::string("\ndefaults -1 ").size(), "\ndefaults 5 ");
+  write(record, text);
+  fs::permissions(record, fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_EQ(leading(), first);
+}
+
 }  // namespace

@@ -114,6 +114,35 @@ struct LoadedEquations {
   EquationNames names;
 };
 
+// The parameters' defaults as the table's own text gives them (TOML numbers, in key order, as the
+// module reads them), when its parameters are `names`; nothing otherwise. A record's `defaults`
+// line is never what a model runs with: editing it changed the model (issue 61 item 4), while the
+// table text is compared byte for byte with the scene's.
+std::optional<std::vector<double>> table_defaults(const std::string& table_text, const std::vector<std::string>& names) {
+  toml::table table;
+  try {
+    table = toml::parse(std::string_view(table_text), std::string_view("[equations]"));
+  } catch (const toml::parse_error&) {
+    return std::nullopt;
+  }
+  std::vector<std::string> keys;
+  std::vector<double> values;
+  if (const toml::node* node = table.get("parameters")) {
+    const toml::table* parameters = node->as_table();
+    if (!parameters) return std::nullopt;
+    for (const auto& [key, value] : *parameters) {
+      std::optional<double> number;
+      if (const auto* i = value.as_integer()) number = static_cast<double>(i->get());
+      if (const auto* f = value.as_floating_point()) number = f->get();
+      if (!number || !std::isfinite(*number)) return std::nullopt;
+      keys.emplace_back(key.str());
+      values.push_back(*number);
+    }
+  }
+  if (keys != names) return std::nullopt;
+  return values;
+}
+
 // The model compiled before from this table (found_equation_plugin), once per process and cache
 // directory; nothing when this program has not compiled it into `cache_dir`.
 std::optional<LoadedEquations> found(const std::string& table_text, const std::filesystem::path& cache_dir) {
@@ -126,7 +155,10 @@ std::optional<LoadedEquations> found(const std::string& table_text, const std::f
   try {
     if (std::optional<FoundPlugin> hit = found_equation_plugin(table_text, cache_dir))
       if (std::optional<EquationNames> names = names_from_text(hit->names))
-        result = LoadedEquations{&(plugins[key] = hit->plugin), *names};
+        if (std::optional<std::vector<double>> defaults = table_defaults(table_text, names->parameters)) {
+          names->parameter_defaults = std::move(*defaults);
+          result = LoadedEquations{&(plugins[key] = hit->plugin), *names};
+        }
   } catch (const BadInput&) {
     // No compiler, an unusable cache, an object that cannot be loaded: the table is read, and
     // its constants checked, first; the compile then says the same (as without a record).
