@@ -358,14 +358,8 @@ class FoldSystem {
   // (f, g) at z: d + 1 values
   Eigen::VectorXd F(const Eigen::VectorXd& z) const {
     const ConstantHistory h = family_.at(z.head(d_), x(z), y(z));
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d_ + 1, d_ + 1);
-    M.topLeftCorner(d_, d_) = h.jacobian();
-    M.topRightCorner(d_, 1) = left_;
-    M.bottomLeftCorner(1, d_) = right_.transpose();
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(d_ + 1);
-    rhs[d_] = 1;
     Eigen::VectorXd out(d_ + 1);
-    out << h.f, M.fullPivLu().solve(rhs)[d_];
+    out << h.f, bordered(h).fullPivLu().solve(unit_last())[d_];
     return out;
   }
 
@@ -373,14 +367,9 @@ class FoldSystem {
   // entries of the bordered solves [J b; c^T 0] (q, g) = (0, 1) and its transpose's.
   double bogdanov_takens_test(const Eigen::VectorXd& z) const {
     const ConstantHistory h = family_.at(z.head(d_), x(z), y(z));
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d_ + 1, d_ + 1);
-    M.topLeftCorner(d_, d_) = h.jacobian();
-    M.topRightCorner(d_, 1) = left_;
-    M.bottomLeftCorner(1, d_) = right_.transpose();
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(d_ + 1);
-    rhs[d_] = 1;
-    const Eigen::VectorXd q = M.fullPivLu().solve(rhs).head(d_);
-    const Eigen::VectorXd p = M.transpose().fullPivLu().solve(rhs).head(d_);
+    const Eigen::MatrixXd M = bordered(h);
+    const Eigen::VectorXd q = M.fullPivLu().solve(unit_last()).head(d_);
+    const Eigen::VectorXd p = M.transpose().fullPivLu().solve(unit_last()).head(d_);
     Eigen::MatrixXcd derivative;
     h.delta(0.0, &derivative);
     return p.dot(derivative.real() * q);
@@ -426,6 +415,17 @@ class FoldSystem {
   long d() const { return d_; }
 
  private:
+  // [J b; c^T 0], J = A + sum B_i at h, b and c the borders
+  Eigen::MatrixXd bordered(const ConstantHistory& h) const {
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(d_ + 1, d_ + 1);
+    M.topLeftCorner(d_, d_) = h.jacobian();
+    M.topRightCorner(d_, 1) = left_;
+    M.bottomLeftCorner(1, d_) = right_.transpose();
+    return M;
+  }
+  // (0, ..., 0, 1): the bordered systems' right-hand side
+  Eigen::VectorXd unit_last() const { return Eigen::VectorXd::Unit(d_ + 1, d_); }
+
   const EquilibriumFamily2& family_;
   const BoundaryOptions& o_;
   long d_;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli_test_support.hpp"
+#include "equation_scenes.hpp"
 #include "delayspec/errors.hpp"
 #include "delayspec_test_paths.hpp"
 
@@ -130,15 +131,7 @@ TEST(FloquetCli, OrbitSeriesIsTheOrbitOverOneMapByStateName) {
   const std::filesystem::path dir = delayspec::testing::fresh_dir("floquet_orbit_series");
   std::filesystem::create_directories(dir);
   const std::string scene = (dir / "forced_pair.toml").string();
-  std::ofstream(scene) << R"toml(model = "equations"
-[equations]
-state = ["x", "v"]
-parameters = { b = 0.1, c = 1.0 }
-period = "2*pi"
-delay = "1"
-rhs = ["v", "-x - c*v - 0.1*x^3 + b*x_tau + cos(t)"]
-history = { x = 0, v = 0 }
-)toml";
+  std::ofstream(scene) << delayspec::testing::kForcedPairEquationsScene;
   const std::string cache = std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE;
   const CliResult f = run({"floquet", scene, "--json", "--set", cache, "--set", "N=40", "--set", "orbit_series=on",
                            "--set", "error_bars=off"});

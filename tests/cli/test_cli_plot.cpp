@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "cli_test_support.hpp"
+#include "equation_scenes.hpp"
 #include "delayspec/continuation.hpp"
 #include "delayspec_test_paths.hpp"
 #include "mathieu_ode.hpp"
@@ -616,16 +617,7 @@ std::vector<double> csv_column(const std::vector<std::vector<std::string>>& rows
 TEST(PlotCli, BranchFiguresNameTheStateAndShowTheChosenComponent) {
   const fs::path dir = fresh_plot_dir("names");
   const fs::path scene = fresh_plot_dir("names_scene") / "forced_pair.toml";
-  // a damped, forced, weakly nonlinear oscillator: one stable orbit for every b of the range
-  std::ofstream(scene) << R"toml(model = "equations"
-[equations]
-state = ["x", "v"]
-parameters = { b = 0.1, c = 1.0 }
-period = "2*pi"
-delay = "1"
-rhs = ["v", "-x - c*v - 0.1*x^3 + b*x_tau + cos(t)"]
-history = { x = 0, v = 0 }
-)toml";
+  std::ofstream(scene) << delayspec::testing::kForcedPairEquationsScene;
   const std::string cache = std::string("model_cache=") + DELAYSPEC_TEST_MODEL_CACHE;
   const std::vector<std::string> branch = {"continue", scene.string(),    "--set", cache,
                                            "--set",    "continue_key=b",  "--set", "continue_from=0.1",

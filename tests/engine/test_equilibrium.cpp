@@ -267,14 +267,14 @@ TEST(EquilibriumBranch, MackeyGlassHopfPointInTauIsTheClosedForm) {
   EXPECT_EQ(branch.points.back().equilibrium.unstable, 2);
 }
 
-// x' = p - x^2 + c (x(t - 1) - x): equilibria x = +-sqrt(p), a fold at p = 0; the root through 0
-// is real (lambda = -2 x - c + c e^{-lambda}: at x = 0, lambda = 0).
+// x' = p - x^2 + c (x(t - delay) - x): equilibria x = +-sqrt(p), a fold at p = 0; the root through
+// 0 is real (lambda = -2 x - c + c e^{-lambda delay}: at x = 0, lambda = 0).
 struct FoldModel {
   static constexpr int d = 1;
   static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
-  double p = 1, c = 0.5;
-  double tau() const { return 1; }
-  double period() const { return 1; }
+  double p = 1, c = 0.5, delay = 1;
+  double tau() const { return delay; }
+  double period() const { return delay; }
   Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const { return Vec<1>(p - y[0] * y[0] + c * (w[0] - y[0])); }
   Mat<1> A(int, double, const Vec<1>& y, const Vec<1>&) const { return Mat<1>::Constant(-2 * y[0] - c); }
   Mat<1> B(int, double, const Vec<1>&, const Vec<1>&) const { return Mat<1>::Constant(c); }
@@ -306,20 +306,8 @@ TEST(EquilibriumBranch, FoldIsPassedAndLocated) {
 // merge into a complex pair, never crossing the axis. Following the pair back onto the two real
 // roots took them for "two roots landed on the same root" and ended the branch there (found while
 // testing Bogdanov-Takens points); the branch now passes it and reaches its fold at p = 0.
-struct MergingRootsModel {
-  static constexpr int d = 1;
-  static constexpr bool has_switching = false, affine_in_state = false, is_linear = false, autonomous = true;
-  double p = 1, q = -1.5;
-  double tau() const { return 2; }
-  double period() const { return 2; }
-  Vec<1> f(int, double, const Vec<1>& y, const Vec<1>& w) const { return Vec<1>(p - y[0] * y[0] + q * (w[0] - y[0])); }
-  Mat<1> A(int, double, const Vec<1>& y, const Vec<1>&) const { return Mat<1>::Constant(-2 * y[0] - q); }
-  Mat<1> B(int, double, const Vec<1>&, const Vec<1>&) const { return Mat<1>::Constant(q); }
-  Vec<1> initial_state() const { return Vec<1>(1); }
-};
-
 TEST(EquilibriumBranch, TwoRealRootsMergingIntoAPairOffTheAxisAreNoCrossing) {
-  const EquilibriumFamily family = family_of<MergingRootsModel>([](double p) { return MergingRootsModel{p, -1.5}; });
+  const EquilibriumFamily family = family_of<FoldModel>([](double p) { return FoldModel{p, -1.5, 2}; });
   EquilibriumBranchOptions o;
   o.from = 1, o.to = -1;
   const EquilibriumBranch branch = continue_equilibrium(family, Vec<1>(1.0), o);

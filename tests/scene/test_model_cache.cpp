@@ -465,6 +465,17 @@ TEST_F(ModelCache, ACompilersGroupWritableObjectIsMadePrivateNotRefused) {
   EXPECT_EQ(fs::status(cache / "made.so").permissions(), fs::perms::owner_all | fs::perms::group_write);
 }
 
+// The leading multiplier of `scene` (as JSON text) from a new process of the program with the
+// model cache `cache` (this process keeps what it loaded); `out` receives the output.
+std::string leading_multiplier(const fs::path& scene, const fs::path& cache, const fs::path& out) {
+  const std::string command = std::string(DELAYSPEC_CLI_PATH) + " floquet " + scene.string() +
+                              " --json --set model_cache=" + cache.string() + " --set N=20 --set nev=1 > " +
+                              out.string() + " 2>/dev/null";
+  EXPECT_EQ(std::system(command.c_str()), 0) << read_text(out);
+  const nlohmann::json j = nlohmann::json::parse(read_text(out), nullptr, false);
+  return j.is_object() && j.contains("multipliers") ? j.at("multipliers").dump() : read_text(out);
+}
+
 // Issue 61 item 4: a cache entry's object is bound to its entry. Two models compiled into one
 // cache, then their objects and checksum records swapped pair for pair (each pair valid on its
 // own): model A run in a new process (this one keeps what it loaded) must not run B's code. It
@@ -477,16 +488,7 @@ TEST_F(ModelCache, AnotherEntrysObjectAndRecordAreNotLoadedAsThisOne) {
   std::string b = kEquations;
   b.replace(b.find("a*x + b*x_tau"), std::string("a*x + b*x_tau").size(), "a*x - b*x_tau");
   write(scene_b, "model = \"equations\"\n" + b);
-  // the multipliers from a new process of the program
-  auto leading = [&](const fs::path& scene) {
-    const fs::path out = dir_ / "out.json";
-    const std::string command = std::string(DELAYSPEC_CLI_PATH) + " floquet " + scene.string() +
-                                " --json --set model_cache=" + cache.string() + " --set N=20 --set nev=1 > " +
-                                out.string() + " 2>/dev/null";
-    EXPECT_EQ(std::system(command.c_str()), 0) << read_text(out);
-    const nlohmann::json j = nlohmann::json::parse(read_text(out), nullptr, false);
-    return j.is_object() && j.contains("multipliers") ? j.at("multipliers").dump() : read_text(out);
-  };
+  auto leading = [&](const fs::path& scene) { return leading_multiplier(scene, cache, dir_ / "out.json"); };
   const std::string a = leading(scene_a), b_values = leading(scene_b);
   ASSERT_NE(a, b_values) << "the two models must differ";
   std::vector<std::string> stems;
@@ -510,15 +512,7 @@ TEST_F(ModelCache, ATableRecordsDefaultsLineDoesNotChangeTheModel) {
   const fs::path cache = dir_ / "cache";
   const fs::path scene = dir_ / "a.toml";
   write(scene, std::string("model = \"equations\"\n") + kEquations);
-  auto leading = [&] {
-    const fs::path out = dir_ / "out.json";
-    const std::string command = std::string(DELAYSPEC_CLI_PATH) + " floquet " + scene.string() +
-                                " --json --set model_cache=" + cache.string() + " --set N=20 --set nev=1 > " +
-                                out.string() + " 2>/dev/null";
-    EXPECT_EQ(std::system(command.c_str()), 0) << read_text(out);
-    const nlohmann::json j = nlohmann::json::parse(read_text(out), nullptr, false);
-    return j.is_object() && j.contains("multipliers") ? j.at("multipliers").dump() : read_text(out);
-  };
+  auto leading = [&] { return leading_multiplier(scene, cache, dir_ / "out.json"); };
   const std::string first = leading();
   fs::path record;
   for (const auto& e : fs::directory_iterator(cache))
