@@ -129,14 +129,27 @@ HopfCurves hopf_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& 
 // simple in J's kernel). A sign change of bt between two curve points is located by Illinois
 // along the chord, each trial corrected onto the curve in the hyperplane normal to the chord
 // (Newton on the extended system); the bound is the final bracket in the plane's units plus the
-// corrector's tolerance over the ranges (as for the Hopf curves' codim-2 points). Cusp points
-// (the fold's quadratic coefficient zero) need the second derivatives of f and are not detected.
+// corrector's tolerance over the ranges (as for the Hopf curves' codim-2 points).
+//
+// Cusp points, where the fold's quadratic coefficient vanishes (two folds meet), the same way on
+// the test p^T D^2 F(y*)(q, q), F(y) = f(y, ..., y) on constant histories (the zero root's
+// eigenfunction is the constant q), its second derivative as the central difference of the
+// family's Jacobian [A B] along q (step 1e-4 (1 + |y*|) / |q|: an O(1e-8) relative error, far
+// below the test's change near a transversal zero). Only with a Jacobian in the family.
 struct FoldCurvePoint {
   double x = 0, y = 0;
   Eigen::VectorXd state;
 };
 
-struct BogdanovTakensPoint {
+enum class FoldCodim2Kind {
+  bogdanov_takens,  // the zero root double
+  cusp              // the fold's quadratic coefficient zero
+};
+// "bogdanov_takens", "cusp".
+std::string to_string(FoldCodim2Kind kind);
+
+struct FoldCodim2Point {
+  FoldCodim2Kind kind = FoldCodim2Kind::bogdanov_takens;
   double x = 0, y = 0;
   double bound = 0;  // on its distance from the exact point, in the plane's units (max over x and y)
   Eigen::VectorXd state;
@@ -147,7 +160,7 @@ struct FoldCurve {
   std::vector<FoldCurvePoint> points;
   BoundaryEnd end = BoundaryEnd::max_points;
   std::string note;
-  std::vector<BogdanovTakensPoint> bogdanov_takens;  // in order along the curve
+  std::vector<FoldCodim2Point> codim2;  // in order along the curve, kind by kind
   std::vector<std::string> notes;                    // a sign change that could not be located: where and why
 };
 

@@ -16,6 +16,10 @@
 
 namespace delayspec {
 
+std::string to_string(FoldCodim2Kind kind) {
+  return kind == FoldCodim2Kind::bogdanov_takens ? "bogdanov_takens" : "cusp";
+}
+
 std::string to_string(HopfCodim2Kind kind) {
   switch (kind) {
     case HopfCodim2Kind::generalised_hopf: return "generalised_hopf";
@@ -375,6 +379,29 @@ class FoldSystem {
     return p.dot(derivative.real() * q);
   }
 
+  // The cusp test p^T D^2 F(y*)(q, q) at z (equilibrium_boundary.hpp); NaN without a Jacobian.
+  double cusp_test(const Eigen::VectorXd& z) const {
+    if (!family_.jacobian) return NAN;
+    const Eigen::VectorXd state = z.head(d_);
+    const ConstantHistory h = family_.at(state, x(z), y(z));
+    const Eigen::MatrixXd M = bordered(h);
+    const Eigen::VectorXd q = M.fullPivLu().solve(unit_last()).head(d_);
+    const Eigen::VectorXd p = M.transpose().fullPivLu().solve(unit_last()).head(d_);
+    const long copies = static_cast<long>(h.taus.size());
+    const auto repeated = [&](const Eigen::VectorXd& v, long n) {
+      Eigen::VectorXd r(d_ * n);
+      for (long k = 0; k < n; ++k) r.segment(k * d_, d_) = v;
+      return r;
+    };
+    const double e = 1e-4 * (1 + state.norm()) / q.norm();
+    const auto J = [&](double s) {
+      const Eigen::VectorXd at = state + s * q;
+      return family_.jacobian(at, repeated(at, copies), x(z), y(z));
+    };
+    const Eigen::VectorXd second = (J(e) - J(-e)) * repeated(q, copies + 1) / (2 * e);
+    return p.dot(second);
+  }
+
   // dF/dz by central differences, relative step 1e-7
   Eigen::MatrixXd jacobian(const Eigen::VectorXd& z) const {
     Eigen::MatrixXd D(d_ + 1, d_ + 2);
@@ -432,19 +459,23 @@ class FoldSystem {
   Eigen::VectorXd left_, right_;
 };
 
-// The Bogdanov-Takens points of a traced fold curve (equilibrium_boundary.hpp): each sign change of
-// the test between consecutive points located by Illinois along the chord.
-void bogdanov_takens_points(FoldSystem& sys, const BoundaryOptions& o, FoldCurve& curve) {
+// The codim-2 points of `kind` on a traced fold curve (equilibrium_boundary.hpp): each sign change
+// of its test between consecutive points located by Illinois along the chord.
+void fold_codim2_points(FoldSystem& sys, const BoundaryOptions& o, FoldCodim2Kind kind, FoldCurve& curve) {
   const long d = sys.d();
   const double sx = std::abs(o.x_to - o.x_from), sy = std::abs(o.y_to - o.y_from);
+  const auto test_at = [&](const Eigen::VectorXd& z) {
+    return kind == FoldCodim2Kind::bogdanov_takens ? sys.bogdanov_takens_test(z) : sys.cusp_test(z);
+  };
   std::vector<double> test;
-  for (const FoldCurvePoint& p : curve.points) test.push_back(sys.bogdanov_takens_test(sys.z_of(p.state, p.x, p.y)));
+  for (const FoldCurvePoint& p : curve.points) test.push_back(test_at(sys.z_of(p.state, p.x, p.y)));
   for (size_t i = 0; i + 1 < curve.points.size(); ++i) {
     if (!(test[i] * test[i + 1] < 0)) continue;  // (a NaN too: nothing to locate)
     const FoldCurvePoint &a = curve.points[i], &b = curve.points[i + 1];
     const Eigen::VectorXd za = sys.z_of(a.state, a.x, a.y), zb = sys.z_of(b.state, b.x, b.y);
     const Eigen::VectorXd row = (zb - za).normalized();
-    BogdanovTakensPoint out;
+    FoldCodim2Point out;
+    out.kind = kind;
     Eigen::VectorXd at = za;
     double lo = 0, hi = 1;
     bool located = true;
@@ -456,9 +487,10 @@ void bogdanov_takens_points(FoldSystem& sys, const BoundaryOptions& o, FoldCurve
       const Eigen::VectorXd trial = za + t * (zb - za);
       int iterations = 0;
       const std::optional<Eigen::VectorXd> on_curve = sys.correct(trial, row, row.dot(trial), iterations);
-      const double v = on_curve ? sys.bogdanov_takens_test(*on_curve) : NAN;
+      const double v = on_curve ? test_at(*on_curve) : NAN;
       if (!std::isfinite(v)) {
-        curve.notes.push_back("a Bogdanov-Takens point between (" + format_number(a.x) + ", " + format_number(a.y) +
+        curve.notes.push_back(std::string(kind == FoldCodim2Kind::cusp ? "a cusp" : "a Bogdanov-Takens point") +
+                              " between (" + format_number(a.x) + ", " + format_number(a.y) +
                               ") and (" + format_number(b.x) + ", " + format_number(b.y) +
                               "): not located (no point of the curve at t = " + format_number(t) + " along the chord)");
         located = false;
@@ -475,7 +507,7 @@ void bogdanov_takens_points(FoldSystem& sys, const BoundaryOptions& o, FoldCurve
     if (!located) continue;
     out.x = sys.x(at), out.y = sys.y(at), out.state = at.head(d);
     out.bound = (hi - lo) * std::max(std::abs(b.x - a.x), std::abs(b.y - a.y)) + o.tolerance * std::max(sx, sy);
-    curve.bogdanov_takens.push_back(std::move(out));
+    curve.codim2.push_back(std::move(out));
   }
 }
 
@@ -565,7 +597,8 @@ FoldCurves fold_curves(const EquilibriumFamily2& family, const Eigen::VectorXd& 
       const FoldCurve& worse = !ok_back ? back : forward;
       curve.end = worse.end;
       curve.note = worse.note;
-      bogdanov_takens_points(sys, b, curve);
+      for (FoldCodim2Kind kind : {FoldCodim2Kind::bogdanov_takens, FoldCodim2Kind::cusp})
+        fold_codim2_points(sys, b, kind, curve);
       BoundaryCurve as_boundary;
       for (const FoldCurvePoint& p : curve.points) as_boundary.points.push_back({p.x, p.y, NAN, 0});
       traced.push_back(std::move(as_boundary));

@@ -410,22 +410,42 @@ TEST(FoldCurves, ABogdanovTakensPointIsLocatedOnItsFoldCurve) {
   const FoldCurve& c = r.curves[0];
   EXPECT_EQ(c.end, BoundaryEnd::to) << c.note;
   for (const FoldCurvePoint& p : c.points) EXPECT_NEAR(p.y, 0, 1e-9);
-  ASSERT_EQ(c.bogdanov_takens.size(), 1u) << (c.notes.empty() ? "" : c.notes[0]);
-  const BogdanovTakensPoint& bt = c.bogdanov_takens[0];
+  ASSERT_EQ(c.codim2.size(), 1u) << (c.notes.empty() ? "" : c.notes[0]);
+  const FoldCodim2Point& bt = c.codim2[0];
+  EXPECT_EQ(bt.kind, FoldCodim2Kind::bogdanov_takens);
   EXPECT_LE(std::abs(bt.x + 0.5), bt.bound) << bt.x + 0.5;
   EXPECT_LE(bt.bound, 1e-8);
   EXPECT_NEAR(bt.y, 0, 1e-9);
   EXPECT_NEAR(bt.state[0], 0, 1e-6);  // x = sqrt p: the equilibrium's error is the root of p's
 }
 
-// The cusp's fold curves (above) have no Bogdanov-Takens point: Delta'(0) = 1 + c = 1.5 everywhere.
-TEST(FoldCurves, NoBogdanovTakensPointWhereTheZeroRootStaysSimple) {
+// The cusp's fold curves away from the cusp (above) have no codim-2 point: Delta'(0) = 1 + c = 1.5
+// everywhere, and F'' = -6 x is not 0 on them (x^2 = q / 3 >= 1/6).
+TEST(FoldCurves, NoCodim2PointWhereTheZeroRootStaysSimpleAndTheFoldQuadratic) {
   HopfCurveOptions o;
   o.boundary.x_from = 0.5, o.boundary.x_to = 2, o.boundary.y_from = -2, o.boundary.y_to = 2;
   const FoldCurves r = fold_curves(family_in_two<CuspModel>([](double q, double p) { return CuspModel{p, q, 0.5}; }),
                                    Vec<1>(-1.4), o);
   ASSERT_EQ(r.curves.size(), 2u);
-  for (const FoldCurve& c : r.curves) EXPECT_TRUE(c.bogdanov_takens.empty());
+  for (const FoldCurve& c : r.curves) EXPECT_TRUE(c.codim2.empty());
+}
+
+// Through the cusp: q from 1 down to -1. The two folds of the branch in p at q = 1 are the ends of
+// one curve, q = 3 x^2, p = -2 x^3, through (0, 0), where F''(x) = -6 x (F(x) = p + q x - x^3, the
+// delay cancelling at a constant history) changes sign: the cusp point, within its bound of the
+// closed form (0, 0), and no Bogdanov-Takens point (Delta'(0) = 1.5).
+TEST(FoldCurves, TheCuspPointIsLocatedWhereTheTwoFoldsMeet) {
+  HopfCurveOptions o;
+  o.boundary.x_from = 1, o.boundary.x_to = -1, o.boundary.y_from = 2, o.boundary.y_to = -2;
+  const FoldCurves r = fold_curves(family_in_two<CuspModel>([](double q, double p) { return CuspModel{p, q, 0.5}; }),
+                                   Vec<1>(-1.4), o);
+  ASSERT_EQ(r.curves.size(), 1u) << (r.notes.empty() ? "" : r.notes[0]);
+  const FoldCurve& c = r.curves[0];
+  ASSERT_EQ(c.codim2.size(), 1u) << (c.notes.empty() ? "" : c.notes[0]);
+  const FoldCodim2Point& cusp = c.codim2[0];
+  EXPECT_EQ(cusp.kind, FoldCodim2Kind::cusp);
+  EXPECT_LE(std::max(std::abs(cusp.x), std::abs(cusp.y)), cusp.bound) << cusp.x << ", " << cusp.y;
+  EXPECT_LE(cusp.bound, 1e-8);
 }
 
 }  // namespace

@@ -100,8 +100,8 @@ json fold_curves_json(const EquilibriaBoundaryRun& run, const FoldCurves& r, dou
     json cj = curve_json("fold", c.end, c.note, c.notes);
     for (const FoldCurvePoint& p : c.points)
       cj["points"].push_back({{"x", p.x}, {"y", p.y}, {"equilibrium", state_values(p.state)}});
-    for (const BogdanovTakensPoint& b : c.bogdanov_takens)
-      cj["codim2"].push_back({{"kind", "bogdanov_takens"},
+    for (const FoldCodim2Point& b : c.codim2)
+      cj["codim2"].push_back({{"kind", to_string(b.kind)},
                               {"x", b.x},
                               {"y", b.y},
                               {"bound", b.bound},
@@ -205,8 +205,10 @@ void print_fold_curves(std::ostream& os, const EquilibriaBoundaryRun& run, const
     if (!c.points.empty())
       os << "    from (" << format_number(c.points.front().x) << ", " << format_number(c.points.front().y) << ") to ("
          << format_number(c.points.back().x) << ", " << format_number(c.points.back().y) << ")\n";
-    for (const BogdanovTakensPoint& b : c.bogdanov_takens)
-      os << "    Bogdanov-Takens point (a double zero root) at " << run.settings.x_key << " = " << format_number(b.x)
+    for (const FoldCodim2Point& b : c.codim2)
+      os << "    " << (b.kind == FoldCodim2Kind::bogdanov_takens ? "Bogdanov-Takens point (a double zero root)"
+                                                                 : "cusp point (two folds meet)")
+         << " at " << run.settings.x_key << " = " << format_number(b.x)
          << ", " << run.settings.y_key << " = " << format_number(b.y) << " +- " << format_number(b.bound, 2) << "\n";
     for (const std::string& n : c.notes) os << "    note: " << n << "\n";
   }
